@@ -1,0 +1,49 @@
+# arco top-level targets. `make test` and `make demo` run the idempotent
+# scripts/setup first, so they work on a fresh Debian 12 machine.
+JOBS ?= $(shell nproc)
+BUILD ?= build
+ASAN_BUILD ?= build-asan
+FUZZ_BUILD ?= build-fuzz
+CMAKE_GEN := -G Ninja
+
+.PHONY: setup build test test-unit test-asan test-fuzz fuzz-long demo bench format clean
+
+setup:
+	@bash scripts/setup
+
+$(BUILD)/build.ninja:
+	cmake -S . -B $(BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release
+
+build: setup $(BUILD)/build.ninja
+	cmake --build $(BUILD) -j $(JOBS)
+
+test-unit: build
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+# AddressSanitizer + UndefinedBehaviorSanitizer build of the unit tests.
+test-asan: setup
+	cmake -S . -B $(ASAN_BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Debug -DARCO_BUILD_BENCH=OFF \
+	  -DARCO_SANITIZE=address,undefined -DCMAKE_CXX_FLAGS="-O1"
+	cmake --build $(ASAN_BUILD) -j $(JOBS)
+	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1 ctest --output-on-failure -j $(JOBS) -LE slow
+
+# libFuzzer harnesses (clang), each run for a short bounded time on its corpus.
+test-fuzz: setup
+	bash scripts/fuzz $(FUZZ_BUILD) 20
+
+fuzz-long: setup
+	bash scripts/fuzz $(FUZZ_BUILD) 600
+
+test: test-unit test-asan test-fuzz
+
+demo: build
+	bash scripts/demo $(BUILD)
+
+bench: build
+	bash bench/run_all.sh $(BUILD)
+
+format:
+	find src bench fuzz -name '*.h' -o -name '*.cc' | xargs clang-format -i
+
+clean:
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD)

@@ -1,0 +1,67 @@
+#include "arco/camera/camera.h"
+
+namespace arco {
+
+Eigen::Matrix3d Camera::K() const {
+  Eigen::Matrix3d k;
+  k << fx, skew, cx, 0, fy, cy, 0, 0, 1;
+  return k;
+}
+
+Eigen::Matrix<double, 3, 4> Camera::ProjectionMatrix() const {
+  Eigen::Matrix<double, 3, 4> rt;
+  rt.leftCols<3>() = cam_from_world_rotation;
+  rt.col(3) = cam_from_world_translation;
+  return K() * rt;
+}
+
+Eigen::Vector3d Camera::CenterInWorld() const {
+  return -cam_from_world_rotation.transpose() * cam_from_world_translation;
+}
+
+Eigen::Vector3d Camera::PointInCamera(const Eigen::Vector3d& point_in_world) const {
+  return cam_from_world_rotation * point_in_world + cam_from_world_translation;
+}
+
+std::optional<Eigen::Vector2d> Camera::Project(const Eigen::Vector3d& point_in_world) const {
+  Eigen::Vector2d pixel;
+  if (!ProjectToPixel(point_in_world.data(), pixel.data())) return std::nullopt;
+  return pixel;
+}
+
+Eigen::Vector2d Camera::PixelToNormalized(const Eigen::Vector2d& pixel) const {
+  // Distorted normalised coordinates from the inverse of K.
+  const double yd = (pixel.y() - cy) / fy;
+  const double xd = (pixel.x() - cx - skew * yd) / fx;
+  if (distortion.IsZero()) return {xd, yd};
+  // Gauss-Newton on f(x, y) = distort(x, y) - (xd, yd), numeric 2x2 Jacobian.
+  Eigen::Vector2d est(xd, yd);
+  for (int iter = 0; iter < 20; ++iter) {
+    double fx0, fy0;
+    Distort(est.x(), est.y(), &fx0, &fy0);
+    const Eigen::Vector2d residual(fx0 - xd, fy0 - yd);
+    if (residual.squaredNorm() < 1e-24) break;
+    const double h = 1e-7;
+    double ax, ay, bx, by;
+    Distort(est.x() + h, est.y(), &ax, &ay);
+    Distort(est.x(), est.y() + h, &bx, &by);
+    Eigen::Matrix2d jac;
+    jac << (ax - fx0) / h, (bx - fx0) / h, (ay - fy0) / h, (by - fy0) / h;
+    const Eigen::Vector2d step = jac.partialPivLu().solve(residual);
+    if (!step.allFinite()) break;
+    est -= step;
+  }
+  return est;
+}
+
+Eigen::Vector2d Camera::UndistortPixel(const Eigen::Vector2d& pixel) const {
+  const Eigen::Vector2d n = PixelToNormalized(pixel);
+  return {fx * n.x() + skew * n.y() + cx, fy * n.y() + cy};
+}
+
+Eigen::Vector3d Camera::RayInWorld(const Eigen::Vector2d& pixel) const {
+  const Eigen::Vector2d n = PixelToNormalized(pixel);
+  return (cam_from_world_rotation.transpose() * Eigen::Vector3d(n.x(), n.y(), 1.0)).normalized();
+}
+
+}  // namespace arco

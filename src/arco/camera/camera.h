@@ -1,0 +1,90 @@
+// Pinhole camera with Brown-Conrady distortion, in OpenCV's conventions:
+//   x_cam = R * X_world + t                       (cam_from_world)
+//   x = X/Z, y = Y/Z, r2 = x^2 + y^2
+//   x' = x (1 + k1 r2 + k2 r2^2 + k3 r2^3) + 2 p1 x y + p2 (r2 + 2 x^2)
+//   y' = y (1 + k1 r2 + k2 r2^2 + k3 r2^3) + p1 (r2 + 2 y^2) + 2 p2 x y
+//   u = fx x' + skew y' + cx,   v = fy y' + cy
+// Pixel coordinates put the origin at the CENTRE of the top-left pixel (OpenCV).
+// Metashape puts it at the corner and swaps the roles of p1/p2; the readers in
+// calibration_io.h convert (u_opencv = u_metashape - 0.5, p1 <-> p2).
+// Units of t (and of world points) are those of the calibration (Rig::units).
+#pragma once
+
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace arco {
+
+struct Distortion {
+  double k1 = 0, k2 = 0, k3 = 0;  // radial
+  double p1 = 0, p2 = 0;          // tangential, OpenCV roles
+  bool IsZero() const { return k1 == 0 && k2 == 0 && k3 == 0 && p1 == 0 && p2 == 0; }
+};
+
+struct Camera {
+  std::string name;    // e.g. "cam0" or "camera_21334181_1"
+  std::string serial;  // e.g. "21334181"; empty when unknown
+  int width = 0, height = 0;
+  double fx = 0, fy = 0, cx = 0, cy = 0, skew = 0;
+  Distortion distortion;
+  Eigen::Matrix3d cam_from_world_rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d cam_from_world_translation = Eigen::Vector3d::Zero();
+
+  Eigen::Matrix3d K() const;
+  // 3x4 P = K [R | t] (no distortion): for DLT on undistorted pixels.
+  Eigen::Matrix<double, 3, 4> ProjectionMatrix() const;
+  Eigen::Vector3d CenterInWorld() const;
+  Eigen::Vector3d PointInCamera(const Eigen::Vector3d& point_in_world) const;
+
+  // Distortion of normalised coordinates (x, y) -> (x', y'); templated for Ceres.
+  template <typename T>
+  void Distort(const T& x, const T& y, T* xd, T* yd) const;
+
+  // Projects a world point to pixels with distortion; templated for autodiff.
+  // Returns false when the point is not in front of the camera (z <= 0).
+  template <typename T>
+  bool ProjectToPixel(const T* point_in_world, T* pixel) const;
+
+  // Convenience: nullopt when behind the camera.
+  std::optional<Eigen::Vector2d> Project(const Eigen::Vector3d& point_in_world) const;
+
+  // Removes distortion: pixel -> normalised image coordinates (x, y) with
+  // X/Z = x, Y/Z = y. Iterative (Gauss-Newton on the forward model).
+  Eigen::Vector2d PixelToNormalized(const Eigen::Vector2d& pixel) const;
+  // Removes distortion but stays in pixels (ideal pinhole pixel with the same K).
+  Eigen::Vector2d UndistortPixel(const Eigen::Vector2d& pixel) const;
+  // Unit viewing ray through a pixel, in world coordinates.
+  Eigen::Vector3d RayInWorld(const Eigen::Vector2d& pixel) const;
+};
+
+template <typename T>
+void Camera::Distort(const T& x, const T& y, T* xd, T* yd) const {
+  const T r2 = x * x + y * y;
+  const T radial = T(1) + r2 * (T(distortion.k1) + r2 * (T(distortion.k2) + r2 * T(distortion.k3)));
+  *xd = x * radial + T(2 * distortion.p1) * x * y + T(distortion.p2) * (r2 + T(2) * x * x);
+  *yd = y * radial + T(distortion.p1) * (r2 + T(2) * y * y) + T(2 * distortion.p2) * x * y;
+}
+
+template <typename T>
+bool Camera::ProjectToPixel(const T* point_in_world, T* pixel) const {
+  T p[3];
+  for (int r = 0; r < 3; ++r) {
+    p[r] = T(cam_from_world_translation[r]);
+    for (int c = 0; c < 3; ++c) p[r] += T(cam_from_world_rotation(r, c)) * point_in_world[c];
+  }
+  if (!(p[2] > T(0))) return false;
+  const T x = p[0] / p[2];
+  const T y = p[1] / p[2];
+  T xd, yd;
+  Distort(x, y, &xd, &yd);
+  pixel[0] = T(fx) * xd + T(skew) * yd + T(cx);
+  pixel[1] = T(fy) * yd + T(cy);
+  return true;
+}
+
+}  // namespace arco

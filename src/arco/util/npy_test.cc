@@ -1,0 +1,61 @@
+#include "arco/util/npy.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+namespace arco {
+namespace {
+
+TEST(Npy, RoundTripsFloatArrayWithNaN) {
+  NpyArray<float> a;
+  a.shape = {2, 3, 3};
+  for (int i = 0; i < 18; ++i) a.data.push_back(static_cast<float>(i) * 0.5f);
+  a.data[4] = NAN;
+  const std::string path = ::testing::TempDir() + "/a.npy";
+  ASSERT_TRUE(WriteNpy(path, a).ok());
+  auto b = ReadNpy<float>(path);
+  ASSERT_TRUE(b.ok()) << b.status().message();
+  EXPECT_EQ(b->shape, a.shape);
+  EXPECT_TRUE(std::isnan(b->at(0, 1, 1)));
+  EXPECT_FLOAT_EQ(b->at(1, 2, 2), 8.5f);
+  // Reading as double converts.
+  auto c = ReadNpy<double>(path);
+  ASSERT_TRUE(c.ok());
+  EXPECT_DOUBLE_EQ(c->at(1, 0, 0), 4.5);
+}
+
+TEST(Npy, HeaderIsAlignedAndScalarShapeWorks) {
+  NpyArray<int32_t> a;
+  a.shape = {4};
+  a.data = {1, 2, 3, 4};
+  const std::string bytes = SerializeNpy(a);
+  const size_t header_len = static_cast<unsigned char>(bytes[8]) | (bytes[9] << 8);
+  EXPECT_EQ((10 + header_len) % 64, 0u);
+  EXPECT_NE(bytes.find("(4,)"), std::string::npos);
+  auto b = ParseNpy<int32_t>(bytes, "mem");
+  ASSERT_TRUE(b.ok());
+  EXPECT_EQ(b->data, a.data);
+}
+
+TEST(Npy, RejectsTruncatedAndGarbage) {
+  NpyArray<double> a;
+  a.shape = {10};
+  a.data.assign(10, 1.0);
+  std::string bytes = SerializeNpy(a);
+  EXPECT_FALSE(ParseNpy<double>(bytes.substr(0, bytes.size() - 3), "t.npy").ok());
+  EXPECT_FALSE(ParseNpy<double>("hello world", "g.npy").ok());
+  EXPECT_FALSE(ParseNpy<double>("", "e.npy").ok());
+  auto nan_as_int = NpyArray<float>{{1}, {NAN}};
+  EXPECT_FALSE(ParseNpy<int32_t>(SerializeNpy(nan_as_int), "n.npy").ok());
+}
+
+TEST(Npy, WriteToMissingFolderFailsAndLeavesNothing) {
+  NpyArray<double> a{{1}, {1.0}};
+  EXPECT_FALSE(WriteNpy("/nonexistent-dir/x.npy", a).ok());
+}
+
+}  // namespace
+}  // namespace arco

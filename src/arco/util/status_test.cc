@@ -1,0 +1,36 @@
+#include "arco/util/status.h"
+
+#include <gtest/gtest.h>
+
+namespace arco {
+namespace {
+
+StatusOr<int> Half(int x) {
+  if (x % 2) return Status::Error("odd");
+  return x / 2;
+}
+
+Status Quarter(int x, int* out) {
+  ARCO_ASSIGN_OR_RETURN(int h, Half(x));
+  ARCO_ASSIGN_OR_RETURN(int q, Half(h));
+  *out = q;
+  return Status::Ok();
+}
+
+TEST(StatusOr, PropagatesErrorsAndValues) {
+  int q = 0;
+  EXPECT_TRUE(Quarter(8, &q).ok());
+  EXPECT_EQ(q, 2);
+  Status s = Quarter(6, &q);
+  EXPECT_FALSE(s.ok());
+  EXPECT_EQ(s.message(), "odd");
+  EXPECT_EQ(s.WithContext("f.json").message(), "f.json: odd");
+}
+
+TEST(StatusOrDeathTest, ValueOfErrorAborts) {
+  StatusOr<int> bad = Status::Error("boom");
+  EXPECT_DEATH((void)bad.value(), "boom");
+}
+
+}  // namespace
+}  // namespace arco
