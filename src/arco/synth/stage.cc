@@ -9,7 +9,7 @@ namespace arco::synth {
 
 // Measured on ../shared/data/spd/cello_1113_scale_camera.xml scaled by 695 mm /
 // its nut-bridge distance in Metashape units (see stage_test.cc).
-const double kSpdCameraDistanceMm = 3090.0;
+const double kSpdCameraDistanceMm = 1999.0;
 
 Status StageOptions::Validate() const {
   if (!(mm_per_unit >= 0) || !std::isfinite(mm_per_unit)) {
