@@ -18,9 +18,15 @@ const Eigen::Vector3d kHeadCentre(0, 690, 30);
 constexpr double kFloorY = -480;  // seat height 480 mm
 constexpr double kUpperArmMm = 290, kForearmMm = 255;
 
-Eigen::Matrix3d RotX(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix(); }
-Eigen::Matrix3d RotY(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).toRotationMatrix(); }
-Eigen::Matrix3d RotZ(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+Eigen::Matrix3d RotX(double a) {
+  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix();
+}
+Eigen::Matrix3d RotY(double a) {
+  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).toRotationMatrix();
+}
+Eigen::Matrix3d RotZ(double a) {
+  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
 
 // Rotation whose columns are the instrument axes given the string axis x and an
 // approximate front direction.
@@ -93,8 +99,8 @@ Rigid InstrumentRestPose(InstrumentKind kind, double scale) {
     // Scroll forward-left, slightly up; top plate up, tilted 25 degrees so the
     // high-string side (-y) is lower (towards the player's right front).
     const double yaw = 45 * kDeg, pitch = 8 * kDeg;
-    const Eigen::Vector3d x(std::sin(yaw) * std::cos(pitch), std::sin(pitch),
-                            std::cos(yaw) * std::cos(pitch));
+    const Eigen::Vector3d x(
+        std::sin(yaw) * std::cos(pitch), std::sin(pitch), std::cos(yaw) * std::cos(pitch));
     Eigen::Matrix3d r = FrameFromAxes(x, Eigen::Vector3d::UnitY());
     r = Eigen::AngleAxisd(25 * kDeg, r.col(0)).toRotationMatrix() * r;
     pose.rotation = r;
@@ -105,7 +111,8 @@ Rigid InstrumentRestPose(InstrumentKind kind, double scale) {
   // Cello / double bass: string axis 55 degrees above horizontal, leaning back
   // towards the performer and 12 degrees to the left; a slight roll.
   const double elevation = 55 * kDeg, yaw = 12 * kDeg;
-  const Eigen::Vector3d x(std::sin(yaw) * std::cos(elevation), std::sin(elevation),
+  const Eigen::Vector3d x(std::sin(yaw) * std::cos(elevation),
+                          std::sin(elevation),
                           -std::cos(yaw) * std::cos(elevation));
   Eigen::Matrix3d r = FrameFromAxes(x, Eigen::Vector3d::UnitZ());
   r = Eigen::AngleAxisd(-8 * kDeg, r.col(0)).toRotationMatrix() * r;
@@ -155,23 +162,25 @@ void BodyKeypoints(const Eigen::Matrix3d& torso,
   auto& p = *out;
   // Head: turned left and tilted onto the chin rest for violin/viola.
   const Eigen::Matrix3d head =
-      torso * (violin_hold ? RotY(25 * kDeg) * RotZ(-12 * kDeg) * RotX(10 * kDeg)
-                           : RotY(8 * kDeg) * RotX(6 * kDeg));
+      torso * (violin_hold ? Eigen::Matrix3d(RotY(25 * kDeg) * RotZ(-12 * kDeg) * RotX(10 * kDeg))
+                           : Eigen::Matrix3d(RotY(8 * kDeg) * RotX(6 * kDeg)));
   const Eigen::Vector3d head_centre = torso * kHeadCentre;
   static const std::array<Eigen::Vector3d, 68> face = FaceTemplate();
   for (int i = 0; i < 68; ++i) p[23 + i] = head_centre + head * face[i];
-  p[0] = head_centre + head * Eigen::Vector3d(0, 0, 108);         // nose
-  p[1] = head_centre + head * Eigen::Vector3d(32, 20, 84);        // left eye
-  p[2] = head_centre + head * Eigen::Vector3d(-32, 20, 84);       // right eye
-  p[3] = head_centre + head * Eigen::Vector3d(76, 10, 0);         // left ear
-  p[4] = head_centre + head * Eigen::Vector3d(-76, 10, 0);        // right ear
+  p[0] = head_centre + head * Eigen::Vector3d(0, 0, 108);    // nose
+  p[1] = head_centre + head * Eigen::Vector3d(32, 20, 84);   // left eye
+  p[2] = head_centre + head * Eigen::Vector3d(-32, 20, 84);  // right eye
+  p[3] = head_centre + head * Eigen::Vector3d(76, 10, 0);    // left ear
+  p[4] = head_centre + head * Eigen::Vector3d(-76, 10, 0);   // right ear
   p[5] = torso * kShoulderL;
   p[6] = torso * kShoulderR;
   // Elbows: the left elbow hangs down and out (cello) or under the instrument
   // (violin); the right elbow follows the bow arm, down and out to the right.
-  const Eigen::Vector3d left_pole = violin_hold ? Eigen::Vector3d(-0.3, -1, 0.2) : Eigen::Vector3d(1, -0.6, 0);
+  const Eigen::Vector3d left_pole =
+      violin_hold ? Eigen::Vector3d(-0.3, -1, 0.2) : Eigen::Vector3d(1, -0.6, 0);
   p[7] = ElbowPosition(p[5], left_wrist, kUpperArmMm, kForearmMm, torso * left_pole);
-  p[8] = ElbowPosition(p[6], right_wrist, kUpperArmMm, kForearmMm, torso * Eigen::Vector3d(-1, -0.8, 0));
+  p[8] = ElbowPosition(
+      p[6], right_wrist, kUpperArmMm, kForearmMm, torso * Eigen::Vector3d(-1, -0.8, 0));
   p[9] = left_wrist;
   p[10] = right_wrist;
   p[11] = kHipL;

@@ -8,11 +8,10 @@
 // (elbow placed by the law of cosines towards a pole direction).
 #pragma once
 
-#include <array>
-#include <cstdint>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
 
 #include "arco/instrument/instrument_model.h"
 
@@ -27,7 +26,9 @@ struct Rigid {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
   Eigen::Vector3d operator*(const Eigen::Vector3d& p) const { return rotation * p + translation; }
-  Rigid operator*(const Rigid& o) const { return {rotation * o.rotation, rotation * o.translation + translation}; }
+  Rigid operator*(const Rigid& o) const {
+    return {rotation * o.rotation, rotation * o.translation + translation};
+  }
   Rigid Inverse() const { return {rotation.transpose(), -(rotation.transpose() * translation)}; }
 };
 

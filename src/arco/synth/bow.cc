@@ -39,7 +39,8 @@ Status BowOptions::Validate() const {
   if (!(contact_fraction > 0 && contact_fraction < 0.3)) {
     return Status::Error("bow: contact fraction must be in (0, 0.3)");
   }
-  if (!(crossing_s >= 0) || !(lift_mm >= 0) || !(tilt_per_string_deg >= 0 && tilt_per_string_deg < 40)) {
+  if (!(crossing_s >= 0) || !(lift_mm >= 0) ||
+      !(tilt_per_string_deg >= 0 && tilt_per_string_deg < 40)) {
     return Status::Error("bow: crossing_s, lift_mm >= 0 and tilt in [0, 40) degrees");
   }
   return Status::Ok();
@@ -51,10 +52,15 @@ BowAnimator::BowAnimator(const hand::HandModel& right_hand,
                          const Performance& performance,
                          const Eigen::Vector3d& right_side,
                          const BowOptions& options)
-    : right_hand_(right_hand), instrument_(instrument), tmpl_(tmpl), perf_(performance), options_(options) {
+    : right_hand_(right_hand),
+      instrument_(instrument),
+      tmpl_(tmpl),
+      perf_(performance),
+      options_(options) {
   const Status status = options.Validate();
   if (!status.ok()) throw std::invalid_argument(status.message());
-  bow_length_mm_ = options.bow_length_mm > 0 ? options.bow_length_mm : TypicalBowMm(instrument.kind());
+  bow_length_mm_ =
+      options.bow_length_mm > 0 ? options.bow_length_mm : TypicalBowMm(instrument.kind());
   side_sign_ = right_side.y() >= 0 ? 1.0 : -1.0;
   // Strokes: alternate down/up; the bow used grows with the note's length.
   double s = 0.15;
@@ -116,7 +122,8 @@ BowFrame BowAnimator::At(double t) const {
   double crossing_u = 1;
   size_t next = 0;
   while (next < notes.size() && notes[next].note.onset_s <= t) ++next;
-  const size_t cur = idx >= 0 ? static_cast<size_t>(idx) : (next < notes.size() ? next : notes.size() - 1);
+  const size_t cur =
+      idx >= 0 ? static_cast<size_t>(idx) : (next < notes.size() ? next : notes.size() - 1);
   string = n_strings - notes[cur].fingering.string_index;
   prev_string = cur > 0 ? n_strings - notes[cur - 1].fingering.string_index : string;
   if (idx < 0 && next < notes.size()) {
@@ -125,15 +132,18 @@ BowFrame BowAnimator::At(double t) const {
     const double start = notes[next].note.onset_s - options_.crossing_s;
     crossing_u = options_.crossing_s > 0 ? SmoothStep((t - start) / options_.crossing_s) : 1;
   } else if (idx >= 0 && options_.crossing_s > 0) {
-    crossing_u = SmoothStep((t - notes[cur].note.onset_s + options_.crossing_s) / options_.crossing_s);
+    crossing_u =
+        SmoothStep((t - notes[cur].note.onset_s + options_.crossing_s) / options_.crossing_s);
   }
-  const double tilt = (TiltDeg(prev_string) + (TiltDeg(string) - TiltDeg(prev_string)) * crossing_u) * kDeg;
+  const double tilt =
+      (TiltDeg(prev_string) + (TiltDeg(string) - TiltDeg(prev_string)) * crossing_u) * kDeg;
   out.string = idx >= 0 ? string : 0;
   const double lift = idx >= 0 ? 0.0 : options_.lift_mm;
 
   // Contact on the string (interpolated across strings while crossing).
   const double f = options_.contact_fraction;
-  const Eigen::Vector3d c0 = tmpl_.strings_mm[static_cast<size_t>(prev_string - 1)].PointAtFraction(f);
+  const Eigen::Vector3d c0 =
+      tmpl_.strings_mm[static_cast<size_t>(prev_string - 1)].PointAtFraction(f);
   const Eigen::Vector3d c1 = tmpl_.strings_mm[static_cast<size_t>(string - 1)].PointAtFraction(f);
   const Eigen::Vector3d contact = c0 + (c1 - c0) * crossing_u + Eigen::Vector3d(0, 0, lift);
   // Bow direction frog -> tip: away from the performer's right, tilted about x.

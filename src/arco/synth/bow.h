@@ -22,11 +22,11 @@
 namespace arco::synth {
 
 struct BowOptions {
-  double bow_length_mm = 0;        // frog to tip; 0 = the instrument's typical bow
-  double contact_fraction = 0.08;  // bow-string contact, fraction of the string from the bridge
-  double crossing_s = 0.06;        // duration of a string crossing
-  double lift_mm = 15;             // bow above the string in silence
-  double tilt_per_string_deg = 12; // tilt between adjacent strings
+  double bow_length_mm = 0;         // frog to tip; 0 = the instrument's typical bow
+  double contact_fraction = 0.08;   // bow-string contact, fraction of the string from the bridge
+  double crossing_s = 0.06;         // duration of a string crossing
+  double lift_mm = 15;              // bow above the string in silence
+  double tilt_per_string_deg = 12;  // tilt between adjacent strings
   Status Validate() const;
 };
 

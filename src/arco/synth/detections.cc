@@ -24,7 +24,9 @@ bool BodyOccludes(const DetectionFrame& f, const Eigen::Vector3d& cam, const Eig
   return u * u + v * v < 1;
 }
 
-double DistanceToSegment(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+double DistanceToSegment(const Eigen::Vector3d& p,
+                         const Eigen::Vector3d& a,
+                         const Eigen::Vector3d& b) {
   const Eigen::Vector3d ab = b - a;
   const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
   return (p - (a + t * ab)).norm();
@@ -45,7 +47,8 @@ bool TorsoOccludes(const DetectionFrame& f, const Eigen::Vector3d& cam, const Ei
 
 Status DetectionOptions::Validate() const {
   if (!(noise_px >= 0 && noise_px < 200)) return Status::Error("noise_px must be in [0, 200)");
-  if (!(outlier_rate >= 0 && outlier_rate <= 1)) return Status::Error("outlier_rate must be in [0, 1]");
+  if (!(outlier_rate >= 0 && outlier_rate <= 1))
+    return Status::Error("outlier_rate must be in [0, 1]");
   if (!(occlusion_rate >= 0 && occlusion_rate <= 1)) {
     return Status::Error("occlusion_rate must be in [0, 1]");
   }
@@ -82,8 +85,10 @@ NpyArray<float> EmulateDetections(const Rig& rig,
     for (int fr = 0; fr < num_frames; ++fr) {
       const DetectionFrame& f = frames[static_cast<size_t>(fr)];
       auto slot = [&](int p) {
-        return &out.data[((static_cast<size_t>(fr) * num_views + static_cast<size_t>(view)) * num_points +
-                          static_cast<size_t>(p)) * 3];
+        return &out.data[((static_cast<size_t>(fr) * num_views + static_cast<size_t>(view)) *
+                              num_points +
+                          static_cast<size_t>(p)) *
+                         3];
       };
       for (int p = 0; p < num_points; ++p) {
         // Draw every random number for every point so one point's fate does not
@@ -106,13 +111,14 @@ NpyArray<float> EmulateDetections(const Rig& rig,
           continue;
         }
         double scale = 1;
-        if (p >= layout.instrument_first) scale = is_bow[static_cast<size_t>(p)] ? o.bow_noise_scale : o.instrument_noise_scale;
+        if (p >= layout.instrument_first)
+          scale = is_bow[static_cast<size_t>(p)] ? o.bow_noise_scale : o.instrument_noise_scale;
         const double sigma = o.noise_px * scale;
         Eigen::Vector2d err(nx * sigma, ny * sigma);
         double score;
-        const bool occluded =
-            o.geometric_occlusion &&
-            (BodyOccludes(f, centre, x) || (!is_torso[static_cast<size_t>(p)] && TorsoOccludes(f, centre, x)));
+        const bool occluded = o.geometric_occlusion &&
+                              (BodyOccludes(f, centre, x) ||
+                               (!is_torso[static_cast<size_t>(p)] && TorsoOccludes(f, centre, x)));
         if (outlier) {
           err = far_px * Eigen::Vector2d(std::cos(angle), std::sin(angle));
           score = outlier_score;

@@ -23,10 +23,9 @@
 //     right hand detections trade places.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "arco/camera/rig.h"
 #include "arco/util/npy.h"
@@ -62,8 +61,8 @@ struct DetectionLayout {
   int num_points = 0;
   int left_hand_first = 91, right_hand_first = 112;
   int instrument_first = 133;
-  std::vector<int> bow_points;           // e.g. frog, tip
-  std::vector<int> torso_points;         // points on the torso surface (never torso-occluded)
+  std::vector<int> bow_points;    // e.g. frog, tip
+  std::vector<int> torso_points;  // points on the torso surface (never torso-occluded)
 };
 
 // (frames, views, points, 3) float array of [x_px, y_px, score].

@@ -18,15 +18,14 @@ double SmoothStep(double x) {
   return x * x * (3 - 2 * x);
 }
 
-// A relaxed playing curl, the IK's reference (clamped into the model's limits).
-hand::HandPose CurledPose(const hand::HandModel& model) {
+hand::HandPose FingerPose(const hand::HandModel& model, double mcp, double pip, double dip) {
   using hand::FingerDof;
   hand::HandPose pose;
   for (int f = 1; f < 5; ++f) {
     const auto finger = static_cast<hand::Finger>(f);
-    pose.angle_rad(finger, FingerDof::kBaseFlex) = 35 * kDeg;
-    pose.angle_rad(finger, FingerDof::kMiddleFlex) = 55 * kDeg;
-    pose.angle_rad(finger, FingerDof::kDistalFlex) = 20 * kDeg;
+    pose.angle_rad(finger, FingerDof::kBaseFlex) = mcp * kDeg;
+    pose.angle_rad(finger, FingerDof::kMiddleFlex) = pip * kDeg;
+    pose.angle_rad(finger, FingerDof::kDistalFlex) = dip * kDeg;
   }
   pose.angle_rad(hand::Finger::kThumb, FingerDof::kBaseFlex) = 20 * kDeg;
   pose.angle_rad(hand::Finger::kThumb, FingerDof::kBaseAbd) = 30 * kDeg;
@@ -38,10 +37,14 @@ hand::HandPose CurledPose(const hand::HandModel& model) {
 }  // namespace
 
 Status LeftHandOptions::Validate() const {
-  for (double v : {hover_mm, mcp_beside_string_mm, mcp_above_strings_mm, shift_s, string_change_s}) {
+  for (double v : {relax_s, shift_s, change_s}) {
     if (!(v >= 0) || !std::isfinite(v)) {
       return Status::Error("left hand: distances and durations must be finite and >= 0");
     }
+  }
+  for (double v : {press_mcp_deg, press_pip_deg, press_dip_deg}) {
+    if (!(v >= -30 && v <= 120))
+      return Status::Error("left hand: pressing angles must be in [-30, 120] deg");
   }
   return Status::Ok();
 }
@@ -66,16 +69,51 @@ LeftHandAnimator::LeftHandAnimator(const hand::HandModel& model,
   wrist_rotation_.col(1) = y_hand;
   wrist_rotation_.col(2) = x_hand.cross(y_hand);
   middle_mcp_in_wrist_ = model.rest_point_mm(hand::KeypointIndex(hand::Finger::kMiddle, 0));
-}
-
-double LeftHandAnimator::AnchorX(double position_semitones) const {
-  // Middle of the four finger places of this position.
+  press_pose_ =
+      FingerPose(model, options.press_mcp_deg, options.press_pip_deg, options.press_dip_deg);
+  curl_pose_ = FingerPose(model, 35, 55, 20);
+  const hand::HandPointsMm in_wrist = hand::ForwardKinematicsInWrist(model, press_pose_);
+  tip_from_mcp_.resize(5);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int f = 0; f < 5; ++f) {
+    tip_from_mcp_[f] =
+        wrist_rotation_ *
+        (in_wrist[hand::TipKeypoint(static_cast<hand::Finger>(f))] - middle_mcp_in_wrist_);
+    if (f > 0) mean += tip_from_mcp_[f] / 4;
+  }
+  // Anchors per note and the glide into each note.
   int max_offset = 0;
-  for (const FingerSpan& s : HandFrameFor(instrument_.name())) {
+  for (const FingerSpan& s : HandFrameFor(instrument.name())) {
     if (!s.extended) max_offset = std::max(max_offset, s.offset_semitones);
   }
-  return instrument_.string_length_mm() *
-         std::pow(2.0, -(position_semitones + 0.5 * max_offset) / 12.0);
+  const int n = instrument.num_strings();
+  const auto& notes = performance.notes;
+  for (size_t i = 0; i < notes.size(); ++i) {
+    const PerformedNote& note = notes[i];
+    const int string = n - note.fingering.string_index;
+    Eigen::Vector3d anchor;
+    if (note.fingering.finger > 0) {
+      const double centre_hz =
+          MidiToHz(note.note.midi_note + note.intonation_cents / 100.0, performance.a4_hz);
+      anchor = ContactInInstrument(instrument, tmpl, string, centre_hz) -
+               tip_from_mcp_[note.fingering.finger];
+    } else {
+      const double x = PlaceX(note.fingering.position_semitones + 0.5 * max_offset);
+      anchor = Eigen::Vector3d(x, StringY(string, x), 0) - mean;
+    }
+    anchors_.push_back(anchor);
+    double glide = options.change_s;
+    if (i > 0) {
+      if (note.fingering.position_semitones != notes[i - 1].fingering.position_semitones)
+        glide = options.shift_s;
+      glide = std::min(glide, 0.5 * (note.note.onset_s - notes[i - 1].note.onset_s));
+    }
+    glide_s_.push_back(glide);
+  }
+}
+
+double LeftHandAnimator::PlaceX(double semitones) const {
+  return instrument_.string_length_mm() * std::pow(2.0, -semitones / 12.0);
 }
 
 double LeftHandAnimator::StringY(int string, double x) const {
@@ -84,118 +122,89 @@ double LeftHandAnimator::StringY(int string, double x) const {
   return s.PointAtFraction(f).y();
 }
 
-double LeftHandAnimator::PositionAt(double t) const {
+Eigen::Vector3d LeftHandAnimator::AnchorAt(double t) const {
   const auto& notes = perf_.notes;
-  if (notes.empty()) return 2;
-  // Last note that started at or before t (or the first note).
-  size_t i = 0;
-  while (i + 1 < notes.size() && notes[i + 1].note.onset_s <= t) ++i;
-  double p = notes[i].fingering.position_semitones;
-  if (t < notes[0].note.onset_s) return notes[0].fingering.position_semitones;
-  if (i + 1 < notes.size()) {
-    const PerformedNote& next = notes[i + 1];
-    const double q = next.fingering.position_semitones;
-    if (q != p) {
-      const double start = std::max(next.note.onset_s - options_.shift_s,
-                                    0.5 * (notes[i].note.onset_s + next.note.onset_s));
-      const double dur = next.note.onset_s - start;
-      if (t > start && dur > 0) p += (q - p) * SmoothStep((t - start) / dur);
-    }
-  }
-  return p;
-}
-
-int LeftHandAnimator::StringForHandAt(double t) const {
-  // The string of the sounding note, else of the next note, else of the last.
-  const int n = static_cast<int>(instrument_.num_strings());
-  const auto& notes = perf_.notes;
-  for (const PerformedNote& note : notes) {
-    if (note.note.offset_s > t) return n - note.fingering.string_index;
-  }
-  return notes.empty() ? 1 : n - notes.back().fingering.string_index;
+  // Next note to start after t.
+  size_t next = 0;
+  while (next < notes.size() && notes[next].note.onset_s <= t) ++next;
+  if (next == 0) return anchors_.front();
+  if (next == notes.size()) return anchors_.back();
+  const double start = notes[next].note.onset_s - glide_s_[next];
+  if (t <= start || glide_s_[next] <= 0) return anchors_[next - 1];
+  return anchors_[next - 1] +
+         (anchors_[next] - anchors_[next - 1]) * SmoothStep((t - start) / glide_s_[next]);
 }
 
 LeftHandFrame LeftHandAnimator::Next(double t) {
   if (t < last_time_s_) throw std::invalid_argument("LeftHandAnimator: time went backwards");
-  const double frame_dt = std::isfinite(last_time_s_) && last_time_s_ > -1e299 ? t - last_time_s_ : 0;
   last_time_s_ = t;
   LeftHandFrame out;
   out.note_index = perf_.NoteIndexAt(t);
   out.f0_hz = perf_.F0HzAt(t);
   const int n = instrument_.num_strings();
-  const PerformedNote* note = out.note_index >= 0 ? &perf_.notes[static_cast<size_t>(out.note_index)] : nullptr;
-  const bool pressed = note && note->fingering.finger > 0;
-
-  // 1. Anchor of the middle MCP.
-  const double p = PositionAt(t);
-  const int hand_string = pressed ? n - note->fingering.string_index : StringForHandAt(t);
-  double x_anchor = AnchorX(p);
-  const double target_y = StringY(hand_string, x_anchor);
-  if (std::isnan(smoothed_string_y_) || options_.string_change_s <= 0) {
-    smoothed_string_y_ = target_y;
-  } else {
-    // First-order glide towards the played string (time constant string_change_s / 3).
-    const double a = 1 - std::exp(-3 * frame_dt / options_.string_change_s);
-    smoothed_string_y_ += a * (target_y - smoothed_string_y_);
+  const auto& notes = perf_.notes;
+  // The note whose hand shape we hold: the sounding one, else the next, else the last.
+  int held = out.note_index;
+  if (held < 0) {
+    held = static_cast<int>(notes.size()) - 1;
+    for (size_t i = 0; i < notes.size(); ++i) {
+      if (notes[i].note.onset_s > t) {
+        held = static_cast<int>(i);
+        break;
+      }
+    }
   }
-  // 2. Vibrato: rock along the string with the contact point.
+  const PerformedNote& hn = notes[static_cast<size_t>(held)];
+  const bool pressed = out.note_index >= 0 && hn.fingering.finger > 0;
+  const int hand_string = n - hn.fingering.string_index;
+
+  Eigen::Vector3d anchor = AnchorAt(t);
   Eigen::Vector3d contact = Eigen::Vector3d::Constant(NAN);
   if (pressed) {
-    const int string = n - note->fingering.string_index;
-    contact = ContactInInstrument(instrument_, tmpl_, string, out.f0_hz);
+    contact = ContactInInstrument(instrument_, tmpl_, hand_string, out.f0_hz);
     if (options_.rock_with_vibrato) {
-      const double centre_hz = MidiToHz(note->note.midi_note + note->intonation_cents / 100.0, perf_.a4_hz);
-      const Eigen::Vector3d centre = ContactInInstrument(instrument_, tmpl_, string, centre_hz);
-      x_anchor += contact.x() - centre.x();
+      const double centre_hz =
+          MidiToHz(hn.note.midi_note + hn.intonation_cents / 100.0, perf_.a4_hz);
+      anchor += contact - ContactInInstrument(instrument_, tmpl_, hand_string, centre_hz);
     }
-    out.string = string;
-    out.finger = note->fingering.finger;
+    out.string = hand_string;
+    out.finger = hn.fingering.finger;
     out.contact_mm = contact;
   }
-  const Eigen::Vector3d mcp_target(x_anchor, smoothed_string_y_ - options_.mcp_beside_string_mm,
-                                   options_.mcp_above_strings_mm);
-  hand::HandPose pose = previous_ ? *previous_ : CurledPose(model_);
+  hand::HandPose pose = previous_ ? *previous_ : press_pose_;
   pose.world_from_wrist_rotation = wrist_rotation_;
-  pose.wrist_in_world_mm = mcp_target - wrist_rotation_ * middle_mcp_in_wrist_;
+  pose.wrist_in_world_mm = anchor - wrist_rotation_ * middle_mcp_in_wrist_;
 
-  // 3. Fingers. Idle fingers hover over their own places on the hand's string.
-  hand::FingerIkOptions hover;
-  hover.joints = hand::FingerIkJoints::kAll;
-  hover.exact_reach = false;
-  hover.seed_levels = 0;
-  hover.max_iterations = 30;
-  if (previous_) {
-    hover.previous_pose = previous_;
-    hover.previous_weight_mm_per_rad = 5.0;
-  }
-  const hand::HandPose curl = CurledPose(model_);
-  const int position = static_cast<int>(std::lround(p));
-  for (const FingerSpan& span : HandFrameFor(instrument_.name())) {
-    if (span.extended) continue;
-    if (pressed && span.finger == note->fingering.finger) continue;
-    const double semis = position + span.offset_semitones;
-    const double x = instrument_.string_length_mm() * std::pow(2.0, -semis / 12.0);
-    const Eigen::Vector3d target(x, StringY(hand_string, x), options_.hover_mm);
-    // Keep the reference curl for this finger, the rest of the pose as solved so far.
-    hand::HandPose ref = pose;
+  // Idle fingers (and the thumb behind the neck) relax towards a hovering curl
+  // with a time constant of relax_s, so a finger that stops pressing lifts off
+  // smoothly instead of jumping.
+  const double dt = previous_ ? t - previous_time_s_ : 1e9;
+  const double keep = options_.relax_s > 0 ? std::exp(-dt / options_.relax_s) : 0.0;
+  for (int f = 0; f < 5; ++f) {
+    if (pressed && f == hn.fingering.finger) continue;
     for (int d = 0; d < 4; ++d) {
-      ref.angles_rad[4 * span.finger + d] = curl.angles_rad[4 * span.finger + d];
+      const int k = 4 * f + d;
+      pose.angles_rad[k] =
+          curl_pose_.angles_rad[k] + keep * (pose.angles_rad[k] - curl_pose_.angles_rad[k]);
     }
-    pose = hand::SolveFingertipIk(model_, ref, static_cast<hand::Finger>(span.finger), target, hover).pose;
   }
-  // The thumb behind the neck, under the second finger's place.
-  {
-    const double x = AnchorX(p);
-    const Eigen::Vector3d target(x, -0.25 * tmpl_.neck_depth_mm, -tmpl_.neck_depth_mm);
-    pose = hand::SolveFingertipIk(model_, pose, hand::Finger::kThumb, target, hover).pose;
+  hand::FingerIkOptions press;
+  press.joints = hand::FingerIkJoints::kAll;
+  press.exact_reach = true;
+  press.seed_levels = 0;
+  press.max_iterations = 50;
+  if (previous_) {
+    press.previous_pose = previous_;
+    press.previous_weight_mm_per_rad = 5.0;
   }
   if (pressed) {
-    hand::FingerIkOptions press = hover;
-    press.exact_reach = true;
-    press.seed_levels = 2;
-    press.max_iterations = 100;
-    const auto finger = static_cast<hand::Finger>(note->fingering.finger);
-    pose = hand::SolveFingertipIk(model_, pose, finger, contact, press).pose;
+    const auto finger = static_cast<hand::Finger>(hn.fingering.finger);
+    hand::HandPose ref = pose;
+    for (int d = 0; d < 4; ++d) {
+      ref.angles_rad[4 * hn.fingering.finger + d] =
+          press_pose_.angles_rad[4 * hn.fingering.finger + d];
+    }
+    pose = hand::SolveFingertipIk(model_, ref, finger, contact, press).pose;
     // Take up what the joints could not reach by moving the whole hand.
     const Eigen::Vector3d residual = contact - hand::FingertipInWorld(model_, pose, finger);
     out.residual_shift_mm = residual.norm();
@@ -203,6 +212,7 @@ LeftHandFrame LeftHandAnimator::Next(double t) {
   }
   out.pose = pose;
   previous_ = pose;
+  previous_time_s_ = t;
   return out;
 }
 

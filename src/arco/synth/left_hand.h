@@ -1,28 +1,29 @@
 // The left hand of the synthetic performer, in the instrument frame
 // (synth_instrument.h), driven by the performance (pitch, fingering).
 //
+// Per note, an anchor for the middle MCP: for a pressed note, where a pressing
+// posture (press_*_deg, clamped into the joint limits) puts the playing
+// fingertip on the contact point of the note's centre pitch; for an open string,
+// at the middle of the hand position's four finger places on that string. The
+// fingers come from the high-string side of the neck on every bowed instrument.
+// Between notes the anchor glides (smoothstep) over `shift_s` when the hand
+// position changes and over `change_s` otherwise, arriving at the next onset.
 // Per frame:
-//  1. The hand position (fingering.h) gives an anchor for the MCP row: along the
-//     strings at the middle of the positions' four finger places, beside the
-//     string being played (towards the high-string side, where the fingers come
-//     from on every bowed instrument), a little above the string plane. Shifts
-//     glide smoothly (smoothstep) over `shift_s` before the next note; string
-//     changes glide over `string_change_s`.
-//  2. Vibrato: the anchor moves along the string by the displacement of the
-//     contact point between the note's centre pitch and the pitch at this
-//     instant, so the hand rocks in phase with the audio's pitch modulation.
-//  3. Fingers by the hand layer's IK (SolveFingertipIk, all four dofs of each
-//     finger, bounded by the joint limits): the idle fingers hover `hover_mm`
-//     above their own places, the thumb reaches for the back of the neck, and the
-//     playing finger's tip goes to the contact point. Whatever the IK cannot reach
+//  1. Vibrato: the anchor moves with the contact point between the note's centre
+//     pitch and the pitch at this instant, so the hand rocks along the string in
+//     phase with the audio's pitch modulation.
+//  2. Idle fingers and the thumb relax towards a hovering curl (time constant
+//     relax_s); the playing finger's tip goes to the contact point by the hand
+//     layer's IK (SolveFingertipIk, all four dofs of the finger, bounded by the
+//     joint limits, regularised towards the pressing posture and the previous
+//     frame). What the IK cannot reach
 //     is taken up by translating the whole hand, so the playing fingertip lies on
 //     the string at the contact point exactly and every joint stays in its limits.
 #pragma once
 
+#include <Eigen/Core>
 #include <optional>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "arco/hand/hand_model.h"
 #include "arco/instrument/instrument_model.h"
@@ -33,11 +34,11 @@
 namespace arco::synth {
 
 struct LeftHandOptions {
-  double hover_mm = 12;          // idle fingertips above their places on the string
-  double mcp_beside_string_mm = 38;  // MCP row beside the played string (towards high strings)
-  double mcp_above_strings_mm = 24;  // MCP row above the string plane
-  double shift_s = 0.15;         // duration of a shift, ending at the next onset
-  double string_change_s = 0.08; // lateral glide of the hand for a string change
+  double relax_s = 0.05;   // idle fingers relax towards the hovering curl
+  double shift_s = 0.15;   // glide of the hand for a change of position
+  double change_s = 0.06;  // glide for a finger or string change in one position
+  // Pressing posture of the playing finger (degrees): MCP, PIP, DIP flexion.
+  double press_mcp_deg = 45, press_pip_deg = 70, press_dip_deg = 30;
   bool rock_with_vibrato = true;
   Status Validate() const;
 };
@@ -67,11 +68,9 @@ class LeftHandAnimator {
   LeftHandFrame Next(double time_s);
 
  private:
-  // Anchor (MCP row centre) along x for a hand position, and y beside a string.
-  double AnchorX(double position_semitones) const;
+  double PlaceX(double semitones) const;  // distance from the bridge of a stop
   double StringY(int string, double x) const;
-  double PositionAt(double time_s) const;
-  int StringForHandAt(double time_s) const;
+  Eigen::Vector3d AnchorAt(double time_s) const;
 
   const hand::HandModel& model_;
   const InstrumentModel& instrument_;
@@ -80,9 +79,13 @@ class LeftHandAnimator {
   LeftHandOptions options_;
   Eigen::Matrix3d wrist_rotation_;  // instrument_from_wrist rotation
   Eigen::Vector3d middle_mcp_in_wrist_;
+  hand::HandPose press_pose_, curl_pose_;
+  std::vector<Eigen::Vector3d> tip_from_mcp_;  // per finger 0..4, pressing posture
+  std::vector<Eigen::Vector3d> anchors_;       // per note
+  std::vector<double> glide_s_;                // glide into note i
   std::optional<hand::HandPose> previous_;
-  double smoothed_string_y_ = NAN;
   double last_time_s_ = -1e300;
+  double previous_time_s_ = 0;
 };
 
 }  // namespace arco::synth

@@ -20,7 +20,8 @@ Rigid RotationAbout(const Eigen::Matrix3d& r, const Eigen::Vector3d& pivot) {
 
 Status SynthOptions::Validate() const {
   if (!(fps >= 1 && fps <= 1000)) return Status::Error("fps must be in [1, 1000]");
-  if (!(tempo_scale > 0.05 && tempo_scale < 20)) return Status::Error("tempo scale must be in (0.05, 20)");
+  if (!(tempo_scale > 0.05 && tempo_scale < 20))
+    return Status::Error("tempo scale must be in (0.05, 20)");
   if (!(max_duration_s >= 0) || !std::isfinite(max_duration_s)) {
     return Status::Error("max duration must be >= 0 s (0 = whole piece)");
   }
@@ -32,7 +33,8 @@ Status SynthOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(left_hand.Validate());
   ARCO_RETURN_IF_ERROR(bow.Validate());
   ARCO_RETURN_IF_ERROR(detection.Validate());
-  if (!(sway.torso_deg >= 0 && sway.instrument_deg >= 0 && sway.min_hz > 0 && sway.max_hz >= sway.min_hz)) {
+  if (!(sway.torso_deg >= 0 && sway.instrument_deg >= 0 && sway.min_hz > 0 &&
+        sway.max_hz >= sway.min_hz)) {
     return Status::Error("sway: amplitudes >= 0 and 0 < min_hz <= max_hz");
   }
   return Status::Ok();
@@ -61,7 +63,8 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
       score.duration_s *= options.tempo_scale;
     }
   } else {
-    ARCO_ASSIGN_OR_RETURN(score, MakeBuiltInPiece(options.piece, score_instrument, options.tempo_scale));
+    ARCO_ASSIGN_OR_RETURN(score,
+                          MakeBuiltInPiece(options.piece, score_instrument, options.tempo_scale));
   }
   cap.score = TruncateScore(score, options.max_duration_s);
   if (cap.score.notes.empty()) return Status::Error("no notes within the requested duration");
@@ -101,7 +104,8 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
   const hand::HandModel right_model = hand::HandModel::Default(hand::HandSide::kRight);
   LeftHandAnimator left(left_model, model, tmpl, cap.performance, options.left_hand);
   const Eigen::Vector3d right_in_instrument = rest.rotation.transpose() * Eigen::Vector3d(-1, 0, 0);
-  const BowAnimator bow(right_model, model, tmpl, cap.performance, right_in_instrument, options.bow);
+  const BowAnimator bow(
+      right_model, model, tmpl, cap.performance, right_in_instrument, options.bow);
   const Sway sway(options.sway, options.seed);
 
   const double duration_s = std::max(cap.score.duration_s, cap.score.notes.back().offset_s);
@@ -122,7 +126,8 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     };
     const Eigen::Matrix3d torso = sway.TorsoRotation(t);
     Rigid performer_from_instrument = RotationAbout(sway.InstrumentRotation(t), pivot) * rest;
-    if (violin_like) performer_from_instrument = Rigid{torso, Eigen::Vector3d::Zero()} * performer_from_instrument;
+    if (violin_like)
+      performer_from_instrument = Rigid{torso, Eigen::Vector3d::Zero()} * performer_from_instrument;
     const Rigid world_from_instrument = world_from_performer * performer_from_instrument;
     Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
     m.topLeftCorner<3, 3>() = world_from_instrument.rotation;
@@ -133,7 +138,8 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     const LeftHandFrame lh = left.Next(t);
     cap.max_residual_shift_mm = std::max(cap.max_residual_shift_mm, lh.residual_shift_mm);
     hand::HandPose lw = lh.pose;
-    lw.world_from_wrist_rotation = world_from_instrument.rotation * lh.pose.world_from_wrist_rotation;
+    lw.world_from_wrist_rotation =
+        world_from_instrument.rotation * lh.pose.world_from_wrist_rotation;
     lw.wrist_in_world_mm = world_from_instrument * lh.pose.wrist_in_world_mm;
     cap.left_hand[static_cast<size_t>(fr)] = lw;
     const hand::HandPointsMm left_pts = hand::ForwardKinematics(left_model, lw);
@@ -142,7 +148,8 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     // Bow and right hand.
     const BowFrame bf = bow.At(t);
     hand::HandPose rw = bf.right_hand;
-    rw.world_from_wrist_rotation = world_from_instrument.rotation * bf.right_hand.world_from_wrist_rotation;
+    rw.world_from_wrist_rotation =
+        world_from_instrument.rotation * bf.right_hand.world_from_wrist_rotation;
     rw.wrist_in_world_mm = world_from_instrument * bf.right_hand.wrist_in_world_mm;
     cap.right_hand[static_cast<size_t>(fr)] = rw;
     const hand::HandPointsMm right_pts = hand::ForwardKinematics(right_model, rw);
@@ -159,8 +166,11 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     // Body from the wrists (performer frame).
     const Rigid performer_from_world = world_from_performer.Inverse();
     std::array<Eigen::Vector3d, kNumBodyPoints> body;
-    BodyKeypoints(torso, performer_from_world * left_pts[0], performer_from_world * right_pts[0],
-                  violin_like, &body);
+    BodyKeypoints(torso,
+                  performer_from_world * left_pts[0],
+                  performer_from_world * right_pts[0],
+                  violin_like,
+                  &body);
     for (int p = 0; p < 91; ++p) set(p, world_from_performer * body[static_cast<size_t>(p)]);
     set(9, left_pts[0]);  // body wrists are the hands' wrists exactly
     set(10, right_pts[0]);
@@ -185,7 +195,8 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
       ct.point_mm = world_from_instrument * lh.contact_mm;
       set(num_capture_points + 8, ct.point_mm);
       for (int j = 0; j < 4; ++j) {
-        set(num_capture_points + 9 + j, left_pts[hand::KeypointIndex(static_cast<hand::Finger>(lh.finger), j)]);
+        set(num_capture_points + 9 + j,
+            left_pts[hand::KeypointIndex(static_cast<hand::Finger>(lh.finger), j)]);
       }
       df.bias_tip = kLeftHandFirst + hand::TipKeypoint(static_cast<hand::Finger>(lh.finger));
       df.bias_dip = df.bias_tip - 1;
@@ -194,10 +205,11 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     // Detection scene.
     df.points.resize(static_cast<size_t>(num_capture_points));
     for (int p = 0; p < num_capture_points; ++p) {
-      df.points[static_cast<size_t>(p)] =
-          Eigen::Vector3d(cap.points3d.at(fr, p, 0), cap.points3d.at(fr, p, 1), cap.points3d.at(fr, p, 2));
+      df.points[static_cast<size_t>(p)] = Eigen::Vector3d(
+          cap.points3d.at(fr, p, 0), cap.points3d.at(fr, p, 1), cap.points3d.at(fr, p, 2));
     }
-    df.body_centre = world_from_instrument * Eigen::Vector3d(tmpl.body_center_x_mm, 0, tmpl.body_plane_z_mm);
+    df.body_centre =
+        world_from_instrument * Eigen::Vector3d(tmpl.body_center_x_mm, 0, tmpl.body_plane_z_mm);
     df.body_axis_x = world_from_instrument.rotation.col(0);
     df.body_axis_y = world_from_instrument.rotation.col(1);
     df.body_half_x = tmpl.body_half_length_mm;
@@ -212,8 +224,8 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
   layout.instrument_first = kNumBodyPoints;
   layout.bow_points = {frog, tip};
   layout.torso_points = {5, 6, 11, 12};
-  cap.keypoints2d = EmulateDetections(cap.rig_mm, det_frames, layout, options.detection, options.seed,
-                                      options.num_threads);
+  cap.keypoints2d = EmulateDetections(
+      cap.rig_mm, det_frames, layout, options.detection, options.seed, options.num_threads);
   return cap;
 }
 

@@ -8,11 +8,10 @@
 // (docs/synth.md lists every file).
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "arco/camera/rig.h"
 #include "arco/hand/hand_model.h"
@@ -81,7 +80,7 @@ struct SyntheticCapture {
   std::vector<hand::HandPose> left_hand, right_hand;  // world_from_wrist, mm
   std::vector<ContactTruth> contact;
   std::vector<Eigen::Matrix4d> world_from_instrument;  // rotation | bridge centre, mm
-  NpyArray<float> keypoints2d;  // (frames, views, capture points, 3)
+  NpyArray<float> keypoints2d;                         // (frames, views, capture points, 3)
   double max_residual_shift_mm = 0;  // largest whole-hand correction the IK needed
   int pressed_frames = 0;
 };

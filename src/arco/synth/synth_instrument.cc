@@ -21,8 +21,8 @@ ScoreInstrument ScoreInstrumentFor(const InstrumentModel& model) {
   for (int string = n; string >= 1; --string) {  // lowest first
     const double open = model.open_hz(string);
     s.open_string_midi.push_back(static_cast<int>(std::lround(69 + 12 * std::log2(open / 440.0))));
-    semis = std::min(semis, static_cast<int>(std::floor(
-                                12 * std::log2(model.max_hz(string) / open) + 1e-6)));
+    semis = std::min(
+        semis, static_cast<int>(std::floor(12 * std::log2(model.max_hz(string) / open) + 1e-6)));
   }
   s.max_semitones_above_open = semis;
   s.gm_program = GmProgramFor(model.kind());

@@ -12,10 +12,9 @@
 // the tail gut), scaled by string length for the other instruments.
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "arco/instrument/instrument_model.h"
 #include "arco/instrument/strings.h"
