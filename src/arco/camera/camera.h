@@ -10,13 +10,12 @@
 // Units of t (and of world points) are those of the calibration (Rig::units).
 #pragma once
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <Eigen/Geometry>
 
 namespace arco {
 

@@ -1,8 +1,8 @@
 #include "arco/camera/camera.h"
 
-#include <random>
-
 #include <gtest/gtest.h>
+
+#include <random>
 
 namespace arco {
 namespace {

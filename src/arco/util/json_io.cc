@@ -57,16 +57,12 @@ std::string ReplaceNonFiniteTokens(const std::string& text) {
 }  // namespace
 
 StatusOr<Json> ParseJsonLenient(const std::string& text, const std::string& source) {
-  Json json = Json::parse(ReplaceNonFiniteTokens(text), nullptr, /*allow_exceptions=*/false);
-  if (json.is_discarded()) {
-    try {
-      (void)Json::parse(ReplaceNonFiniteTokens(text));
-    } catch (const Json::parse_error& e) {
-      return Status::Error(source + ": malformed JSON (" + e.what() + ")");
-    }
-    return Status::Error(source + ": malformed JSON");
+  // Json::exception covers parse errors and number overflow (e.g. 1e400).
+  try {
+    return Json::parse(ReplaceNonFiniteTokens(text));
+  } catch (const Json::exception& e) {
+    return Status::Error(source + ": malformed JSON (" + e.what() + ")");
   }
-  return json;
 }
 
 StatusOr<Json> ReadJsonFile(const std::string& path) {

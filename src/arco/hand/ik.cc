@@ -1,0 +1,433 @@
+#include "arco/hand/ik.h"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+#include "arco/hand/kinematics.h"
+
+namespace arco::hand {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+constexpr double kActiveTolRad = 1e-6;
+// Grid levels per free joint for restarts, by number of free joints (<= 1296 points).
+constexpr int kAutoSeedLevels[5] = {2, 33, 17, 9, 6};
+
+// Tip position error (mm, world) as a function of the N free angles of a finger;
+// the other dofs stay at their reference values.
+template <int N>
+struct TipCost {
+  const HandModel* model;
+  Finger finger;
+  std::array<double, 4> fixed;  // reference dofs of the finger
+  std::array<int, N> slots;     // which of the 4 slots are free
+  Eigen::Matrix3d rotation;     // world_from_wrist
+  Eigen::Vector3d translation;  // wrist in world
+  Eigen::Vector3d target;
+
+  template <typename T>
+  bool operator()(const T* x, T* residual) const {
+    T dof[4];
+    for (int i = 0; i < 4; ++i) dof[i] = T(fixed[i]);
+    for (int i = 0; i < N; ++i) dof[slots[i]] = x[i];
+    Eigen::Matrix<T, 3, 1> p[4];
+    FingerPointsInWrist(*model, finger, dof, p);
+    const Eigen::Matrix<T, 3, 1> tip = rotation.cast<T>() * p[3] + translation.cast<T>();
+    for (int r = 0; r < 3; ++r) residual[r] = tip[r] - T(target[r]);
+    return true;
+  }
+};
+
+// weight * (x - anchor), analytic.
+class AnchorCost : public ceres::CostFunction {
+ public:
+  AnchorCost(std::vector<double> anchor, double weight) : anchor_(std::move(anchor)), w_(weight) {
+    set_num_residuals(static_cast<int>(anchor_.size()));
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(anchor_.size()));
+  }
+  bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override {
+    const int n = static_cast<int>(anchor_.size());
+    for (int i = 0; i < n; ++i) residuals[i] = w_ * (x[0][i] - anchor_[i]);
+    if (jacobians && jacobians[0]) {
+      for (int i = 0; i < n * n; ++i) jacobians[0][i] = 0;
+      for (int i = 0; i < n; ++i) jacobians[0][i * n + i] = w_;
+    }
+    return true;
+  }
+
+ private:
+  std::vector<double> anchor_;
+  double w_;
+};
+
+struct SolveOutcome {
+  std::vector<double> x;
+  double distance_mm = 0;
+  double regularisation = 0;  // sum of squared anchor residuals (unscaled weights)
+  bool converged = false;
+  int iterations = 0;
+  int solves = 0;
+  std::string termination;
+};
+
+template <int N>
+ceres::CostFunction* MakeTipCost(const TipCost<N>& functor) {
+  return new ceres::AutoDiffCostFunction<TipCost<N>, 3, N>(new TipCost<N>(functor));
+}
+
+struct IkProblemSpec {
+  const HandModel* model;
+  Finger finger;
+  std::array<double, 4> reference;  // clamped reference dofs of the finger
+  std::vector<int> slots;
+  std::vector<double> lower, upper, ref_free, prev_free;
+  bool has_prev = false;
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d translation, target;
+};
+
+double TipDistance(const IkProblemSpec& s, const std::vector<double>& x) {
+  std::array<double, 4> dof = s.reference;
+  for (size_t i = 0; i < s.slots.size(); ++i) dof[s.slots[i]] = x[i];
+  Eigen::Vector3d p[4];
+  FingerPointsInWrist(*s.model, s.finger, dof.data(), p);
+  return (s.rotation * p[3] + s.translation - s.target).norm();
+}
+
+// One bounded trust-region solve from x (in place) with the given weights.
+void SolveOnce(const IkProblemSpec& s,
+               double w_ref,
+               double w_prev,
+               int max_iterations,
+               std::vector<double>* x,
+               SolveOutcome* out) {
+  const int n = static_cast<int>(s.slots.size());
+  ceres::Problem problem;
+  ceres::CostFunction* tip = nullptr;
+  auto fill = [&](auto functor) {
+    functor.model = s.model;
+    functor.finger = s.finger;
+    functor.fixed = s.reference;
+    for (int i = 0; i < n; ++i) functor.slots[i] = s.slots[i];
+    functor.rotation = s.rotation;
+    functor.translation = s.translation;
+    functor.target = s.target;
+    return MakeTipCost(functor);
+  };
+  switch (n) {
+    case 1:
+      tip = fill(TipCost<1>{});
+      break;
+    case 2:
+      tip = fill(TipCost<2>{});
+      break;
+    case 3:
+      tip = fill(TipCost<3>{});
+      break;
+    case 4:
+      tip = fill(TipCost<4>{});
+      break;
+    default:
+      ARCO_CHECK(false) << "unsupported free dof count " << n;
+  }
+  problem.AddResidualBlock(tip, nullptr, x->data());
+  if (w_ref > 0) problem.AddResidualBlock(new AnchorCost(s.ref_free, w_ref), nullptr, x->data());
+  if (s.has_prev && w_prev > 0) {
+    problem.AddResidualBlock(new AnchorCost(s.prev_free, w_prev), nullptr, x->data());
+  }
+  for (int i = 0; i < n; ++i) {
+    problem.SetParameterLowerBound(x->data(), i, s.lower[i]);
+    problem.SetParameterUpperBound(x->data(), i, s.upper[i]);
+  }
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.max_num_iterations = max_iterations;
+  options.function_tolerance = 1e-14;
+  options.gradient_tolerance = 1e-14;
+  options.parameter_tolerance = 1e-12;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  out->converged = summary.termination_type == ceres::CONVERGENCE;
+  out->iterations += static_cast<int>(summary.iterations.size());
+  out->solves += 1;
+  out->termination = ceres::TerminationTypeToString(summary.termination_type);
+}
+
+// Gradient of the weighted cost with respect to the free angles.
+std::vector<double> CostGradient(const IkProblemSpec& s,
+                                 double w_ref,
+                                 double w_prev,
+                                 const std::vector<double>& x) {
+  using Jet = ceres::Jet<double, 4>;
+  Jet dof[4];
+  for (int i = 0; i < 4; ++i) dof[i] = Jet(s.reference[i]);
+  for (size_t i = 0; i < s.slots.size(); ++i) dof[s.slots[i]] = Jet(x[i], static_cast<int>(i));
+  Eigen::Matrix<Jet, 3, 1> p[4];
+  FingerPointsInWrist(*s.model, s.finger, dof, p);
+  const Eigen::Matrix<Jet, 3, 1> r =
+      s.rotation.cast<Jet>() * p[3] + (s.translation - s.target).cast<Jet>();
+  const Jet cost = r.squaredNorm();
+  std::vector<double> g(x.size());
+  for (size_t i = 0; i < x.size(); ++i) {
+    g[i] = cost.v[i] + 2 * w_ref * w_ref * (x[i] - s.ref_free[i]);
+    if (s.has_prev) g[i] += 2 * w_prev * w_prev * (x[i] - s.prev_free[i]);
+  }
+  return g;
+}
+
+// Ceres projects trust-region steps onto the bounds, which crawls when a joint
+// sits on a limit that the unconstrained step points through. An active-set
+// loop fixes those joints (on the limit, gradient pointing outwards) and
+// re-solves the rest, until the active set no longer changes.
+void SolveActiveSet(const IkProblemSpec& s,
+                    double w_ref,
+                    double w_prev,
+                    int max_iterations,
+                    std::vector<double>* x,
+                    SolveOutcome* out) {
+  SolveOnce(s, w_ref, w_prev, max_iterations, x, out);
+  std::vector<bool> previous_active;
+  for (int round = 0; round < 4; ++round) {
+    const std::vector<double> g = CostGradient(s, w_ref, w_prev, *x);
+    std::vector<bool> active(x->size(), false);
+    int num_active = 0;
+    for (size_t i = 0; i < x->size(); ++i) {
+      const double xi = (*x)[i];
+      active[i] = (xi <= s.lower[i] + 1e-12 && g[i] > 0) || (xi >= s.upper[i] - 1e-12 && g[i] < 0);
+      num_active += active[i];
+    }
+    if (num_active == 0 || num_active == static_cast<int>(x->size()) || active == previous_active) {
+      break;
+    }
+    previous_active = active;
+    IkProblemSpec reduced = s;
+    reduced.slots.clear();
+    reduced.lower.clear();
+    reduced.upper.clear();
+    reduced.ref_free.clear();
+    reduced.prev_free.clear();
+    std::vector<double> xr;
+    for (size_t i = 0; i < x->size(); ++i) {
+      if (active[i]) {
+        reduced.reference[s.slots[i]] = (*x)[i];
+        continue;
+      }
+      reduced.slots.push_back(s.slots[i]);
+      reduced.lower.push_back(s.lower[i]);
+      reduced.upper.push_back(s.upper[i]);
+      reduced.ref_free.push_back(s.ref_free[i]);
+      if (s.has_prev) reduced.prev_free.push_back(s.prev_free[i]);
+      xr.push_back((*x)[i]);
+    }
+    SolveOnce(reduced, w_ref, w_prev, max_iterations, &xr, out);
+    for (size_t i = 0, j = 0; i < x->size(); ++i) {
+      if (!active[i]) (*x)[i] = xr[j++];
+    }
+  }
+}
+
+// from_reference: the first start (regularised solve, then the exact-reach
+// polish); restarts from seeds skip the regularised stage, which would drag
+// them back towards the reference's basin.
+SolveOutcome SolveFrom(const IkProblemSpec& s,
+                       const FingerIkOptions& o,
+                       std::vector<double> x,
+                       bool from_reference) {
+  SolveOutcome out;
+  if (from_reference || !o.exact_reach) {
+    SolveActiveSet(
+        s, o.reference_weight_mm_per_rad, o.previous_weight_mm_per_rad, o.max_iterations, &x, &out);
+  }
+  if (o.exact_reach) {
+    SolveActiveSet(s,
+                   1e-4 * o.reference_weight_mm_per_rad,
+                   1e-4 * o.previous_weight_mm_per_rad,
+                   o.max_iterations,
+                   &x,
+                   &out);
+  }
+  for (size_t i = 0; i < x.size(); ++i) x[i] = std::clamp(x[i], s.lower[i], s.upper[i]);
+  out.x = x;
+  out.distance_mm = TipDistance(s, x);
+  for (size_t i = 0; i < x.size(); ++i) {
+    out.regularisation += std::pow(o.reference_weight_mm_per_rad * (x[i] - s.ref_free[i]), 2);
+    if (s.has_prev) {
+      out.regularisation += std::pow(o.previous_weight_mm_per_rad * (x[i] - s.prev_free[i]), 2);
+    }
+  }
+  return out;
+}
+
+bool Better(const SolveOutcome& a, const SolveOutcome& b, double tol_mm) {
+  const double da = a.distance_mm <= tol_mm ? 0.0 : a.distance_mm;
+  const double db = b.distance_mm <= tol_mm ? 0.0 : b.distance_mm;
+  if (da != db) return da < db;
+  return a.regularisation < b.regularisation;
+}
+
+}  // namespace
+
+const char* FingerIkJointsName(FingerIkJoints joints) {
+  switch (joints) {
+    case FingerIkJoints::kPipDip:
+      return "pip_dip";
+    case FingerIkJoints::kMcpFlexPipDip:
+      return "mcp_flex_pip_dip";
+    case FingerIkJoints::kAll:
+      return "all";
+  }
+  return "invalid";
+}
+
+std::vector<FingerDof> FreeDofs(FingerIkJoints joints) {
+  switch (joints) {
+    case FingerIkJoints::kPipDip:
+      return {FingerDof::kMiddleFlex, FingerDof::kDistalFlex};
+    case FingerIkJoints::kMcpFlexPipDip:
+      return {FingerDof::kBaseFlex, FingerDof::kMiddleFlex, FingerDof::kDistalFlex};
+    case FingerIkJoints::kAll:
+      return {FingerDof::kBaseFlex,
+              FingerDof::kBaseAbd,
+              FingerDof::kMiddleFlex,
+              FingerDof::kDistalFlex};
+  }
+  throw std::invalid_argument("FreeDofs: unknown FingerIkJoints value");
+}
+
+Status FingerIkOptions::Validate() const {
+  auto bad = [](const std::string& what) { return Status::Error("FingerIkOptions: " + what); };
+  if (!(reference_weight_mm_per_rad >= 0) || !std::isfinite(reference_weight_mm_per_rad))
+    return bad("reference_weight_mm_per_rad must be finite and >= 0");
+  if (!(previous_weight_mm_per_rad >= 0) || !std::isfinite(previous_weight_mm_per_rad))
+    return bad("previous_weight_mm_per_rad must be finite and >= 0");
+  if (!(max_change_deg > 0)) return bad("max_change_deg must be > 0");
+  if (seed_levels < 0 || seed_levels == 1 || seed_levels > 32) {
+    return bad("seed_levels must be 0 (auto) or in [2, 32]");
+  }
+  if (restarts < 0) return bad("restarts must be >= 0");
+  if (!(reach_tolerance_mm > 0)) return bad("reach_tolerance_mm must be > 0");
+  if (max_iterations < 1) return bad("max_iterations must be >= 1");
+  if (previous_pose && previous_weight_mm_per_rad > 0) {
+    for (double a : previous_pose->angles_rad) {
+      if (!std::isfinite(a)) return bad("previous_pose has a non-finite angle");
+    }
+  }
+  return Status::Ok();
+}
+
+FingerIkResult SolveFingertipIk(const HandModel& model,
+                                const HandPose& reference,
+                                Finger finger,
+                                const Eigen::Vector3d& target_in_world_mm,
+                                const FingerIkOptions& options) {
+  const Status valid = options.Validate();
+  if (!valid.ok()) throw std::invalid_argument(valid.message());
+  const int f = static_cast<int>(finger);
+  if (f < 0 || f >= kNumFingers) throw std::invalid_argument("SolveFingertipIk: bad finger");
+
+  FingerIkResult result;
+  result.pose = ClampToLimits(model, reference);
+  for (int d = 0; d < kNumJointDofs; ++d) {
+    if (!(reference.angles_rad[d] == result.pose.angles_rad[d])) ++result.clamped_reference_dofs;
+  }
+  if (!target_in_world_mm.allFinite() || !reference.world_from_wrist_rotation.allFinite() ||
+      !reference.wrist_in_world_mm.allFinite()) {
+    result.status =
+        Status::Error(std::string("fingertip IK: non-finite ") +
+                      (target_in_world_mm.allFinite() ? "reference wrist pose" : "target"));
+    result.initial_distance_mm = result.final_distance_mm = std::nan("");
+    result.termination = "not run";
+    return result;
+  }
+
+  IkProblemSpec s;
+  s.model = &model;
+  s.finger = finger;
+  for (int i = 0; i < 4; ++i) s.reference[i] = result.pose.angles_rad[4 * f + i];
+  s.rotation = reference.world_from_wrist_rotation;
+  s.translation = reference.wrist_in_world_mm;
+  s.target = target_in_world_mm;
+  s.has_prev = options.previous_pose.has_value() && options.previous_weight_mm_per_rad > 0;
+  const double max_change_rad = options.max_change_deg * kDegToRad;
+  for (FingerDof slot : FreeDofs(options.joints)) {
+    const int i = static_cast<int>(slot);
+    const int dof = 4 * f + i;
+    const double lower = std::max(model.min_rad(dof), s.reference[i] - max_change_rad);
+    const double upper = std::min(model.max_rad(dof), s.reference[i] + max_change_rad);
+    if (!(upper - lower > 1e-12)) continue;  // a locked joint (min == max) stays fixed
+    s.slots.push_back(i);
+    s.lower.push_back(lower);
+    s.upper.push_back(upper);
+    s.ref_free.push_back(s.reference[i]);
+    if (s.has_prev) {
+      s.prev_free.push_back(
+          std::clamp(options.previous_pose->angles_rad[dof], s.lower.back(), s.upper.back()));
+    }
+  }
+  result.initial_distance_mm = TipDistance(s, s.ref_free);
+  if (s.slots.empty()) {
+    result.final_distance_mm = result.initial_distance_mm;
+    result.converged = true;
+    result.termination = "no free joint";
+    return result;
+  }
+
+  SolveOutcome best = SolveFrom(s, options, s.ref_free, /*from_reference=*/true);
+  int iterations = best.iterations, solves = best.solves;
+  if (best.distance_mm > options.reach_tolerance_mm && options.restarts > 0) {
+    // The reach cost has genuine local minima on the limits (corners of the
+    // box, targets behind the finger), so restart from the best points of a
+    // deterministic grid over the bounds (corners included).
+    const int n = static_cast<int>(s.slots.size());
+    const int levels = options.seed_levels > 0 ? options.seed_levels : kAutoSeedLevels[n];
+    int combos = 1;
+    for (int i = 0; i < n; ++i) combos *= levels;
+    std::vector<std::pair<double, int>> scored(combos);
+    std::vector<double> seed(n);
+    auto decode = [&](int c) {
+      for (int i = 0; i < n; ++i, c /= levels) {
+        seed[i] = s.lower[i] + (s.upper[i] - s.lower[i]) * (c % levels) / (levels - 1.0);
+      }
+    };
+    for (int c = 0; c < combos; ++c) {
+      decode(c);
+      scored[c] = {TipDistance(s, seed), c};
+    }
+    const int keep = std::min(options.restarts, combos);
+    std::partial_sort(scored.begin(), scored.begin() + keep, scored.end());
+    for (int r = 0; r < keep; ++r) {
+      decode(scored[r].second);
+      SolveOutcome candidate = SolveFrom(s, options, seed, /*from_reference=*/false);
+      iterations += candidate.iterations;
+      solves += candidate.solves;
+      if (Better(candidate, best, options.reach_tolerance_mm)) best = candidate;
+    }
+  }
+
+  for (size_t i = 0; i < s.slots.size(); ++i) {
+    const int dof = 4 * f + s.slots[i];
+    result.pose.angles_rad[dof] = best.x[i];
+    if (best.x[i] <= model.min_rad(dof) + kActiveTolRad ||
+        best.x[i] >= model.max_rad(dof) - kActiveTolRad) {
+      result.active_limit_dofs.push_back(dof);
+    } else if (best.x[i] <= s.lower[i] + kActiveTolRad || best.x[i] >= s.upper[i] - kActiveTolRad) {
+      result.step_limited = true;
+    }
+  }
+  ARCO_CHECK(CountLimitViolations(model, result.pose) == 0) << "IK produced a limit violation";
+  result.converged = best.converged;
+  result.iterations = iterations;
+  result.solves = solves;
+  result.final_distance_mm = best.distance_mm;
+  result.termination = best.termination;
+  return result;
+}
+
+}  // namespace arco::hand

@@ -1,0 +1,79 @@
+// Inverse kinematics: "put this fingertip at this point" with a chosen set of
+// free joints, joint limits as hard bounds (Ceres trust region with parameter
+// bounds), and regularisation towards a reference pose (and optionally the
+// previous frame's pose). This is the audio-guided correction's solver (the
+// paper's Eq. 3 adjusts PIP and DIP of the note-playing finger: kPipDip).
+//
+// Cost over the free angles x (rad) of one finger:
+//   |tip(x) - target|^2 + w_ref^2 |x - x_ref|^2 + w_prev^2 |x - x_prev|^2
+// subject to  max(min_k, x_ref,k - max_change) <= x_k <= min(max_k, x_ref,k + max_change).
+// With exact_reach, a second solve with the weights scaled by 1e-4 starts from
+// the first: the regularisation picks the solution (redundant dofs, unreachable
+// targets) and reachable targets are then met to ~1e-6 mm.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "arco/hand/hand_model.h"
+#include "arco/util/status.h"
+
+namespace arco::hand {
+
+enum class FingerIkJoints {
+  kPipDip,         // PIP + DIP flexion (thumb: MCP + IP), the paper's mode
+  kMcpFlexPipDip,  // + MCP flexion (thumb: + CMC flexion)
+  kAll,            // MCP flexion + abduction + PIP + DIP (thumb: CMC 2 axes + MCP + IP)
+};
+const char* FingerIkJointsName(FingerIkJoints joints);
+
+struct FingerIkOptions {
+  FingerIkJoints joints = FingerIkJoints::kPipDip;
+  double reference_weight_mm_per_rad = 1.0;  // pull towards the reference angles
+  // Optional temporal regularisation towards the previous frame's angles.
+  std::optional<HandPose> previous_pose;
+  double previous_weight_mm_per_rad = 0.0;
+  // Largest change of any free angle from the reference ("small steps"), deg.
+  double max_change_deg = 360.0;
+  bool exact_reach = true;  // see the header comment
+  // When the tip ends farther than reach_tolerance_mm, evaluate a grid of
+  // seed_levels values per free joint over its bounds (0 = automatic: 33, 17, 9
+  // or 6 levels for 1-4 free joints) and restart from the `restarts` best grid
+  // points (0 = never restart).
+  int seed_levels = 0;
+  int restarts = 3;
+  double reach_tolerance_mm = 1e-3;
+  int max_iterations = 100;
+  // Invalid values (negative weights, max_change_deg <= 0, ...) -> message.
+  Status Validate() const;
+};
+
+struct FingerIkResult {
+  // Not OK for unusable input (non-finite target or reference wrist); `pose`
+  // is then the reference clamped into the limits.
+  Status status;
+  HandPose pose;                   // reference with the free angles solved; within limits
+  bool converged = false;          // Ceres reported convergence of the chosen solve
+  int iterations = 0;              // all trust-region iterations, all solves
+  int solves = 0;                  // 1 or 2 per start, more with restarts
+  double initial_distance_mm = 0;  // from the (clamped) reference
+  double final_distance_mm = 0;
+  std::vector<int> active_limit_dofs;  // dofs (DofIndex) at an anatomical limit
+  bool step_limited = false;           // a free dof ended on the max_change box
+  int clamped_reference_dofs = 0;      // reference angles that were outside limits
+  std::string termination;             // Ceres' termination of the chosen solve
+};
+
+// Throws std::invalid_argument on invalid options.
+FingerIkResult SolveFingertipIk(const HandModel& model,
+                                const HandPose& reference,
+                                Finger finger,
+                                const Eigen::Vector3d& target_in_world_mm,
+                                const FingerIkOptions& options);
+
+// Slots (FingerDof) freed by a joints choice.
+std::vector<FingerDof> FreeDofs(FingerIkJoints joints);
+
+}  // namespace arco::hand
