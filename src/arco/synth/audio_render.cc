@@ -27,8 +27,9 @@ std::string Quote(const std::string& s) {
 Status RunFluidsynth(const AudioRenderOptions& o, const std::string& midi, const std::string& wav) {
   std::error_code ec;
   std::filesystem::remove(wav, ec);
-  const std::string cmd = "fluidsynth -ni -q -R 0 -C 0 -r " + std::to_string(o.sample_rate_hz) + " -F " +
-                          Quote(wav) + " " + Quote(o.soundfont) + " " + Quote(midi) + " >/dev/null 2>&1";
+  const std::string cmd = "fluidsynth -ni -q -R 0 -C 0 -r " + std::to_string(o.sample_rate_hz) +
+                          " -F " + Quote(wav) + " " + Quote(o.soundfont) + " " + Quote(midi) +
+                          " >/dev/null 2>&1";
   if (std::system(cmd.c_str()) != 0 || !FileExists(wav)) {
     return Status::Error(wav + ": fluidsynth failed (is the fluidsynth package installed?)");
   }
@@ -60,7 +61,8 @@ StatusOr<std::map<int, SampleContour>> MeasureContours(const std::map<int, doubl
   ARCO_RETURN_IF_ERROR(audio::WriteMidiFile(midi, probe));
   ARCO_RETURN_IF_ERROR(RunFluidsynth(o, midi, wav));
   audio::PitchTrackerOptions po;
-  ARCO_ASSIGN_OR_RETURN(po.range, audio::InstrumentRangeByName(instrument == "double_bass" ? "bass" : instrument));
+  ARCO_ASSIGN_OR_RETURN(
+      po.range, audio::InstrumentRangeByName(instrument == "double_bass" ? "bass" : instrument));
   po.fps = 1.0 / SampleContour().step_s;
   po.a4_hz = a4_hz;
   audio::PitchSummary summary;
@@ -76,7 +78,8 @@ StatusOr<std::map<int, SampleContour>> MeasureContours(const std::map<int, doubl
       // Sample time tau is heard at onset + latency + tau.
       const double time = onset + o.latency_s + j * c.step_s;
       const auto row = static_cast<size_t>(std::lround(time / c.step_s));
-      if (row >= tracked.frames.size() || j * c.step_s < 0.06) continue;  // the attack is unreliable
+      if (row >= tracked.frames.size() || j * c.step_s < 0.06)
+        continue;  // the attack is unreliable
       const audio::PitchFrame& f = tracked.frames[row];
       if (!f.voiced) continue;
       const double cents = 1200 * std::log2(f.f0_hz / expected);
@@ -85,7 +88,8 @@ StatusOr<std::map<int, SampleContour>> MeasureContours(const std::map<int, doubl
       valid.push_back(cents);
     }
     if (valid.size() < 20) continue;  // not measurable: leave this key uncompensated
-    std::nth_element(valid.begin(), valid.begin() + static_cast<long>(valid.size() / 2), valid.end());
+    std::nth_element(
+        valid.begin(), valid.begin() + static_cast<long>(valid.size() / 2), valid.end());
     c.median_cents = valid[valid.size() / 2];
     // Holes (attack, unvoiced rows) take the nearest earlier value, else the median.
     double last = c.median_cents;
@@ -145,8 +149,10 @@ Status AddRoomNoise(const std::string& wav, double dbfs, uint64_t seed) {
 }  // namespace
 
 Status AudioRenderOptions::Validate() const {
-  if (sample_rate_hz < 8000 || sample_rate_hz > 192000) return Status::Error("audio rate must be 8-192 kHz");
-  if (!(bend_step_s > 0 && bend_step_s <= 0.05)) return Status::Error("bend step must be in (0, 0.05] s");
+  if (sample_rate_hz < 8000 || sample_rate_hz > 192000)
+    return Status::Error("audio rate must be 8-192 kHz");
+  if (!(bend_step_s > 0 && bend_step_s <= 0.05))
+    return Status::Error("bend step must be in (0, 0.05] s");
   if (!(latency_s >= 0 && latency_s < 0.1)) return Status::Error("latency must be in [0, 0.1) s");
   if (!(room_noise_dbfs <= 0 && room_noise_dbfs > -200)) {
     return Status::Error("room noise must be in (-200, 0] dBFS (0 = none)");
@@ -211,9 +217,11 @@ Status RenderPerformanceAudio(const Performance& perf,
       double& d = key_duration_s[n.note.midi_note];
       d = std::max(d, n.note.offset_s - n.note.onset_s);
     }
-    ARCO_ASSIGN_OR_RETURN(contours, MeasureContours(key_duration_s, gm_program, instrument, perf.a4_hz, o, work_dir));
+    ARCO_ASSIGN_OR_RETURN(
+        contours, MeasureContours(key_duration_s, gm_program, instrument, perf.a4_hz, o, work_dir));
   }
-  ARCO_RETURN_IF_ERROR(audio::WriteMidiFile(midi_path, PerformanceToMidi(perf, gm_program, contours, o)));
+  ARCO_RETURN_IF_ERROR(
+      audio::WriteMidiFile(midi_path, PerformanceToMidi(perf, gm_program, contours, o)));
   ARCO_RETURN_IF_ERROR(RunFluidsynth(o, midi_path, wav_path));
   if (o.room_noise_dbfs < 0) ARCO_RETURN_IF_ERROR(AddRoomNoise(wav_path, o.room_noise_dbfs, seed));
   if (summary) {

@@ -1,11 +1,11 @@
 // Rendered audio against the truth pitch, tracked by arco's own tracker.
 #include "arco/synth/audio_render.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-
-#include <gtest/gtest.h>
 
 #include "arco/audio/pitch_tracker.h"
 #include "arco/synth/test_instruments.h"
@@ -34,8 +34,8 @@ TEST_P(RenderedAudio, TrackedPitchMatchesTruthWithinFiveCents) {
   const std::string dir = ::testing::TempDir() + "/render_" + c.instrument;
   std::filesystem::create_directories(dir);
   AudioRenderSummary summary;
-  const Status st = RenderPerformanceAudio(*perf, c.program, c.instrument, {}, dir, dir + "/p.mid",
-                                           dir + "/p.wav", 0, &summary);
+  const Status st = RenderPerformanceAudio(
+      *perf, c.program, c.instrument, {}, dir, dir + "/p.mid", dir + "/p.wav", 0, &summary);
   ASSERT_TRUE(st.ok()) << st.message();
   EXPECT_FALSE(summary.key_offset_cents.empty());
   audio::PitchTrackerOptions po;
@@ -58,7 +58,10 @@ TEST_P(RenderedAudio, TrackedPitchMatchesTruthWithinFiveCents) {
     }
     err.push_back(std::abs(1200 * std::log2(f.f0_hz / perf->F0HzAt(f.time_s))));
     if (getenv("ARCO_DEBUG_AUDIO")) {
-      std::printf("%d t=%.2f key %d err %.1f vib %.1f off %.1f\n", i, f.time_s, n.midi_note,
+      std::printf("%d t=%.2f key %d err %.1f vib %.1f off %.1f\n",
+                  i,
+                  f.time_s,
+                  n.midi_note,
                   1200 * std::log2(f.f0_hz / perf->F0HzAt(f.time_s)),
                   perf->notes[static_cast<size_t>(i)].VibratoCentsOnlyAt(f.time_s),
                   summary.key_offset_cents[n.midi_note]);
@@ -68,8 +71,13 @@ TEST_P(RenderedAudio, TrackedPitchMatchesTruthWithinFiveCents) {
   std::sort(err.begin(), err.end());
   const double median = err[err.size() / 2];
   const double p90 = err[err.size() * 9 / 10];
-  std::printf("%s %s: median %.2f cents, p90 %.2f cents, unvoiced %d of %zu\n", c.instrument, c.piece,
-              median, p90, unvoiced, err.size() + unvoiced);
+  std::printf("%s %s: median %.2f cents, p90 %.2f cents, unvoiced %d of %zu\n",
+              c.instrument,
+              c.piece,
+              median,
+              p90,
+              unvoiced,
+              err.size() + unvoiced);
   EXPECT_LT(median, 5.0);
   EXPECT_LT(p90, 5.0);
   EXPECT_LT(unvoiced, static_cast<int>(err.size()) / 20);
@@ -77,7 +85,8 @@ TEST_P(RenderedAudio, TrackedPitchMatchesTruthWithinFiveCents) {
 
 INSTANTIATE_TEST_SUITE_P(Pieces,
                          RenderedAudio,
-                         ::testing::Values(Case{"cello", "slow-melody", 42}, Case{"violin", "scale-2oct", 40}));
+                         ::testing::Values(Case{"cello", "slow-melody", 42},
+                                           Case{"violin", "scale-2oct", 40}));
 
 TEST(PerformanceToMidi, BendsCarryIntonationAndVibratoMinusKeyOffset) {
   auto score = MakeBuiltInPiece("slow-melody", testing::Cello());
