@@ -4,7 +4,7 @@ set -euo pipefail
 build="${1:-build}"
 status=0
 for exe in "$build"/bench/*; do
-  [ -x "$exe" ] || continue
+  [ -f "$exe" ] && [ -x "$exe" ] || continue
   echo "== $(basename "$exe")"
   "$exe" --benchmark_min_time=0.5 || status=1
 done
