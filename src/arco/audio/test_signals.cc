@@ -104,11 +104,24 @@ Status WriteToneWavStreaming(const std::string& path,
   return Status::Ok();
 }
 
+namespace {
+// The per-process scratch folder; removed when the test process exits.
+struct ScratchDir {
+  std::filesystem::path path;
+  ScratchDir()
+      : path(std::filesystem::temp_directory_path() /
+             ("arco_audio_test_" + std::to_string(::getpid()))) {}
+  ~ScratchDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+};
+}  // namespace
+
 std::string TempPath(const std::string& name) {
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("arco_audio_test_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return (dir / name).string();
+  static ScratchDir scratch;
+  std::filesystem::create_directories(scratch.path);
+  return (scratch.path / name).string();
 }
 
 }  // namespace arco::audio::testing

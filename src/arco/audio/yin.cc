@@ -87,6 +87,7 @@ YinAnalyzer::YinAnalyzer(const YinOptions& options) : options_(options) {
   cmndf_.assign(max_lag_ + 2, 1.0);
   minima_.reserve(max_lag_);
   minima_prob_.reserve(max_lag_);
+  minima_value_.reserve(max_lag_);
   std::lock_guard<std::mutex> lock(PlannerMutex());
   time_ = fftw_alloc_real(n);
   auto* spectrum = fftw_alloc_complex(n / 2 + 1);
@@ -154,12 +155,20 @@ void YinAnalyzer::Analyze(const float* window, FrameCandidates* out) {
   // Dips of d' inside the lag range, shortest lag first.
   minima_.clear();
   minima_prob_.clear();
+  minima_value_.clear();
   int global = -1;
   for (int tau = std::max(min_lag_, 2); tau < max_lag_; ++tau) {
     if (cmndf_[tau] < cmndf_[tau - 1] && cmndf_[tau] <= cmndf_[tau + 1]) {
+      // Depth of the dip at its parabolic vertex: at short lags the integer
+      // lag can sit far up the dip's wall, which would make a true period look
+      // worse than its sub-harmonic (octave-down errors on high notes).
+      const double a = cmndf_[tau - 1], b = cmndf_[tau], c = cmndf_[tau + 1];
+      const double curvature = a - 2.0 * b + c;
+      const double vertex = curvature > 0 ? b - (a - c) * (a - c) / (8.0 * curvature) : b;
       minima_.push_back(tau);
+      minima_value_.push_back(std::clamp(vertex, 0.0, b));
       minima_prob_.push_back(0.0);
-      if (global < 0 || cmndf_[tau] < cmndf_[minima_[global]]) {
+      if (global < 0 || minima_value_.back() < minima_value_[global]) {
         global = static_cast<int>(minima_.size()) - 1;
       }
     }
@@ -173,33 +182,33 @@ void YinAnalyzer::Analyze(const float* window, FrameCandidates* out) {
   };
   double earlier_min = 1e9;
   for (size_t k = 0; k < minima_.size(); ++k) {
-    const double v = cmndf_[minima_[k]];
+    const double v = minima_value_[k];
     if (v < earlier_min) {
       minima_prob_[k] = cdf(std::min(earlier_min, 1.0)) - cdf(v);
       earlier_min = v;
     }
   }
   // Thresholds below every dip: pYIN gives 1% of their mass to the global minimum.
-  minima_prob_[global] += 0.01 * cdf(cmndf_[minima_[global]]);
+  minima_prob_[global] += 0.01 * cdf(minima_value_[global]);
 
   // Sub-harmonic check: mass at lag tau moves to a dip near 2*tau or 3*tau that
   // is much deeper (then tau was a harmonic, not the period).
   if (options_.subharmonic_ratio > 0) {
     for (size_t k = 0; k < minima_.size(); ++k) {
       if (minima_prob_[k] <= 0) continue;
-      const double v = cmndf_[minima_[k]];
+      const double v = minima_value_[k];
       for (int mult = 2; mult <= 3; ++mult) {
         const double target = static_cast<double>(minima_[k]) * mult;
         const double tolerance = std::max(2.0, 0.03 * target);
         int best = -1;
         for (size_t q = k + 1; q < minima_.size(); ++q) {
           if (std::abs(minima_[q] - target) <= tolerance &&
-              (best < 0 || cmndf_[minima_[q]] < cmndf_[minima_[best]])) {
+              (best < 0 || minima_value_[q] < minima_value_[best])) {
             best = static_cast<int>(q);
           }
         }
         if (best >= 0) {
-          const double vb = cmndf_[minima_[best]];
+          const double vb = minima_value_[best];
           if (vb < options_.subharmonic_ratio * v && v - vb > 0.03) {
             minima_prob_[best] += minima_prob_[k];
             minima_prob_[k] = 0;
@@ -225,7 +234,7 @@ void YinAnalyzer::Analyze(const float* window, FrameCandidates* out) {
     PitchCandidate& c = out->candidates[out->count++];
     c.f0_hz = options_.sample_rate_hz / lag;
     c.probability = minima_prob_[best];
-    c.cmndf = cmndf_[minima_[best]];
+    c.cmndf = minima_value_[best];
     minima_prob_[best] = 0;
   }
 }

@@ -101,6 +101,7 @@ class YinAnalyzer {
   std::vector<double> diff_, cmndf_;
   std::vector<int> minima_;
   std::vector<double> minima_prob_;
+  std::vector<double> minima_value_;  // d' at the dip's parabolic vertex
 };
 
 }  // namespace arco::audio

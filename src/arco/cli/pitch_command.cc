@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "arco/audio/notes.h"
 #include "arco/audio/pitch_tracker.h"
 #include "arco/cli/command.h"
 #include "arco/cli/progress.h"
@@ -21,6 +22,8 @@ struct PitchCommandOptions {
   double min_f0_hz = 0, max_f0_hz = 0;
   std::string output = "pitch.csv";
   std::string fine_output;
+  std::string notes_output;
+  std::string midi_output;
 };
 
 int RunPitch(const PitchCommandOptions& o) {
@@ -52,6 +55,22 @@ int RunPitch(const PitchCommandOptions& o) {
     written = audio::WritePitchCsv(o.fine_output, track->fine);
     if (!written.ok()) return PrintError(written.message());
   }
+  audio::NoteOptions note_options;
+  note_options.a4_hz = o.a4_hz;
+  audio::NoteAnalysis notes = audio::SegmentNotes(track->fine, track->fine_fps, note_options);
+  if (!o.notes_output.empty()) {
+    written = audio::WriteNotesCsv(o.notes_output, notes);
+    if (!written.ok()) return PrintError(written.message());
+  }
+  if (!o.midi_output.empty()) {
+    written = audio::WriteMidiFile(
+        o.midi_output,
+        audio::NotesToMidi(
+            notes, track->fine, note_options, audio::GmProgramForInstrument(options.range.name)));
+    if (!written.ok()) return PrintError(written.message());
+  }
+  int with_vibrato = 0;
+  for (const auto& n : notes.notes) with_vibrato += n.vibrato_rate_hz > 0;
   std::printf("%s: %s, %d Hz, %d ch, %.2f s (analysed at %d Hz)\n",
               o.input.c_str(),
               summary.source_format.c_str(),
@@ -69,6 +88,10 @@ int RunPitch(const PitchCommandOptions& o) {
     std::printf(", range %.2f-%.2f Hz", summary.min_f0_hz, summary.max_f0_hz);
   }
   std::printf("\n");
+  std::printf("notes: %zu (%d with vibrato), glides: %zu\n",
+              notes.notes.size(),
+              with_vibrato,
+              notes.glides.size());
   for (const auto& w : summary.warnings) std::printf("warning: %s\n", w.c_str());
   std::printf("wrote %s; %.3f s CPU (%.0fx real time)\n",
               o.output.c_str(),
@@ -107,6 +130,13 @@ std::function<int()> SetupPitch(CLI::App& app) {
   cmd->add_option("--a4", options->a4_hz, "Tuning reference A4 (Hz)")->capture_default_str();
   cmd->add_option("-o,--output", options->output, "pitch.csv to write")->capture_default_str();
   cmd->add_option("--fine", options->fine_output, "Also write the fine-hop track (CSV)");
+  cmd->add_option("--notes",
+                  options->notes_output,
+                  "Write notes.csv: notes (onset, offset, median f0, MIDI, cents vs ET at --a4, "
+                  "vibrato rate Hz and extent cents) and glides");
+  cmd->add_option("--midi",
+                  options->midi_output,
+                  "Write the notes as a standard MIDI file with pitch bends (range +-2 semitones)");
   return [options] { return RunPitch(*options); };
 }
 
