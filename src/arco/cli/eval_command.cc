@@ -11,10 +11,17 @@ namespace {
 
 struct Args {
   eval::EvalRequest r;
+  std::vector<std::string> truths;
   std::string output;
 };
 
-int Run(const Args& a) {
+int Run(Args& a) {
+  // One truth without --truth-frame: a synthetic truth folder; else labelled frames.
+  if (a.truths.size() == 1 && a.r.truth_frames.empty()) {
+    a.r.truth = a.truths[0];
+  } else {
+    a.r.labels = a.truths;
+  }
   auto report = eval::Evaluate(a.r);
   if (!report.ok()) return PrintError(report.status().message());
   if (!a.output.empty()) {
@@ -39,15 +46,14 @@ std::function<int()> SetupEval(CLI::App& app) {
   auto a = std::make_shared<Args>();
   cmd->add_option("result_dir", a->r.result_dir, "Result folder (result.json with stages)")
       ->required();
-  cmd->add_option(
-         "--truth",
-         a->r.truth,
-         "Truth: an `arco synth` truth folder, or a points JSON from `arco triangulate --view ...`")
+  cmd->add_option("--truth",
+                  a->truths,
+                  "Truth: an `arco synth` truth folder, or points JSONs from `arco triangulate "
+                  "--view ...` (repeat, one per labelled frame, each with a --truth-frame)")
       ->required();
   cmd->add_option("--truth-frame",
-                  a->r.truth_frame,
-                  "Frame number (capture numbering, from 1) a points JSON labels")
-      ->capture_default_str();
+                  a->r.truth_frames,
+                  "Frame number (capture numbering, from 1) each points JSON labels, in order");
   cmd->add_option("--pitch",
                   a->r.pitch_csv,
                   "Estimated pitch.csv (default: RESULT_DIR/pitch.csv when present)");

@@ -139,11 +139,11 @@ MethodMetrics EvaluateMethod(const std::string& method,
   std::vector<int> pck_hits(options.pck_thresholds_mm.size(), 0);
   int hand_truth_valid = 0, hand_missing = 0, string_hits = 0, finger_hits = 0;
   for (int fr = 0; fr < truth.num_frames; ++fr) {
-    bool any_truth = false;
+    bool any_truth = false;  // any truth point at all in this frame
+    for (int p = 0; p < truth.num_points && !any_truth; ++p) any_truth = truth.valid(fr, p);
     // Whole body without alignment.
     for (int p = 0; p < std::min(num_points, kNumWholeBody); ++p) {
       if (!truth.valid(fr, p)) continue;
-      any_truth = true;
       if (result.valid(fr, p)) body_err.push_back((truth.at(fr, p) - result.at(fr, p)).norm());
     }
     // Left hand after aligning the wrists by translation (the paper's protocol).
