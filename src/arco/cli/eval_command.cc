@@ -4,6 +4,8 @@
 
 #include "arco/cli/command.h"
 #include "arco/eval/evaluate.h"
+#include "arco/eval/plot.h"
+#include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
 
 namespace arco::cli {
@@ -12,7 +14,7 @@ namespace {
 struct Args {
   eval::EvalRequest r;
   std::vector<std::string> truths;
-  std::string output;
+  std::string output, plot;
 };
 
 int Run(Args& a) {
@@ -37,6 +39,11 @@ int Run(Args& a) {
   for (const auto& w : report->warnings)
     std::fprintf(stderr, "arco eval: warning: %s\n", w.c_str());
   if (!a.output.empty()) std::printf("\nwrote %s\n", a.output.c_str());
+  if (!a.plot.empty()) {
+    const Status st = AtomicWriteFile(a.plot, eval::EvalPlotSvg(*report, report->fps));
+    if (!st.ok()) return PrintError(st.message());
+    std::printf("wrote %s\n", a.plot.c_str());
+  }
   return 0;
 }
 
@@ -64,6 +71,8 @@ std::function<int()> SetupEval(CLI::App& app) {
                   "Tolerance before a geometric joint angle counts as a limit violation (deg)")
       ->capture_default_str();
   cmd->add_option("-o,--output", a->output, "Write the metrics as JSON here");
+  cmd->add_option(
+      "--plot", a->plot, "Write an SVG plot (pitch; hand error and contact deviation per frame)");
   return [a] { return Run(*a); };
 }
 

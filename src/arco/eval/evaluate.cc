@@ -150,6 +150,7 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
   if (result.contains("keypoint_names"))
     result_names = result["keypoint_names"].get<std::vector<std::string>>();
   report.units = result.value("units", std::string("unknown"));
+  report.fps = result.value("fps", 30.0);
   if (report.units != "mm")
     report.warnings.push_back("result units are '" + report.units + "', not mm");
 
@@ -304,6 +305,8 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
         e[static_cast<size_t>(f.frame)] = f.f0_hz;
     }
     report.pitch = EvaluatePitch(truth_f0, e);
+    report.truth_f0_hz = truth_f0;
+    report.estimate_f0_hz = e;
   }
   return report;
 }

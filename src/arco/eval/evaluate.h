@@ -40,6 +40,8 @@ struct EvalReport {
   std::string units;
   std::vector<MethodMetrics> methods;
   std::optional<PitchMetrics> pitch;
+  std::vector<double> truth_f0_hz, estimate_f0_hz;  // per frame, 0 = unvoiced (plots)
+  double fps = 30;
   std::vector<std::string> warnings;
 
   Json ToJson(const EvalOptions& options) const;
