@@ -6,11 +6,10 @@
 // refinement. Cost grows with the square of the number of views.
 #pragma once
 
-#include <optional>
-#include <vector>
-
 #include <Eigen/Core>
 #include <Eigen/SVD>
+#include <optional>
+#include <vector>
 
 #include "arco/camera/rig.h"
 

@@ -51,9 +51,10 @@ const Scene& GetScene() {
   return *scene;
 }
 
-NpyArray<double> RunArco(const Scene& s, int threads) {
+NpyArray<double> RunArco(const Scene& s, int threads, bool refine = true) {
   SequenceTriangulationOptions o;
   o.num_threads = threads;
+  o.point.refine = refine;
   auto r = TriangulateSequence(s.rig, s.view_to_camera, s.detections, o);
   return std::move(r->points3d);
 }
@@ -63,7 +64,8 @@ NpyArray<double> RunBaseline(const Scene& s, int threads) {
   out.shape = {kFrames, kPoints, 3};
   out.data.assign(kFrames * kPoints * 3, NAN);
   ParallelFor(
-      kFrames, threads,
+      kFrames,
+      threads,
       [&](int64_t f, int) {
         std::vector<Eigen::Vector2d> pixels(kCameras);
         std::vector<double> scores(kCameras);
@@ -111,6 +113,19 @@ void BM_ArcoSequence(benchmark::State& state) {
   ReportAccuracy(state, points);
 }
 BENCHMARK(BM_ArcoSequence)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// What the Levenberg-Marquardt refinement costs and buys (one thread).
+void BM_ArcoSequenceNoRefine(benchmark::State& state) {
+  const Scene& s = GetScene();
+  NpyArray<double> points;
+  for (auto _ : state) {
+    points = RunArco(s, 1, /*refine=*/false);
+    benchmark::DoNotOptimize(points.data.data());
+  }
+  state.SetItemsProcessed(state.iterations() * kFrames * kPoints);
+  ReportAccuracy(state, points);
+}
+BENCHMARK(BM_ArcoSequenceNoRefine)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_ExhaustivePairsBaseline(benchmark::State& state) {
   const Scene& s = GetScene();
