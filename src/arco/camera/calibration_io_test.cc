@@ -385,6 +385,20 @@ TEST(Writers, RejectInvalidRigs) {
   EXPECT_FALSE(WriteSpdJson(rig).ok());
 }
 
+TEST(ValidateCamera, NamesMustBePrintableUtf8) {
+  Camera cam = MakeRig().cameras[0];
+  for (const std::string name : {"cam\xCD", "a\nb", "\xC0\xAF", "x\xE2\x82", "\xED\xA0\x80"}) {
+    cam.name = name;
+    EXPECT_FALSE(ValidateCamera(cam).ok()) << name;
+  }
+  for (const std::string name : {"caméra 1", "カメラ", "a: \"b\" {c} [d] #e", "\xF0\x9F\x8E\xBB"}) {
+    cam.name = name;
+    EXPECT_TRUE(ValidateCamera(cam).ok()) << name;
+  }
+  cam.serial = "12\x01";
+  EXPECT_FALSE(ValidateCamera(cam).ok());
+}
+
 TEST(SpdRigTable, MapsNamesAndSerialsBothWays) {
   EXPECT_EQ(SpdSerialForName("cam0"), "21334181");
   EXPECT_EQ(SpdSerialForName("cam19"), "21334211");

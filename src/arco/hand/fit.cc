@@ -1,12 +1,11 @@
 #include "arco/hand/fit.h"
 
-#include <Eigen/Geometry>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
+#include "arco/geometry/alignment.h"
 #include "arco/geometry/triangulation.h"
 #include "arco/hand/fit_costs.h"
 
@@ -56,7 +55,7 @@ void AddBounds(const HandModel& model, ceres::Problem* problem, double* angles) 
 
 ceres::Solver::Options SolverOptions(int max_iterations) {
   ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
+  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   options.max_num_iterations = max_iterations;
   options.function_tolerance = 1e-10;
   options.parameter_tolerance = 1e-10;
@@ -141,24 +140,19 @@ Status HandFit3dOptions::Validate() const {
 }
 
 std::optional<HandPose> AlignPalm(const HandModel& model, const HandPointsMm& points_in_world_mm) {
-  std::vector<int> ids;
+  std::vector<Eigen::Vector3d> source, target;
   for (int k : kPalmKeypoints) {
-    if (points_in_world_mm[k].allFinite()) ids.push_back(k);
+    if (!points_in_world_mm[k].allFinite()) continue;
+    source.push_back(model.rest_point_mm(k));
+    target.push_back(points_in_world_mm[k]);
   }
-  if (ids.size() < 3) return std::nullopt;
-  Eigen::Matrix3Xd src(3, ids.size()), dst(3, ids.size());
-  for (size_t i = 0; i < ids.size(); ++i) {
-    src.col(i) = model.rest_point_mm(ids[i]);
-    dst.col(i) = points_in_world_mm[ids[i]];
-  }
-  // Degenerate (collinear) palm points leave the rotation undetermined.
-  const Eigen::Matrix3Xd centered = dst.colwise() - dst.rowwise().mean();
-  const Eigen::Vector3d sv = Eigen::JacobiSVD<Eigen::Matrix3Xd>(centered).singularValues();
-  if (!(sv[1] > 1e-3 * std::max(sv[0], 1e-9))) return std::nullopt;
-  const Eigen::Matrix4d t = Eigen::umeyama(src, dst, /*with_scaling=*/false);
+  if (source.size() < 3) return std::nullopt;
+  // Nullopt for coincident or collinear palm points (rotation undetermined).
+  const std::optional<AlignmentResult> fit = AlignPoints(source, target, {}, AlignmentOptions{});
+  if (!fit) return std::nullopt;
   HandPose pose;
-  pose.world_from_wrist_rotation = t.topLeftCorner<3, 3>();
-  pose.wrist_in_world_mm = t.topRightCorner<3, 1>();
+  pose.world_from_wrist_rotation = fit->target_from_source.RotationMatrix();
+  pose.wrist_in_world_mm = fit->target_from_source.translation;
   return pose;
 }
 
@@ -264,11 +258,12 @@ HandFitResult FitHandMultiView(const HandModel& model,
                    ceres::Solver::Summary* summary) {
     ceres::Problem problem;
     const double c = options.robust_loss_px;
-    problem.AddResidualBlock(new internal::ReprojectionCost({&model, &observations, c * c}),
-                             nullptr,
-                             params.aa,
-                             params.t,
-                             params.angles);
+    problem.AddResidualBlock(
+        new HandCostFunction<ReprojectionResiduals>({&model, &observations, c * c}),
+        nullptr,
+        params.aa,
+        params.t,
+        params.angles);
     if (has_previous) {
       const HandPose& prev = *init.previous_pose;
       TemporalResiduals temporal{prev.world_from_wrist_rotation,

@@ -62,6 +62,30 @@ struct ReprojectionResiduals {
       r[1] *= scale;
     }
   }
+  // Observation i: its 2 residuals and their derivative w.r.t. its keypoint.
+  int ResidualWithDerivative(int i,
+                             const Eigen::Vector3d* points,
+                             double* residual,
+                             Eigen::Matrix3d* d_residual,
+                             int* keypoint) const {
+    using Jet3 = ceres::Jet<double, 3>;
+    const PixelObservation& o = (*observations)[i];
+    *keypoint = o.keypoint;
+    Jet3 q[3], pixel[2], r[2];
+    for (int c = 0; c < 3; ++c) q[c] = Jet3(points[o.keypoint][c], c);
+    if (!o.camera->ProjectToPixel(q, pixel)) {
+      r[0] = Jet3(o.sqrt_weight * 10.0 * std::sqrt(loss_c2));
+      r[1] = Jet3(0.0);
+    } else {
+      r[0] = pixel[0] - o.pixel.x();
+      r[1] = pixel[1] - o.pixel.y();
+      const Jet3 scale = o.sqrt_weight * CauchyScale(r[0] * r[0] + r[1] * r[1], loss_c2);
+      r[0] *= scale;
+      r[1] *= scale;
+    }
+    for (int j = 0; j < 2; ++j) residual[j] = r[j].a, d_residual->row(j) = r[j].v.transpose();
+    return 2;
+  }
 };
 
 struct PointResiduals {
@@ -84,6 +108,29 @@ struct PointResiduals {
       const T scale = CauchyScale(r[0] * r[0] + r[1] * r[1] + r[2] * r[2], loss_c2);
       for (int c = 0; c < 3; ++c) r[c] *= scale;
     }
+  }
+  // Keypoint i: its 3 residuals (0 when missing) and their derivative.
+  int ResidualWithDerivative(int i,
+                             const Eigen::Vector3d* points,
+                             double* residual,
+                             Eigen::Matrix3d* d_residual,
+                             int* keypoint) const {
+    using Jet3 = ceres::Jet<double, 3>;
+    *keypoint = i;
+    if (!(*targets)[i].allFinite()) {
+      residual[0] = residual[1] = residual[2] = 0;
+      d_residual->setZero();
+      return 3;
+    }
+    Jet3 r[3];
+    for (int c = 0; c < 3; ++c) r[c] = Jet3(points[i][c] - (*targets)[i][c], c);
+    const Jet3 scale = CauchyScale(r[0] * r[0] + r[1] * r[1] + r[2] * r[2], loss_c2);
+    for (int c = 0; c < 3; ++c) {
+      r[c] *= scale;
+      residual[c] = r[c].a;
+      d_residual->row(c) = r[c].v.transpose();
+    }
+    return 3;
   }
 };
 
@@ -109,13 +156,14 @@ struct TemporalResiduals {
   }
 };
 
-// Reprojection cost with the chain rule split in two: FK in Jet<26> once, then
-// each projection (and its robust scaling) in Jet<3> with respect to the 3D
-// point, multiplied out (2x3 * 3x26). Several times cheaper than projecting
-// 26-wide Jets; same values and derivatives.
-class ReprojectionCost : public ceres::CostFunction {
+// Jacobians by the chain rule: keypoint Jacobians from the kinematic tree
+// (HandPointsAndJacobians), times the 2x3 (projection + robust scaling) or 3x3
+// (robust scaling) derivative of each residual with respect to its keypoint,
+// both from small Jets. Values come from the templated residual functors.
+template <typename Residuals>
+class HandCostFunction : public ceres::CostFunction {
  public:
-  explicit ReprojectionCost(ReprojectionResiduals residuals) : r_(residuals) {
+  explicit HandCostFunction(Residuals residuals) : r_(residuals) {
     set_num_residuals(r_.num_residuals());
     mutable_parameter_block_sizes()->assign({3, 3, kNumJointDofs});
   }
@@ -124,40 +172,22 @@ class ReprojectionCost : public ceres::CostFunction {
       r_(x[0], x[1], x[2], residuals);
       return true;
     }
-    using Jet = ceres::Jet<double, 6 + kNumJointDofs>;
-    using Jet3 = ceres::Jet<double, 3>;
-    Jet p[6 + kNumJointDofs];
-    for (int i = 0; i < 3; ++i) p[i] = Jet(x[0][i], i), p[3 + i] = Jet(x[1][i], 3 + i);
-    for (int i = 0; i < kNumJointDofs; ++i) p[6 + i] = Jet(x[2][i], 6 + i);
-    Eigen::Matrix<Jet, 3, 1> points[kNumHandKeypoints];
-    HandPointsInWorld(*r_.model, p, p + 3, p + 6, points);
+    Eigen::Vector3d points[kNumHandKeypoints];
+    HandPointJacobian point_jacobians[kNumHandKeypoints];
+    HandPointsAndJacobians(*r_.model, x[0], x[1], x[2], points, point_jacobians);
     const int sizes[3] = {3, 3, kNumJointDofs};
     const int offsets[3] = {0, 3, 6};
-    for (size_t i = 0; i < r_.observations->size(); ++i) {
-      const PixelObservation& o = (*r_.observations)[i];
-      const Eigen::Matrix<Jet, 3, 1>& point = points[o.keypoint];
-      Jet3 q[3], pixel[2], r[2];
-      for (int c = 0; c < 3; ++c) q[c] = Jet3(point[c].a, c);
-      if (!o.camera->ProjectToPixel(q, pixel)) {
-        r[0] = Jet3(o.sqrt_weight * 10.0 * std::sqrt(r_.loss_c2));
-        r[1] = Jet3(0.0);
-      } else {
-        r[0] = pixel[0] - o.pixel.x();
-        r[1] = pixel[1] - o.pixel.y();
-        const Jet3 scale = o.sqrt_weight * CauchyScale(r[0] * r[0] + r[1] * r[1], r_.loss_c2);
-        r[0] *= scale;
-        r[1] *= scale;
-      }
-      for (int row = 0; row < 2; ++row) {
-        const int out_row = 2 * static_cast<int>(i) + row;
-        residuals[out_row] = r[row].a;
-        const Eigen::Matrix<double, 1, 6 + kNumJointDofs> d = r[row].v[0] * point[0].v.transpose() +
-                                                              r[row].v[1] * point[1].v.transpose() +
-                                                              r[row].v[2] * point[2].v.transpose();
+    Eigen::Matrix<double, 3, 3> d_residual;  // rows: residual components (<= 3)
+    int row = 0;
+    for (int i = 0; row < num_residuals(); ++i) {
+      int keypoint;
+      const int dim = r_.ResidualWithDerivative(i, points, residuals + row, &d_residual, &keypoint);
+      for (int j = 0; j < dim; ++j, ++row) {
+        const Eigen::Matrix<double, 1, 6 + kNumJointDofs> d =
+            d_residual.row(j) * point_jacobians[keypoint];
         for (int b = 0; b < 3; ++b) {
           if (jacobians[b] == nullptr) continue;
-          for (int j = 0; j < sizes[b]; ++j)
-            jacobians[b][out_row * sizes[b] + j] = d[offsets[b] + j];
+          for (int c = 0; c < sizes[b]; ++c) jacobians[b][row * sizes[b] + c] = d[offsets[b] + c];
         }
       }
     }
@@ -165,45 +195,7 @@ class ReprojectionCost : public ceres::CostFunction {
   }
 
  private:
-  ReprojectionResiduals r_;
-};
-
-// A cost over {3, 3, 20} whose Jacobian comes from one forward pass in
-// ceres::Jet<double, 26> (cheaper than per-residual autodiff blocks).
-template <typename Residuals>
-class HandCostFunction : public ceres::CostFunction {
- public:
-  explicit HandCostFunction(Residuals residuals) : residuals_(residuals) {
-    set_num_residuals(residuals_.num_residuals());
-    mutable_parameter_block_sizes()->assign({3, 3, kNumJointDofs});
-  }
-  bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override {
-    if (jacobians == nullptr) {
-      residuals_(x[0], x[1], x[2], residuals);
-      return true;
-    }
-    using Jet = ceres::Jet<double, 6 + kNumJointDofs>;
-    Jet p[6 + kNumJointDofs];
-    for (int i = 0; i < 3; ++i) p[i] = Jet(x[0][i], i), p[3 + i] = Jet(x[1][i], 3 + i);
-    for (int i = 0; i < kNumJointDofs; ++i) p[6 + i] = Jet(x[2][i], 6 + i);
-    const int n = num_residuals();
-    std::vector<Jet> r(n);
-    residuals_(p, p + 3, p + 6, r.data());
-    const int sizes[3] = {3, 3, kNumJointDofs};
-    const int offsets[3] = {0, 3, 6};
-    for (int row = 0; row < n; ++row) {
-      residuals[row] = r[row].a;
-      for (int b = 0; b < 3; ++b) {
-        if (jacobians[b] == nullptr) continue;
-        for (int i = 0; i < sizes[b]; ++i)
-          jacobians[b][row * sizes[b] + i] = r[row].v[offsets[b] + i];
-      }
-    }
-    return true;
-  }
-
- private:
-  Residuals residuals_;
+  Residuals r_;
 };
 
 }  // namespace arco::hand::internal
