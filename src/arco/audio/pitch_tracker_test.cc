@@ -192,6 +192,10 @@ TEST(PitchTrackerOptions, AbsurdValuesAreErrors) {
   o = Options("cello");
   o.start_s = NAN;
   EXPECT_FALSE(o.Validate().ok());
+  o.start_s = -1e5;
+  EXPECT_FALSE(o.Validate().ok());
+  o.start_s = -2.5;  // video starts before the audio: allowed
+  EXPECT_TRUE(o.Validate().ok());
   o = Options("cello");
   o.range.min_f0_hz = 5000;
   EXPECT_FALSE(o.Validate().ok());
