@@ -362,6 +362,7 @@ TEST(ArcoJson, MalformedInputsGiveErrors) {
       {"{}", "no \"cameras\" array"},
       {R"({"cameras": []})", "no cameras"},
       {R"({"format": "other", "cameras": []})", "\"format\""},
+      {R"({"version": 2, "cameras": []})", "unsupported \"version\""},
       {R"({"cameras": [{"name": 1}]})", "no string \"name\""},
       {R"({"cameras": [{"name": "a", "width": 10.5}]})", "no integer \"width\""},
       {R"({"cameras": [{"name": "a", "width": 10, "height": 10, "K": [1]}]})", "1 numbers"},
