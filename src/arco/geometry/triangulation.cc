@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 
 namespace arco {
@@ -30,10 +31,15 @@ std::optional<Eigen::Vector3d> SolveHomogeneous(const Eigen::Matrix4d& ata) {
 WorldConditioning ConditioningFromCameraCenters(const std::vector<Eigen::Vector3d>& centers) {
   WorldConditioning c;
   if (centers.empty()) return c;
-  for (const auto& x : centers) c.center += x;
+  // Sum in lexicographic order so the result does not depend on camera order.
+  std::vector<Eigen::Vector3d> sorted = centers;
+  std::sort(sorted.begin(), sorted.end(), [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+  });
+  for (const auto& x : sorted) c.center += x;
   c.center /= static_cast<double>(centers.size());
   double sum_sq = 0;
-  for (const auto& x : centers) sum_sq += (x - c.center).squaredNorm();
+  for (const auto& x : sorted) sum_sq += (x - c.center).squaredNorm();
   const double rms = std::sqrt(sum_sq / static_cast<double>(centers.size()));
   c.scale = (std::isfinite(rms) && rms > 0) ? rms : 1.0;
   return c;

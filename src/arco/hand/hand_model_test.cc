@@ -242,3 +242,38 @@ TEST(HandKinematics, AutodiffJacobianMatchesCentralDifferences) {
 
 }  // namespace
 }  // namespace arco::hand
+
+namespace arco::hand {
+namespace {
+
+// Tree-structured analytic-chain Jacobians against full 26-wide autodiff.
+TEST(HandKinematics, FastJacobiansMatchFullAutodiff) {
+  using Jet = ceres::Jet<double, 26>;
+  const HandModel model = HandModel::Default(HandSide::kRight);
+  std::mt19937 rng(15);
+  for (int trial = 0; trial < 10; ++trial) {
+    HandPose pose = testing::RandomPose(model, rng);
+    if (trial == 0) pose.SetWristAngleAxis(Eigen::Vector3d::Zero());
+    double x[26];
+    const Eigen::Vector3d aa = pose.WristAngleAxis();
+    for (int i = 0; i < 3; ++i) x[i] = aa[i], x[3 + i] = pose.wrist_in_world_mm[i];
+    for (int d = 0; d < kNumJointDofs; ++d) x[6 + d] = pose.angles_rad[d];
+    Jet jx[26];
+    for (int i = 0; i < 26; ++i) jx[i] = Jet(x[i], i);
+    Eigen::Matrix<Jet, 3, 1> jp[21];
+    HandPointsInWorld(model, jx, jx + 3, jx + 6, jp);
+    Eigen::Vector3d points[21];
+    HandPointJacobian jac[21];
+    HandPointsAndJacobians(model, x, x + 3, x + 6, points, jac);
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      for (int r = 0; r < 3; ++r) {
+        EXPECT_NEAR(points[k][r], jp[k][r].a, 1e-10);
+        for (int i = 0; i < 26; ++i)
+          EXPECT_NEAR(jac[k](r, i), jp[k][r].v[i], 1e-10) << k << " " << i;
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace arco::hand

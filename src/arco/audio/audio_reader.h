@@ -1,0 +1,50 @@
+// Streaming audio decoding. Conventions for the whole audio layer:
+// - Samples are float in [-1, 1], mono (all channels averaged: downmix).
+// - Sample index n of a stream at rate fs is at time n / fs seconds; index 0 is
+//   the first decoded sample (container start offsets are ignored).
+// - Readers never hold the whole file: callers pull blocks (ReadMono).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "arco/util/status.h"
+
+namespace arco::audio {
+
+struct AudioInfo {
+  int sample_rate_hz = 0;
+  int channels = 0;
+  // Frames promised by the header; -1 when the container does not say (FFmpeg
+  // streams). A file that delivers fewer is reported as truncated.
+  int64_t frames = -1;
+  std::string format;  // e.g. "WAV (Microsoft) 16 bit PCM" or "ffmpeg aac"
+};
+
+class AudioReader {
+ public:
+  virtual ~AudioReader() = default;
+  const AudioInfo& info() const { return info_; }
+  // Reads up to `max_frames` mono samples into `out`; returns the number read,
+  // 0 at the end of the stream, or an error (corrupt data mid-stream).
+  virtual StatusOr<int64_t> ReadMono(float* out, int64_t max_frames) = 0;
+
+ protected:
+  AudioInfo info_;
+};
+
+// Opens WAV/FLAC/OGG/AIFF... with libsndfile, anything else (audio track of a
+// video, mp3, aac, ...) with FFmpeg. Errors name the file and the problem.
+StatusOr<std::unique_ptr<AudioReader>> OpenAudio(const std::string& path);
+
+// libsndfile only (also used directly by tests).
+StatusOr<std::unique_ptr<AudioReader>> OpenAudioWithSndfile(const std::string& path);
+// FFmpeg libavformat/libavcodec only: the best audio stream of any container.
+StatusOr<std::unique_ptr<AudioReader>> OpenAudioWithFfmpeg(const std::string& path);
+// Decodes an in-memory file image with libsndfile's virtual IO (fuzzing and
+// tests). `bytes` must outlive the reader.
+StatusOr<std::unique_ptr<AudioReader>> OpenAudioFromMemory(const std::string* bytes,
+                                                           const std::string& name);
+
+}  // namespace arco::audio

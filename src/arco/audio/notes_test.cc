@@ -1,0 +1,127 @@
+// Note segmentation, vibrato and glides on pitch tracks with known truth.
+#include "arco/audio/notes.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+namespace arco::audio {
+namespace {
+
+constexpr double kFps = 120.0;
+
+// A fine track from f0(t) (<= 0: unvoiced), like TrackPitch produces.
+std::vector<PitchFrame> Track(const std::function<double(double)>& f0, double seconds) {
+  std::vector<PitchFrame> fine;
+  for (int j = 0; j < static_cast<int>(seconds * kFps); ++j) {
+    PitchFrame f;
+    f.frame = j;
+    f.time_s = j / kFps;
+    const double hz = f0(f.time_s);
+    f.voiced = hz > 0;
+    f.f0_hz = f.voiced ? hz : 0;
+    f.confidence = f.voiced ? 0.9 : 0.0;
+    fine.push_back(f);
+  }
+  return fine;
+}
+
+double Hz(double midi, double cents = 0) {
+  return 440.0 * std::exp2((midi + cents / 100 - 69) / 12);
+}
+
+TEST(SegmentNotes, LegatoScaleWithIntonationAndGaps) {
+  // C3 (+10 cents) 0.0-0.5, D3 (-20 cents) 0.5-1.0 (legato), rest, E3 1.2-1.6.
+  auto f0 = [](double t) {
+    if (t < 0.5) return Hz(48, 10);
+    if (t < 1.0) return Hz(50, -20);
+    if (t < 1.2) return 0.0;
+    if (t < 1.6) return Hz(52);
+    return 0.0;
+  };
+  const auto analysis = SegmentNotes(Track(f0, 2.0), kFps, NoteOptions());
+  ASSERT_EQ(analysis.notes.size(), 3u);
+  EXPECT_TRUE(analysis.glides.empty());
+  const int midi[] = {48, 50, 52};
+  const double cents[] = {10, -20, 0};
+  const double onset[] = {0.0, 0.5, 1.2}, offset[] = {0.5, 1.0, 1.6};
+  for (int i = 0; i < 3; ++i) {
+    const Note& n = analysis.notes[i];
+    EXPECT_EQ(n.midi_note, midi[i]);
+    EXPECT_NEAR(n.cents_from_et, cents[i], 0.01);
+    EXPECT_NEAR(n.median_f0_hz, Hz(midi[i], cents[i]), 1e-6);
+    // The moving median moves the legato boundary by at most a frame or two.
+    EXPECT_NEAR(n.onset_s, onset[i], 2.5 / kFps) << i;
+    EXPECT_NEAR(n.offset_s, offset[i], 2.5 / kFps) << i;
+    EXPECT_EQ(n.vibrato_rate_hz, 0.0);
+  }
+  EXPECT_EQ(NoteName(48), "C3");
+  EXPECT_EQ(NoteName(61), "C#4");
+  EXPECT_EQ(NoteName(36), "C2");
+}
+
+TEST(SegmentNotes, VibratoRateAndExtent) {
+  for (double rate : {4.5, 6.0, 7.5}) {
+    for (double extent : {15.0, 40.0}) {
+      auto f0 = [&](double t) { return Hz(57, extent * std::sin(2 * M_PI * rate * t)); };
+      const auto analysis = SegmentNotes(Track(f0, 1.5), kFps, NoteOptions());
+      ASSERT_EQ(analysis.notes.size(), 1u) << rate << " " << extent;
+      const Note& n = analysis.notes[0];
+      EXPECT_EQ(n.midi_note, 57);
+      EXPECT_NEAR(n.vibrato_rate_hz, rate, 0.1 * rate) << rate;
+      EXPECT_NEAR(n.vibrato_extent_cents, extent, 0.15 * extent) << extent;
+    }
+  }
+}
+
+TEST(SegmentNotes, GlideBetweenTwoNotes) {
+  // A2 held, 0.2 s portamento up a fifth, E3 held.
+  auto f0 = [](double t) {
+    if (t < 0.6) return Hz(45);
+    if (t < 0.8) return Hz(45 + 7 * (t - 0.6) / 0.2);
+    return Hz(52);
+  };
+  const auto analysis = SegmentNotes(Track(f0, 1.5), kFps, NoteOptions());
+  ASSERT_EQ(analysis.glides.size(), 1u);
+  const Glide& g = analysis.glides[0];
+  EXPECT_NEAR(g.start_s, 0.6, 0.06);
+  EXPECT_NEAR(g.end_s, 0.8, 0.06);
+  EXPECT_LT(g.start_f0_hz, g.end_f0_hz);
+  ASSERT_EQ(analysis.notes.size(), 2u);
+  EXPECT_EQ(analysis.notes[0].midi_note, 45);
+  EXPECT_EQ(analysis.notes[1].midi_note, 52);
+}
+
+TEST(SegmentNotes, SilenceGivesNothingAndBadOptionsThrow) {
+  const auto analysis = SegmentNotes(Track([](double) { return 0.0; }, 1.0), kFps, NoteOptions());
+  EXPECT_TRUE(analysis.notes.empty());
+  EXPECT_TRUE(analysis.glides.empty());
+  NoteOptions bad;
+  bad.min_note_s = -1;
+  EXPECT_FALSE(bad.Validate().ok());
+  EXPECT_THROW(SegmentNotes({}, kFps, bad), std::invalid_argument);
+}
+
+TEST(NotesToMidi, BendsFollowThePitchInsideNotes) {
+  auto f0 = [](double t) { return t < 1.0 ? Hz(57, 30 * std::sin(2 * M_PI * 5 * t)) : 0.0; };
+  const auto fine = Track(f0, 1.2);
+  const auto analysis = SegmentNotes(fine, kFps, NoteOptions());
+  ASSERT_EQ(analysis.notes.size(), 1u);
+  const MidiFile file = NotesToMidi(analysis, fine, NoteOptions(), 42);
+  ASSERT_EQ(file.tracks.size(), 1u);
+  const auto& track = file.tracks[0];
+  EXPECT_EQ(track.program, 42);
+  ASSERT_EQ(track.notes.size(), 1u);
+  EXPECT_EQ(track.notes[0].midi_note, 57);
+  ASSERT_GT(track.bends.size(), 50u);
+  double max_bend = 0;
+  for (const auto& b : track.bends) {
+    max_bend = std::max(max_bend, std::abs(b.semitones));
+    EXPECT_NEAR(b.semitones * 100, 30 * std::sin(2 * M_PI * 5 * b.time_s), 1.0);
+  }
+  EXPECT_NEAR(max_bend, 0.30, 0.01);
+}
+
+}  // namespace
+}  // namespace arco::audio

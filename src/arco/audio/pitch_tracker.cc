@@ -1,0 +1,213 @@
+#include "arco/audio/pitch_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <sstream>
+
+#include "arco/audio/sample_stream.h"
+#include "arco/util/file_io.h"
+
+namespace arco::audio {
+
+StatusOr<InstrumentRange> InstrumentRangeByName(const std::string& name) {
+  // Lowest open string minus about a semitone and a half; the top leaves room for
+  // high positions and harmonics (violin above E7 = 2637 Hz, issue: >= 3.5 kHz).
+  // Analysis rates keep the shortest period >= 6 samples and the harmonics that
+  // matter below Nyquist.
+  if (name == "violin") return InstrumentRange{"violin", 180.0, 4200.0, 32000};
+  if (name == "viola") return InstrumentRange{"viola", 120.0, 2800.0, 24000};
+  if (name == "cello") return InstrumentRange{"cello", 60.0, 2000.0, 16000};
+  if (name == "bass" || name == "contrabass" || name == "double-bass") {
+    return InstrumentRange{"bass", 38.0, 1200.0, 16000};
+  }
+  if (name == "any") return InstrumentRange{"any", 38.0, 4200.0, 32000};
+  return Status::Error("unknown instrument '" + name +
+                       "' (expected violin, viola, cello, bass or any)");
+}
+
+Status PitchTrackerOptions::Validate() const {
+  if (!(fps > 0 && fps <= 1000)) {
+    return Status::Error("--fps must be in (0, 1000], got " + std::to_string(fps));
+  }
+  if (!std::isfinite(start_s) || std::abs(start_s) > 1e6) {
+    return Status::Error("--start-s must be a finite time within 1e6 s");
+  }
+  if (hops_per_frame < 0 || hops_per_frame > 100) {
+    return Status::Error("hops per frame must be in [0, 100]");
+  }
+  if (max_frames < -1) return Status::Error("max_frames must be >= -1");
+  if (!(a4_hz >= 300 && a4_hz <= 600)) return Status::Error("--a4 must be in [300, 600] Hz");
+  if (!(range.min_f0_hz >= 20 && range.max_f0_hz > range.min_f0_hz &&
+        range.max_f0_hz <= range.analysis_rate_hz / 4.0)) {
+    return Status::Error("pitch range must satisfy 20 <= min < max <= analysis rate / 4");
+  }
+  return Status::Ok();
+}
+
+StatusOr<PitchTrack> TrackPitch(std::unique_ptr<AudioReader> reader,
+                                const PitchTrackerOptions& options,
+                                PitchSummary* summary,
+                                const ProgressFn& progress) {
+  const std::clock_t cpu_start = std::clock();
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  PitchTrack track;
+  track.fps = options.fps;
+  track.start_s = options.start_s;
+  track.hops_per_frame = options.hops_per_frame > 0
+                             ? options.hops_per_frame
+                             : std::max(1, static_cast<int>(std::ceil(100.0 / options.fps - 1e-9)));
+  const int hops = track.hops_per_frame;
+  track.fine_fps = options.fps * hops;
+
+  YinOptions yin = options.yin;
+  yin.sample_rate_hz = options.range.analysis_rate_hz;
+  yin.min_f0_hz = options.range.min_f0_hz;
+  yin.max_f0_hz = options.range.max_f0_hz;
+  PitchHmmOptions hmm_options = options.hmm;
+  hmm_options.min_f0_hz = options.range.min_f0_hz;
+  hmm_options.max_f0_hz = options.range.max_f0_hz;
+  hmm_options.frame_rate_hz = track.fine_fps;
+  YinAnalyzer analyzer(yin);
+  const AudioInfo info = reader->info();
+  const double rate = yin.sample_rate_hz;
+  if (info.frames > 0) {
+    const double expected_s = static_cast<double>(info.frames) / info.sample_rate_hz;
+    const double rows = (expected_s - options.start_s) * track.fine_fps + 2;
+    if (rows > 0 && rows < 1e9) track.fine.reserve(static_cast<size_t>(rows));
+  }
+  PitchHmm hmm(hmm_options, [&](const DecodedFrame& d) {
+    PitchFrame f;
+    f.frame = d.index;
+    f.time_s = options.start_s + static_cast<double>(d.index) / track.fine_fps;
+    f.f0_hz = d.voiced ? d.f0_hz : 0.0;
+    f.confidence = d.confidence;
+    f.voiced = d.voiced;
+    track.fine.push_back(f);
+  });
+  SampleStream stream(std::move(reader), yin.sample_rate_hz);
+  const int window = analyzer.window_length();
+  std::vector<float> buffer(static_cast<size_t>(window));
+  FrameCandidates candidates;
+  const int64_t max_fine = options.max_frames >= 0 ? options.max_frames * hops : -1;
+  ARCO_ASSIGN_OR_RETURN(const bool has_audio, stream.Has(0));
+  const double expected_s =
+      info.frames > 0 ? static_cast<double>(info.frames) / info.sample_rate_hz : -1.0;
+  for (int64_t j = 0; has_audio && (max_fine < 0 || j < max_fine); ++j) {
+    // Time from j directly (no accumulated hop), centre = nearest sample.
+    const double time_s = options.start_s + static_cast<double>(j) / track.fine_fps;
+    const int64_t centre = std::llround(time_s * rate);
+    if (centre >= 0) {
+      ARCO_ASSIGN_OR_RETURN(const bool inside, stream.Has(centre));
+      if (!inside) break;
+    }
+    ARCO_RETURN_IF_ERROR(stream.Read(centre - window / 2, window, buffer.data()));
+    analyzer.Analyze(buffer.data(), &candidates);
+    hmm.Push(candidates);
+    if (progress && expected_s > 0 && j % 256 == 0) progress(std::min(1.0, time_s / expected_s));
+  }
+  hmm.Finish();
+  for (size_t j = 0; j < track.fine.size(); j += hops) {
+    PitchFrame f = track.fine[j];
+    f.frame = static_cast<int64_t>(j / hops);
+    f.time_s = options.start_s + static_cast<double>(f.frame) / options.fps;
+    track.frames.push_back(f);
+  }
+
+  if (summary != nullptr) {
+    *summary = PitchSummary();
+    summary->source_format = info.format;
+    summary->source_rate_hz = info.sample_rate_hz;
+    summary->source_channels = info.channels;
+    summary->analysis_rate_hz = yin.sample_rate_hz;
+    summary->duration_s = static_cast<double>(stream.source_samples()) / info.sample_rate_hz;
+    summary->frames = static_cast<int64_t>(track.frames.size());
+    int64_t voiced = 0;
+    for (const auto& f : track.frames) {
+      if (!f.voiced) continue;
+      summary->min_f0_hz = voiced == 0 ? f.f0_hz : std::min(summary->min_f0_hz, f.f0_hz);
+      summary->max_f0_hz = std::max(summary->max_f0_hz, f.f0_hz);
+      ++voiced;
+    }
+    summary->voiced_fraction =
+        track.frames.empty() ? 0.0 : static_cast<double>(voiced) / track.frames.size();
+    if (info.frames > 0 && stream.source_samples() < info.frames) {
+      summary->warnings.push_back("truncated: the header promises " + std::to_string(info.frames) +
+                                  " samples, only " + std::to_string(stream.source_samples()) +
+                                  " decoded");
+    }
+    if (stream.source_samples() == 0) {
+      summary->warnings.push_back("empty: the file holds no audio samples");
+    } else if (track.frames.empty()) {
+      summary->warnings.push_back("empty: no video frame falls inside the audio (check --start-s)");
+    } else if (voiced == 0) {
+      summary->warnings.push_back("no voiced frames: the audio is silent or unpitched");
+    }
+    summary->cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+  }
+  return track;
+}
+
+StatusOr<PitchTrack> TrackPitchFile(const std::string& path,
+                                    const PitchTrackerOptions& options,
+                                    PitchSummary* summary,
+                                    const ProgressFn& progress) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  ARCO_ASSIGN_OR_RETURN(auto reader, OpenAudio(path));
+  auto track = TrackPitch(std::move(reader), options, summary, progress);
+  if (!track.ok()) return track.status();
+  return track;
+}
+
+Status WritePitchCsv(const std::string& path, const std::vector<PitchFrame>& frames) {
+  return AtomicWriteWith(path, [&](std::ostream& out) {
+    out << "frame,time_s,f0_hz,confidence,voiced\n";
+    char line[160];
+    for (const auto& f : frames) {
+      std::snprintf(line,
+                    sizeof(line),
+                    "%lld,%.6f,%.4f,%.4f,%d\n",
+                    static_cast<long long>(f.frame),
+                    f.time_s,
+                    f.voiced ? f.f0_hz : 0.0,
+                    f.confidence,
+                    f.voiced ? 1 : 0);
+      out << line;
+    }
+    return Status::Ok();
+  });
+}
+
+StatusOr<std::vector<PitchFrame>> ReadPitchCsv(const std::string& path) {
+  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
+  std::istringstream in(text);
+  std::string line;
+  if (!std::getline(in, line) || line.rfind("frame,time_s,f0_hz,confidence,voiced", 0) != 0) {
+    return Status::Error(path + ": not a pitch.csv (bad header)");
+  }
+  std::vector<PitchFrame> frames;
+  int line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.empty()) continue;
+    PitchFrame f;
+    long long frame = 0;
+    int voiced = 0;
+    if (std::sscanf(line.c_str(),
+                    "%lld,%lf,%lf,%lf,%d",
+                    &frame,
+                    &f.time_s,
+                    &f.f0_hz,
+                    &f.confidence,
+                    &voiced) != 5) {
+      return Status::Error(path + ": line " + std::to_string(line_number) + ": malformed row");
+    }
+    f.frame = frame;
+    f.voiced = voiced != 0;
+    frames.push_back(f);
+  }
+  return frames;
+}
+
+}  // namespace arco::audio

@@ -1,0 +1,95 @@
+// Pitch of a recording sampled at video-frame times.
+//
+// Timing contract: fine row j is at time_s = start_s + j / (fps * hops_per_frame);
+// video row i is fine row i * hops_per_frame, i.e. time_s = start_s + i / fps
+// exactly, and its analysis window is centred on the analysis-rate sample
+// nearest that time (computed from i directly, never accumulated: no drift).
+// Times are seconds on the audio's own clock (sample 0 at 0 s).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "arco/audio/audio_reader.h"
+#include "arco/audio/pitch_hmm.h"
+#include "arco/audio/yin.h"
+#include "arco/util/status.h"
+
+namespace arco::audio {
+
+// Playing range and analysis rate of an instrument (DOMAIN.md, Instruments).
+struct InstrumentRange {
+  std::string name;
+  double min_f0_hz = 0;
+  double max_f0_hz = 0;
+  int analysis_rate_hz = 0;
+};
+// "violin", "viola", "cello", "bass" (or "contrabass", "double-bass"); "any"
+// covers them all. Error for unknown names.
+StatusOr<InstrumentRange> InstrumentRangeByName(const std::string& name);
+
+struct PitchTrackerOptions {
+  InstrumentRange range;    // from InstrumentRangeByName
+  double fps = 30.0;        // video frame rate, rows of the frame track
+  double start_s = 0.0;     // audio time of video frame 0 (may be negative)
+  int hops_per_frame = 0;   // fine rows per video frame; 0 = auto (fine rate >= 100 Hz)
+  int64_t max_frames = -1;  // stop after this many video frames (-1: end of audio)
+  double a4_hz = 440.0;     // reference for cents/MIDI (used by notes)
+  YinOptions yin;           // rate and range are taken from `range`
+  PitchHmmOptions hmm;      // range and frame rate are taken from the above
+  // Readable error for absurd values (fps <= 0 or > 1000, ranges, ...).
+  Status Validate() const;
+};
+
+struct PitchFrame {
+  int64_t frame = 0;
+  double time_s = 0;
+  double f0_hz = 0;  // 0 when unvoiced
+  double confidence = 0;
+  bool voiced = false;
+};
+
+struct PitchTrack {
+  double fps = 0;       // rate of `frames`
+  double fine_fps = 0;  // rate of `fine`
+  int hops_per_frame = 1;
+  double start_s = 0;
+  std::vector<PitchFrame> frames;  // one per video frame
+  std::vector<PitchFrame> fine;    // every hop (frames[i] == fine[i * hops_per_frame])
+};
+
+struct PitchSummary {
+  std::string source_format;
+  int source_rate_hz = 0;
+  int source_channels = 0;
+  int analysis_rate_hz = 0;
+  double duration_s = 0;  // decoded audio length
+  int64_t frames = 0;
+  double voiced_fraction = 0;           // of video frames
+  double min_f0_hz = 0, max_f0_hz = 0;  // over voiced frames (0 when none)
+  double cpu_seconds = 0;               // process CPU time spent (informational; not in results)
+  std::vector<std::string> warnings;    // e.g. truncated file, silent audio
+};
+
+// Progress callback: fraction of the expected duration done (may be unknown: -1).
+using ProgressFn = std::function<void(double fraction)>;
+
+// Tracks pitch from an open reader. Errors: decode failures mid-stream.
+StatusOr<PitchTrack> TrackPitch(std::unique_ptr<AudioReader> reader,
+                                const PitchTrackerOptions& options,
+                                PitchSummary* summary,
+                                const ProgressFn& progress = nullptr);
+// Opens `path` (OpenAudio) and tracks it.
+StatusOr<PitchTrack> TrackPitchFile(const std::string& path,
+                                    const PitchTrackerOptions& options,
+                                    PitchSummary* summary,
+                                    const ProgressFn& progress = nullptr);
+
+// pitch.csv: header `frame,time_s,f0_hz,confidence,voiced`, written atomically.
+Status WritePitchCsv(const std::string& path, const std::vector<PitchFrame>& frames);
+// Reads a file written by WritePitchCsv (tests, tools).
+StatusOr<std::vector<PitchFrame>> ReadPitchCsv(const std::string& path);
+
+}  // namespace arco::audio

@@ -1,0 +1,141 @@
+#include "arco/audio/test_music.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <random>
+
+#include "arco/util/file_io.h"
+
+namespace arco::audio::testing {
+namespace {
+
+struct Range {
+  int low, high, program;
+};
+
+Range RangeOf(const std::string& instrument) {
+  if (instrument == "violin") return {55, 98, 40};  // G3 .. D7 (2349 Hz)
+  if (instrument == "viola") return {48, 84, 41};   // C3 .. C6
+  if (instrument == "bass") return {28, 55, 43};    // E1 .. G3
+  return {36, 76, 42};                              // cello C2 .. E5
+}
+
+// Bend (semitones) in effect at time t: the last bend event at or before t.
+double BendAt(const MidiTrack& track, double t) {
+  double bend = 0;
+  for (const auto& b : track.bends) {
+    if (b.time_s <= t + 1e-9)
+      bend = b.semitones;
+    else
+      break;
+  }
+  return bend;
+}
+
+}  // namespace
+
+TestMusic MakeTestMusic(const std::string& instrument, int notes, uint32_t seed) {
+  TestMusic music;
+  music.instrument = instrument;
+  const Range range = RangeOf(instrument);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  MidiTrack track;
+  track.program = range.program;
+  track.name = instrument;
+  double t = 0.5;
+  for (int i = 0; i < notes; ++i) {
+    // Sweep the range up and down with random steps so every register is used.
+    const double phase = static_cast<double>(i) / std::max(1, notes - 1);
+    const double centre =
+        range.low + (range.high - range.low) * (1.0 - std::abs(2.0 * phase - 1.0));
+    int midi = static_cast<int>(std::lround(centre + (unit(rng) - 0.5) * 6.0));
+    midi = std::clamp(midi, range.low, range.high);
+    const double duration = 0.45 + 0.5 * unit(rng);
+    MidiNote note{t, t + duration, midi, 90};
+    track.notes.push_back(note);
+    track.bends.push_back({t, 0.0});
+    // All Sound Off before each note: the sampled release of the previous note
+    // would otherwise ring under this one (a two-note chord, not monophonic
+    // truth). The previous note's note-off at the same tick comes first.
+    if (i > 0) track.controls.push_back({t, 120, 0});
+    if (i % 3 == 1) {  // vibrato: a bend every 10 ms
+      const double rate = 5.0 + 1.5 * unit(rng), extent = 0.2 + 0.2 * unit(rng);
+      for (double u = 0.01; u < duration; u += 0.01) {
+        track.bends.push_back({t + u, extent * std::sin(2.0 * M_PI * rate * u)});
+      }
+    } else if (i % 10 == 4) {  // glide: up a whole tone over the middle third
+      for (double u = duration / 3; u < duration; u += 0.01) {
+        const double x = std::min(1.0, (u - duration / 3) / (duration / 3));
+        track.bends.push_back({t + u, 2.0 * x});
+      }
+    }
+    t += duration;
+    if (i % 6 == 5) t += 1.0;  // rest
+  }
+  std::stable_sort(
+      track.bends.begin(), track.bends.end(), [](const MidiPitchBend& a, const MidiPitchBend& b) {
+        return a.time_s < b.time_s;
+      });
+  music.duration_s = t + 1.0;
+  music.midi.bend_range_semitones = 2.0;
+  music.midi.tracks.push_back(track);
+  return music;
+}
+
+TruthVoicing TestMusic::Voicing(double time_s) const {
+  const double t = time_s - kFluidsynthLatencyS;
+  const auto& notes = midi.tracks[0].notes;
+  for (const auto& n : notes) {
+    if (t >= n.onset_s + 0.06 && t <= n.offset_s - 0.03) return TruthVoicing::kVoiced;
+  }
+  for (const auto& n : notes) {
+    if (t >= n.onset_s - 0.01 && t < n.offset_s + 0.7) return TruthVoicing::kUnscored;
+  }
+  return t < 0 ? TruthVoicing::kUnscored : TruthVoicing::kUnvoiced;
+}
+
+double TestMusic::F0Hz(double time_s) const {
+  if (Voicing(time_s) != TruthVoicing::kVoiced) return 0.0;
+  const double t = time_s - kFluidsynthLatencyS;
+  const auto& track = midi.tracks[0];
+  for (const auto& n : track.notes) {
+    if (t >= n.onset_s && t < n.offset_s) {
+      return 440.0 * std::exp2((n.midi_note + BendAt(track, t) - 69.0) / 12.0);
+    }
+  }
+  return 0.0;
+}
+
+Status WriteTruthCsv(const std::string& path, const TestMusic& music, double rate_hz) {
+  return AtomicWriteWith(path, [&](std::ostream& out) {
+    out << "time_s,f0_hz,voicing\n";
+    char line[96];
+    for (int64_t i = 0; i / rate_hz < music.duration_s; ++i) {
+      const double t = i / rate_hz;
+      const TruthVoicing v = music.Voicing(t);
+      const int code = v == TruthVoicing::kVoiced ? 1 : (v == TruthVoicing::kUnvoiced ? 0 : -1);
+      std::snprintf(line, sizeof(line), "%.6f,%.4f,%d\n", t, music.F0Hz(t), code);
+      out << line;
+    }
+    return Status::Ok();
+  });
+}
+
+Status RenderWithFluidsynth(const std::string& midi_path,
+                            const std::string& wav_path,
+                            int sample_rate_hz) {
+  if (!FileExists(kSoundfont)) return Status::Error(std::string(kSoundfont) + ": no soundfont");
+  const std::string command = "fluidsynth -ni -q -R 0 -C 0 -g 1.0 -r " +
+                              std::to_string(sample_rate_hz) + " -F '" + wav_path + "' '" +
+                              kSoundfont + "' '" + midi_path + "' >/dev/null 2>&1";
+  if (std::system(command.c_str()) != 0 || !FileExists(wav_path)) {
+    return Status::Error(wav_path + ": fluidsynth rendering failed");
+  }
+  return Status::Ok();
+}
+
+}  // namespace arco::audio::testing

@@ -1,0 +1,50 @@
+// Test music with known pitch truth: a seeded melody per instrument written as
+// MIDI (with pitch-bend vibrato and glides), rendered by the fluidsynth CLI with
+// the Debian FluidR3_GM soundfont. Used by the render tests and bench/pitch_peers.sh.
+//
+// Measured on Debian 12 (fluidsynth 2.3, FluidR3_GM): output starts about 3 ms
+// after the MIDI event (kFluidsynthLatencyS), the string samples need 20-50 ms
+// to speak and release over a few hundred ms, and the sampled notes sit within
+// about +-15 cents of equal temperament. Truth therefore counts a note as
+// voiced from onset + 60 ms to offset - 30 ms and unvoiced only from offset +
+// 0.7 s until the next onset; everything else is not scored. Each note starts
+// with All Sound Off (CC 120) so the previous note's release does not overlap.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "arco/audio/midi_file.h"
+#include "arco/util/status.h"
+
+namespace arco::audio::testing {
+
+constexpr double kFluidsynthLatencyS = 0.003;
+constexpr const char* kSoundfont = "/usr/share/sounds/sf2/FluidR3_GM.sf2";
+
+enum class TruthVoicing { kVoiced, kUnvoiced, kUnscored };
+
+struct TestMusic {
+  std::string instrument;
+  MidiFile midi;
+  double duration_s = 0;
+  // Truth at time t (audio clock of the rendering): f0 in Hz when voiced.
+  TruthVoicing Voicing(double time_s) const;
+  double F0Hz(double time_s) const;  // 0 unless Voicing() == kVoiced
+};
+
+// violin | viola | cello | bass. About `notes` notes across the instrument's
+// range, every third with vibrato (5-6.5 Hz, 20-40 cents), one glide per ten
+// notes, a rest of >= 1 s after every sixth note.
+TestMusic MakeTestMusic(const std::string& instrument, int notes, uint32_t seed);
+
+// time_s,f0_hz,voicing (1 voiced, 0 unvoiced, -1 unscored) every 1/rate_hz.
+Status WriteTruthCsv(const std::string& path, const TestMusic& music, double rate_hz);
+
+// fluidsynth -ni -R 0 -C 0 -r RATE -F wav soundfont midi; error if it fails.
+Status RenderWithFluidsynth(const std::string& midi_path,
+                            const std::string& wav_path,
+                            int sample_rate_hz = 44100);
+
+}  // namespace arco::audio::testing

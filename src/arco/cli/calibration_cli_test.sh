@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# End-to-end checks of `arco calibration show/convert` on the real SPD files:
+# JSON shape and conventions, conversions, and bad input (one error line, exit 1,
+# no output file). usage: calibration_cli_test.sh ARCO_BINARY SHARED_DATA_DIR
+set -uo pipefail
+arco=$1
+spd=$2/spd
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail=0
+check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
+
+"$arco" calibration show "$spd/cello_1113_scale_camera.xml" --json >"$tmp/show.json" 2>"$tmp/err"
+check '[ $? -eq 0 ] && [ ! -s "$tmp/err" ]' "show --json exits 0 without warnings"
+check 'python3 - "$tmp/show.json" "$spd/cello_1113_scale_camera.json" <<"PY"
+import json, sys
+show = json.load(open(sys.argv[1]))
+spd = json.load(open(sys.argv[2]))
+assert list(show) == ["cameras"], list(show)
+cams = show["cameras"]
+assert len(cams) == 20
+serials = ["21334181","21334237","21334180","21334209","21334208","21334186","21293326",
+           "21293325","21293324","21334206","21334220","21334183","21334207","21334191",
+           "21334184","21334238","21334221","21334219","21334190","21334211"]
+by_serial = {c["serial"]: c for c in cams}
+for i, serial in enumerate(serials):
+    c, s = by_serial[serial], spd["cam%d" % i]
+    assert set(c) == {"name","serial","width","height","K","R","t","distortion"}, set(c)
+    assert c["name"] == "camera_%s_1" % serial
+    assert (c["width"], c["height"]) == (2300, 2656)
+    assert max(abs(a - b) for a, b in zip(c["R"], s["R"])) < 1e-12
+    assert max(abs(a - b) for a, b in zip(c["t"], s["T"])) < 1e-12
+    # OpenCV pixel centre vs the SPD file, which keeps Metashape corner origin.
+    assert abs(c["K"][2] - (s["K"][2] - 0.5)) < 1e-9 and abs(c["K"][5] - (s["K"][5] - 0.5)) < 1e-9
+    assert c["K"][0] == s["K"][0] and c["K"][4] == s["K"][4]
+    d = c["distortion"]
+    assert (d["k1"], d["k2"], d["p1"], d["p2"], d["k3"]) == (s["distort"][0], s["distort"][1], s["distort"][3], s["distort"][2], s["distort"][4])
+PY' "show --json agrees with the authors' JSON"
+
+"$arco" calibration show "$spd/cello_1113_pgy_camera.xml" --json >"$tmp/pgy.json"
+check 'python3 -c "import json,sys; c=json.load(open(sys.argv[1]))[\"cameras\"]; assert all(x[\"K\"][2]==1149.5 and x[\"K\"][5]==1327.5 for x in c)" "$tmp/pgy.json"' \
+  "pgy principal point is the image centre"
+
+check '"$arco" calibration show "$spd/camera.json" | grep -q "spd-json, 20 cameras, world units: metashape"' "table header"
+
+for out in rig.yaml rig.xml rig.json; do
+  "$arco" calibration convert "$spd/camera.xml" "$tmp/$out" >/dev/null
+  check '[ $? -eq 0 ]' "convert to $out"
+  "$arco" calibration show "$tmp/$out" --json >"$tmp/$out.show"
+  "$arco" calibration show "$spd/camera.xml" --json >"$tmp/orig.show"
+  check 'cmp -s "$tmp/$out.show" "$tmp/orig.show"' "$out round trip prints the same JSON"
+done
+"$arco" calibration convert "$spd/camera.xml" "$tmp/spd.json" --format spd >/dev/null
+check 'python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert sorted(d)==sorted(\"cam%d\"%i for i in range(20))" "$tmp/spd.json"' \
+  "--format spd writes camN keys"
+
+# Bad input: one line naming the file, exit 1, no output file.
+printf '<document><chunk><sensors>' >"$tmp/truncated.xml"
+for bad in "$tmp/missing.xml" "$tmp/truncated.xml"; do
+  "$arco" calibration convert "$bad" "$tmp/out.yaml" >/dev/null 2>"$tmp/err"
+  rc=$?
+  check '[ $rc -eq 1 ] && [ $(wc -l <"$tmp/err") -eq 1 ] && grep -q "$bad" "$tmp/err"' "error line for $bad"
+  check '[ ! -e "$tmp/out.yaml" ] && [ -z "$(ls "$tmp" | grep out.yaml)" ]' "no output for $bad"
+done
+"$arco" calibration convert "$spd/camera.xml" "$tmp/out.txt" >/dev/null 2>"$tmp/err"
+check '[ $? -eq 1 ] && grep -q "out.txt" "$tmp/err" && [ ! -e "$tmp/out.txt" ]' "unknown extension"
+"$arco" calibration show "$tmp/truncated.xml" >/dev/null 2>"$tmp/err"
+check '[ $? -eq 1 ] && grep -q "malformed XML" "$tmp/err"' "show on malformed XML"
+
+[ $fail -eq 0 ] && echo "calibration CLI: all checks passed"
+exit $fail

@@ -1,0 +1,178 @@
+// `arco triangulate`: 3D points from labelled views, or whole captures.
+#include <chrono>
+#include <cstdio>
+#include <memory>
+
+#include "arco/cli/command.h"
+#include "arco/cli/progress.h"
+#include "arco/cli/triangulate.h"
+#include "arco/instrument/instrument_model.h"
+
+namespace arco::cli {
+namespace {
+
+struct Args {
+  std::string capture_dir, output, calibration, label_origin = "corner", scale_instrument;
+  std::vector<std::string> views, filters;
+  TriangulationOptions t;
+  bool no_refine = false, ignore_distortion = false;
+  int threads = 0, max_gap_frames = 5;
+};
+
+// "KEY=VALUE" -> (KEY, VALUE); `form` is shown in the error, e.g. "CAMERA=LABELME.json".
+StatusOr<std::pair<std::string, std::string>> SplitAssignment(const std::string& s,
+                                                              const std::string& option,
+                                                              const std::string& form) {
+  const size_t eq = s.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == s.size()) {
+    return Status::Error(option + " \"" + s + "\" must look like " + form);
+  }
+  return std::make_pair(s.substr(0, eq), s.substr(eq + 1));
+}
+
+int RunViews(const Args& a) {
+  LabelViewsOptions o;
+  o.calibration = a.calibration;
+  o.triangulation = a.t;
+  o.ignore_distortion = a.ignore_distortion;
+  o.label_origin = a.label_origin == "center" ? PixelOrigin::kCenter : PixelOrigin::kCorner;
+  for (const auto& v : a.views) {
+    auto kv = SplitAssignment(v, "--view", "CAMERA=LABELME.json");
+    if (!kv.ok()) return PrintError(kv.status().message());
+    o.views.push_back(*kv);
+  }
+  if (!a.scale_instrument.empty()) {
+    auto model = InstrumentModel::Create(a.scale_instrument);
+    if (!model.ok()) return PrintError("--scale-to: " + model.status().message());
+    o.reference_string_length_mm = model->string_length_mm();
+  }
+  auto result = TriangulateLabelViews(o);
+  if (!result.ok()) return PrintError(result.status().message());
+  const Status written = WriteJsonFile(a.output, *result);
+  if (!written.ok()) return PrintError(written.message());
+  std::fputs(FormatLabelViewsReport(*result).c_str(), stdout);
+  std::printf("wrote %s\n", a.output.c_str());
+  return 0;
+}
+
+int RunCapture(const Args& a) {
+  CaptureOptions o;
+  o.capture_dir = a.capture_dir;
+  o.result_dir = a.output;
+  o.triangulation.point = a.t;
+  o.triangulation.num_threads = a.threads;
+  for (const auto& f : a.filters) {
+    auto kv = SplitAssignment(f, "--filter", "GROUP=SPEC");
+    if (!kv.ok()) return PrintError(kv.status().message());
+    auto spec = ParseFilterSpec(kv->second);
+    if (!spec.ok()) return PrintError("--filter " + f + ": " + spec.status().message());
+    spec->max_gap_frames = a.max_gap_frames;
+    o.filters.emplace_back(kv->first, *spec);
+  }
+  std::unique_ptr<ProgressBar> bar;
+  const auto start = std::chrono::steady_clock::now();
+  auto summary = TriangulateCapture(
+      o,
+      [&](int64_t n) {
+        if (bar) bar->Add(n);
+      },
+      [&](int64_t frames) { bar = std::make_unique<ProgressBar>("triangulate", frames); });
+  if (bar) bar->Finish();
+  if (!summary.ok()) return PrintError(summary.status().message());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const auto& s = summary->triangulation;
+  std::printf(
+      "triangulated %lld of %lld points (%.1f%%) over %lld frames x %lld keypoints from %lld "
+      "views\nmedian reprojection RMS %.2f px, mean inlier views %.1f, units %s\n"
+      "time %.2f s (%.0f points/s) -> %s\n",
+      static_cast<long long>(s.triangulated),
+      static_cast<long long>(s.points),
+      s.points ? 100.0 * s.triangulated / s.points : 0.0,
+      static_cast<long long>(s.frames),
+      static_cast<long long>(summary->keypoints),
+      static_cast<long long>(summary->views),
+      s.median_rms_reprojection_px,
+      s.mean_inliers,
+      summary->units.c_str(),
+      seconds,
+      seconds > 0 ? s.points / seconds : 0.0,
+      a.output.c_str());
+  return 0;
+}
+
+std::function<int()> Setup(CLI::App& app) {
+  auto a = std::make_shared<Args>();
+  CLI::App* sub = app.add_subcommand(
+      "triangulate",
+      "3D keypoints from calibrated views: labelled views (--calibration, --view) to a JSON "
+      "file, or a capture folder (docs/formats.md) to a result folder");
+  sub->add_option("capture_dir",
+                  a->capture_dir,
+                  "Capture folder with capture.json and 2D keypoints (sequence mode)");
+  sub->add_option(
+         "-o,--output", a->output, "Output: JSON file (labelled views) or result folder (capture)")
+      ->required();
+  sub->add_option("--calibration",
+                  a->calibration,
+                  "Calibration file (Metashape XML, SPD JSON, OpenCV YAML/XML, arco JSON)");
+  sub->add_option(
+      "--view", a->views, "CAMERA=LABELME.json, CAMERA a camera name or serial; repeat per view");
+  sub->add_option("--min-score", a->t.min_score, "Ignore detections below this score [0..1]")
+      ->capture_default_str();
+  sub->add_option("--max-reprojection-px", a->t.max_reprojection_px, "RANSAC inlier gate, pixels")
+      ->capture_default_str();
+  sub->add_option("--max-ransac-trials",
+                  a->t.max_ransac_trials,
+                  "Most camera pairs tried per point (all pairs when fewer)")
+      ->capture_default_str();
+  sub->add_option("--robust-loss-px",
+                  a->t.robust_loss_scale_px,
+                  "Soft-L1 loss scale of the refinement, pixels")
+      ->capture_default_str();
+  sub->add_flag("--no-refine", a->no_refine, "Skip the Levenberg-Marquardt refinement");
+  sub->add_flag("--ignore-distortion",
+                a->ignore_distortion,
+                "Triangulate as if the lenses had no distortion (for comparison)");
+  sub->add_option("--label-origin",
+                  a->label_origin,
+                  "Pixel origin of labelme coordinates: corner (labelme) or center (OpenCV)")
+      ->check(CLI::IsMember({"corner", "center"}))
+      ->capture_default_str();
+  sub->add_option("--scale-to",
+                  a->scale_instrument,
+                  "Also report lengths in mm, taking the mean string side (nut-bridge) as this "
+                  "instrument's string length (cello 695 mm, violin 328 mm)");
+  sub->add_option("--threads", a->threads, "Worker threads (0 = all cores); results do not change")
+      ->capture_default_str();
+  sub->add_option("--filter",
+                  a->filters,
+                  "GROUP=SPEC temporal filter, e.g. body=butterworth:6:4, left_hand=savgol:9:2, "
+                  "instrument=oneeuro:1:0.5, all=none; repeatable, later wins")
+      ->capture_default_str();
+  sub->add_option("--max-gap-frames",
+                  a->max_gap_frames,
+                  "Fill NaN gaps up to this many frames before filtering (0 = none)")
+      ->capture_default_str();
+  return [a]() {
+    a->t.refine = !a->no_refine;
+    const bool views_mode = !a->views.empty() || !a->calibration.empty();
+    if (views_mode && !a->capture_dir.empty()) {
+      return PrintError("give either CAPTURE_DIR or --calibration with --view, not both");
+    }
+    if (views_mode) {
+      if (a->calibration.empty()) return PrintError("--view needs --calibration");
+      if (!a->filters.empty()) return PrintError("--filter applies to capture folders only");
+      return RunViews(*a);
+    }
+    if (a->capture_dir.empty()) {
+      return PrintError("give a CAPTURE_DIR, or --calibration CAL with --view CAMERA=LABELS");
+    }
+    if (!a->scale_instrument.empty()) return PrintError("--scale-to applies to labelled views");
+    return RunCapture(*a);
+  };
+}
+
+}  // namespace
+ARCO_REGISTER_COMMAND(triangulate, 20, Setup);
+}  // namespace arco::cli

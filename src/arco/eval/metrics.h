@@ -1,0 +1,136 @@
+// Evaluation metrics of a motion-capture result against truth (docs/evaluation.md).
+//
+// Points are in millimetres, world frame, as frames x points x 3 with NaN for
+// missing values, in the SPD/COCO-WholeBody layout (0-132 whole body, 91-111 left
+// hand, 112-132 right hand, 133.. instrument points; DOMAIN.md section 3).
+//
+// The paper's protocol (Jin et al. 2024, section 7): hand MPJPE after aligning
+// the wrists by translation; contact deviation = distance from the note-playing
+// fingertip to the contact point, on frames where a note is pressed.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace arco::eval {
+
+constexpr int kLeftHandFirst = 91;  // COCO-WholeBody left-hand wrist
+constexpr int kRightHandFirst = 112;
+constexpr int kNumWholeBody = 133;
+constexpr int kNumHand = 21;
+
+// Hand keypoint (0..20) of a finger's joint: finger 1 = index .. 4 = little,
+// 0 = thumb; joint 0 = MCP (thumb CMC) .. 3 = tip.
+constexpr int HandJoint(int finger, int joint) { return 1 + 4 * finger + joint; }
+
+// frames x points x 3, NaN = missing.
+struct PointSequence {
+  int num_frames = 0;
+  int num_points = 0;
+  std::vector<double> xyz;  // C order
+
+  PointSequence() = default;
+  PointSequence(int frames, int points);  // filled with NaN
+  Eigen::Vector3d at(int frame, int point) const;
+  void set(int frame, int point, const Eigen::Vector3d& p);
+  bool valid(int frame, int point) const;  // all three finite
+};
+
+// Per-frame contact: which string is stopped by which finger where.
+// string: 1 = highest string .. 4 = lowest, 0 = no pressed note (rest, open
+// string, unvoiced). finger: 1 = index .. 4 = little, 0 = none.
+struct ContactTrack {
+  std::vector<int> string;
+  std::vector<int> finger;
+  std::vector<Eigen::Vector3d> point_mm;  // NaN when string == 0
+
+  int num_frames() const { return static_cast<int>(string.size()); }
+  bool pressed(int frame) const { return string[static_cast<size_t>(frame)] > 0; }
+};
+
+struct HandJointLimitsDeg {
+  // Flexion ranges of the PIP (slot 0) and DIP (slot 1) joints per finger,
+  // thumb first (the thumb's entries are ignored: its flexion axis cannot be
+  // told from keypoints reliably); geometric angles measured from keypoints.
+  double min_deg[5][2];
+  double max_deg[5][2];
+  // Geometric angle of each joint in the model's rest pose (all dofs zero),
+  // subtracted before comparing: rest bones need not be collinear.
+  double rest_deg[5][2] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}};
+};
+
+struct EvalOptions {
+  std::vector<double> pck_thresholds_mm = {5, 10, 20};
+  // Tolerance added to the joint limits before a geometric angle counts as a
+  // violation: angles measured from keypoints carry the rest pose's small bends.
+  double joint_limit_tolerance_deg = 2.0;
+  std::optional<HandJointLimitsDeg> limits;  // absent: joint limits not evaluated
+  int instrument_first = kNumWholeBody;      // first instrument point
+  int num_instrument_points = 0;             // 0 = none
+  // Points of the 13 SPD contact-stage extras (string ends), first index; -1 = none.
+  int string_points_first = -1;
+};
+
+struct MethodMetrics {
+  std::string method;
+  int frames = 0;                     // frames with truth
+  int contact_frames = 0;             // frames with a pressed note in the truth
+  double mpjpe_hand_mm = NAN;         // left hand, wrist-aligned, 20 joints
+  double mpjpe_note_finger_mm = NAN;  // MCP..tip of the truth's playing finger, contact frames
+  double contact_deviation_mm = NAN;  // playing fingertip to truth contact point
+  double contact_deviation_median_mm = NAN;
+  std::vector<double> pck;       // per threshold, left hand wrist-aligned
+  double string_accuracy = NAN;  // NaN when the method writes no contact annotation
+  double finger_accuracy = NAN;
+  int joint_limit_violations = -1;  // -1: not evaluated
+  double mpjpe_body_mm = NAN;       // whole body 0..132, no alignment
+  double instrument_error_mm = NAN;
+  double string_error_mm = NAN;
+  double missing_hand_fraction = 0;  // truth-valid hand joints the method left NaN
+};
+
+// Metrics of one method. `contact` may be null (the method writes none).
+// Throws std::invalid_argument when the frame counts of truth and result differ.
+MethodMetrics EvaluateMethod(const std::string& method,
+                             const PointSequence& truth,
+                             const ContactTrack& truth_contact,
+                             const PointSequence& result,
+                             const ContactTrack* result_contact,
+                             const EvalOptions& options);
+
+// Geometric flexion of a hand's PIP and DIP joints (degrees) from its 21
+// keypoints, signed: positive bends towards the palm. The flexion axis is the
+// hand's lateral axis, x = (index MCP - little MCP) for a right hand and its
+// negative for a left hand (hand/hand_model.h: +x = distal x palmar in both
+// hands), made orthogonal to the wrist -> middle MCP direction. NaN when a
+// keypoint is missing. angles[finger][0] = PIP, [1] = DIP; thumb = MCP, IP.
+void HandFlexionDeg(const Eigen::Vector3d hand[kNumHand], bool left, double angles[5][2]);
+
+// Number of (frame, joint) pairs among the PIP and DIP joints of the index to
+// little fingers (8 per frame) outside [min - tol, max + tol] after removing
+// the rest angle.
+int CountJointLimitViolations(const PointSequence& points,
+                              int hand_first,
+                              bool left,
+                              const HandJointLimitsDeg& limits,
+                              double tolerance_deg);
+
+struct PitchMetrics {
+  int frames = 0;
+  int truth_voiced_frames = 0;
+  double rpa50 = NAN;  // raw pitch accuracy within 50 cents, over truth-voiced frames
+  double rpa25 = NAN;
+  double voicing_recall = NAN;       // truth-voiced frames estimated voiced
+  double voicing_false_alarm = NAN;  // truth-unvoiced frames estimated voiced
+  double median_abs_cents = NAN;     // over frames voiced in both
+};
+
+// f0 in Hz per frame; <= 0 or NaN = unvoiced. Sizes must match (else throws).
+PitchMetrics EvaluatePitch(const std::vector<double>& truth_f0_hz,
+                           const std::vector<double>& estimate_f0_hz);
+
+}  // namespace arco::eval

@@ -1,0 +1,61 @@
+// Rigid and similarity transforms of 3D points, named by the frames they map
+// between (COLMAP style): `Rigid3d cam_from_world` maps world points into the
+// camera frame, p_cam = cam_from_world * p_world. Composition reads right to left:
+// (a_from_b * b_from_c) = a_from_c.
+//
+// Rotations are stored as unit quaternions (Eigen, Hamilton convention) and kept
+// normalised by every constructor and composition.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace arco {
+
+// x -> R x + t.
+struct Rigid3d {
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  Rigid3d() = default;
+  Rigid3d(const Eigen::Quaterniond& rotation, const Eigen::Vector3d& translation);
+  // Throws std::invalid_argument unless `rotation` is a proper rotation matrix
+  // (|R^T R - I| < 1e-6, det > 0).
+  Rigid3d(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation);
+
+  Eigen::Matrix3d RotationMatrix() const { return rotation.toRotationMatrix(); }
+  // [R | t], 3x4.
+  Eigen::Matrix<double, 3, 4> ToMatrix() const;
+  Rigid3d Inverse() const;
+  Eigen::Vector3d operator*(const Eigen::Vector3d& point) const {
+    return rotation * point + translation;
+  }
+  Rigid3d operator*(const Rigid3d& other) const;
+};
+
+// x -> s R x + t with s > 0.
+struct Sim3d {
+  double scale = 1.0;
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  Sim3d() = default;
+  // Throws std::invalid_argument unless scale > 0 and finite.
+  Sim3d(double scale, const Eigen::Quaterniond& rotation, const Eigen::Vector3d& translation);
+  Sim3d(double scale, const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation);
+  explicit Sim3d(const Rigid3d& rigid) : rotation(rigid.rotation), translation(rigid.translation) {}
+
+  Eigen::Matrix3d RotationMatrix() const { return rotation.toRotationMatrix(); }
+  // [s R | t], 3x4.
+  Eigen::Matrix<double, 3, 4> ToMatrix() const;
+  Sim3d Inverse() const;
+  Eigen::Vector3d operator*(const Eigen::Vector3d& point) const {
+    return scale * (rotation * point) + translation;
+  }
+  Sim3d operator*(const Sim3d& other) const;
+};
+
+// Throws std::invalid_argument unless `rotation` is a proper rotation matrix.
+void CheckRotationMatrix(const Eigen::Matrix3d& rotation, const char* what);
+
+}  // namespace arco

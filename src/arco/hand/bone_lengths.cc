@@ -1,0 +1,90 @@
+#include "arco/hand/bone_lengths.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace arco::hand {
+namespace {
+
+double MedianInPlace(std::vector<double>* v) {
+  const size_t mid = v->size() / 2;
+  std::nth_element(v->begin(), v->begin() + mid, v->end());
+  const double upper = (*v)[mid];
+  if (v->size() % 2 == 1) return upper;
+  const double lower = *std::max_element(v->begin(), v->begin() + mid);
+  return 0.5 * (lower + upper);
+}
+
+}  // namespace
+
+Status BoneLengthOptions::Validate() const {
+  auto bad = [](const std::string& m) { return Status::Error("BoneLengthOptions: " + m); };
+  if (min_samples < 1) return bad("min_samples must be >= 1");
+  if (!(mad_gate > 0)) return bad("mad_gate must be > 0");
+  if (!(min_mad_mm >= 0)) return bad("min_mad_mm must be >= 0");
+  if (!(min_ratio > 0 && min_ratio <= 1 && max_ratio >= 1 && std::isfinite(max_ratio))) {
+    return bad("need 0 < min_ratio <= 1 <= max_ratio");
+  }
+  return Status::Ok();
+}
+
+StatusOr<BoneLengthEstimate> EstimateBoneLengths(const std::vector<HandPointsMm>& frames,
+                                                 const HandModel& prior,
+                                                 const BoneLengthOptions& options) {
+  const Status valid = options.Validate();
+  if (!valid.ok()) throw std::invalid_argument(valid.message());
+  BoneLengthEstimate out;
+  std::vector<double> ratios;
+  std::vector<double> samples;
+  samples.reserve(frames.size());
+  for (int k = 1; k < kNumHandKeypoints; ++k) {
+    const int parent = ParentKeypoint(k);
+    const double prior_mm = prior.bone_length_mm(k);
+    samples.clear();
+    for (const HandPointsMm& f : frames) {
+      if (!f[k].allFinite() || !f[parent].allFinite()) continue;
+      const double d = (f[k] - f[parent]).norm();
+      if (d >= 0.3 * prior_mm && d <= 3.0 * prior_mm) samples.push_back(d);
+    }
+    out.samples[k] = static_cast<int>(samples.size());
+    if (out.samples[k] < options.min_samples) continue;
+    std::vector<double> work = samples;
+    const double median = MedianInPlace(&work);
+    for (size_t i = 0; i < samples.size(); ++i) work[i] = std::abs(samples[i] - median);
+    const double sigma = std::max(1.4826 * MedianInPlace(&work), options.min_mad_mm);
+    std::vector<double> inliers;
+    for (double d : samples) {
+      if (std::abs(d - median) <= options.mad_gate * sigma) inliers.push_back(d);
+    }
+    out.inliers[k] = static_cast<int>(inliers.size());
+    out.lengths_mm[k] = MedianInPlace(&inliers);
+    out.from_data[k] = 1;
+    ratios.push_back(out.lengths_mm[k] / prior_mm);
+  }
+  if (ratios.empty()) {
+    std::ostringstream msg;
+    msg << "bone lengths: no bone has " << options.min_samples
+        << " frames with both keypoints triangulated (" << frames.size() << " frames)";
+    return Status::Error(msg.str());
+  }
+  out.hand_scale = MedianInPlace(&ratios);
+  if (out.hand_scale < options.min_ratio || out.hand_scale > options.max_ratio) {
+    std::ostringstream msg;
+    msg << "bone lengths: the hand measures " << out.hand_scale
+        << " x an average adult hand; are the world units millimetres?";
+    return Status::Error(msg.str());
+  }
+  for (int k = 1; k < kNumHandKeypoints; ++k) {
+    const double prior_mm = prior.bone_length_mm(k);
+    if (!out.from_data[k]) out.lengths_mm[k] = out.hand_scale * prior_mm;
+    const double clamped =
+        std::clamp(out.lengths_mm[k], options.min_ratio * prior_mm, options.max_ratio * prior_mm);
+    out.clamped[k] = clamped != out.lengths_mm[k];
+    out.lengths_mm[k] = clamped;
+  }
+  return out;
+}
+
+}  // namespace arco::hand

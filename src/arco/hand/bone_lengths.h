@@ -1,0 +1,44 @@
+// Per-performer bone lengths from a capture: for every bone, the median over
+// frames of the triangulated distance between its two keypoints, after
+// rejecting gross samples (outside [0.3, 3] x the prior length) and outliers
+// (beyond mad_gate robust standard deviations from the median). Bones with too
+// few samples take the prior length times the hand's overall scale; every
+// length is finally clamped to [min_ratio, max_ratio] x the prior length.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "arco/hand/hand_model.h"
+#include "arco/hand/kinematics.h"
+#include "arco/util/status.h"
+
+namespace arco::hand {
+
+struct BoneLengthOptions {
+  int min_samples = 10;     // frames with both keypoints finite, after gross rejection
+  double mad_gate = 3.0;    // outlier gate in robust standard deviations (1.4826 MAD)
+  double min_mad_mm = 1.0;  // floor of the robust deviation
+  double min_ratio = 0.6;   // anatomical bounds relative to the prior bone
+  double max_ratio = 1.6;
+  Status Validate() const;
+};
+
+struct BoneLengthEstimate {
+  BoneLengthsMm lengths_mm{};                    // by child keypoint (entry 0 unused)
+  std::array<int, kNumHandKeypoints> samples{};  // after gross rejection
+  std::array<int, kNumHandKeypoints> inliers{};
+  std::array<uint8_t, kNumHandKeypoints> from_data{};  // 0: prior length x scale
+  std::array<uint8_t, kNumHandKeypoints> clamped{};    // hit the anatomical bounds
+  double hand_scale = 1.0;  // median over measured bones of length / prior length
+};
+
+// `frames`: triangulated keypoints per frame (mm, NaN = missing). Errors when no
+// bone has enough samples or the hand's scale is outside [min_ratio, max_ratio]
+// (e.g. world units that are not millimetres).
+StatusOr<BoneLengthEstimate> EstimateBoneLengths(const std::vector<HandPointsMm>& frames,
+                                                 const HandModel& prior,
+                                                 const BoneLengthOptions& options);
+
+}  // namespace arco::hand

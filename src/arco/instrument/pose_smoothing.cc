@@ -1,0 +1,85 @@
+#include "arco/instrument/pose_smoothing.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <stdexcept>
+
+namespace arco {
+
+Status PoseSmoothingOptions::Validate() const {
+  if (!std::isfinite(sigma_frames) || sigma_frames <= 0) {
+    return Status::Error("pose smoothing: sigma_frames must be > 0");
+  }
+  if (radius_frames < 0) return Status::Error("pose smoothing: radius_frames must be >= 0");
+  if (max_fill_gap_frames < 0) {
+    return Status::Error("pose smoothing: max_fill_gap_frames must be >= 0");
+  }
+  return Status::Ok();
+}
+
+std::vector<InstrumentFramePose> SmoothFramePoses(const std::vector<InstrumentFramePose>& frames,
+                                                  const PoseSmoothingOptions& options) {
+  const Status status = options.Validate();
+  if (!status.ok()) throw std::invalid_argument(status.message());
+  const int n = static_cast<int>(frames.size());
+  const int radius = options.radius_frames > 0
+                         ? options.radius_frames
+                         : static_cast<int>(std::ceil(3.0 * options.sigma_frames));
+  std::vector<double> kernel(radius + 1);
+  for (int d = 0; d <= radius; ++d) {
+    kernel[d] = std::exp(-0.5 * d * d / (options.sigma_frames * options.sigma_frames));
+  }
+  std::vector<Eigen::Vector4d> quats(n);
+  std::vector<int> prev_ok(n, -1), next_ok(n, -1);
+  for (int f = 0, last = -1; f < n; ++f) {
+    if (frames[f].status == FrameFitStatus::kOk) {
+      quats[f] = Eigen::Quaterniond(frames[f].pose.rotation).normalized().coeffs();
+      last = f;
+    }
+    prev_ok[f] = last;
+  }
+  for (int f = n - 1, next = -1; f >= 0; --f) {
+    if (frames[f].status == FrameFitStatus::kOk) next = f;
+    next_ok[f] = next;
+  }
+
+  std::vector<InstrumentFramePose> out = frames;
+  for (int f = 0; f < n; ++f) {
+    const InstrumentFramePose& in = frames[f];
+    if (in.status == FrameFitStatus::kTooFewPoints) {
+      // Fill only gaps bounded by kOk frames on both sides within the limit.
+      if (options.max_fill_gap_frames == 0 || prev_ok[f] < 0 || next_ok[f] < 0 ||
+          next_ok[f] - prev_ok[f] - 1 > options.max_fill_gap_frames) {
+        continue;
+      }
+    } else if (in.status == FrameFitStatus::kHighResidual && !options.replace_high_residual) {
+      continue;
+    }
+    Eigen::Matrix4d accum = Eigen::Matrix4d::Zero();
+    Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+    double weight_sum = 0;
+    double units = 0;
+    for (int g = std::max(0, f - radius); g <= std::min(n - 1, f + radius); ++g) {
+      if (frames[g].status != FrameFitStatus::kOk) continue;
+      const double w = kernel[std::abs(g - f)];
+      accum += w * quats[g] * quats[g].transpose();
+      translation += w * frames[g].pose.translation;
+      units = frames[g].pose.world_units_per_mm;
+      weight_sum += w;
+    }
+    if (weight_sum <= 0) continue;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(accum);
+    Eigen::Vector4d q = eig.eigenvectors().col(3);  // largest eigenvalue (ascending order)
+    if (q(3) < 0) q = -q;                           // canonical sign, so results are reproducible
+    const Eigen::Quaterniond mean(q(3), q(0), q(1), q(2));  // coeffs() order is x, y, z, w
+    out[f].filled = in.status != FrameFitStatus::kOk;
+    out[f].status = FrameFitStatus::kOk;
+    out[f].pose.rotation = mean.normalized().toRotationMatrix();
+    out[f].pose.translation = translation / weight_sum;
+    out[f].pose.world_units_per_mm = units;
+  }
+  return out;
+}
+
+}  // namespace arco

@@ -1,0 +1,46 @@
+// Optional temporal smoothing of per-frame instrument poses. The instrument is rigid, so
+// smoothing the pose (not the keypoints or the strings) keeps the strings straight and
+// evenly spaced; recompute strings and contacts from the smoothed poses afterwards:
+//
+//   InstrumentFit fit = *FitInstrument(model, keypoints, hints);
+//   std::vector<InstrumentFramePose> smooth = SmoothFramePoses(fit.frames, {});
+//   for (frame f with smooth[f].has_pose())
+//     strings = StringsAt(fit.instrument, smooth[f].pose);          // template_fit.h
+//     point   = strings[s - 1].PointAtFraction(contact.fraction_from_bridge);
+//
+// Method: a Gaussian kernel over time (sigma_frames, truncated at radius_frames) over the
+// frames that have a pose with status kOk; translation by the weighted mean; rotation by
+// the weighted quaternion average of Markley et al. 2007 (the eigenvector of
+// sum w q q^T with the largest eigenvalue), which does not depend on order or on the
+// quaternions' signs. The scale (world units per mm) is constant per clip and kept.
+#pragma once
+
+#include <vector>
+
+#include "arco/instrument/template_fit.h"
+#include "arco/util/status.h"
+
+namespace arco {
+
+struct PoseSmoothingOptions {
+  double sigma_frames = 2.0;  // Gaussian kernel width in frames
+  int radius_frames = 0;      // kernel half-width; 0 = ceil(3 sigma)
+  // Frames without a pose (or with kHighResidual) get a smoothed pose when kOk frames
+  // exist on BOTH sides within this many frames; 0 = never fill.
+  int max_fill_gap_frames = 0;
+  // When true, kHighResidual frames keep their own pose out of the average but receive
+  // the smoothed pose of their neighbours (if any lie within radius_frames).
+  bool replace_high_residual = true;
+
+  Status Validate() const;
+};
+
+// Returns one entry per frame: the smoothed pose (status kOk), or the input entry
+// unchanged when no kOk frame lies within the kernel (or, for frames without a pose, the
+// gap is larger than max_fill_gap_frames). rms_residual_mm, inlier_mask etc. are copied
+// from the input; recompute residuals with PoseResidualMm when needed. Throws
+// std::invalid_argument for options that fail Validate().
+std::vector<InstrumentFramePose> SmoothFramePoses(const std::vector<InstrumentFramePose>& frames,
+                                                  const PoseSmoothingOptions& options = {});
+
+}  // namespace arco

@@ -1,0 +1,151 @@
+#include "arco/instrument/rigid_align.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <cmath>
+#include <stdexcept>
+
+namespace arco {
+
+// TODO(instrument): switch to arco_geometry's (weighted) Umeyama once it lands on main.
+bool FitRigid(const Eigen::Matrix3Xd& source,
+              const Eigen::Matrix3Xd& target,
+              const std::vector<int>& indices,
+              double min_spread,
+              Eigen::Matrix3d* rotation,
+              Eigen::Vector3d* translation) {
+  const int n = static_cast<int>(indices.size());
+  if (n < 3) return false;
+  Eigen::Vector3d s_mean = Eigen::Vector3d::Zero();
+  Eigen::Vector3d t_mean = Eigen::Vector3d::Zero();
+  for (int i : indices) {
+    s_mean += source.col(i);
+    t_mean += target.col(i);
+  }
+  s_mean /= n;
+  t_mean /= n;
+  Eigen::Matrix3d cross = Eigen::Matrix3d::Zero();  // sum (s - s_mean)(t - t_mean)^T
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (int i : indices) {
+    const Eigen::Vector3d s = source.col(i) - s_mean;
+    cross += s * (target.col(i) - t_mean).transpose();
+    scatter += s * s.transpose();
+  }
+  // Collinear (or coincident) source points leave the rotation about their line free.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter, Eigen::EigenvaluesOnly);
+  const double second = std::sqrt(std::max(0.0, eig.eigenvalues()(1)) / n);
+  if (!(second >= min_spread)) return false;
+  // Kabsch: R = V diag(1, 1, det(V U^T)) U^T for cross = U S V^T (Umeyama 1991, Eq. 39-40).
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cross, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0) d(2, 2) = -1;
+  *rotation = svd.matrixV() * d * svd.matrixU().transpose();
+  *translation = t_mean - *rotation * s_mean;
+  return rotation->allFinite() && translation->allFinite();
+}
+
+namespace {
+
+struct Hypothesis {
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d translation;
+  std::vector<int> inliers;
+  double residual_sum = 0;
+};
+
+void Score(const Eigen::Matrix3Xd& source,
+           const Eigen::Matrix3Xd& target,
+           const std::vector<int>& common,
+           double gate,
+           Hypothesis* h) {
+  h->inliers.clear();
+  h->residual_sum = 0;
+  for (int i : common) {
+    const double r = (target.col(i) - (h->rotation * source.col(i) + h->translation)).norm();
+    if (r <= gate) {
+      h->inliers.push_back(i);
+      h->residual_sum += r;
+    }
+  }
+}
+
+bool Better(const Hypothesis& a, const Hypothesis& b) {
+  if (a.inliers.size() != b.inliers.size()) return a.inliers.size() > b.inliers.size();
+  return a.residual_sum < b.residual_sum;
+}
+
+}  // namespace
+
+RigidAlignment AlignRigidRobust(const Eigen::Matrix3Xd& source,
+                                const Eigen::Matrix3Xd& target,
+                                double gate,
+                                double min_spread) {
+  if (source.cols() != target.cols() || source.cols() > 32) {
+    throw std::invalid_argument(
+        "AlignRigidRobust: source and target need the same number of "
+        "columns (at most 32)");
+  }
+  RigidAlignment out;
+  std::vector<int> common;
+  for (int i = 0; i < source.cols(); ++i) {
+    if (source.col(i).allFinite() && target.col(i).allFinite()) common.push_back(i);
+  }
+  out.num_common = static_cast<int>(common.size());
+  if (common.size() < 3) return out;
+
+  Hypothesis best;
+  bool have_best = false;
+  if (FitRigid(source, target, common, min_spread, &best.rotation, &best.translation)) {
+    Score(source, target, common, gate, &best);
+    have_best = true;
+  }
+  if (!have_best || best.inliers.size() < common.size()) {
+    // Exhaustive minimal samples.
+    Hypothesis h;
+    std::vector<int> sample(3);
+    const int n = static_cast<int>(common.size());
+    for (int a = 0; a < n; ++a) {
+      for (int b = a + 1; b < n; ++b) {
+        for (int c = b + 1; c < n; ++c) {
+          sample = {common[a], common[b], common[c]};
+          if (!FitRigid(source, target, sample, min_spread, &h.rotation, &h.translation)) {
+            continue;
+          }
+          Score(source, target, common, gate, &h);
+          if (!have_best || Better(h, best)) {
+            best = h;
+            have_best = true;
+          }
+        }
+      }
+    }
+  }
+  if (!have_best || best.inliers.size() < 3) return out;
+  // Refit on the inliers, then re-select once with the refined pose.
+  for (int round = 0; round < 2; ++round) {
+    Hypothesis refit;
+    if (!FitRigid(source, target, best.inliers, min_spread, &refit.rotation, &refit.translation)) {
+      break;
+    }
+    Score(source, target, common, gate, &refit);
+    if (refit.inliers.size() < 3) break;
+    const bool same = refit.inliers == best.inliers;
+    best = refit;
+    if (same) break;
+  }
+  // Final least squares on the final inlier set (also checks it is not collinear).
+  if (!FitRigid(source, target, best.inliers, min_spread, &out.rotation, &out.translation)) {
+    return out;
+  }
+  out.ok = true;
+  double sum_sq = 0;
+  for (int i : best.inliers) {
+    out.inlier_mask |= (1u << i);
+    sum_sq += (target.col(i) - (out.rotation * source.col(i) + out.translation)).squaredNorm();
+  }
+  out.num_inliers = static_cast<int>(best.inliers.size());
+  out.rms_residual = std::sqrt(sum_sq / out.num_inliers);
+  return out;
+}
+
+}  // namespace arco

@@ -1,0 +1,98 @@
+// On-disk capture and result folders (documented in docs/formats.md).
+//
+//   CAPTURE_DIR/capture.json        manifest (this header's CaptureManifest)
+//   CAPTURE_DIR/keypoints2d.npy     (frames, views, points, 3) [x_px, y_px, score],
+//                                   float32/float64, NaN = missing; views in the
+//                                   manifest's camera order; pixels in the calibration's
+//                                   image (OpenCV convention, origin at the centre of
+//                                   the top-left pixel)
+//   RESULT_DIR/result.json          what each stage wrote, with options and summaries
+//   RESULT_DIR/triangulation/*.npy  points3d.npy (F, P, 3) and per-point quality
+//   RESULT_DIR/<stage>/...          later stages (hand, vision, paper, arco, eval)
+// Paths inside manifests are relative to the folder holding the manifest.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "arco/mocap/keypoint_layout.h"
+#include "arco/mocap/triangulate_sequence.h"
+#include "arco/util/json_io.h"
+#include "arco/util/npy.h"
+#include "arco/util/status.h"
+
+namespace arco {
+
+inline constexpr char kCaptureManifestName[] = "capture.json";
+inline constexpr char kResultManifestName[] = "result.json";
+
+struct CaptureCamera {
+  std::string name;                     // matches a calibration camera's name or serial
+  std::string serial;                   // optional
+  std::string video;                    // optional, relative path
+  std::vector<int64_t> dropped_frames;  // global frame numbers this camera did not record
+};
+
+struct CaptureManifest {
+  int version = 1;
+  std::string name;
+  std::string instrument = "none";  // cello, violin, viola, double_bass or none
+  double fps = 30.0;
+  int64_t frame_first = 1;  // global number of the first frame in the arrays
+  int64_t frame_count = 0;
+  double tuning_a4_hz = 440.0;
+  std::string calibration;                  // calibration file (any format arco reads)
+  std::string audio;                        // optional audio file
+  double audio_offset_s = 0.0;              // audio time at the start of frame `frame_first`
+  std::string keypoints2d;                  // optional .npy of 2D keypoints
+  std::string layout;                       // keypoint layout name, or "custom" with keypoint_names
+  std::vector<std::string> keypoint_names;  // only for layout "custom"
+  std::vector<CaptureCamera> cameras;
+
+  // The layout of the keypoint arrays (built-in or custom); empty name when unknown.
+  StatusOr<KeypointLayout> Layout() const;
+  // Index of a camera by name or serial, -1 when absent.
+  int FindCamera(const std::string& id) const;
+  // Global frames number the synchronised frames of the recording from 1 (SPD's
+  // convention); a camera's video holds only the frames it recorded, so global frame g
+  // is its video frame g - (its drops before g), 1-based (SPD's FrameDropIDLog rule).
+  // -1 when the camera dropped g.
+  int64_t VideoFrameNumber(int view, int64_t global_frame) const;
+};
+
+// `source` names the manifest in error messages.
+StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const std::string& source);
+StatusOr<CaptureManifest> ReadCaptureManifest(const std::string& capture_dir);
+Json CaptureManifestToJson(const CaptureManifest& manifest);
+Status WriteCaptureManifest(const std::string& capture_dir, const CaptureManifest& manifest);
+
+// Path of a manifest entry: relative entries are resolved against `dir`.
+std::string ResolveCapturePath(const std::string& dir, const std::string& entry);
+
+// Reads the 2D keypoints named by the manifest and checks their shape against it:
+// (frame_count, cameras, layout size, 3). Frames a camera dropped are set to NaN.
+StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,
+                                                  const CaptureManifest& manifest);
+
+// Result folder: writes RESULT_DIR/triangulation/ (built in a temporary folder and
+// renamed into place) and records the stage in result.json, keeping other stages.
+struct TriangulationStageInfo {
+  std::string capture_dir;
+  std::string units;  // of the rig
+  Json options;       // triangulation and filter options as run
+  SequenceTriangulationSummary summary;
+};
+Status WriteTriangulationResult(const std::string& result_dir,
+                                const CaptureManifest& manifest,
+                                const KeypointLayout& layout,
+                                const SequenceTriangulation& raw,
+                                const NpyArray<double>& points3d_filtered,
+                                const TriangulationStageInfo& info);
+
+// Reads RESULT_DIR/result.json (empty object when absent) and a stage's points3d.npy.
+StatusOr<Json> ReadResultManifest(const std::string& result_dir);
+StatusOr<NpyArray<double>> ReadResultPoints3d(const std::string& result_dir,
+                                              const std::string& stage);
+
+}  // namespace arco

@@ -1,0 +1,193 @@
+#include "arco/mocap/capture.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "arco/mocap/test_dir.h"
+#include "arco/util/file_io.h"
+
+namespace arco {
+namespace {
+
+using testing::TempDir;
+
+CaptureManifest SampleManifest() {
+  CaptureManifest m;
+  m.name = "cello_1113_scale";
+  m.instrument = "cello";
+  m.fps = 30;
+  m.frame_first = 128;
+  m.frame_count = 4;
+  m.tuning_a4_hz = 442;
+  m.calibration = "calibration.xml";
+  m.audio = "audio.wav";
+  m.audio_offset_s = 1.25;
+  m.keypoints2d = "keypoints2d.npy";
+  m.layout = "spd_cello";
+  m.cameras = {{"cam0", "21334181", "videos/21334181.avi", {129, 300}},
+               {"cam1", "21334237", "", {}}};
+  return m;
+}
+
+TEST(KeypointLayout, BuiltInLayoutsHaveSpdSizesAndNames) {
+  auto size = [](const char* n) { return FindKeypointLayout(n)->size(); };
+  EXPECT_EQ(size("coco_wholebody_133"), 133);
+  EXPECT_EQ(size("hand_21"), 21);
+  EXPECT_EQ(size("spd_cello"), 142);
+  EXPECT_EQ(size("spd_violin"), 140);
+  EXPECT_EQ(size("contact_13"), 13);
+  EXPECT_EQ(size("spd_cello_contact"), 155);
+  EXPECT_EQ(size("spd_violin_contact"), 153);
+  EXPECT_EQ(FindKeypointLayout("nope"), nullptr);
+  const KeypointLayout& cello = *FindKeypointLayout("spd_cello_contact");
+  EXPECT_EQ(cello.Find("left_wrist"), 9);
+  EXPECT_EQ(cello.Find("left_hand_wrist"), 91);
+  EXPECT_EQ(cello.Find("left_hand_index_tip"), 99);
+  EXPECT_EQ(cello.Find("right_hand_little_tip"), 132);
+  EXPECT_EQ(cello.Find("scroll_top"), 133);
+  EXPECT_EQ(cello.Find("nut_l"), 134);
+  EXPECT_EQ(cello.Find("tip"), 141);
+  EXPECT_EQ(cello.Find("string4_top"), 142);
+  EXPECT_EQ(cello.Find("contact"), 150);
+  EXPECT_EQ(cello.Find("finger_tip"), 154);
+  const KeypointLayout& violin = *FindKeypointLayout("spd_violin_contact");
+  EXPECT_EQ(violin.Find("frog"), 138);
+  EXPECT_EQ(violin.Find("string4_top"), 140);
+  EXPECT_EQ(violin.Group("bow")->size(), 2u);
+  EXPECT_EQ(violin.Group("left_hand")->front(), 91);
+  EXPECT_EQ(violin.Group("all")->size(), 153u);
+  EXPECT_EQ(violin.Group("tail"), nullptr);
+  EXPECT_EQ(CanonicalKeypointName("tip_plate"), "tip");
+}
+
+TEST(CaptureManifest, WriteThenReadRoundTrips) {
+  TempDir dir;
+  const CaptureManifest m = SampleManifest();
+  ASSERT_TRUE(WriteCaptureManifest(dir.path(), m).ok());
+  auto r = ReadCaptureManifest(dir.path());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(CaptureManifestToJson(*r), CaptureManifestToJson(m));
+  EXPECT_EQ(r->cameras[0].dropped_frames, (std::vector<int64_t>{129, 300}));
+  EXPECT_EQ(r->FindCamera("21334237"), 1);
+  EXPECT_EQ(r->FindCamera("cam0"), 0);
+  EXPECT_EQ(r->FindCamera("cam9"), -1);
+}
+
+TEST(CaptureManifest, VideoFrameNumbersSkipDroppedFrames) {
+  const CaptureManifest m = SampleManifest();  // cam0 dropped 129 and 300
+  EXPECT_EQ(m.VideoFrameNumber(0, 128), 128);
+  EXPECT_EQ(m.VideoFrameNumber(0, 129), -1);
+  EXPECT_EQ(m.VideoFrameNumber(0, 130), 129);
+  EXPECT_EQ(m.VideoFrameNumber(0, 301), 299);
+  EXPECT_EQ(m.VideoFrameNumber(1, 301), 301);
+}
+
+TEST(CaptureManifest, MalformedManifestsNameTheFileAndProblem) {
+  const Json good = CaptureManifestToJson(SampleManifest());
+  auto parse_with = [&](auto edit) {
+    Json j = good;
+    edit(j);
+    return ParseCaptureManifest(j.dump(), "cap/capture.json");
+  };
+  auto expect_error = [](const StatusOr<CaptureManifest>& r, const std::string& words) {
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.status().message().find("cap/capture.json"), std::string::npos);
+    EXPECT_NE(r.status().message().find(words), std::string::npos) << r.status().message();
+  };
+  expect_error(parse_with([](Json& j) { j.erase("fps"); }), "fps");
+  expect_error(parse_with([](Json& j) { j["fps"] = "thirty"; }), "fps");
+  expect_error(parse_with([](Json& j) { j["fps"] = -1; }), "fps");
+  expect_error(parse_with([](Json& j) { j["format"] = "other"; }), "format");
+  expect_error(parse_with([](Json& j) { j["version"] = 2; }), "version");
+  expect_error(parse_with([](Json& j) { j["instrument"] = "lute"; }), "instrument");
+  expect_error(parse_with([](Json& j) { j["frames"]["count"] = 1.5; }), "count");
+  expect_error(parse_with([](Json& j) { j["cameras"] = Json::array(); }), "cameras");
+  expect_error(parse_with([](Json& j) { j["cameras"][1]["name"] = "cam0"; }), "twice");
+  expect_error(parse_with([](Json& j) { j["cameras"][0]["dropped_frames"] = {1.5}; }),
+               "dropped_frames");
+  expect_error(parse_with([](Json& j) { j["keypoints2d"]["layout"] = "nope"; }), "nope");
+  expect_error(parse_with([](Json& j) { j["keypoints2d"]["layout"] = "custom"; }),
+               "keypoint_names");
+  expect_error(parse_with([](Json& j) { j.erase("calibration"); }), "calibration");
+  expect_error(ParseCaptureManifest("{\"format\": ", "cap/capture.json"), "malformed JSON");
+  expect_error(
+      ParseCaptureManifest("{\"format\": \"arco-capture\", \"fps\": NaN}", "cap/capture.json"), "");
+  expect_error(ParseCaptureManifest("[1, 2]", "cap/capture.json"), "object");
+  EXPECT_FALSE(ReadCaptureManifest("/nonexistent/dir").ok());
+}
+
+TEST(CaptureKeypoints, ShapeIsCheckedAndDroppedFramesBecomeNaN) {
+  TempDir dir;
+  CaptureManifest m = SampleManifest();
+  ASSERT_TRUE(WriteCaptureManifest(dir.path(), m).ok());
+  NpyArray<float> k;
+  k.shape = {4, 2, 142, 3};
+  k.data.assign(4 * 2 * 142 * 3, 5.0f);
+  ASSERT_TRUE(WriteNpy(dir / "keypoints2d.npy", k).ok());
+  auto r = ReadCaptureKeypoints2d(dir.path(), m);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_TRUE(std::isnan(r->at(1, 0, 7, 0)));  // global 129 = frame index 1, dropped by cam0
+  EXPECT_EQ(r->at(1, 1, 7, 0), 5.0);
+  EXPECT_EQ(r->at(0, 0, 7, 0), 5.0);
+  k.shape = {4, 2, 133, 3};
+  k.data.resize(4 * 2 * 133 * 3);
+  ASSERT_TRUE(WriteNpy(dir / "keypoints2d.npy", k).ok());
+  r = ReadCaptureKeypoints2d(dir.path(), m);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("keypoints2d.npy"), std::string::npos);
+  EXPECT_NE(r.status().message().find("(4, 2, 142, 3)"), std::string::npos);
+}
+
+TEST(TriangulationResult, WritesStageFolderAndKeepsOtherStages) {
+  TempDir dir;
+  const std::string result_dir = dir / "result";
+  ASSERT_TRUE(MakeDirectories(result_dir).ok());
+  ASSERT_TRUE(
+      WriteJsonFile(result_dir + "/result.json",
+                    Json{{"format", "arco-result"}, {"stages", {{"arco", {{"dir", "arco"}}}}}})
+          .ok());
+  const CaptureManifest m = SampleManifest();
+  SequenceTriangulation raw;
+  raw.points3d.shape = {4, 142, 3};
+  raw.points3d.data.assign(4 * 142 * 3, 1.0);
+  raw.rms_reprojection_px.shape = {4, 142};
+  raw.rms_reprojection_px.data.assign(4 * 142, 2.0f);
+  raw.num_inliers.shape = raw.num_views.shape = {4, 142};
+  raw.num_inliers.data.assign(4 * 142, 2);
+  raw.num_views.data.assign(4 * 142, 2);
+  raw.inlier_mask.shape = {4, 142, 2};
+  raw.inlier_mask.data.assign(4 * 142 * 2, 1);
+  TriangulationStageInfo info;
+  info.capture_dir = "cap";
+  info.units = "m";
+  info.summary = Summarize(raw);
+  ASSERT_TRUE(WriteTriangulationResult(
+                  result_dir, m, *FindKeypointLayout("spd_cello"), raw, raw.points3d, info)
+                  .ok());
+  auto manifest = ReadResultManifest(result_dir);
+  ASSERT_TRUE(manifest.ok());
+  EXPECT_TRUE((*manifest)["stages"].contains("arco"));
+  EXPECT_EQ((*manifest)["stages"]["triangulation"]["summary"]["triangulated"], 568);
+  EXPECT_EQ((*manifest)["keypoint_names"].size(), 142u);
+  auto points = ReadResultPoints3d(result_dir, "triangulation");
+  ASSERT_TRUE(points.ok());
+  EXPECT_EQ(points->shape, raw.points3d.shape);
+  for (const char* f : {"points3d_raw.npy",
+                        "reprojection_rms_px.npy",
+                        "inlier_count.npy",
+                        "view_count.npy",
+                        "inlier_mask.npy"}) {
+    EXPECT_TRUE(FileExists(result_dir + "/triangulation/" + f)) << f;
+  }
+  int entries = 0;
+  for (const auto& e : std::filesystem::directory_iterator(result_dir)) {
+    (void)e;
+    ++entries;
+  }
+  EXPECT_EQ(entries, 2);  // result.json and triangulation/, no temporary folder left
+}
+
+}  // namespace
+}  // namespace arco

@@ -1,0 +1,253 @@
+#include "arco/mocap/triangulate_point.h"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "arco/geometry/robust.h"
+
+namespace arco {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Reprojection residual with distortion, scaled by sqrt(weight).
+struct ReprojectionCost {
+  const Camera* camera;
+  Eigen::Vector2d pixel;
+  double sqrt_weight;
+
+  template <typename T>
+  bool operator()(const T* point_in_world, T* residual) const {
+    T projected[2];
+    if (!camera->ProjectToPixel(point_in_world, projected)) return false;
+    residual[0] = T(sqrt_weight) * (projected[0] - T(pixel.x()));
+    residual[1] = T(sqrt_weight) * (projected[1] - T(pixel.y()));
+    return true;
+  }
+};
+
+// Undistorted-image error (px) of a conditioned point in one view; +inf behind it.
+double GateErrorPx(const Matrix34d& conditioned_p,
+                   const Eigen::Vector3d& x_conditioned,
+                   const TriangulationScratch::View& v) {
+  const Eigen::Vector3d h = conditioned_p * x_conditioned.homogeneous();
+  if (!(h.z() > 0)) return kInf;
+  return (h.head<2>() / h.z() - v.normalized).norm() * v.focal_px;
+}
+
+}  // namespace
+
+Status TriangulationOptions::Validate() const {
+  auto bad = [](const std::string& m) { return Status::Error("triangulation options: " + m); };
+  if (!(min_score >= 0 && min_score <= 1)) return bad("min_score must be in [0, 1]");
+  if (!(max_reprojection_px > 0 && std::isfinite(max_reprojection_px))) {
+    return bad("max_reprojection_px must be a positive number");
+  }
+  if (max_ransac_trials < 1) return bad("max_ransac_trials must be >= 1");
+  if (!(ransac_confidence > 0 && ransac_confidence < 1)) {
+    return bad("ransac_confidence must be in (0, 1)");
+  }
+  if (!(robust_loss_scale_px > 0 && std::isfinite(robust_loss_scale_px))) {
+    return bad("robust_loss_scale_px must be a positive number");
+  }
+  if (refine && max_refine_iterations < 1) {
+    return bad("max_refine_iterations must be >= 1 when refine is on");
+  }
+  return Status::Ok();
+}
+
+double ReprojectionErrorPx(const Camera& camera,
+                           const Eigen::Vector3d& point_in_world,
+                           const Eigen::Vector2d& pixel) {
+  const auto projected = camera.Project(point_in_world);
+  if (!projected) return kInf;
+  return (*projected - pixel).norm();
+}
+
+Triangulator::Triangulator(const Rig& rig, const TriangulationOptions& options)
+    : rig_(rig), options_(options) {
+  const Status status = options.Validate();
+  if (!status.ok()) throw std::invalid_argument(status.message());
+  if (rig.cameras.empty()) throw std::invalid_argument("Triangulator: the rig has no cameras");
+  std::vector<Eigen::Vector3d> centers;
+  for (const Camera& c : rig_.cameras) centers.push_back(c.CenterInWorld());
+  conditioning_ = ConditioningFromCameraCenters(centers);
+  for (const Camera& c : rig_.cameras) {
+    Matrix34d rt;
+    rt.leftCols<3>() = c.cam_from_world_rotation;
+    rt.col(3) = c.cam_from_world_translation;
+    conditioned_cam_from_world_.push_back(ConditionProjection(rt, conditioning_));
+  }
+  const int n = static_cast<int>(rig_.cameras.size());
+  pair_schedules_.resize(static_cast<size_t>(n) + 1);
+  for (int k = 2; k <= n; ++k) {
+    pair_schedules_[k] = MakePairSchedule(k, options_.max_ransac_trials, options_.seed);
+  }
+}
+
+std::optional<TriangulatedPoint> Triangulator::Triangulate(
+    const std::vector<PointObservation>& observations, TriangulationScratch* scratch_in) const {
+  TriangulationScratch local;
+  TriangulationScratch& s = scratch_in ? *scratch_in : local;
+  const int num_cameras = static_cast<int>(rig_.cameras.size());
+
+  // 1. Usable views, undistorted, in a camera-order independent order.
+  s.views.clear();
+  for (const PointObservation& o : observations) {
+    if (o.camera < 0 || o.camera >= num_cameras) {
+      throw std::invalid_argument("Triangulate: camera index " + std::to_string(o.camera) +
+                                  " outside the rig");
+    }
+    if (!o.pixel.allFinite() || !(o.score >= options_.min_score)) continue;
+    const Camera& cam = rig_.cameras[o.camera];
+    s.views.push_back(
+        {o.camera, o.pixel, o.score, cam.PixelToNormalized(o.pixel), std::sqrt(cam.fx * cam.fy)});
+  }
+  std::sort(s.views.begin(), s.views.end(), [](const auto& a, const auto& b) {
+    if (a.score != b.score) return a.score > b.score;
+    if (a.pixel.x() != b.pixel.x()) return a.pixel.x() < b.pixel.x();
+    return a.pixel.y() < b.pixel.y();
+  });
+  for (size_t i = 1; i < s.views.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      if (s.views[i].camera == s.views[j].camera) {
+        throw std::invalid_argument("Triangulate: camera " + std::to_string(s.views[i].camera) +
+                                    " observed twice");
+      }
+    }
+  }
+  const int n = static_cast<int>(s.views.size());
+  if (n < 2) return std::nullopt;
+  const double gate = options_.max_reprojection_px;
+  auto p_of = [&](int view) -> const Matrix34d& {
+    return conditioned_cam_from_world_[s.views[view].camera];
+  };
+
+  // 2. RANSAC over pairs: most inliers wins, ties by the truncated (MSAC) cost.
+  s.inlier.assign(n, 0);
+  s.best_inlier.assign(n, 0);
+  int best_count = 0;
+  double best_cost = kInf;
+  int64_t needed = std::numeric_limits<int64_t>::max();
+  int64_t trial = 0;
+  for (const auto& [a, b] : pair_schedules_[n]) {
+    if (trial >= needed) break;
+    ++trial;
+    const auto x = TriangulateTwoViewsConditioned(
+        p_of(a), s.views[a].normalized, p_of(b), s.views[b].normalized);
+    if (!x) continue;
+    int count = 0;
+    double cost = 0;
+    for (int k = 0; k < n; ++k) {
+      const double e = GateErrorPx(p_of(k), *x, s.views[k]);
+      const bool in = e < gate;
+      s.inlier[k] = in;
+      count += in;
+      cost += in ? e * e : gate * gate;
+    }
+    if (!s.inlier[a] || !s.inlier[b]) continue;  // behind a sampled camera or inconsistent
+    if (count > best_count || (count == best_count && cost < best_cost)) {
+      best_count = count;
+      best_cost = cost;
+      s.best_inlier = s.inlier;
+      if (best_count == n) break;
+      needed =
+          RansacTrialsNeeded(static_cast<double>(best_count) / n, 2, options_.ransac_confidence);
+    }
+  }
+  if (best_count < 2) return std::nullopt;
+
+  // 3. Weighted DLT on the inliers; re-gate against all views and solve once more
+  //    when the consensus set changed (local optimisation, Chum et al. 2003).
+  auto solve_inliers = [&](const std::vector<char>& in) -> std::optional<Eigen::Vector3d> {
+    s.dlt.clear();
+    for (int k = 0; k < n; ++k) {
+      if (!in[k]) continue;
+      const double w = (options_.weight_by_score ? s.views[k].score : 1.0) * s.views[k].focal_px;
+      s.dlt.push_back({p_of(k), s.views[k].normalized, w});
+    }
+    return TriangulateDltConditioned(s.dlt.data(), static_cast<int>(s.dlt.size()));
+  };
+  std::optional<Eigen::Vector3d> xc = solve_inliers(s.best_inlier);
+  for (int round = 0; round < 2 && xc; ++round) {
+    int count = 0;
+    bool changed = false;
+    for (int k = 0; k < n; ++k) {
+      const bool in = GateErrorPx(p_of(k), *xc, s.views[k]) < gate;
+      s.inlier[k] = in;
+      count += in;
+      changed |= (in != static_cast<bool>(s.best_inlier[k]));
+    }
+    if (!changed) break;
+    if (count < 2) {
+      xc.reset();
+      break;
+    }
+    s.best_inlier = s.inlier;
+    xc = solve_inliers(s.best_inlier);
+  }
+  if (!xc) return std::nullopt;
+  Eigen::Vector3d x_world = conditioning_.center + conditioning_.scale * *xc;
+
+  // 4. Robust Levenberg-Marquardt on the distorted reprojection error.
+  TriangulatedPoint result;
+  if (options_.refine) {
+    ceres::Problem::Options problem_options;
+    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(problem_options);
+    ceres::SoftLOneLoss loss(options_.robust_loss_scale_px);
+    Eigen::Vector3d x = x_world;
+    for (int k = 0; k < n; ++k) {
+      if (!s.best_inlier[k]) continue;
+      const double w = options_.weight_by_score ? s.views[k].score : 1.0;
+      auto* cost = new ceres::AutoDiffCostFunction<ReprojectionCost, 2, 3>(
+          new ReprojectionCost{&rig_.cameras[s.views[k].camera], s.views[k].pixel, std::sqrt(w)});
+      problem.AddResidualBlock(cost, &loss, x.data());
+    }
+    ceres::Solver::Options solver_options;
+    solver_options.minimizer_type = ceres::TRUST_REGION;
+    solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+    solver_options.linear_solver_type = ceres::DENSE_QR;
+    solver_options.max_num_iterations = options_.max_refine_iterations;
+    solver_options.logging_type = ceres::SILENT;
+    solver_options.minimizer_progress_to_stdout = false;
+    solver_options.num_threads = 1;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &problem, &summary);
+    if (summary.IsSolutionUsable() && x.allFinite() && summary.final_cost <= summary.initial_cost) {
+      x_world = x;
+      result.refined = true;
+    }
+  }
+
+  // Final classification with the true (distorted) projection.
+  result.point_in_world = x_world;
+  result.num_views = n;
+  double sum_sq = 0;
+  for (int k = 0; k < n; ++k) {
+    const double e =
+        ReprojectionErrorPx(rig_.cameras[s.views[k].camera], x_world, s.views[k].pixel);
+    if (e < gate) {
+      result.inlier_cameras.push_back(s.views[k].camera);
+      sum_sq += e * e;
+    }
+  }
+  if (result.inlier_cameras.size() < 2) return std::nullopt;
+  std::sort(result.inlier_cameras.begin(), result.inlier_cameras.end());
+  result.rms_reprojection_px =
+      std::sqrt(sum_sq / static_cast<double>(result.inlier_cameras.size()));
+  return result;
+}
+
+std::optional<TriangulatedPoint> TriangulateRobust(const Rig& rig,
+                                                   const TriangulationOptions& options,
+                                                   const std::vector<PointObservation>& views) {
+  return Triangulator(rig, options).Triangulate(views);
+}
+
+}  // namespace arco

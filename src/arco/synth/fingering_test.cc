@@ -1,0 +1,137 @@
+#include "arco/synth/fingering.h"
+
+#include <gtest/gtest.h>
+
+#include "arco/synth/test_instruments.h"
+
+namespace arco::synth {
+namespace {
+
+using testing::Cello;
+using testing::Violin;
+
+Score Notes(std::vector<std::pair<int, double>> notes) {
+  Score s;
+  double t = 0;
+  for (auto [m, d] : notes) {
+    s.notes.push_back({m, t, t + d - 0.02, 80});
+    t += d;
+  }
+  s.duration_s = t + 0.5;
+  return s;
+}
+
+int FingerOffset(const NoteFingering& f, const std::string& instrument) {
+  for (const auto& span : HandFrameFor(instrument)) {
+    if (span.finger == f.finger && span.extended == f.extended &&
+        f.position_semitones + span.offset_semitones == f.semitone_on_string) {
+      return span.offset_semitones;
+    }
+  }
+  return -100;
+}
+
+// Every planned fingering sounds the written note and is a legal hand frame.
+void ExpectPlayable(const Score& score, const FingeringPlan& plan, const ScoreInstrument& ins) {
+  ASSERT_EQ(plan.notes.size(), score.notes.size());
+  for (size_t i = 0; i < score.notes.size(); ++i) {
+    const NoteFingering& f = plan.notes[i];
+    ASSERT_GE(f.string_index, 0);
+    ASSERT_LT(f.string_index, 4);
+    EXPECT_EQ(ins.open_string_midi[f.string_index] + f.semitone_on_string,
+              score.notes[i].midi_note);
+    if (f.finger == 0) {
+      EXPECT_EQ(f.semitone_on_string, 0);
+    } else {
+      EXPECT_NE(FingerOffset(f, ins.name), -100) << "note " << i;
+    }
+  }
+}
+
+TEST(PlanFingering, LowScaleOnTheCStringUsesFirstPosition) {
+  // C2 D2 E2 F2: open, 1, 3, 4 in first position (finger 1 on D).
+  const Score s = Notes({{36, 0.5}, {38, 0.5}, {40, 0.5}, {41, 0.5}});
+  auto plan = PlanFingering(s, Cello());
+  ASSERT_TRUE(plan.ok()) << plan.status().message();
+  ExpectPlayable(s, *plan, Cello());
+  EXPECT_EQ(plan->notes[0].finger, 0);
+  for (int i = 1; i < 4; ++i) {
+    EXPECT_EQ(plan->notes[i].string_index, 0);
+    EXPECT_EQ(plan->notes[i].position_semitones, 2);
+  }
+  EXPECT_EQ(plan->notes[1].finger, 1);
+  EXPECT_EQ(plan->notes[2].finger, 3);
+  EXPECT_EQ(plan->notes[3].finger, 4);
+  EXPECT_EQ(plan->num_shifts, 0);
+}
+
+TEST(PlanFingering, OpenStringForShortNotesStoppedForLongVibratoNotes) {
+  // A3 short: open A string. A3 long: a stopped note (open strings cannot vibrate).
+  auto short_plan = PlanFingering(Notes({{57, 0.3}}), Cello());
+  ASSERT_TRUE(short_plan.ok());
+  EXPECT_EQ(short_plan->notes[0].finger, 0);
+  EXPECT_EQ(short_plan->notes[0].string_index, 3);
+  auto long_plan = PlanFingering(Notes({{57, 2.0}}), Cello());
+  ASSERT_TRUE(long_plan.ok());
+  // Cheapest by the documented costs: D string, 3rd finger in 5th-semitone position
+  // (0.12 * 5 = 0.60 beats 4th finger in position 4: 0.48 + 0.2 = 0.68).
+  EXPECT_EQ(long_plan->notes[0].string_index, 2);
+  EXPECT_EQ(long_plan->notes[0].finger, 3);
+  EXPECT_EQ(long_plan->notes[0].position_semitones, 5);
+  EXPECT_NEAR(long_plan->total_cost, 0.60, 1e-12);
+}
+
+TEST(PlanFingering, BuiltInPiecesArePlayableWithFewShifts) {
+  for (const auto& ins : {Cello(), Violin(), testing::Viola(), testing::Bass()}) {
+    for (const auto& name : BuiltInPieceNames()) {
+      auto score = MakeBuiltInPiece(name, ins);
+      ASSERT_TRUE(score.ok());
+      auto plan = PlanFingering(*score, ins);
+      ASSERT_TRUE(plan.ok()) << ins.name << " " << name << ": " << plan.status().message();
+      ExpectPlayable(*score, *plan, ins);
+      // A player shifts on a minority of notes.
+      EXPECT_LT(plan->num_shifts, static_cast<int>(score->notes.size()) / 2)
+          << ins.name << " " << name;
+    }
+  }
+}
+
+TEST(PlanFingering, OpenStringPieceUsesOpenStrings) {
+  auto score = MakeBuiltInPiece("open-strings", Cello());
+  ASSERT_TRUE(score.ok());
+  auto plan = PlanFingering(*score, Cello());
+  ASSERT_TRUE(plan.ok());
+  EXPECT_GE(plan->num_open_strings, 8);
+}
+
+TEST(PlanFingering, ShiftCostsTradeOffAgainstPosition) {
+  // With a huge shift cost, the planner stays in one position for a melody that
+  // fits in it; with zero shift cost it moves to the lowest positions.
+  const Score s = Notes({{52, 0.4}, {55, 0.4}, {53, 0.4}, {59, 0.4}, {57, 0.4}});
+  FingeringOptions sticky;
+  sticky.shift_cost = 100;
+  sticky.open_string_cost = 100;
+  auto plan = PlanFingering(s, Cello(), sticky);
+  ASSERT_TRUE(plan.ok());
+  EXPECT_EQ(plan->num_shifts, 0);
+  ExpectPlayable(s, *plan, Cello());
+}
+
+TEST(PlanFingering, RejectsBadOptionsAndUnplayableNotes) {
+  FingeringOptions bad;
+  bad.shift_cost = -1;
+  EXPECT_FALSE(PlanFingering(Notes({{50, 0.5}}), Cello(), bad).ok());
+  bad = {};
+  bad.max_position_semitones = 0;
+  EXPECT_FALSE(bad.Validate().ok());
+  // A5 needs position 18+ on the A string; with max position 5 it is unplayable.
+  FingeringOptions low;
+  low.max_position_semitones = 5;
+  auto plan = PlanFingering(Notes({{81, 0.5}}), Cello(), low);
+  ASSERT_FALSE(plan.ok());
+  EXPECT_NE(plan.status().message().find("note 81 (A5)"), std::string::npos);
+  EXPECT_THROW(HandFrameFor("lute"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace arco::synth

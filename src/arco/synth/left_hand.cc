@@ -1,0 +1,219 @@
+#include "arco/synth/left_hand.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "arco/hand/ik.h"
+#include "arco/hand/kinematics.h"
+#include "arco/synth/fingering.h"
+
+namespace arco::synth {
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+double SmoothStep(double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return x * x * (3 - 2 * x);
+}
+
+hand::HandPose FingerPose(const hand::HandModel& model, double mcp, double pip, double dip) {
+  using hand::FingerDof;
+  hand::HandPose pose;
+  for (int f = 1; f < 5; ++f) {
+    const auto finger = static_cast<hand::Finger>(f);
+    pose.angle_rad(finger, FingerDof::kBaseFlex) = mcp * kDeg;
+    pose.angle_rad(finger, FingerDof::kMiddleFlex) = pip * kDeg;
+    pose.angle_rad(finger, FingerDof::kDistalFlex) = dip * kDeg;
+  }
+  pose.angle_rad(hand::Finger::kThumb, FingerDof::kBaseFlex) = 20 * kDeg;
+  pose.angle_rad(hand::Finger::kThumb, FingerDof::kBaseAbd) = 30 * kDeg;
+  pose.angle_rad(hand::Finger::kThumb, FingerDof::kMiddleFlex) = 15 * kDeg;
+  pose.angle_rad(hand::Finger::kThumb, FingerDof::kDistalFlex) = 15 * kDeg;
+  return hand::ClampToLimits(model, pose);
+}
+
+}  // namespace
+
+Status LeftHandOptions::Validate() const {
+  for (double v : {relax_s, shift_s, change_s}) {
+    if (!(v >= 0) || !std::isfinite(v)) {
+      return Status::Error("left hand: distances and durations must be finite and >= 0");
+    }
+  }
+  for (double v : {press_mcp_deg, press_pip_deg, press_dip_deg}) {
+    if (!(v >= -30 && v <= 120))
+      return Status::Error("left hand: pressing angles must be in [-30, 120] deg");
+  }
+  return Status::Ok();
+}
+
+LeftHandAnimator::LeftHandAnimator(const hand::HandModel& model,
+                                   const InstrumentModel& instrument,
+                                   const InstrumentTemplate& tmpl,
+                                   const Performance& performance,
+                                   const LeftHandOptions& options)
+    : model_(model), instrument_(instrument), tmpl_(tmpl), perf_(performance), options_(options) {
+  const Status status = options.Validate();
+  if (!status.ok()) throw std::invalid_argument(status.message());
+  if (model.side() != hand::HandSide::kLeft) {
+    throw std::invalid_argument("LeftHandAnimator needs a left hand model");
+  }
+  // Wrist frame in the instrument frame: index side (-x of a left hand) towards
+  // the nut (+x), fingers pointing forward over the fingerboard and a little
+  // towards the low strings, palm facing the low-string side.
+  const Eigen::Vector3d x_hand(-1, 0, 0);
+  const Eigen::Vector3d y_hand = Eigen::Vector3d(0, 0.35, 0.94).normalized();
+  wrist_rotation_.col(0) = x_hand;
+  wrist_rotation_.col(1) = y_hand;
+  wrist_rotation_.col(2) = x_hand.cross(y_hand);
+  middle_mcp_in_wrist_ = model.rest_point_mm(hand::KeypointIndex(hand::Finger::kMiddle, 0));
+  press_pose_ =
+      FingerPose(model, options.press_mcp_deg, options.press_pip_deg, options.press_dip_deg);
+  curl_pose_ = FingerPose(model, 35, 55, 20);
+  const hand::HandPointsMm in_wrist = hand::ForwardKinematicsInWrist(model, press_pose_);
+  tip_from_mcp_.resize(5);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int f = 0; f < 5; ++f) {
+    tip_from_mcp_[f] =
+        wrist_rotation_ *
+        (in_wrist[hand::TipKeypoint(static_cast<hand::Finger>(f))] - middle_mcp_in_wrist_);
+    if (f > 0) mean += tip_from_mcp_[f] / 4;
+  }
+  // Anchors per note and the glide into each note.
+  int max_offset = 0;
+  for (const FingerSpan& s : HandFrameFor(instrument.name())) {
+    if (!s.extended) max_offset = std::max(max_offset, s.offset_semitones);
+  }
+  const int n = instrument.num_strings();
+  const auto& notes = performance.notes;
+  for (size_t i = 0; i < notes.size(); ++i) {
+    const PerformedNote& note = notes[i];
+    const int string = n - note.fingering.string_index;
+    Eigen::Vector3d anchor;
+    if (note.fingering.finger > 0) {
+      const double centre_hz =
+          MidiToHz(note.note.midi_note + note.intonation_cents / 100.0, performance.a4_hz);
+      anchor = ContactInInstrument(instrument, tmpl, string, centre_hz) -
+               tip_from_mcp_[note.fingering.finger];
+    } else {
+      const double x = PlaceX(note.fingering.position_semitones + 0.5 * max_offset);
+      anchor = Eigen::Vector3d(x, StringY(string, x), 0) - mean;
+    }
+    anchors_.push_back(anchor);
+    double glide = options.change_s;
+    if (i > 0) {
+      if (note.fingering.position_semitones != notes[i - 1].fingering.position_semitones)
+        glide = options.shift_s;
+      glide = std::min(glide, 0.5 * (note.note.onset_s - notes[i - 1].note.onset_s));
+    }
+    glide_s_.push_back(glide);
+  }
+}
+
+double LeftHandAnimator::PlaceX(double semitones) const {
+  return instrument_.string_length_mm() * std::pow(2.0, -semitones / 12.0);
+}
+
+double LeftHandAnimator::StringY(int string, double x) const {
+  const StringSegment& s = tmpl_.strings_mm[static_cast<size_t>(string - 1)];
+  const double f = std::clamp(x / instrument_.string_length_mm(), 0.0, 1.0);
+  return s.PointAtFraction(f).y();
+}
+
+Eigen::Vector3d LeftHandAnimator::AnchorAt(double t) const {
+  const auto& notes = perf_.notes;
+  // Next note to start after t.
+  size_t next = 0;
+  while (next < notes.size() && notes[next].note.onset_s <= t) ++next;
+  if (next == 0) return anchors_.front();
+  if (next == notes.size()) return anchors_.back();
+  const double start = notes[next].note.onset_s - glide_s_[next];
+  if (t <= start || glide_s_[next] <= 0) return anchors_[next - 1];
+  return anchors_[next - 1] +
+         (anchors_[next] - anchors_[next - 1]) * SmoothStep((t - start) / glide_s_[next]);
+}
+
+LeftHandFrame LeftHandAnimator::Next(double t) {
+  if (t < last_time_s_) throw std::invalid_argument("LeftHandAnimator: time went backwards");
+  last_time_s_ = t;
+  LeftHandFrame out;
+  out.note_index = perf_.NoteIndexAt(t);
+  out.f0_hz = perf_.F0HzAt(t);
+  const int n = instrument_.num_strings();
+  const auto& notes = perf_.notes;
+  // The note whose hand shape we hold: the sounding one, else the next, else the last.
+  int held = out.note_index;
+  if (held < 0) {
+    held = static_cast<int>(notes.size()) - 1;
+    for (size_t i = 0; i < notes.size(); ++i) {
+      if (notes[i].note.onset_s > t) {
+        held = static_cast<int>(i);
+        break;
+      }
+    }
+  }
+  const PerformedNote& hn = notes[static_cast<size_t>(held)];
+  const bool pressed = out.note_index >= 0 && hn.fingering.finger > 0;
+  const int hand_string = n - hn.fingering.string_index;
+
+  Eigen::Vector3d anchor = AnchorAt(t);
+  Eigen::Vector3d contact = Eigen::Vector3d::Constant(NAN);
+  if (pressed) {
+    contact = ContactInInstrument(instrument_, tmpl_, hand_string, out.f0_hz);
+    if (options_.rock_with_vibrato) {
+      const double centre_hz =
+          MidiToHz(hn.note.midi_note + hn.intonation_cents / 100.0, perf_.a4_hz);
+      anchor += contact - ContactInInstrument(instrument_, tmpl_, hand_string, centre_hz);
+    }
+    out.string = hand_string;
+    out.finger = hn.fingering.finger;
+    out.contact_mm = contact;
+  }
+  hand::HandPose pose = previous_ ? *previous_ : press_pose_;
+  pose.world_from_wrist_rotation = wrist_rotation_;
+  pose.wrist_in_world_mm = anchor - wrist_rotation_ * middle_mcp_in_wrist_;
+
+  // Idle fingers (and the thumb behind the neck) relax towards a hovering curl
+  // with a time constant of relax_s, so a finger that stops pressing lifts off
+  // smoothly instead of jumping.
+  const double dt = previous_ ? t - previous_time_s_ : 1e9;
+  const double keep = options_.relax_s > 0 ? std::exp(-dt / options_.relax_s) : 0.0;
+  for (int f = 0; f < 5; ++f) {
+    if (pressed && f == hn.fingering.finger) continue;
+    for (int d = 0; d < 4; ++d) {
+      const int k = 4 * f + d;
+      pose.angles_rad[k] =
+          curl_pose_.angles_rad[k] + keep * (pose.angles_rad[k] - curl_pose_.angles_rad[k]);
+    }
+  }
+  hand::FingerIkOptions press;
+  press.joints = hand::FingerIkJoints::kAll;
+  press.exact_reach = true;
+  press.seed_levels = 0;
+  press.max_iterations = 50;
+  if (previous_) {
+    press.previous_pose = previous_;
+    press.previous_weight_mm_per_rad = 5.0;
+  }
+  if (pressed) {
+    const auto finger = static_cast<hand::Finger>(hn.fingering.finger);
+    hand::HandPose ref = pose;
+    for (int d = 0; d < 4; ++d) {
+      ref.angles_rad[4 * hn.fingering.finger + d] =
+          press_pose_.angles_rad[4 * hn.fingering.finger + d];
+    }
+    pose = hand::SolveFingertipIk(model_, ref, finger, contact, press).pose;
+    // Take up what the joints could not reach by moving the whole hand.
+    const Eigen::Vector3d residual = contact - hand::FingertipInWorld(model_, pose, finger);
+    out.residual_shift_mm = residual.norm();
+    pose.wrist_in_world_mm += residual;
+  }
+  out.pose = pose;
+  previous_ = pose;
+  previous_time_s_ = t;
+  return out;
+}
+
+}  // namespace arco::synth

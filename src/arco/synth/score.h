@@ -1,0 +1,76 @@
+// Scores for synthetic performances: what notes are played and when.
+//
+// A Score is a monophonic list of notes (MIDI numbers, onset/offset in seconds).
+// Built-in pieces are generated per instrument from its open strings, so the same
+// piece name gives a sensible part on cello, violin, viola or double bass. Scores
+// can also be read from a Standard MIDI File (midi_reader.h).
+//
+// Conventions: MIDI note 69 = A4; times are seconds from the start of the
+// performance; notes are sorted by onset and never overlap (offset <= next onset).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "arco/util/status.h"
+
+namespace arco::synth {
+
+// What the score and the fingering planner need to know about an instrument.
+// Filled from the instrument model (see synth_instrument.h); kept minimal so the
+// score layer is testable on its own.
+struct ScoreInstrument {
+  std::string name;                   // "cello", "violin", ...
+  std::vector<int> open_string_midi;  // lowest string first
+  int max_semitones_above_open = 24;  // playable range per string (two octaves)
+  int gm_program = 42;                // General MIDI program (0-based: 42 = cello)
+
+  int LowestMidi() const;
+  int HighestMidi() const;
+  // True when some string can sound `midi_note`.
+  bool InRange(int midi_note) const;
+};
+
+struct ScoreNote {
+  int midi_note = 60;
+  double onset_s = 0;
+  double offset_s = 0;
+  int velocity = 80;  // 1..127
+};
+
+struct Score {
+  std::string name;  // piece name or MIDI file name
+  std::vector<ScoreNote> notes;
+  double duration_s = 0;  // end of the last note plus a short release
+};
+
+// Names of the built-in pieces, in the order `arco synth --help` lists them.
+const std::vector<std::string>& BuiltInPieceNames();
+
+// One-line description of a built-in piece (for --help and docs).
+std::string DescribeBuiltInPiece(const std::string& name);
+
+// Generates a built-in piece for an instrument. `tempo_scale` > 1 plays slower
+// (all durations multiplied). Unknown names return an error listing the names.
+StatusOr<Score> MakeBuiltInPiece(const std::string& name,
+                                 const ScoreInstrument& instrument,
+                                 double tempo_scale = 1.0);
+
+// Checks ordering, positive durations, no overlap, and that every note is in the
+// instrument's range; the error names the first offending note ("note 30 (F#1)
+// at 2.500 s is below the cello's lowest note C2 (36)"). `source` prefixes it.
+Status ValidateScore(const Score& score,
+                     const ScoreInstrument& instrument,
+                     const std::string& source);
+
+// Keeps only the notes that start before `max_duration_s` (clipping the last),
+// so a long piece can be shortened for a demo. No-op when <= 0.
+Score TruncateScore(const Score& score, double max_duration_s);
+
+// "C4", "F#1", "A#5": scientific pitch name with sharps (MIDI 60 = C4).
+std::string MidiNoteName(int midi_note);
+
+// Frequency of a MIDI note plus a deviation in cents, given A4.
+double MidiToHz(double midi_note, double a4_hz = 440.0);
+
+}  // namespace arco::synth

@@ -1,0 +1,97 @@
+#include "arco/synth/score.h"
+
+#include <gtest/gtest.h>
+
+#include "arco/synth/test_instruments.h"
+
+namespace arco::synth {
+namespace {
+
+using testing::Bass;
+using testing::Cello;
+using testing::Viola;
+using testing::Violin;
+
+TEST(MidiNoteName, NamesOctavesAndSharps) {
+  EXPECT_EQ(MidiNoteName(60), "C4");
+  EXPECT_EQ(MidiNoteName(36), "C2");
+  EXPECT_EQ(MidiNoteName(30), "F#1");
+  EXPECT_EQ(MidiNoteName(69), "A4");
+  EXPECT_EQ(MidiNoteName(0), "C-1");
+  EXPECT_NEAR(MidiToHz(69), 440.0, 1e-12);
+  EXPECT_NEAR(MidiToHz(36), 65.406, 1e-3);
+  EXPECT_NEAR(MidiToHz(57, 442.0), 221.0, 1e-9);
+}
+
+TEST(MakeBuiltInPiece, EveryPieceIsValidOnEveryInstrument) {
+  for (const auto& ins : {Cello(), Violin(), Viola(), Bass()}) {
+    for (const auto& name : BuiltInPieceNames()) {
+      auto score = MakeBuiltInPiece(name, ins);
+      ASSERT_TRUE(score.ok()) << ins.name << " " << name << ": " << score.status().message();
+      EXPECT_GT(score->notes.size(), 10u);
+      EXPECT_TRUE(ValidateScore(*score, ins, name).ok());
+      EXPECT_GT(score->duration_s, score->notes.back().offset_s);
+      EXPECT_FALSE(DescribeBuiltInPiece(name).empty());
+    }
+  }
+}
+
+TEST(MakeBuiltInPiece, ScaleStartsOnLowestOpenStringAndClimbsTwoOctaves) {
+  auto score = MakeBuiltInPiece("scale-2oct", Cello());
+  ASSERT_TRUE(score.ok());
+  ASSERT_EQ(score->notes.size(), 29u);
+  EXPECT_EQ(score->notes.front().midi_note, 36);  // C2
+  EXPECT_EQ(score->notes[1].midi_note, 38);       // D2
+  EXPECT_EQ(score->notes[14].midi_note, 60);      // C4
+  EXPECT_EQ(score->notes.back().midi_note, 36);
+  // Tempo scale stretches every time.
+  auto slow = MakeBuiltInPiece("scale-2oct", Cello(), 2.0);
+  ASSERT_TRUE(slow.ok());
+  EXPECT_NEAR(slow->notes[3].onset_s - 0.25, 2 * (score->notes[3].onset_s - 0.25), 1e-12);
+}
+
+TEST(MakeBuiltInPiece, SlowMelodyHasLongNotes) {
+  auto score = MakeBuiltInPiece("slow-melody", Cello());
+  ASSERT_TRUE(score.ok());
+  int long_notes = 0;
+  for (const auto& n : score->notes) long_notes += (n.offset_s - n.onset_s) > 1.0;
+  EXPECT_GE(long_notes, 5);
+}
+
+TEST(MakeBuiltInPiece, UnknownPieceListsTheNames) {
+  auto score = MakeBuiltInPiece("bolero", Cello());
+  ASSERT_FALSE(score.ok());
+  EXPECT_NE(score.status().message().find("unknown piece 'bolero'"), std::string::npos);
+  EXPECT_NE(score.status().message().find("scale-2oct"), std::string::npos);
+  EXPECT_FALSE(MakeBuiltInPiece("scale-2oct", Cello(), 0.0).ok());
+}
+
+TEST(ValidateScore, NamesTheOutOfRangeNote) {
+  Score s;
+  s.notes = {{48, 0.0, 0.5, 80}, {30, 2.5, 3.0, 80}};
+  const Status status = ValidateScore(s, Cello(), "tune.mid");
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.message(),
+            "tune.mid: note 30 (F#1) at 2.500 s is outside the cello's range C2 (36) to A5 (81)");
+  s.notes = {{48, 0.0, 0.5, 80}, {50, 0.4, 0.8, 80}};
+  EXPECT_NE(ValidateScore(s, Cello(), "x").message().find("starts before"), std::string::npos);
+  s.notes = {{48, 0.5, 0.5, 80}};
+  EXPECT_NE(ValidateScore(s, Cello(), "x").message().find("no positive duration"),
+            std::string::npos);
+  s.notes.clear();
+  EXPECT_FALSE(ValidateScore(s, Cello(), "x").ok());
+}
+
+TEST(TruncateScore, KeepsNotesBeforeTheLimit) {
+  auto score = MakeBuiltInPiece("scale-2oct", Cello());
+  ASSERT_TRUE(score.ok());
+  const Score t = TruncateScore(*score, 3.0);
+  ASSERT_FALSE(t.notes.empty());
+  EXPECT_LT(t.notes.size(), score->notes.size());
+  EXPECT_LE(t.notes.back().offset_s, 3.0);
+  EXPECT_LE(t.duration_s, 3.5);
+  EXPECT_EQ(TruncateScore(*score, 0).notes.size(), score->notes.size());
+}
+
+}  // namespace
+}  // namespace arco::synth
