@@ -22,16 +22,19 @@ bool NeedsIk(const DecodeContext& context, const FrameContact& c, int f) {
          c.point_in_world_mm.allFinite();
 }
 
+// IK of the contact's finger, started from (and anchored at) `start`, by default the
+// fitted (vision) hand.
 FrameIk Solve(const DecodeContext& context,
               const FrameContact& c,
               int f,
-              const hand::FingerIkOptions& options) {
-  const hand::FingerIkResult r =
-      hand::SolveFingertipIk(context.input->hand_model,
-                             *context.input->vision_hand[static_cast<size_t>(f)],
-                             static_cast<hand::Finger>(c.finger),
-                             c.point_in_world_mm,
-                             options);
+              const hand::FingerIkOptions& options,
+              const hand::HandPose* start = nullptr) {
+  const hand::FingerIkResult r = hand::SolveFingertipIk(
+      context.input->hand_model,
+      start != nullptr ? *start : *context.input->vision_hand[static_cast<size_t>(f)],
+      static_cast<hand::Finger>(c.finger),
+      c.point_in_world_mm,
+      options);
   FrameIk out;
   out.solved = r.status.ok();
   out.pose = r.pose;
@@ -63,8 +66,8 @@ std::vector<std::optional<hand::HandPose>> SolvePaperIk(const DecodeContext& con
   hand::FingerIkOptions ik;
   ik.joints = hand::FingerIkJoints::kPipDip;
   ik.reference_weight_mm_per_rad = options.reference_weight_mm_per_rad;
-  ik.exact_reach = true;
-  ik.restarts = 0;  // a local solve from the fitted pose, as the paper's L-BFGS-B
+  ik.exact_reach = false;  // one solve of the (nearly) unregularised reach cost
+  ik.restarts = 0;         // a local solve from the fitted pose, as the paper's L-BFGS-B
   ik.max_iterations = options.max_iterations;
   std::vector<FrameIk> solved(static_cast<size_t>(n));
   ParallelFor(n, num_threads, [&](int64_t f, int) {
@@ -96,57 +99,52 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
   ik.exact_reach = true;
   ik.max_iterations = options.max_iterations;
 
-  // Pass 1: each frame on its own.
-  std::vector<FrameIk> pass1(static_cast<size_t>(n));
-  ParallelFor(n, num_threads, [&](int64_t f, int) {
+  // Runs: maximal stretches of consecutive frames to correct with the same note, string and
+  // finger. Within a run the frames are solved in time order, each with a prior toward the
+  // previous frame's solution; runs are independent and solved in parallel.
+  std::vector<std::pair<int, int>> runs;  // [first, last]
+  for (int f = 0; f < n; ++f) {
     const FrameContact& c = (*contacts)[static_cast<size_t>(f)];
-    if (NeedsIk(context, c, static_cast<int>(f))) {
-      pass1[static_cast<size_t>(f)] = Solve(context, c, static_cast<int>(f), ik);
-    }
-  });
-  std::vector<FrameIk> final_ik = pass1;
-
-  // Pass 2: a prior toward the pass-1 angles smoothed within runs of the same note, string
-  // and finger.
-  if (options.temporal_weight_mm_per_rad > 0 && options.temporal_sigma_frames > 0) {
-    const int radius = static_cast<int>(std::ceil(3.0 * options.temporal_sigma_frames));
-    auto same_run = [&](int a, int b) {
-      const FrameContact& ca = (*contacts)[static_cast<size_t>(a)];
-      const FrameContact& cb = (*contacts)[static_cast<size_t>(b)];
-      return pass1[static_cast<size_t>(b)].solved && ca.note == cb.note && ca.string == cb.string &&
-             ca.finger == cb.finger;
-    };
-    ParallelFor(n, num_threads, [&](int64_t f64, int) {
-      const int f = static_cast<int>(f64);
-      const FrameIk& own = pass1[static_cast<size_t>(f)];
-      if (!own.solved) return;
-      const FrameContact& c = (*contacts)[static_cast<size_t>(f)];
-      const int finger = c.finger;
-      double sum[4] = {0, 0, 0, 0}, weight = 0;
-      // Walk out from f while the run continues (the run is contiguous).
-      for (int dir = -1; dir <= 1; dir += 2) {
-        for (int d = (dir < 0 ? 0 : 1); d <= radius; ++d) {
-          const int g = f + dir * d;
-          if (g < 0 || g >= n || !same_run(f, g)) break;
-          const double w = std::exp(
-              -0.5 * d * d / (options.temporal_sigma_frames * options.temporal_sigma_frames));
-          for (int s = 0; s < 4; ++s) {
-            sum[s] += w * pass1[static_cast<size_t>(g)].pose.angles_rad[4 * finger + s];
-          }
-          weight += w;
-        }
+    if (!NeedsIk(context, c, f)) continue;
+    if (!runs.empty() && runs.back().second == f - 1) {
+      const FrameContact& p = (*contacts)[static_cast<size_t>(f - 1)];
+      if (p.note == c.note && p.string == c.string && p.finger == c.finger) {
+        runs.back().second = f;
+        continue;
       }
-      hand::FingerIkOptions ik2 = ik;
-      hand::HandPose smooth = own.pose;
-      for (int s = 0; s < 4; ++s) smooth.angles_rad[4 * finger + s] = sum[s] / weight;
-      ik2.previous_pose = smooth;
-      ik2.previous_weight_mm_per_rad = options.temporal_weight_mm_per_rad;
-      FrameIk second = Solve(context, c, f, ik2);
-      second.solves += own.solves;
-      second.iterations += own.iterations;
-      final_ik[static_cast<size_t>(f)] = second;
-    });
+    }
+    runs.emplace_back(f, f);
   }
+  const bool temporal = options.temporal_weight_mm_per_rad > 0;
+  std::vector<FrameIk> final_ik(static_cast<size_t>(n));
+  ParallelFor(
+      static_cast<int64_t>(runs.size()),
+      num_threads,
+      [&](int64_t r, int) {
+        const auto [first, last] = runs[static_cast<size_t>(r)];
+        for (int f = first; f <= last; ++f) {
+          const FrameContact& c = (*contacts)[static_cast<size_t>(f)];
+          const FrameIk* prev = f > first ? &final_ik[static_cast<size_t>(f - 1)] : nullptr;
+          if (!temporal || prev == nullptr || !prev->solved) {
+            final_ik[static_cast<size_t>(f)] = Solve(context, c, f, ik);
+            continue;
+          }
+          // The cost is symmetric in its two anchors, so the solve starts from the previous
+          // frame's angles of this finger (near the answer: few iterations), anchored there
+          // with the temporal weight, and the fitted pose is the second anchor.
+          const hand::HandPose& vision = *context.input->vision_hand[static_cast<size_t>(f)];
+          hand::HandPose start = vision;
+          for (int s = 0; s < 4; ++s) {
+            start.angles_rad[4 * c.finger + s] = prev->pose.angles_rad[4 * c.finger + s];
+          }
+          hand::FingerIkOptions chained = ik;
+          chained.reference_weight_mm_per_rad = options.temporal_weight_mm_per_rad;
+          chained.previous_pose = vision;
+          chained.previous_weight_mm_per_rad = options.reference_weight_mm_per_rad;
+          final_ik[static_cast<size_t>(f)] = Solve(context, c, f, chained, &start);
+        }
+      },
+      1);
 
   std::vector<std::optional<hand::HandPose>> hands = VisionHands(context);
   for (int f = 0; f < n; ++f) {

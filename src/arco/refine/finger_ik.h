@@ -6,13 +6,13 @@
 // weakly pulled toward the fitted pose; whatever distance remains is reported, no frame is
 // rejected (the paper has no lift test).
 //
-// arco mode, frames independent (parallel) in each pass:
+// arco mode:
 //  1. bounded IK over MCP flexion and abduction, PIP and DIP (ArcoIkOptions::joints) with a
-//     prior toward the fitted (vision) angles;
-//  2. the pass-1 angles of the playing finger are smoothed with a Gaussian over time within
-//     each run of frames sharing note, string and finger; a second IK per frame adds a prior
-//     toward that smoothed solution (temporal smoothness without a sequential dependency);
-//  3. lift test: a solution whose tip stays farther than max_residual_mm from the contact
+//     prior toward the fitted (vision) angles and, for temporal smoothness, toward the
+//     previous frame's solution. Frames are chained in time order only within a run (the
+//     consecutive frames of one note with the same string and finger); runs are
+//     independent and solved in parallel, so results do not depend on the thread count;
+//  2. lift test: a solution whose tip stays farther than max_residual_mm from the contact
 //     is rejected (the finger cannot reach it), the frame flagged kOutOfReach and its hand
 //     left as fitted. (The decoder already rejected contacts beyond the lift distance.)
 // Other fingers, the thumb and the wrist are never changed.

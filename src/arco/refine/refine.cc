@@ -145,9 +145,6 @@ Status ArcoIkOptions::Validate() const {
   if (!(temporal_weight_mm_per_rad >= 0 && Finite(temporal_weight_mm_per_rad))) {
     return Status::Error("arco IK options: temporal_weight_mm_per_rad must be >= 0");
   }
-  if (!(temporal_sigma_frames >= 0 && Finite(temporal_sigma_frames))) {
-    return Status::Error("arco IK options: temporal_sigma_frames must be >= 0");
-  }
   if (!(lift_max_distance_mm >= 0 && Finite(lift_max_distance_mm))) {
     return Status::Error("arco IK options: lift_max_distance_mm must be >= 0 (0 = automatic)");
   }

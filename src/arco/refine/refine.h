@@ -50,8 +50,8 @@ struct PaperOptions {
   double binding_cents = 30.0;  // keep the binding while the pitch stays this close
   // IK of Eq. 3: PIP and DIP of the bound finger, a weak pull toward the fitted pose (the
   // paper has none; it only selects among equally good solutions).
-  double reference_weight_mm_per_rad = 0.1;
-  int max_iterations = 50;
+  double reference_weight_mm_per_rad = 0.01;
+  int max_iterations = 15;
   Status Validate() const;
 };
 
@@ -79,14 +79,13 @@ struct ArcoDecodeOptions {
 struct ArcoIkOptions {
   hand::FingerIkJoints joints = hand::FingerIkJoints::kAll;  // MCP flex+abd, PIP, DIP
   double reference_weight_mm_per_rad = 2.0;  // prior toward the fitted (vision) pose
-  double temporal_weight_mm_per_rad = 4.0;   // toward the temporally smoothed solution
-  double temporal_sigma_frames = 1.5;        // Gaussian smoothing within one note
+  double temporal_weight_mm_per_rad = 4.0;   // toward the previous frame's solution
   // Lift test: a contact farther than this from the fitted fingertip is rejected (0 = the
   // finger's tip-to-PIP length, the dataset authors' cello rule) ...
   double lift_max_distance_mm = 0.0;
   // ... and so is one the bounded IK cannot bring the tip within this distance of.
   double max_residual_mm = 3.0;
-  int max_iterations = 50;
+  int max_iterations = 15;
   Status Validate() const;
 };
 

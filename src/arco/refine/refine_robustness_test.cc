@@ -167,7 +167,7 @@ TEST(Refine, InvalidInputAndOptionsThrowWithAMessage) {
   ob.ik.max_residual_mm = 0;
   EXPECT_FALSE(ob.Validate().ok());
   ob = {};
-  ob.ik.temporal_sigma_frames = NAN;
+  ob.ik.temporal_weight_mm_per_rad = NAN;
   EXPECT_FALSE(ob.Validate().ok());
   ob = {};
   ob.num_threads = -1;
