@@ -10,6 +10,7 @@
 
 #include "arco/hand/kinematics.h"
 #include "arco/mocap/capture.h"
+#include "arco/mocap/keypoint_layout.h"
 #include "arco/util/file_io.h"
 
 namespace arco::refine {
@@ -37,11 +38,15 @@ Status WriteContactsCsv(const std::string& path, const std::vector<FrameContact>
     out << kContactsCsvHeader << '\n';
     for (size_t f = 0; f < contacts.size(); ++f) {
       const FrameContact& c = contacts[f];
+      const bool pressed = c.pressed();
+      const Eigen::Vector3d p = pressed ? c.point_in_world_mm : Eigen::Vector3d::Constant(kNaN);
+      const int open = c.state == ContactState::kOpenString ? c.string : 0;
       out << f << ',' << ContactStateName(c.state) << ',' << ContactReasonName(c.reason) << ','
-          << c.string << ',' << c.finger << ',' << c.note << ',' << Num(c.point_in_world_mm.x())
-          << ',' << Num(c.point_in_world_mm.y()) << ',' << Num(c.point_in_world_mm.z()) << ','
-          << Num(c.from_nut_mm) << ',' << Num(c.f0_hz) << ',' << Num(c.confidence) << ','
-          << Num(c.tip_distance_vision_mm) << ',' << Num(c.tip_distance_refined_mm) << '\n';
+          << (pressed ? c.string : 0) << ',' << (pressed ? c.finger : 0) << ',' << c.note << ','
+          << Num(p.x()) << ',' << Num(p.y()) << ',' << Num(p.z()) << ','
+          << Num(pressed ? c.from_nut_mm : kNaN) << ',' << Num(c.f0_hz) << ',' << Num(c.confidence)
+          << ',' << Num(c.tip_distance_vision_mm) << ',' << Num(c.tip_distance_refined_mm) << ','
+          << open << '\n';
     }
     return Status::Ok();
   });
@@ -116,7 +121,8 @@ NpyArray<double> BuildSpdPoints(const SpdSources& sources,
     hand::HandPointsMm points;
     if (h) {
       points = hand::ForwardKinematics(sources.hand_model, *h);
-      for (int k = 0; k < hand::kNumHandKeypoints; ++k) SetPoint(&out, f, kLeftHandFirst + k, points[k]);
+      for (int k = 0; k < hand::kNumHandKeypoints; ++k)
+        SetPoint(&out, f, kLeftHandFirst + k, points[k]);
     }
     const auto& strings = sources.strings_in_world_mm[static_cast<size_t>(f)];
     const int64_t extra = num_base;
@@ -133,7 +139,9 @@ NpyArray<double> BuildSpdPoints(const SpdSources& sources,
     SetPoint(&out, f, extra + 8, c.point_in_world_mm);
     if (h && c.finger >= 1 && c.finger <= 4) {
       for (int j = 0; j < 4; ++j) {
-        SetPoint(&out, f, extra + 9 + j,
+        SetPoint(&out,
+                 f,
+                 extra + 9 + j,
                  points[hand::KeypointIndex(static_cast<hand::Finger>(c.finger), j)]);
       }
     } else {
@@ -156,7 +164,8 @@ NpyArray<double> HandParams(const std::vector<std::optional<hand::HandPose>>& ha
       out.at(f, c) = aa[c];
       out.at(f, 3 + c) = h->wrist_in_world_mm[c];
     }
-    for (int d = 0; d < hand::kNumJointDofs; ++d) out.at(f, 6 + d) = h->angles_rad[static_cast<size_t>(d)];
+    for (int d = 0; d < hand::kNumJointDofs; ++d)
+      out.at(f, 6 + d) = h->angles_rad[static_cast<size_t>(d)];
   }
   return out;
 }
@@ -174,52 +183,73 @@ StatusOr<std::vector<std::optional<hand::HandPose>>> HandsFromParams(const NpyAr
     hand::HandPose pose;
     pose.SetWristAngleAxis(Eigen::Vector3d(params.at(f, 0), params.at(f, 1), params.at(f, 2)));
     pose.wrist_in_world_mm = Eigen::Vector3d(params.at(f, 3), params.at(f, 4), params.at(f, 5));
-    for (int d = 0; d < hand::kNumJointDofs; ++d) pose.angles_rad[static_cast<size_t>(d)] = params.at(f, 6 + d);
+    for (int d = 0; d < hand::kNumJointDofs; ++d)
+      pose.angles_rad[static_cast<size_t>(d)] = params.at(f, 6 + d);
     out[static_cast<size_t>(f)] = pose;
   }
   return out;
 }
 
-Status WriteMethodResult(const std::string& result_dir, const MethodOutput& output) {
-  ARCO_ASSIGN_OR_RETURN(Json manifest, ReadResultManifest(result_dir));
+Status WriteStageFolder(const std::string& result_dir,
+                        const std::string& stage,
+                        const std::function<Status(const std::string& dir)>& write,
+                        Json entry) {
+  ARCO_RETURN_IF_ERROR(ReadResultManifest(result_dir).status());  // not some other JSON
   ARCO_RETURN_IF_ERROR(MakeDirectories(result_dir));
-  const std::string final_dir = JoinPath(result_dir, output.method);
+  const std::string final_dir = JoinPath(result_dir, stage);
   const std::string tmp_dir =
-      JoinPath(result_dir, "." + output.method + ".tmp-" + std::to_string(::getpid()));
+      JoinPath(result_dir, "." + stage + ".tmp-" + std::to_string(::getpid()));
   std::error_code ec;
   fs::remove_all(tmp_dir, ec);
   ARCO_RETURN_IF_ERROR(MakeDirectories(tmp_dir));
-  Json files = {{"points3d", "points3d.npy"}, {"hand_params", "hand_params.npy"}};
-  auto write_all = [&]() -> Status {
-    ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, "points3d.npy"), output.points3d));
-    ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, "hand_params.npy"), HandParams(output.hands)));
-    if (!output.contacts.empty()) {
-      ARCO_RETURN_IF_ERROR(WriteContactsCsv(JoinPath(tmp_dir, "contacts.csv"), output.contacts));
-      ARCO_RETURN_IF_ERROR(WriteFingeringCsv(JoinPath(tmp_dir, "fingering.csv"), output.fingering));
-      files["contacts"] = "contacts.csv";
-      files["fingering"] = "fingering.csv";
-    }
-    return Status::Ok();
-  };
-  Status status = write_all();
+  Status status = write(tmp_dir);
   if (status.ok()) {
     fs::remove_all(final_dir, ec);
     fs::rename(tmp_dir, final_dir, ec);
-    if (ec) status = Status::Error(final_dir + ": cannot move results into place (" + ec.message() + ")");
+    if (ec)
+      status = Status::Error(final_dir + ": cannot move results into place (" + ec.message() + ")");
   }
   if (!status.ok()) {
     fs::remove_all(tmp_dir, ec);
     return status;
   }
+  entry["dir"] = stage;
+  return RecordStage(result_dir, stage, entry);
+}
+
+Status RecordStage(const std::string& result_dir, const std::string& stage, const Json& entry) {
+  ARCO_ASSIGN_OR_RETURN(Json manifest, ReadResultManifest(result_dir));
   manifest["format"] = "arco-result";
   if (!manifest.contains("version")) manifest["version"] = 1;
-  manifest["stages"][output.method] = {{"dir", output.method},
-                                       {"files", files},
-                                       {"layout", output.layout},
-                                       {"units", "mm"},
-                                       {"options", output.options},
-                                       {"summary", output.summary}};
+  manifest["stages"][stage] = entry;
   return WriteJsonFile(JoinPath(result_dir, kResultManifestName), manifest);
+}
+
+Status WriteMethodResult(const std::string& result_dir, const MethodOutput& output) {
+  Json files = {{"points3d", "points3d.npy"}, {"hand_params", "hand_params.npy"}};
+  if (!output.contacts.empty()) {
+    files["contact"] = "contacts.csv";
+    files["fingering"] = "fingering.csv";
+  }
+  const KeypointLayout* layout = FindKeypointLayout(output.layout);
+  auto write = [&](const std::string& dir) -> Status {
+    ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, "points3d.npy"), output.points3d));
+    ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, "hand_params.npy"), HandParams(output.hands)));
+    if (!output.contacts.empty()) {
+      ARCO_RETURN_IF_ERROR(WriteContactsCsv(JoinPath(dir, "contacts.csv"), output.contacts));
+      ARCO_RETURN_IF_ERROR(WriteFingeringCsv(JoinPath(dir, "fingering.csv"), output.fingering));
+    }
+    return Status::Ok();
+  };
+  return WriteStageFolder(result_dir,
+                          output.method,
+                          write,
+                          {{"files", files},
+                           {"layout", output.layout},
+                           {"keypoint_names", layout ? layout->names : std::vector<std::string>()},
+                           {"units", "mm"},
+                           {"options", output.options},
+                           {"summary", output.summary}});
 }
 
 StatusOr<std::vector<ContactRow>> ReadContactsCsv(const std::string& path) {
@@ -241,26 +271,30 @@ StatusOr<std::vector<ContactRow>> ReadContactsCsv(const std::string& path) {
     while (std::getline(ss, cell, ',')) cells.push_back(cell);
     if (!line.empty() && line.back() == ',') cells.push_back("");
     const std::string where = path + ":" + std::to_string(line_number) + ": ";
-    if (cells.size() != 14) {
-      return Status::Error(where + "expected 14 fields, found " + std::to_string(cells.size()));
+    if (cells.size() != 15) {
+      return Status::Error(where + "expected 15 fields, found " + std::to_string(cells.size()));
     }
     ContactRow r;
-    int64_t i0 = 0, i3 = 0, i4 = 0, i5 = 0;
+    int64_t i0 = 0, i3 = 0, i4 = 0, i5 = 0, i14 = 0;
     double d[8];
     bool ok = ParseInt(cells[0], &i0) && ParseInt(cells[3], &i3) && ParseInt(cells[4], &i4) &&
-              ParseInt(cells[5], &i5);
+              ParseInt(cells[5], &i5) && ParseInt(cells[14], &i14);
     for (int k = 0; k < 8 && ok; ++k) ok = ParseDouble(cells[static_cast<size_t>(6 + k)], &d[k]);
     if (!ok) return Status::Error(where + "a field is not a number");
-    if (cells[1] != "pressed" && cells[1] != "open" && cells[1] != "rest" && cells[1] != "uncertain") {
+    if (cells[1] != "pressed" && cells[1] != "open" && cells[1] != "rest" &&
+        cells[1] != "uncertain") {
       return Status::Error(where + "unknown state '" + cells[1] + "'");
     }
-    if (i3 < 0 || i3 > 4 || i4 < 0 || i4 > 4) return Status::Error(where + "string or finger out of range");
+    if (i3 < 0 || i3 > 4 || i4 < 0 || i4 > 4 || i14 < 0 || i14 > 4) {
+      return Status::Error(where + "string or finger out of range");
+    }
     r.frame = i0;
     r.state = cells[1];
     r.reason = cells[2];
     r.string = static_cast<int>(i3);
     r.finger = static_cast<int>(i4);
     r.note = static_cast<int>(i5);
+    r.open_string = static_cast<int>(i14);
     r.point_mm = Eigen::Vector3d(d[0], d[1], d[2]);
     r.from_nut_mm = d[3];
     r.f0_hz = d[4];

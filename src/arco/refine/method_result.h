@@ -9,12 +9,15 @@
 //                                        angle-axis (3, rad), wrist position (3, mm), the
 //                                        20 joint angles (rad, hand/hand_model.h); NaN row
 //                                        = no hand
-//   RESULT_DIR/<method>/contacts.csv     paper, arco: one row per frame (kContactsCsvHeader)
+//   RESULT_DIR/<method>/contacts.csv     paper, arco: one row per frame (kContactsCsvHeader);
+//                                        frame = row of the arrays, from 0
 //   RESULT_DIR/<method>/fingering.csv    paper, arco: one row per note (kFingeringCsvHeader)
-// and RESULT_DIR/result.json "stages"."<method>" = {dir, files, layout, options, summary}.
+// and RESULT_DIR/result.json "stages"."<method>" = {dir, files (points3d, hand_params,
+// contact, fingering), layout, keypoint_names, units, options, summary}.
 // The folder is written whole or not at all (temporary folder + rename).
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,9 +32,12 @@
 
 namespace arco::refine {
 
+// string, finger and contact_*_mm describe a pressed contact only (0 / NaN otherwise, the
+// columns `arco eval` reads, as truth/contact.csv); open_string names the sounding open
+// string on open-string frames.
 inline constexpr char kContactsCsvHeader[] =
-    "frame,state,reason,string,finger,note,x_mm,y_mm,z_mm,from_nut_mm,f0_hz,confidence,"
-    "tip_distance_vision_mm,tip_distance_refined_mm";
+    "frame,state,reason,string,finger,note,contact_x_mm,contact_y_mm,contact_z_mm,from_nut_mm,"
+    "f0_hz,confidence,tip_distance_vision_mm,tip_distance_refined_mm,open_string";
 inline constexpr char kFingeringCsvHeader[] =
     "note,first_frame,last_frame,onset_s,duration_s,f0_hz,midi_note,note_name,cents_off,state,"
     "string,finger,position_semitones,from_nut_mm,pressed_frames,open_frames,uncertain_frames";
@@ -79,12 +85,24 @@ struct MethodOutput {
 // Writes RESULT_DIR/<method>/ and its entry in result.json (other stages kept).
 Status WriteMethodResult(const std::string& result_dir, const MethodOutput& output);
 
+// Sets result.json "stages"."<stage>" = entry (other stages kept; the manifest is created
+// when absent).
+Status RecordStage(const std::string& result_dir, const std::string& stage, const Json& entry);
+
+// Writes RESULT_DIR/<stage>/ whole or not at all: `write` fills a temporary folder, which
+// then replaces the stage folder; result.json "stages"."<stage>" becomes `entry` plus
+// "dir" (other stages kept; the manifest is created when absent).
+Status WriteStageFolder(const std::string& result_dir,
+                        const std::string& stage,
+                        const std::function<Status(const std::string& dir)>& write,
+                        Json entry);
+
 // One row of contacts.csv, as read back (for `arco eval` and tools).
 struct ContactRow {
   int64_t frame = 0;
   std::string state;  // pressed, open, rest, uncertain
   std::string reason;
-  int string = 0, finger = 0, note = -1;
+  int string = 0, finger = 0, note = -1, open_string = 0;
   Eigen::Vector3d point_mm = Eigen::Vector3d::Constant(kNaN);
   double from_nut_mm = kNaN, f0_hz = 0, confidence = 0;
   double tip_distance_vision_mm = kNaN, tip_distance_refined_mm = kNaN;

@@ -42,7 +42,9 @@ TEST(BuildSpdPoints, SpdLayoutWithStringsContactAndPlayingFinger) {
     EXPECT_EQ(layout->size(), kind == InstrumentKind::kCello ? 155 : 153);
     const int extra = layout->Find("string4_top");
     ASSERT_EQ(extra, kind == InstrumentKind::kCello ? 142 : 140);
-    auto at = [&](int f, int p) { return Eigen::Vector3d(a.at(f, p, 0), a.at(f, p, 1), a.at(f, p, 2)); };
+    auto at = [&](int f, int p) {
+      return Eigen::Vector3d(a.at(f, p, 0), a.at(f, p, 1), a.at(f, p, 2));
+    };
     // Body and instrument points come through; the left hand is the refined one.
     EXPECT_EQ(a.at(5, 0, 1), sources.base_points_mm.at(5, 0, 1));
     EXPECT_EQ(a.at(5, 135, 2), sources.base_points_mm.at(5, 135, 2));
@@ -87,7 +89,8 @@ TEST(HandParams, RoundTrip) {
 
 TEST(WriteMethodResult, WritesTheFolderAndTheManifestAndReadsBack) {
   arco::testing::TempDir dir;
-  const testing::Scene scene = testing::MakeScene(InstrumentKind::kCello, {{0, 0, 0, 2}, {2, 2, 3, 8}});
+  const testing::Scene scene =
+      testing::MakeScene(InstrumentKind::kCello, {{0, 0, 0, 2}, {2, 2, 3, 8}});
   RefineOptions o;
   const RefineResult r = Refine(scene.input, o);
   MethodOutput out;
@@ -147,13 +150,15 @@ TEST(ReadContactsCsv, MalformedFilesNameTheFileAndLine) {
   const auto b = ReadContactsCsv(dir / "b.csv");
   ASSERT_FALSE(b.ok());
   EXPECT_NE(b.status().message().find("b.csv:2"), std::string::npos) << b.status().message();
-  ASSERT_TRUE(AtomicWriteFile(dir / "c.csv", header + "0,pressed,,1,2,0,x,2,3,4,5,6,7,8\n").ok());
+  ASSERT_TRUE(AtomicWriteFile(dir / "c.csv", header + "0,pressed,,1,2,0,x,2,3,4,5,6,7,8,0\n").ok());
   EXPECT_FALSE(ReadContactsCsv(dir / "c.csv").ok());
-  ASSERT_TRUE(AtomicWriteFile(dir / "d.csv", header + "0,flying,,1,2,0,1,2,3,4,5,6,7,8\n").ok());
+  ASSERT_TRUE(AtomicWriteFile(dir / "d.csv", header + "0,flying,,1,2,0,1,2,3,4,5,6,7,8,0\n").ok());
   EXPECT_FALSE(ReadContactsCsv(dir / "d.csv").ok());
-  ASSERT_TRUE(AtomicWriteFile(dir / "e.csv", header + "0,pressed,,9,2,0,1,2,3,4,5,6,7,8\n").ok());
+  ASSERT_TRUE(AtomicWriteFile(dir / "e.csv", header + "0,pressed,,9,2,0,1,2,3,4,5,6,7,8,0\n").ok());
   EXPECT_FALSE(ReadContactsCsv(dir / "e.csv").ok());
-  ASSERT_TRUE(AtomicWriteFile(dir / "f.csv", header + "0,rest,unvoiced,0,0,-1,nan,nan,nan,nan,0,0.1,nan,nan\n").ok());
+  ASSERT_TRUE(AtomicWriteFile(dir / "f.csv",
+                              header + "0,rest,unvoiced,0,0,-1,nan,nan,nan,nan,0,0.1,nan,nan,0\n")
+                  .ok());
   const auto f = ReadContactsCsv(dir / "f.csv");
   ASSERT_TRUE(f.ok()) << f.status().message();
   EXPECT_TRUE(std::isnan((*f)[0].point_mm.x()));
