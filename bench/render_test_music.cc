@@ -18,11 +18,12 @@ int main(int argc, char** argv) {
   const unsigned seed = argc > 3 ? static_cast<unsigned>(std::atoi(argv[3])) : 11;
   if (!arco::MakeDirectories(dir).ok()) return 1;
   for (const char* instrument : {"cello", "violin", "viola", "bass"}) {
-    const auto music = arco::audio::testing::MakeTestMusic(instrument, notes, seed);
+    auto music = arco::audio::testing::MakeTestMusic(instrument, notes, seed);
     const std::string base = arco::JoinPath(dir, instrument);
     arco::Status s = arco::audio::WriteMidiFile(base + ".mid", music.midi);
-    if (s.ok()) s = arco::audio::testing::WriteTruthCsv(base + "_truth.csv", music, 100.0);
     if (s.ok()) s = arco::audio::testing::RenderWithFluidsynth(base + ".mid", base + ".wav");
+    if (s.ok()) s = arco::audio::testing::MarkSilentNotes(base + ".wav", &music);
+    if (s.ok()) s = arco::audio::testing::WriteTruthCsv(base + "_truth.csv", music, 100.0);
     if (!s.ok()) {
       std::fprintf(stderr, "render_test_music: %s\n", s.message().c_str());
       return 1;

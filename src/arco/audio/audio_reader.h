@@ -13,6 +13,10 @@
 
 namespace arco::audio {
 
+// Sample rates outside this range are rejected as unsupported.
+constexpr int kMinRateHz = 1000;
+constexpr int kMaxRateHz = 768000;
+
 struct AudioInfo {
   int sample_rate_hz = 0;
   int channels = 0;

@@ -59,8 +59,9 @@ class FfmpegReader : public AudioReader {
     if (rc < 0) return Status::Error(path + ": cannot open decoder: " + AvError(rc));
     const int rate = r->codec_->sample_rate;
     const int channels = r->codec_->ch_layout.nb_channels;
-    if (rate <= 0 || rate > 10000000) {
-      return Status::Error(path + ": invalid sample rate " + std::to_string(rate));
+    if (rate < kMinRateHz || rate > kMaxRateHz) {
+      return Status::Error(path +
+                           ": unsupported sample rate (need 1-768 kHz): " + std::to_string(rate));
     }
     if (channels <= 0 || channels > 1024) {
       return Status::Error(path + ": invalid channel count " + std::to_string(channels));

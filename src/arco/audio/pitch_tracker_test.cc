@@ -2,12 +2,14 @@
 #include "arco/audio/pitch_tracker.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <cmath>
 #include <fstream>
 #include <sstream>
 
 #include "arco/audio/test_signals.h"
+#include "arco/util/file_io.h"
 
 namespace arco::audio {
 namespace {
@@ -78,7 +80,14 @@ TEST(TrackPitch, NoDriftOverTwelveMinutes) {
   const std::string path = testing::TempPath("long.wav");
   ASSERT_TRUE(testing::WriteToneWavStreaming(path, f0, 720.0, tone).ok());
   auto o = Options("cello", 30.0);
+  rusage before;
+  getrusage(RUSAGE_SELF, &before);
   const auto track = Track(path, o);
+  rusage after;
+  getrusage(RUSAGE_SELF, &after);
+  // Streaming: the 12 minutes (46 MB as float at 16 kHz) are never held at once;
+  // only the output rows (about 4 MB) stay.
+  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 30 * 1024) << "kB of peak memory growth";
   ASSERT_EQ(track.frames.size(), 720u * 30u);
   int checked = 0;
   for (int k = 1; k * period_s < 719; ++k) {
@@ -199,6 +208,44 @@ TEST(TrackPitch, StartPastTheEndIsAFlaggedEmptyResult) {
   EXPECT_TRUE(track.frames.empty());
   ASSERT_FALSE(summary.warnings.empty());
   EXPECT_NE(summary.warnings[0].find("empty"), std::string::npos);
+}
+
+TEST(TrackPitch, ZeroLengthAudioIsAFlaggedEmptyResult) {
+  const std::string path = testing::TempPath("zero.wav");
+  ASSERT_TRUE(testing::WriteWav(path, {}, 44100).ok());
+  PitchSummary summary;
+  const auto track = Track(path, Options("viola"), &summary);
+  EXPECT_TRUE(track.frames.empty());
+  ASSERT_FALSE(summary.warnings.empty());
+  EXPECT_NE(summary.warnings[0].find("no audio samples"), std::string::npos);
+}
+
+TEST(TrackPitch, UnsupportedCodecIsOneClearError) {
+  // A WAV whose format tag (0x7777) no decoder knows.
+  std::string wav = "RIFF";
+  auto put32 = [&](uint32_t v) {
+    for (int i = 0; i < 4; ++i) wav.push_back(char(v >> (8 * i)));
+  };
+  auto put16 = [&](uint16_t v) {
+    for (int i = 0; i < 2; ++i) wav.push_back(char(v >> (8 * i)));
+  };
+  put32(36 + 64);
+  wav += "WAVEfmt ";
+  put32(16);
+  put16(0x7777);
+  put16(1);
+  put32(8000);
+  put32(16000);
+  put16(2);
+  put16(16);
+  wav += "data";
+  put32(64);
+  wav += std::string(64, '\x11');
+  const std::string path = testing::TempPath("odd_codec.wav");
+  ASSERT_TRUE(AtomicWriteFile(path, wav).ok());
+  auto track = TrackPitchFile(path, Options("cello"), nullptr);
+  ASSERT_FALSE(track.ok());
+  EXPECT_EQ(track.status().message().rfind(path + ": ", 0), 0u) << track.status().message();
 }
 
 TEST(WritePitchCsv, RoundTrips) {

@@ -40,8 +40,11 @@ Resampler::Resampler(int input_rate_hz, int output_rate_hz)
   const double ratio = std::max(1.0, static_cast<double>(down_) / static_cast<double>(up_));
   taps_ = 2 * static_cast<int>(std::ceil(kZeroCrossings * ratio));
   taps_ = (taps_ + 7) / 8 * 8;  // the dot product runs 8 lanes; extra taps are zero
-  interpolate_phases_ = up_ > kMaxTablePhases;
-  table_phases_ = static_cast<int>(interpolate_phases_ ? kMaxTablePhases : up_);
+  // At most ~4M coefficients (16 MB) whatever the ratio.
+  const int64_t max_phases =
+      std::max<int64_t>(64, std::min<int64_t>(kMaxTablePhases, (1 << 22) / taps_));
+  interpolate_phases_ = up_ > max_phases;
+  table_phases_ = static_cast<int>(interpolate_phases_ ? max_phases : up_);
   const int rows = table_phases_ + (interpolate_phases_ ? 1 : 0);
   table_.resize(static_cast<size_t>(rows) * taps_);
   // Normalised cutoff in cycles per input sample, and the half-width of support.

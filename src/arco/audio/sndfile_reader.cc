@@ -65,8 +65,9 @@ class SndfileReader : public AudioReader {
     if (reader->file_ == nullptr) {
       return Status::Error(name + ": cannot decode audio: " + sf_strerror(nullptr));
     }
-    if (sf_info.samplerate <= 0 || sf_info.samplerate > 10000000) {
-      return Status::Error(name + ": invalid sample rate " + std::to_string(sf_info.samplerate));
+    if (sf_info.samplerate < kMinRateHz || sf_info.samplerate > kMaxRateHz) {
+      return Status::Error(name + ": unsupported sample rate (need 1-768 kHz): " +
+                           std::to_string(sf_info.samplerate));
     }
     if (sf_info.channels <= 0 || sf_info.channels > kMaxChannels) {
       return Status::Error(name + ": invalid channel count " + std::to_string(sf_info.channels));

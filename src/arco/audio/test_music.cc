@@ -7,6 +7,7 @@
 #include <fstream>
 #include <random>
 
+#include "arco/audio/audio_reader.h"
 #include "arco/util/file_io.h"
 
 namespace arco::audio::testing {
@@ -89,8 +90,12 @@ TestMusic MakeTestMusic(const std::string& instrument, int notes, uint32_t seed)
 TruthVoicing TestMusic::Voicing(double time_s) const {
   const double t = time_s - kFluidsynthLatencyS;
   const auto& notes = midi.tracks[0].notes;
-  for (const auto& n : notes) {
-    if (t >= n.onset_s + 0.06 && t <= n.offset_s - 0.03) return TruthVoicing::kVoiced;
+  for (size_t i = 0; i < notes.size(); ++i) {
+    const auto& n = notes[i];
+    if (t >= n.onset_s + 0.06 && t <= n.offset_s - 0.03) {
+      const bool mute = i < silent.size() && silent[i];
+      return mute ? TruthVoicing::kUnscored : TruthVoicing::kVoiced;
+    }
   }
   for (const auto& n : notes) {
     if (t >= n.onset_s - 0.01 && t < n.offset_s + 0.7) return TruthVoicing::kUnscored;
@@ -123,6 +128,29 @@ Status WriteTruthCsv(const std::string& path, const TestMusic& music, double rat
     }
     return Status::Ok();
   });
+}
+
+Status MarkSilentNotes(const std::string& wav_path, TestMusic* music) {
+  ARCO_ASSIGN_OR_RETURN(auto reader, OpenAudio(wav_path));
+  const double rate = reader->info().sample_rate_hz;
+  std::vector<float> samples, block(1 << 15);
+  while (true) {
+    ARCO_ASSIGN_OR_RETURN(const int64_t n, reader->ReadMono(block.data(), 1 << 15));
+    if (n == 0) break;
+    samples.insert(samples.end(), block.begin(), block.begin() + n);
+  }
+  const auto& notes = music->midi.tracks[0].notes;
+  music->silent.assign(notes.size(), 0);
+  for (size_t i = 0; i < notes.size(); ++i) {
+    const int64_t a = static_cast<int64_t>((notes[i].onset_s + 0.06 + kFluidsynthLatencyS) * rate);
+    const int64_t b = std::min<int64_t>(static_cast<int64_t>(samples.size()),
+                                        static_cast<int64_t>((notes[i].offset_s - 0.03) * rate));
+    double energy = 0;
+    for (int64_t k = a; k < b; ++k) energy += double(samples[k]) * samples[k];
+    const double rms = b > a ? std::sqrt(energy / (b - a)) : 0.0;
+    music->silent[i] = rms < std::pow(10.0, -45.0 / 20.0);
+  }
+  return Status::Ok();
 }
 
 Status RenderWithFluidsynth(const std::string& midi_path,

@@ -3,6 +3,7 @@
 #include "arco/camera/calibration_io.h"
 
 #include <cmath>
+#include <cstdint>
 #include <set>
 #include <sstream>
 
@@ -16,6 +17,43 @@ constexpr const char* kSpdSerials[] = {
     "21334221", "21334219", "21334190", "21334211", "21334218", "21334182", "21334236", "21334210",
 };
 constexpr int kSpdCameraCount = sizeof(kSpdSerials) / sizeof(kSpdSerials[0]);
+
+constexpr int kMaxImageSide = 1000000;
+
+// Names go into JSON and YAML: they must be valid UTF-8 without control characters.
+bool IsPrintableUtf8(const std::string& text) {
+  size_t i = 0;
+  while (i < text.size()) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    int extra = 0;
+    uint32_t code = 0;
+    if (c < 0x80) {
+      if (c < 0x20 || c == 0x7F) return false;
+      ++i;
+      continue;
+    } else if ((c & 0xE0) == 0xC0) {
+      extra = 1, code = c & 0x1F;
+    } else if ((c & 0xF0) == 0xE0) {
+      extra = 2, code = c & 0x0F;
+    } else if ((c & 0xF8) == 0xF0) {
+      extra = 3, code = c & 0x07;
+    } else {
+      return false;
+    }
+    if (i + extra >= text.size()) return false;  // truncated sequence
+    for (int k = 1; k <= extra; ++k) {
+      const unsigned char next = static_cast<unsigned char>(text[i + k]);
+      if ((next & 0xC0) != 0x80) return false;
+      code = (code << 6) | (next & 0x3F);
+    }
+    // Overlong forms, surrogates and values past U+10FFFF are invalid.
+    static constexpr uint32_t kMin[] = {0, 0x80, 0x800, 0x10000};
+    if (code < kMin[extra] || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) return false;
+    if (code < 0xA0) return false;  // C1 controls
+    i += extra + 1;
+  }
+  return true;
+}
 
 bool AllFinite(std::initializer_list<double> values) {
   for (double v : values) {
@@ -47,8 +85,12 @@ const char* CalibrationFormatName(CalibrationFormat format) {
 Status ValidateCamera(const Camera& camera) {
   const std::string who = "camera '" + camera.name + "'";
   if (camera.name.empty()) return Status::Error("a camera has an empty name");
-  if (camera.width <= 0 || camera.height <= 0) {
-    return Status::Error(who + ": image size must be positive (got " +
+  if (!IsPrintableUtf8(camera.name) || !IsPrintableUtf8(camera.serial)) {
+    return Status::Error("a camera name or serial is not printable UTF-8");
+  }
+  if (camera.width <= 0 || camera.height <= 0 || camera.width > kMaxImageSide ||
+      camera.height > kMaxImageSide) {
+    return Status::Error(who + ": image size must be 1 to 1000000 px a side (got " +
                          std::to_string(camera.width) + "x" + std::to_string(camera.height) + ")");
   }
   if (!AllFinite({camera.fx, camera.fy, camera.cx, camera.cy, camera.skew})) {

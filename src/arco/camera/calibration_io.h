@@ -46,7 +46,7 @@ struct Calibration {
 };
 
 // Checks what every reader guarantees and every writer needs: at least one camera,
-// unique non-empty names, positive image size and focal lengths, finite values,
+// unique non-empty names, image sides of 1..1e6 px and focal lengths, finite values,
 // a proper rotation (|R^T R - I| < 1e-6, det > 0). The message names the camera.
 Status ValidateCamera(const Camera& camera);
 Status ValidateRig(const Rig& rig);

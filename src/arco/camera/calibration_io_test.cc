@@ -362,6 +362,7 @@ TEST(ArcoJson, MalformedInputsGiveErrors) {
       {"{}", "no \"cameras\" array"},
       {R"({"cameras": []})", "no cameras"},
       {R"({"format": "other", "cameras": []})", "\"format\""},
+      {R"({"version": 2, "cameras": []})", "unsupported \"version\""},
       {R"({"cameras": [{"name": 1}]})", "no string \"name\""},
       {R"({"cameras": [{"name": "a", "width": 10.5}]})", "no integer \"width\""},
       {R"({"cameras": [{"name": "a", "width": 10, "height": 10, "K": [1]}]})", "1 numbers"},
@@ -383,6 +384,20 @@ TEST(Writers, RejectInvalidRigs) {
   rig = MakeRig();
   rig.cameras[0].fx = std::nan("");
   EXPECT_FALSE(WriteSpdJson(rig).ok());
+}
+
+TEST(ValidateCamera, NamesMustBePrintableUtf8) {
+  Camera cam = MakeRig().cameras[0];
+  for (const std::string name : {"cam\xCD", "a\nb", "\xC0\xAF", "x\xE2\x82", "\xED\xA0\x80"}) {
+    cam.name = name;
+    EXPECT_FALSE(ValidateCamera(cam).ok()) << name;
+  }
+  for (const std::string name : {"caméra 1", "カメラ", "a: \"b\" {c} [d] #e", "\xF0\x9F\x8E\xBB"}) {
+    cam.name = name;
+    EXPECT_TRUE(ValidateCamera(cam).ok()) << name;
+  }
+  cam.serial = "12\x01";
+  EXPECT_FALSE(ValidateCamera(cam).ok());
 }
 
 TEST(SpdRigTable, MapsNamesAndSerialsBothWays) {

@@ -251,6 +251,9 @@ StatusOr<Calibration> ParseArcoJson(const std::string& text, const std::string& 
   if (auto format = json.find("format"); format != json.end() && *format != kArcoFormat) {
     return fail("\"format\" is not \"" + std::string(kArcoFormat) + "\"");
   }
+  if (auto version = json.find("version"); version != json.end() && *version != 1) {
+    return fail("unsupported \"version\" (this arco reads version 1)");
+  }
   auto cameras = json.find("cameras");
   if (cameras == json.end() || !cameras->is_array()) return fail("no \"cameras\" array");
   Calibration result;

@@ -161,6 +161,43 @@ TEST(RealCalibration, RigCentresSurroundThePerformer) {
   }
 }
 
+TEST(RealCalibration, UndistortionRoundTripsOverTheWholeImage) {
+  // Every pixel of every real camera (grid incl. the corners) maps to a normalised
+  // point that projects back onto it: the Gauss-Newton undistortion converges.
+  for (const char* name :
+       {"cello_1113_scale_camera.xml", "camera.xml", "cello_1113_pgy_camera.xml"}) {
+    const Calibration cal = Read(name);
+    for (const Camera& cam : cal.rig.cameras) {
+      double worst_px = 0;
+      for (int i = 0; i <= 20; ++i) {
+        for (int j = 0; j <= 20; ++j) {
+          const Eigen::Vector2d pixel(-0.5 + cam.width * i / 20.0, -0.5 + cam.height * j / 20.0);
+          const Eigen::Vector2d n = cam.PixelToNormalized(pixel);
+          double xd, yd;
+          cam.Distort(n.x(), n.y(), &xd, &yd);
+          const Eigen::Vector2d back(cam.fx * xd + cam.skew * yd + cam.cx, cam.fy * yd + cam.cy);
+          worst_px = std::max(worst_px, (back - pixel).norm());
+        }
+      }
+      EXPECT_LT(worst_px, 1e-6) << name << " " << cam.name;
+    }
+  }
+}
+
+TEST(RealCalibration, RadialDistortionMovesEdgePointsByFifteenToTwentyPixels) {
+  // DOMAIN.md section 4: k1 about -0.08 moves points near the image edge by 15-20 px.
+  const Calibration cal = Read("cello_1113_scale_camera.xml");
+  const Camera& cam = cal.rig.cameras[0];
+  // "Near the edge": 50 px inside the left and right borders, on the principal row.
+  const Eigen::Vector2d left(50.0, cam.cy), right(cam.width - 51.0, cam.cy);
+  for (const Eigen::Vector2d& pixel : {left, right}) {
+    const double shift = (cam.UndistortPixel(pixel) - pixel).norm();
+    std::printf("undistortion shift at (%.0f, %.0f): %.2f px\n", pixel.x(), pixel.y(), shift);
+    EXPECT_GT(shift, 15.0);
+    EXPECT_LT(shift, 20.0);
+  }
+}
+
 TEST(RealCalibration, SpdWriterReproducesAuthorsJson) {
   // Our SPD writer applied to the XML gives the authors' file, key by key.
   const Calibration xml = Read("cello_1113_scale_camera.xml");

@@ -1,5 +1,6 @@
 #include "arco/camera/camera.h"
 
+#include <ceres/jet.h>
 #include <gtest/gtest.h>
 
 #include <random>
@@ -52,6 +53,60 @@ TEST(Camera, ProjectionMatrixMatchesUndistortedProjection) {
   const Eigen::Vector3d p(0.1, 0.2, 0.3);
   Eigen::Vector3d h = cam.ProjectionMatrix() * p.homogeneous();
   EXPECT_TRUE(h.hnormalized().isApprox(*cam.Project(p), 1e-12));
+}
+
+}  // namespace
+}  // namespace arco
+
+namespace arco {
+namespace {
+
+TEST(Camera, UndistortPixelGivesThePinholeProjection) {
+  const Camera cam = MakeDistortedCamera();
+  Camera pinhole = cam;
+  pinhole.distortion = {};
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  for (int i = 0; i < 100; ++i) {
+    const Eigen::Vector3d p_world =
+        cam.CenterInWorld() + cam.cam_from_world_rotation.transpose() *
+                                  Eigen::Vector3d(u(rng), u(rng) * 1.2, 2.0 + u(rng));
+    const Eigen::Vector2d distorted = *cam.Project(p_world);
+    const Eigen::Vector2d ideal = *pinhole.Project(p_world);
+    EXPECT_LT((cam.UndistortPixel(distorted) - ideal).norm(), 1e-8);
+  }
+}
+
+TEST(Camera, AutodiffJacobianMatchesFiniteDifferences) {
+  const Camera cam = MakeDistortedCamera();
+  using Jet = ceres::Jet<double, 3>;
+  const Eigen::Vector3d p = cam.CenterInWorld() + cam.cam_from_world_rotation.transpose() *
+                                                      Eigen::Vector3d(0.3, -0.4, 2.2);
+  Jet point[3], pixel[2];
+  for (int k = 0; k < 3; ++k) point[k] = Jet(p[k], k);
+  ASSERT_TRUE(cam.ProjectToPixel(point, pixel));
+  for (int k = 0; k < 3; ++k) {
+    const double h = 1e-6;
+    Eigen::Vector3d plus = p, minus = p;
+    plus[k] += h;
+    minus[k] -= h;
+    const Eigen::Vector2d numeric = (*cam.Project(plus) - *cam.Project(minus)) / (2 * h);
+    EXPECT_NEAR(pixel[0].v[k], numeric.x(), 1e-5 * std::max(1.0, std::abs(numeric.x())));
+    EXPECT_NEAR(pixel[1].v[k], numeric.y(), 1e-5 * std::max(1.0, std::abs(numeric.y())));
+  }
+  EXPECT_NEAR(pixel[0].a, cam.Project(p)->x(), 1e-12);
+}
+
+TEST(Camera, MetashapeAndOpenCvTangentialRolesAreSwapped) {
+  // With only p1 set, OpenCV moves x by p2-free terms: x' = x + 2 p1 x y,
+  // y' = y + p1 (r^2 + 2 y^2); Metashape's p2 does exactly this (DOMAIN.md section 4).
+  Camera cam;
+  cam.distortion.p1 = 0.01;
+  double xd, yd;
+  const double x = 0.3, y = -0.2, r2 = x * x + y * y;
+  cam.Distort(x, y, &xd, &yd);
+  EXPECT_DOUBLE_EQ(xd, x + 2 * 0.01 * x * y);
+  EXPECT_DOUBLE_EQ(yd, y + 0.01 * (r2 + 2 * y * y));
 }
 
 }  // namespace

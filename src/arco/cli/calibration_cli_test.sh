@@ -12,7 +12,7 @@ check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
 
 "$arco" calibration show "$spd/cello_1113_scale_camera.xml" --json >"$tmp/show.json" 2>"$tmp/err"
 check '[ $? -eq 0 ] && [ ! -s "$tmp/err" ]' "show --json exits 0 without warnings"
-check 'python3 - "$tmp/show.json" "$spd/cello_1113_scale_camera.json" <<"PY"
+check '/usr/bin/python3 - "$tmp/show.json" "$spd/cello_1113_scale_camera.json" <<"PY"
 import json, sys
 show = json.load(open(sys.argv[1]))
 spd = json.load(open(sys.argv[2]))
@@ -38,7 +38,7 @@ for i, serial in enumerate(serials):
 PY' "show --json agrees with the authors' JSON"
 
 "$arco" calibration show "$spd/cello_1113_pgy_camera.xml" --json >"$tmp/pgy.json"
-check 'python3 -c "import json,sys; c=json.load(open(sys.argv[1]))[\"cameras\"]; assert all(x[\"K\"][2]==1149.5 and x[\"K\"][5]==1327.5 for x in c)" "$tmp/pgy.json"' \
+check '/usr/bin/python3 -c "import json,sys; c=json.load(open(sys.argv[1]))[\"cameras\"]; assert all(x[\"K\"][2]==1149.5 and x[\"K\"][5]==1327.5 for x in c)" "$tmp/pgy.json"' \
   "pgy principal point is the image centre"
 
 check '"$arco" calibration show "$spd/camera.json" | grep -q "spd-json, 20 cameras, world units: metashape"' "table header"
@@ -51,7 +51,7 @@ for out in rig.yaml rig.xml rig.json; do
   check 'cmp -s "$tmp/$out.show" "$tmp/orig.show"' "$out round trip prints the same JSON"
 done
 "$arco" calibration convert "$spd/camera.xml" "$tmp/spd.json" --format spd >/dev/null
-check 'python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert sorted(d)==sorted(\"cam%d\"%i for i in range(20))" "$tmp/spd.json"' \
+check '/usr/bin/python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert sorted(d)==sorted(\"cam%d\"%i for i in range(20))" "$tmp/spd.json"' \
   "--format spd writes camN keys"
 
 # Bad input: one line naming the file, exit 1, no output file.

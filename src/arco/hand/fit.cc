@@ -124,7 +124,7 @@ Status HandFitOptions::Validate() const {
   if (!(view_gate_px > 0)) return bad("view_gate_px must be > 0");
   if (min_keypoints_per_view < 1) return bad("min_keypoints_per_view must be >= 1");
   if (min_views < 1) return bad("min_views must be >= 1");
-  if (!(min_initial_points >= 3)) return bad("min_initial_points must be >= 3");
+  if (min_initial_points < 3) return bad("min_initial_points must be >= 3");
   if (!(temporal_angle_weight_px_per_rad >= 0) || !(temporal_rotation_weight_px_per_rad >= 0) ||
       !(temporal_translation_weight_px_per_mm >= 0)) {
     return bad("temporal weights must be >= 0");
@@ -164,11 +164,16 @@ HandFit3dResult FitHandToPoints3d(const HandModel& model,
   if (!valid.ok()) throw std::invalid_argument(valid.message());
   HandFit3dResult result;
   for (const auto& p : points_in_world_mm) result.num_points += p.allFinite();
-  std::optional<HandPose> start = initial;
-  if (!start) start = AlignPalm(model, points_in_world_mm);
+  std::optional<HandPose> start;
+  if (initial && initial->world_from_wrist_rotation.allFinite() &&
+      initial->wrist_in_world_mm.allFinite()) {
+    start = initial;
+  } else {
+    start = AlignPalm(model, points_in_world_mm);
+  }
   if (!start || result.num_points < 3) {
     result.problem = "fewer than 3 usable (finite, non-collinear) palm points to initialise from";
-    result.pose = ClampToLimits(model, initial.value_or(HandPose{}));
+    result.pose = ClampToLimits(model, HandPose{});
     return result;
   }
   PoseParams params(ClampToLimits(model, *start));

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,7 +26,8 @@ namespace arco::hand {
 // convention; a keypoint is missing when its score is below the threshold or
 // its pixel is not finite.
 struct HandKeypoints2d {
-  std::array<Eigen::Vector2d, kNumHandKeypoints> pixels;
+  HandKeypoints2d() { pixels.fill(Eigen::Vector2d::Constant(std::nan(""))); }
+  std::array<Eigen::Vector2d, kNumHandKeypoints> pixels;  // NaN until set
   std::array<double, kNumHandKeypoints> scores{};
 };
 
@@ -84,8 +86,9 @@ struct HandFit3dResult {
   std::string termination;
 };
 
-// Robust fit to 3D keypoints (NaN = missing). Initial wrist pose from a rigid
-// alignment of the palm points (wrist, thumb CMC, four MCPs), or `initial`.
+// Robust fit to 3D keypoints (NaN = missing). Initial pose `initial` when given
+// and finite, else a rigid alignment of the palm points (wrist, thumb CMC, four
+// MCPs) with the angles at zero.
 HandFit3dResult FitHandToPoints3d(const HandModel& model,
                                   const HandPointsMm& points_in_world_mm,
                                   const HandFit3dOptions& options,

@@ -1,9 +1,11 @@
 #include "arco/instrument/pose_smoothing.h"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
+
+#include "arco/geometry/rotation.h"
 
 namespace arco {
 
@@ -30,11 +32,11 @@ std::vector<InstrumentFramePose> SmoothFramePoses(const std::vector<InstrumentFr
   for (int d = 0; d <= radius; ++d) {
     kernel[d] = std::exp(-0.5 * d * d / (options.sigma_frames * options.sigma_frames));
   }
-  std::vector<Eigen::Vector4d> quats(n);
+  std::vector<Eigen::Quaterniond> quats(n);
   std::vector<int> prev_ok(n, -1), next_ok(n, -1);
   for (int f = 0, last = -1; f < n; ++f) {
     if (frames[f].status == FrameFitStatus::kOk) {
-      quats[f] = Eigen::Quaterniond(frames[f].pose.rotation).normalized().coeffs();
+      quats[f] = Eigen::Quaterniond(frames[f].pose.rotation).normalized();
       last = f;
     }
     prev_ok[f] = last;
@@ -56,26 +58,26 @@ std::vector<InstrumentFramePose> SmoothFramePoses(const std::vector<InstrumentFr
     } else if (in.status == FrameFitStatus::kHighResidual && !options.replace_high_residual) {
       continue;
     }
-    Eigen::Matrix4d accum = Eigen::Matrix4d::Zero();
+    std::vector<Eigen::Quaterniond> window;
+    std::vector<double> weights;
     Eigen::Vector3d translation = Eigen::Vector3d::Zero();
     double weight_sum = 0;
     double units = 0;
     for (int g = std::max(0, f - radius); g <= std::min(n - 1, f + radius); ++g) {
       if (frames[g].status != FrameFitStatus::kOk) continue;
       const double w = kernel[std::abs(g - f)];
-      accum += w * quats[g] * quats[g].transpose();
+      window.push_back(quats[g]);
+      weights.push_back(w);
       translation += w * frames[g].pose.translation;
       units = frames[g].pose.world_units_per_mm;
       weight_sum += w;
     }
     if (weight_sum <= 0) continue;
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(accum);
-    Eigen::Vector4d q = eig.eigenvectors().col(3);  // largest eigenvalue (ascending order)
-    if (q(3) < 0) q = -q;                           // canonical sign, so results are reproducible
-    const Eigen::Quaterniond mean(q(3), q(0), q(1), q(2));  // coeffs() order is x, y, z, w
+    const std::optional<Eigen::Quaterniond> mean = AverageQuaternions(window, weights);
+    if (!mean) continue;
     out[f].filled = in.status != FrameFitStatus::kOk;
     out[f].status = FrameFitStatus::kOk;
-    out[f].pose.rotation = mean.normalized().toRotationMatrix();
+    out[f].pose.rotation = mean->normalized().toRotationMatrix();
     out[f].pose.translation = translation / weight_sum;
     out[f].pose.world_units_per_mm = units;
   }

@@ -10,9 +10,10 @@
 //
 // Method: a Gaussian kernel over time (sigma_frames, truncated at radius_frames) over the
 // frames that have a pose with status kOk; translation by the weighted mean; rotation by
-// the weighted quaternion average of Markley et al. 2007 (the eigenvector of
-// sum w q q^T with the largest eigenvalue), which does not depend on order or on the
-// quaternions' signs. The scale (world units per mm) is constant per clip and kept.
+// the weighted quaternion average of Markley et al. 2007 (arco_geometry's
+// AverageQuaternions: the eigenvector of sum w q q^T with the largest eigenvalue), which
+// does not depend on order or on the quaternions' signs. The scale (world units per mm) is constant
+// per clip and kept.
 #pragma once
 
 #include <vector>

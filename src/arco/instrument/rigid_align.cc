@@ -1,13 +1,17 @@
 #include "arco/instrument/rigid_align.h"
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
+
+#include "arco/geometry/alignment.h"
 
 namespace arco {
 
-// TODO(instrument): switch to arco_geometry's (weighted) Umeyama once it lands on main.
+// The spread check here is stricter than AlignPoints' own rank test: a near-collinear
+// triple of noisy keypoints fixes the roll about its line only to noise / spread.
 bool FitRigid(const Eigen::Matrix3Xd& source,
               const Eigen::Matrix3Xd& target,
               const std::vector<int>& indices,
@@ -17,30 +21,24 @@ bool FitRigid(const Eigen::Matrix3Xd& source,
   const int n = static_cast<int>(indices.size());
   if (n < 3) return false;
   Eigen::Vector3d s_mean = Eigen::Vector3d::Zero();
-  Eigen::Vector3d t_mean = Eigen::Vector3d::Zero();
-  for (int i : indices) {
-    s_mean += source.col(i);
-    t_mean += target.col(i);
-  }
+  for (int i : indices) s_mean += source.col(i);
   s_mean /= n;
-  t_mean /= n;
-  Eigen::Matrix3d cross = Eigen::Matrix3d::Zero();  // sum (s - s_mean)(t - t_mean)^T
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (int i : indices) {
-    const Eigen::Vector3d s = source.col(i) - s_mean;
-    cross += s * (target.col(i) - t_mean).transpose();
+  std::vector<Eigen::Vector3d> from(n), to(n);
+  for (int j = 0; j < n; ++j) {
+    const Eigen::Vector3d s = source.col(indices[j]) - s_mean;
     scatter += s * s.transpose();
+    from[j] = source.col(indices[j]);
+    to[j] = target.col(indices[j]);
   }
-  // Collinear (or coincident) source points leave the rotation about their line free.
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter, Eigen::EigenvaluesOnly);
   const double second = std::sqrt(std::max(0.0, eig.eigenvalues()(1)) / n);
   if (!(second >= min_spread)) return false;
-  // Kabsch: R = V diag(1, 1, det(V U^T)) U^T for cross = U S V^T (Umeyama 1991, Eq. 39-40).
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cross, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  if ((svd.matrixV() * svd.matrixU().transpose()).determinant() < 0) d(2, 2) = -1;
-  *rotation = svd.matrixV() * d * svd.matrixU().transpose();
-  *translation = t_mean - *rotation * s_mean;
+  // Closed-form Kabsch/Umeyama solve (arco_geometry).
+  const std::optional<AlignmentResult> fit = AlignPoints(from, to, {}, AlignmentOptions());
+  if (!fit) return false;
+  *rotation = fit->target_from_source.RotationMatrix();
+  *translation = fit->target_from_source.translation;
   return rotation->allFinite() && translation->allFinite();
 }
 

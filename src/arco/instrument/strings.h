@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "arco/geometry/transform.h"
 #include "arco/instrument/instrument_model.h"
 #include "arco/util/status.h"
 
@@ -45,6 +46,15 @@ struct InstrumentPose {
   }
   Eigen::Vector3d ToInstrument(const Eigen::Vector3d& point_in_world) const {
     return rotation.transpose() * (point_in_world - translation) / world_units_per_mm;
+  }
+  // The same map as arco_geometry's similarity transform.
+  Sim3d world_from_instrument() const { return Sim3d(world_units_per_mm, rotation, translation); }
+  static InstrumentPose FromSim3d(const Sim3d& world_from_instrument) {
+    InstrumentPose pose;
+    pose.rotation = world_from_instrument.RotationMatrix();
+    pose.translation = world_from_instrument.translation;
+    pose.world_units_per_mm = world_from_instrument.scale;
+    return pose;
   }
 };
 

@@ -193,6 +193,16 @@ TEST(GeometryFromEdges, DegenerateInputIsAnError) {
   EXPECT_FALSE(GeometryFromEdges(Cello(), scene.edges, hint, bad).ok());
 }
 
+TEST(InstrumentPose, MatchesSim3d) {
+  const Scene scene = MakeScene();
+  const Sim3d sim = scene.truth.world_from_instrument();
+  const Eigen::Vector3d p(100, -5, 20);
+  EXPECT_LT((sim * p - scene.truth.ToWorld(p)).norm(), 1e-12);
+  const InstrumentPose back = InstrumentPose::FromSim3d(sim);
+  EXPECT_LT((back.ToWorld(p) - scene.truth.ToWorld(p)).norm(), 1e-12);
+  EXPECT_LT((back.ToInstrument(scene.truth.ToWorld(p)) - p).norm(), 1e-9);
+}
+
 TEST(StringsInWorld, MatchesTheGeometry) {
   const Scene scene = MakeScene();
   auto g = GeometryFromEdges(Cello(), scene.edges, Performer(scene.performer));

@@ -122,6 +122,27 @@ INSTANTIATE_TEST_SUITE_P(Writers,
 
 using SaveCalibrationTest = TempDir;
 
+TEST_F(SaveCalibrationTest, NamesWithYamlAndXmlSpecialCharactersRoundTrip) {
+  auto cal = LoadCalibration(SpdPath("camera.xml"));
+  ASSERT_TRUE(cal.ok());
+  Rig rig = cal->rig;
+  rig.cameras.resize(5);
+  const std::vector<std::string> names = {
+      "caméra 1", "a: \"b\" {c} [d] #e", "<x & y>", "カメラ", " 'lead' "};
+  for (size_t i = 0; i < names.size(); ++i) rig.cameras[i].name = names[i];
+  rig.cameras[1].serial = "0012";
+  for (const char* file : {"rig.yaml", "rig.xml", "rig.json"}) {
+    ASSERT_TRUE(SaveCalibration(Path(file), rig).ok()) << file;
+    auto back = LoadCalibration(Path(file));
+    ASSERT_TRUE(back.ok()) << back.status().message();
+    ASSERT_EQ(back->rig.cameras.size(), names.size());
+    for (size_t i = 0; i < names.size(); ++i) {
+      EXPECT_EQ(back->rig.cameras[i].name, names[i]) << file;
+      EXPECT_EQ(back->rig.cameras[i].serial, rig.cameras[i].serial) << file;
+    }
+  }
+}
+
 TEST_F(SaveCalibrationTest, RefusesUnknownExtensionAndInvalidRigWithoutLeavingAFile) {
   auto cal = LoadCalibration(SpdPath("camera.xml"));
   ASSERT_TRUE(cal.ok());

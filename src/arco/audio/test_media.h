@@ -1,0 +1,27 @@
+// Writes small test videos with FFmpeg's libraries (tests only): a Matroska
+// file with an FFV1 (lossless) grayscale video whose frame brightness is given
+// per frame, and optionally a PCM audio track.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "arco/util/status.h"
+
+namespace arco::audio::testing {
+
+struct TestVideo {
+  int width = 160, height = 120;
+  int fps = 30;
+  int frames = 90;
+  // Grey level (0..255) of frame k; pixels get this value plus a fixed texture.
+  std::function<double(int frame)> brightness = [](int) { return 64.0; };
+  std::vector<float> audio;  // mono samples at audio_rate_hz; empty: no audio track
+  int audio_rate_hz = 48000;
+  std::string audio_codec = "pcm_s16le";  // or "flac", "aac"
+};
+
+Status WriteTestVideo(const std::string& path, const TestVideo& video);
+
+}  // namespace arco::audio::testing

@@ -1,0 +1,58 @@
+// The work behind `arco pitch` and `arco sync` (pitch_command.cc and
+// sync_command.cc parse argv into these options; tests call these directly).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "arco/audio/notes.h"
+#include "arco/audio/pitch_tracker.h"
+#include "arco/audio/sync.h"
+#include "arco/util/status.h"
+
+namespace arco::cli {
+
+struct PitchRunOptions {
+  std::string input;        // audio file or video with an audio track
+  std::string capture_dir;  // optional: audio, offset, fps, frames, instrument, A4 from
+                            // CAPTURE_DIR/capture.json (explicit options below win)
+  std::string instrument;   // violin | viola | cello | bass | any (default cello)
+  double fps = NAN;         // default 30 (or the manifest's)
+  double start_s = NAN;     // audio time of video frame 0 (default 0 or the manifest's)
+  int64_t frames = -1;      // -1: to the end of the audio (or the manifest's count)
+  int hops_per_frame = 0;
+  double a4_hz = NAN;                   // default 440 (or the manifest's)
+  double min_f0_hz = 0, max_f0_hz = 0;  // overrides of the instrument range
+  std::string output = "pitch.csv";
+  std::string fine_output, notes_output, midi_output;
+};
+
+struct PitchRunResult {
+  std::string input;  // the audio actually read
+  audio::PitchTrackerOptions tracker;
+  audio::PitchSummary summary;
+  double fine_fps = 0;
+  int notes = 0, notes_with_vibrato = 0, glides = 0;
+};
+
+// Tracks, writes pitch.csv (and the optional outputs). Errors are one line that
+// names the file.
+StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& options,
+                                  const audio::ProgressFn& progress = nullptr);
+std::string FormatPitchReport(const PitchRunOptions& options, const PitchRunResult& result);
+
+struct SyncRunOptions {
+  std::string audio;
+  std::string video;
+  std::string capture_dir;  // optional: store the offset as the manifest's audio offset_s
+  audio::SyncOptions sync;
+};
+
+// Finds the event in both files; with capture_dir, writes audio.file (when empty)
+// and audio.offset_s into CAPTURE_DIR/capture.json.
+StatusOr<audio::SyncResult> RunSync(const SyncRunOptions& options);
+std::string FormatSyncReport(const SyncRunOptions& options, const audio::SyncResult& result);
+
+}  // namespace arco::cli

@@ -1,0 +1,149 @@
+// `arco pitch` / `arco sync` work functions: outputs, errors, capture manifests.
+#include "arco/cli/audio.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "arco/audio/test_media.h"
+#include "arco/audio/test_signals.h"
+#include "arco/mocap/capture.h"
+#include "arco/util/file_io.h"
+
+namespace arco::cli {
+namespace {
+
+namespace testing = audio::testing;
+
+TEST(RunPitch, WritesPitchNotesAndMidi) {
+  // A3 for 1 s, rest, C3 with vibrato for 1 s.
+  auto f0 = [](double t) {
+    if (t > 0.2 && t < 1.2) return 220.0;
+    if (t > 1.5 && t < 2.5) return 130.81 * std::exp2(0.3 / 12 * std::sin(2 * M_PI * 6 * t));
+    return 0.0;
+  };
+  testing::ToneOptions tone;
+  tone.harmonics = 6;
+  const std::string wav = testing::TempPath("cli.wav");
+  ASSERT_TRUE(testing::WriteWav(wav, testing::RenderTone(f0, 3.0, tone), 44100).ok());
+  PitchRunOptions o;
+  o.input = wav;
+  o.output = testing::TempPath("pitch.csv");
+  o.notes_output = testing::TempPath("notes.csv");
+  o.midi_output = testing::TempPath("notes.mid");
+  auto result = RunPitch(o);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_EQ(result->summary.frames, 90);
+  EXPECT_EQ(result->notes, 2);
+  EXPECT_EQ(result->notes_with_vibrato, 1);
+  auto rows = audio::ReadPitchCsv(o.output);
+  ASSERT_TRUE(rows.ok());
+  EXPECT_EQ(rows->size(), 90u);
+  auto notes = ReadFileToString(o.notes_output);
+  ASSERT_TRUE(notes.ok());
+  EXPECT_NE(notes->find("note,"), std::string::npos);
+  EXPECT_NE(notes->find(",A3,"), std::string::npos);
+  EXPECT_NE(notes->find(",C3,"), std::string::npos);
+  auto midi = ReadFileToString(o.midi_output);
+  ASSERT_TRUE(midi.ok());
+  auto parsed = audio::ParseMidi(*midi);
+  ASSERT_TRUE(parsed.ok());
+  int note_ons = 0;
+  for (const auto& e : parsed->events) note_ons += e.type == 0x90;
+  EXPECT_EQ(note_ons, 2);
+  const std::string report = FormatPitchReport(o, *result);
+  EXPECT_NE(report.find("notes: 2 (1 with vibrato)"), std::string::npos) << report;
+}
+
+TEST(RunPitch, BadInputIsOneErrorAndNoOutput) {
+  PitchRunOptions o;
+  o.input = testing::TempPath("missing.wav");
+  o.output = testing::TempPath("never.csv");
+  auto result = RunPitch(o);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.status().message().rfind(o.input, 0), 0u) << result.status().message();
+  EXPECT_FALSE(FileExists(o.output));
+  const std::string truncated = testing::TempPath("trunc.wav");
+  ASSERT_TRUE(AtomicWriteFile(truncated, std::string("RIFF\x24\x00\x00\x00WAVEfmt ", 16)).ok());
+  o.input = truncated;
+  EXPECT_FALSE(RunPitch(o).ok());
+  EXPECT_FALSE(FileExists(o.output));
+  // Absurd options are errors too.
+  const std::string wav = testing::TempPath("ok.wav");
+  ASSERT_TRUE(testing::WriteWav(wav, std::vector<float>(4410, 0.0f), 44100).ok());
+  o.input = wav;
+  o.fps = 0;
+  EXPECT_FALSE(RunPitch(o).ok());
+  o.fps = 30;
+  o.instrument = "banjo";
+  EXPECT_FALSE(RunPitch(o).ok());
+  o.instrument = "cello";
+  o.min_f0_hz = 3000;
+  EXPECT_FALSE(RunPitch(o).ok());
+  EXPECT_FALSE(FileExists(o.output));
+  // All-silent audio: a clearly flagged result, not an error.
+  o.min_f0_hz = 0;
+  auto silent = RunPitch(o);
+  ASSERT_TRUE(silent.ok());
+  EXPECT_NE(FormatPitchReport(o, *silent).find("warning: no voiced frames"), std::string::npos);
+}
+
+TEST(RunSyncThenPitch, OffsetGoesThroughTheCaptureManifest) {
+  const std::string dir = testing::TempPath("capture");
+  ASSERT_TRUE(MakeDirectories(dir).ok());
+  CaptureManifest manifest;
+  manifest.name = "take";
+  manifest.instrument = "cello";
+  manifest.fps = 30;
+  manifest.frame_count = 45;
+  manifest.calibration = "calibration.json";
+  CaptureCamera camera;
+  camera.name = "cam0";
+  camera.video = "cam0.mkv";
+  manifest.cameras = {camera};
+  ASSERT_TRUE(WriteCaptureManifest(dir, manifest).ok());
+  // Video: flash at 0.5 s. Audio: a click at 2.0 s, then a G2 tone from 2.2 s.
+  testing::TestVideo video;
+  video.frames = 60;
+  video.brightness = [](int k) { return k >= 15 ? 200.0 : 40.0; };  // frame 15 = 0.5 s
+  ASSERT_TRUE(testing::WriteTestVideo(JoinPath(dir, "cam0.mkv"), video).ok());
+  testing::ToneOptions tone;
+  tone.harmonics = 6;
+  tone.amplitude = 0.3;
+  auto audio = testing::RenderTone([](double t) { return t > 2.2 ? 98.0 : 0.0; }, 4.0, tone);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> gauss(0, 1);
+  for (int i = 0; i < 60; ++i) audio[88200 + i] += static_cast<float>(0.9 * std::exp(-i / 20.0) * gauss(rng));
+  const std::string wav = JoinPath(dir, "take.wav");
+  ASSERT_TRUE(testing::WriteWav(wav, audio, 44100).ok());
+  SyncRunOptions s;
+  s.audio = wav;
+  s.video = JoinPath(dir, "cam0.mkv");
+  s.capture_dir = dir;
+  auto sync = RunSync(s);
+  ASSERT_TRUE(sync.ok()) << sync.status().message();
+  // The light is on from frame 15's exposure start, (15 - 1/2)/30 s.
+  EXPECT_NEAR(sync->offset_s, 2.0 - 14.5 / 30.0, 0.004);
+  auto stored = ReadCaptureManifest(dir);
+  ASSERT_TRUE(stored.ok());
+  EXPECT_DOUBLE_EQ(stored->audio_offset_s, sync->offset_s);
+  EXPECT_EQ(stored->audio, "take.wav");
+  PitchRunOptions p;
+  p.capture_dir = dir;
+  p.output = testing::TempPath("capture_pitch.csv");
+  auto pitch = RunPitch(p);
+  ASSERT_TRUE(pitch.ok()) << pitch.status().message();
+  EXPECT_EQ(pitch->tracker.start_s, sync->offset_s);
+  EXPECT_EQ(pitch->summary.frames, 45);
+  EXPECT_EQ(pitch->tracker.range.name, "cello");
+  auto rows = audio::ReadPitchCsv(p.output);
+  ASSERT_TRUE(rows.ok());
+  // Video frame 30 (1 s into the video) is audio time offset + 1 s = 2.52 s: G2.
+  EXPECT_NEAR((*rows)[30].time_s, sync->offset_s + 1.0, 1e-6);
+  EXPECT_TRUE((*rows)[30].voiced);
+  EXPECT_NEAR((*rows)[30].f0_hz, 98.0, 0.2);
+}
+
+}  // namespace
+}  // namespace arco::cli

@@ -1,0 +1,66 @@
+// `arco eval`: scores every method in a result folder against truth and prints
+// the ablation table (docs/evaluation.md).
+#include <cstdio>
+
+#include "arco/cli/command.h"
+#include "arco/eval/evaluate.h"
+#include "arco/util/json_io.h"
+
+namespace arco::cli {
+namespace {
+
+struct Args {
+  eval::EvalRequest r;
+  std::string output;
+};
+
+int Run(const Args& a) {
+  auto report = eval::Evaluate(a.r);
+  if (!report.ok()) return PrintError(report.status().message());
+  if (!a.output.empty()) {
+    const Status st = WriteJsonFile(a.output, report->ToJson(a.r.metrics));
+    if (!st.ok()) return PrintError(st.message());
+  }
+  std::printf("arco eval: %s truth, %d frames (%d with a pressed note), units %s\n\n",
+              report->truth_kind.c_str(),
+              report->truth_frames,
+              report->contact_frames,
+              report->units.c_str());
+  std::fputs(report->MarkdownTable(a.r.metrics).c_str(), stdout);
+  for (const auto& w : report->warnings)
+    std::fprintf(stderr, "arco eval: warning: %s\n", w.c_str());
+  if (!a.output.empty()) std::printf("\nwrote %s\n", a.output.c_str());
+  return 0;
+}
+
+std::function<int()> SetupEval(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "eval", "Score a result folder against truth (synthetic truth/ or labelled views)");
+  auto a = std::make_shared<Args>();
+  cmd->add_option("result_dir", a->r.result_dir, "Result folder (result.json with stages)")
+      ->required();
+  cmd->add_option(
+         "--truth",
+         a->r.truth,
+         "Truth: an `arco synth` truth folder, or a points JSON from `arco triangulate --view ...`")
+      ->required();
+  cmd->add_option("--truth-frame",
+                  a->r.truth_frame,
+                  "Frame number (capture numbering, from 1) a points JSON labels")
+      ->capture_default_str();
+  cmd->add_option("--pitch",
+                  a->r.pitch_csv,
+                  "Estimated pitch.csv (default: RESULT_DIR/pitch.csv when present)");
+  cmd->add_option("--pck-mm", a->r.metrics.pck_thresholds_mm, "PCK thresholds (mm)")
+      ->capture_default_str();
+  cmd->add_option("--limit-tolerance-deg",
+                  a->r.joint_limit_tolerance_deg,
+                  "Tolerance before a geometric joint angle counts as a limit violation (deg)")
+      ->capture_default_str();
+  cmd->add_option("-o,--output", a->output, "Write the metrics as JSON here");
+  return [a] { return Run(*a); };
+}
+
+}  // namespace
+ARCO_REGISTER_COMMAND(eval, 70, SetupEval);
+}  // namespace arco::cli

@@ -1,0 +1,41 @@
+// `arco sync`: the audio offset of a video from a clap (or any sharp event).
+#include <cstdio>
+#include <memory>
+
+#include "arco/cli/audio.h"
+#include "arco/cli/command.h"
+
+namespace arco::cli {
+namespace {
+
+std::function<int()> SetupSync(CLI::App& app) {
+  auto o = std::make_shared<SyncRunOptions>();
+  auto* cmd = app.add_subcommand(
+      "sync", "Find a clap/flash in audio and video; print offset_s (audio = video + offset)");
+  cmd->add_option("audio", o->audio, "Audio recording (or a video whose audio track to use)")
+      ->required();
+  cmd->add_option("--video", o->video, "Video of one camera showing the event")->required();
+  cmd->add_option("--fps", o->sync.video_fps, "Video frame rate (Hz; default: the stream's)");
+  cmd->add_option("--audio-near-s",
+                  o->sync.audio_near_s,
+                  "Look for the audio event near this time (s; default: strongest anywhere)");
+  cmd->add_option(
+      "--video-near-s", o->sync.video_near_s, "Look for the video event near this video time (s)");
+  cmd->add_option("--search-s", o->sync.search_s, "Half-width of the windows above (s)")
+      ->capture_default_str();
+  cmd->add_option("--max-s", o->sync.max_seconds, "Scan at most this much of each file (s)")
+      ->capture_default_str();
+  cmd->add_option("--capture",
+                  o->capture_dir,
+                  "Capture folder: store the offset as audio.offset_s in its capture.json");
+  return [o] {
+    auto result = RunSync(*o);
+    if (!result.ok()) return PrintError(result.status().message());
+    std::fputs(FormatSyncReport(*o, *result).c_str(), stdout);
+    return 0;
+  };
+}
+
+}  // namespace
+ARCO_REGISTER_COMMAND(sync, 101, SetupSync);
+}  // namespace arco::cli

@@ -1,0 +1,222 @@
+// `arco synth`: a synthetic performance with exact truth (docs/synth.md).
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
+#include "arco/cli/command.h"
+#include "arco/io/calibration_file.h"
+#include "arco/synth/capture_writer.h"
+#include "arco/synth/synth.h"
+
+#ifndef ARCO_SHARED_DATA_DIR
+#define ARCO_SHARED_DATA_DIR ""
+#endif
+
+namespace arco::cli {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr char kDefaultRig[] = "spd/cello_1113_scale_camera.xml";
+
+// The SPD rig: $ARCO_SHARED_DATA_DIR, then the data folder this binary was built
+// with, then ../shared/data next to the repository that holds the binary
+// (REPO/build/bin/arco), then ../shared/data from the working directory.
+std::string DefaultCalibration() {
+  std::vector<fs::path> candidates;
+  if (const char* env = std::getenv("ARCO_SHARED_DATA_DIR"))
+    candidates.emplace_back(fs::path(env) / kDefaultRig);
+  if (*ARCO_SHARED_DATA_DIR) candidates.emplace_back(fs::path(ARCO_SHARED_DATA_DIR) / kDefaultRig);
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    for (fs::path p = exe.parent_path(); !p.empty() && p != p.root_path(); p = p.parent_path()) {
+      candidates.emplace_back(p / ".." / "shared" / "data" / kDefaultRig);
+    }
+  }
+  candidates.emplace_back(fs::path("..") / "shared" / "data" / kDefaultRig);
+  for (const fs::path& c : candidates) {
+    if (fs::exists(c, ec)) return fs::weakly_canonical(c, ec).string();
+  }
+  return (fs::path("..") / "shared" / "data" / kDefaultRig).string();
+}
+
+struct Args {
+  synth::SynthOptions o;
+  synth::WriteOptions w;
+  std::string calibration, output;
+  bool no_audio = false, no_sample_tuning = false, no_vibrato = false,
+       no_geometric_occlusion = false;
+  bool list_pieces = false;
+};
+
+int Run(Args& a) {
+  if (a.list_pieces) {
+    for (const auto& name : synth::BuiltInPieceNames()) {
+      std::printf("%-14s %s\n", name.c_str(), synth::DescribeBuiltInPiece(name).c_str());
+    }
+    return 0;
+  }
+  if (a.output.empty()) return PrintError("synth: -o OUT_DIR is required");
+  if (a.calibration.empty()) a.calibration = DefaultCalibration();
+  a.o.expression.vibrato = !a.no_vibrato;
+  a.o.detection.geometric_occlusion = !a.no_geometric_occlusion;
+  a.w.audio = !a.no_audio;
+  a.w.audio_render.tune_soundfont = !a.no_sample_tuning;
+  a.w.calibration_source = a.calibration;
+  const auto start = std::chrono::steady_clock::now();
+  auto calibration = LoadCalibration(a.calibration);
+  if (!calibration.ok()) return PrintError(calibration.status().message());
+  auto capture = synth::Generate(calibration->rig, a.o);
+  if (!capture.ok()) {
+    const std::string where = a.o.midi_path.empty() ? a.calibration : a.o.midi_path;
+    const std::string msg = capture.status().message();
+    // Messages from the MIDI reader already name the file.
+    return PrintError(msg.rfind(where, 0) == 0 ? msg : where + ": " + msg);
+  }
+  const double generate_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::fprintf(stderr,
+               "synth: generated %d frames in %.1f s; writing %s\n",
+               capture->num_frames,
+               generate_s,
+               a.output.c_str());
+  synth::WriteSummary ws;
+  const Status written = synth::WriteCapture(*capture, a.output, a.w, &ws);
+  if (!written.ok()) return PrintError(written.message());
+  const double total_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const auto& c = *capture;
+  const auto& k = c.keypoints2d;
+  int64_t detected = 0, confident = 0;
+  for (int64_t i = 0; i < k.size() / 3; ++i) {
+    detected += !std::isnan(k.data[static_cast<size_t>(3 * i)]);
+    confident += k.data[static_cast<size_t>(3 * i + 2)] >= 0.5f;
+  }
+  const int64_t slots = k.size() / 3;
+  std::printf("arco synth: %s, %s, seed %llu\n",
+              c.options.instrument.c_str(),
+              c.options.midi_path.empty() ? c.options.piece.c_str() : c.options.midi_path.c_str(),
+              static_cast<unsigned long long>(c.options.seed));
+  std::printf("  calibration   %s (%zu cameras, %.1f mm per unit)\n",
+              a.calibration.c_str(),
+              c.rig_mm.cameras.size(),
+              c.stage.mm_per_unit);
+  std::printf("  performance   %zu notes, %.2f s, %d frames at %g fps, %d with a pressed note\n",
+              c.performance.notes.size(),
+              c.num_frames / c.options.fps,
+              c.num_frames,
+              c.options.fps,
+              c.pressed_frames);
+  std::printf("  fingering     %d shifts, %d open strings, %d string crossings\n",
+              c.fingering.num_shifts,
+              c.fingering.num_open_strings,
+              c.fingering.num_string_crossings);
+  std::printf(
+      "  left hand     largest whole-hand correction %.1f mm (fingertips exact on the strings)\n",
+      c.max_residual_shift_mm);
+  std::printf("  detections    %.1f%% of keypoint slots in view, %.1f%% with score >= 0.5\n",
+              100.0 * detected / std::max<int64_t>(1, slots),
+              100.0 * confident / std::max<int64_t>(1, slots));
+  if (a.w.audio) {
+    double worst = 0;
+    for (const auto& [key, cents] : ws.audio.key_offset_cents)
+      worst = std::max(worst, std::abs(cents));
+    std::printf(
+        "  audio         audio.wav (%zu keys measured, sample detuning up to %.1f cents, "
+        "compensated)\n",
+        ws.audio.key_offset_cents.size(),
+        worst);
+  }
+  std::printf("  wrote         %s (%.1f MB) and %s/truth/ in %.1f s\n",
+              a.output.c_str(),
+              ws.bytes / 1e6,
+              a.output.c_str(),
+              total_s);
+  return 0;
+}
+
+std::function<int()> SetupSynth(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "synth", "Synthesise a string performance with exact truth (docs/synth.md)");
+  auto a = std::make_shared<Args>();
+  cmd->add_option("-o,--output", a->output, "Output capture folder (truth/ goes inside)");
+  cmd->add_option("--instrument", a->o.instrument, "cello, violin, viola or double_bass")
+      ->capture_default_str();
+  cmd->add_option("--piece", a->o.piece, "Built-in piece (see --list-pieces)")
+      ->capture_default_str();
+  cmd->add_flag("--list-pieces", a->list_pieces, "List the built-in pieces and exit");
+  cmd->add_option("--midi",
+                  a->o.midi_path,
+                  "Standard MIDI File to play instead of a piece (one note at a time)");
+  cmd->add_option("--calibration",
+                  a->calibration,
+                  "Camera calibration (any format arco reads); default: the SPD rig " +
+                      std::string(kDefaultRig) +
+                      " found via $ARCO_SHARED_DATA_DIR or ../shared/data");
+  cmd->add_option("--seed", a->o.seed, "Random seed (same seed, same capture)")
+      ->capture_default_str();
+  cmd->add_option("--fps", a->o.fps, "Video frame rate (Hz)")->capture_default_str();
+  cmd->add_option(
+         "--duration-s", a->o.max_duration_s, "Keep only the first seconds of the piece (0 = all)")
+      ->capture_default_str();
+  cmd->add_option("--tempo-scale", a->o.tempo_scale, "Stretch all durations (> 1 plays slower)")
+      ->capture_default_str();
+  cmd->add_option("--a4", a->o.a4_hz, "Concert pitch A4 (Hz)")->capture_default_str();
+  cmd->add_option("--intonation-cents",
+                  a->o.expression.intonation_sigma_cents,
+                  "Std. dev. of per-note intonation error (cents, clipped to +-15)")
+      ->capture_default_str();
+  cmd->add_flag("--no-vibrato", a->no_vibrato, "Play every note straight");
+  cmd->add_option("--vibrato-max-cents",
+                  a->o.expression.vibrato_extent_max_cents,
+                  "Largest vibrato extent (half peak-to-peak, cents)")
+      ->capture_default_str();
+  cmd->add_option("--noise-px", a->o.detection.noise_px, "2D detection noise per axis (px)")
+      ->capture_default_str();
+  cmd->add_option("--outlier-rate",
+                  a->o.detection.outlier_rate,
+                  "Gross outliers per keypoint, and hand swaps per view and frame (fraction)")
+      ->capture_default_str();
+  cmd->add_option(
+         "--occlusion-rate",
+         a->o.detection.occlusion_rate,
+         "Random detector drop-outs per keypoint (fraction), on top of geometric occlusion")
+      ->capture_default_str();
+  cmd->add_flag("--no-geometric-occlusion",
+                a->no_geometric_occlusion,
+                "Do not occlude points hidden by the instrument body or the torso");
+  cmd->add_option(
+         "--finger-bias-mm",
+         a->o.detection.finger_bias_mm,
+         "3D offset of the playing fingertip off the string as the detector sees it (mm; DIP half)")
+      ->capture_default_str();
+  cmd->add_option("--mm-per-unit",
+                  a->o.stage.mm_per_unit,
+                  "Millimetres per calibration unit (0 = automatic: from the units, else the SPD "
+                  "rig's camera distance)")
+      ->capture_default_str();
+  cmd->add_flag("--no-audio", a->no_audio, "Skip rendering audio.wav");
+  cmd->add_option("--soundfont", a->w.audio_render.soundfont, "SoundFont for fluidsynth")
+      ->capture_default_str();
+  cmd->add_flag("--no-sample-tuning",
+                a->no_sample_tuning,
+                "Do not measure and compensate the soundfont samples' own pitch");
+  cmd->add_option("--room-noise-dbfs",
+                  a->w.audio_render.room_noise_dbfs,
+                  "Room noise RMS level (dBFS, e.g. -50; 0 = none)")
+      ->capture_default_str();
+  cmd->add_option("--threads",
+                  a->o.num_threads,
+                  "Worker threads (0 = all cores; results do not depend on it)")
+      ->capture_default_str();
+  cmd->add_flag("--overwrite", a->w.overwrite, "Replace an existing output folder");
+  return [a] { return Run(*a); };
+}
+
+}  // namespace
+ARCO_REGISTER_COMMAND(synth, 60, SetupSynth);
+}  // namespace arco::cli

@@ -1,0 +1,372 @@
+#include "arco/eval/evaluate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "arco/audio/pitch_tracker.h"
+#include "arco/hand/kinematics.h"
+#include "arco/mocap/capture.h"
+#include "arco/mocap/keypoint_layout.h"
+#include "arco/util/file_io.h"
+#include "arco/util/npy.h"
+
+namespace arco::eval {
+namespace {
+
+// Stages in the order the ablation table lists them; others follow by name.
+const std::vector<std::string> kMethodOrder = {"triangulation", "vision", "paper", "arco"};
+
+std::vector<std::string> SplitCsv(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cell;
+  std::istringstream in(line);
+  while (std::getline(in, cell, ',')) out.push_back(cell);
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
+double ParseNumber(const std::string& s) {
+  if (s.empty() || s == "nan" || s == "NaN") return NAN;
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  return end && *end == '\0' ? v : NAN;
+}
+
+// Points of `array` (F, P, 3) re-indexed into `names` by keypoint name.
+StatusOr<PointSequence> ToSequence(const NpyArray<double>& array,
+                                   const std::vector<std::string>& array_names,
+                                   const std::vector<std::string>& names,
+                                   const std::string& source) {
+  if (array.shape.size() != 3 || array.shape[2] != 3) {
+    return Status::Error(source + ": expected an array of shape (frames, points, 3)");
+  }
+  if (static_cast<int64_t>(array_names.size()) != array.shape[1]) {
+    return Status::Error(source + ": " + std::to_string(array.shape[1]) +
+                         " points but the layout names " + std::to_string(array_names.size()));
+  }
+  std::map<std::string, int> index;
+  for (size_t i = 0; i < array_names.size(); ++i) index[array_names[i]] = static_cast<int>(i);
+  PointSequence s(static_cast<int>(array.shape[0]), static_cast<int>(names.size()));
+  for (size_t p = 0; p < names.size(); ++p) {
+    auto it = index.find(names[p]);
+    if (it == index.end()) continue;
+    for (int f = 0; f < s.num_frames; ++f) {
+      s.set(
+          f,
+          static_cast<int>(p),
+          Eigen::Vector3d(
+              array.at(f, it->second, 0), array.at(f, it->second, 1), array.at(f, it->second, 2)));
+    }
+  }
+  return s;
+}
+
+std::string Fmt(double v, int digits = 2) {
+  if (std::isnan(v)) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
+  return buf;
+}
+
+}  // namespace
+
+HandJointLimitsDeg DefaultLeftHandLimits() {
+  const auto model = hand::HandModel::Default(hand::HandSide::kLeft);
+  const hand::JointLimitsDeg& lim = model.limits_deg();
+  HandJointLimitsDeg out;
+  for (int f = 0; f < 5; ++f) {
+    const auto finger = static_cast<hand::Finger>(f);
+    out.min_deg[f][0] = lim[hand::DofIndex(finger, hand::FingerDof::kMiddleFlex)].min_deg;
+    out.max_deg[f][0] = lim[hand::DofIndex(finger, hand::FingerDof::kMiddleFlex)].max_deg;
+    out.min_deg[f][1] = lim[hand::DofIndex(finger, hand::FingerDof::kDistalFlex)].min_deg;
+    out.max_deg[f][1] = lim[hand::DofIndex(finger, hand::FingerDof::kDistalFlex)].max_deg;
+  }
+  const hand::HandPointsMm rest = hand::ForwardKinematicsInWrist(model, hand::HandPose{});
+  Eigen::Vector3d pts[kNumHand];
+  for (int k = 0; k < kNumHand; ++k) pts[k] = rest[k];
+  HandFlexionDeg(pts, /*left=*/true, out.rest_deg);
+  return out;
+}
+
+StatusOr<ContactTrack> ReadContactCsv(const std::string& path, int num_frames) {
+  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
+  std::istringstream in(text);
+  std::string line;
+  if (!std::getline(in, line)) return Status::Error(path + ": empty contact file");
+  const std::vector<std::string> header = SplitCsv(line);
+  std::map<std::string, size_t> col;
+  for (size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
+  for (const char* need :
+       {"frame", "string", "finger", "contact_x_mm", "contact_y_mm", "contact_z_mm"}) {
+    if (!col.count(need)) return Status::Error(path + ": no column '" + need + "'");
+  }
+  ContactTrack t;
+  t.string.assign(static_cast<size_t>(num_frames), 0);
+  t.finger.assign(static_cast<size_t>(num_frames), 0);
+  t.point_mm.assign(static_cast<size_t>(num_frames), Eigen::Vector3d::Constant(NAN));
+  int row = 1;
+  while (std::getline(in, line)) {
+    ++row;
+    if (line.empty()) continue;
+    const std::vector<std::string> cells = SplitCsv(line);
+    if (cells.size() < header.size())
+      return Status::Error(path + ": row " + std::to_string(row) + " is short");
+    const double frame = ParseNumber(cells[col["frame"]]);
+    const double string = ParseNumber(cells[col["string"]]);
+    const double finger = ParseNumber(cells[col["finger"]]);
+    if (std::isnan(frame) || std::isnan(string) || std::isnan(finger) || frame < 0 || string < 0 ||
+        string > 8 || finger < 0 || finger > 4) {
+      return Status::Error(path + ": row " + std::to_string(row) +
+                           " has a bad frame, string or finger");
+    }
+    if (frame >= num_frames) continue;
+    const auto f = static_cast<size_t>(frame);
+    t.string[f] = static_cast<int>(string);
+    t.finger[f] = static_cast<int>(finger);
+    t.point_mm[f] = Eigen::Vector3d(ParseNumber(cells[col["contact_x_mm"]]),
+                                    ParseNumber(cells[col["contact_y_mm"]]),
+                                    ParseNumber(cells[col["contact_z_mm"]]));
+    if (t.string[f] > 0 && (t.finger[f] == 0 || !t.point_mm[f].allFinite())) {
+      return Status::Error(path + ": row " + std::to_string(row) +
+                           " presses a string without a finger or point");
+    }
+  }
+  return t;
+}
+
+StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
+  EvalReport report;
+  ARCO_ASSIGN_OR_RETURN(const Json result, ReadResultManifest(r.result_dir));
+  if (!result.contains("stages") || !result["stages"].is_object()) {
+    return Status::Error(JoinPath(r.result_dir, "result.json") +
+                         ": no stages (run arco triangulate first)");
+  }
+  std::vector<std::string> result_names;
+  if (result.contains("keypoint_names"))
+    result_names = result["keypoint_names"].get<std::vector<std::string>>();
+  report.units = result.value("units", std::string("unknown"));
+  if (report.units != "mm")
+    report.warnings.push_back("result units are '" + report.units + "', not mm");
+
+  // Truth.
+  PointSequence truth;
+  ContactTrack truth_contact;
+  std::vector<std::string> truth_names;
+  std::vector<double> truth_f0;
+  EvalOptions options = r.metrics;
+  const bool folder = std::filesystem::is_directory(r.truth);
+  if (folder) {
+    report.truth_kind = "synthetic";
+    ARCO_ASSIGN_OR_RETURN(const Json tj, ReadJsonFile(JoinPath(r.truth, "truth.json")));
+    const std::string layout_name = tj.value("truth_layout", std::string());
+    const KeypointLayout* layout = FindKeypointLayout(layout_name);
+    if (!layout)
+      return Status::Error(JoinPath(r.truth, "truth.json") + ": unknown truth layout '" +
+                           layout_name + "'");
+    truth_names = layout->names;
+    const std::string path = JoinPath(r.truth, "points3d.npy");
+    ARCO_ASSIGN_OR_RETURN(const NpyArray<double> tp, ReadNpy<double>(path));
+    ARCO_ASSIGN_OR_RETURN(truth, ToSequence(tp, truth_names, truth_names, path));
+    ARCO_ASSIGN_OR_RETURN(truth_contact,
+                          ReadContactCsv(JoinPath(r.truth, "contact.csv"), truth.num_frames));
+    const KeypointLayout* capture_layout = FindKeypointLayout(tj.value("layout", std::string()));
+    options.num_instrument_points = capture_layout ? capture_layout->size() - kNumWholeBody : 0;
+    options.instrument_first = kNumWholeBody;
+    for (size_t i = 0; i < truth_names.size(); ++i) {
+      if (truth_names[i] == "string4_top") options.string_points_first = static_cast<int>(i);
+    }
+    auto pitch = audio::ReadPitchCsv(JoinPath(r.truth, "pitch.csv"));
+    if (pitch.ok()) {
+      for (const auto& f : *pitch) truth_f0.push_back(f.voiced ? f.f0_hz : 0.0);
+    }
+  } else {
+    // Labelled views triangulated by `arco triangulate --view`: one frame.
+    report.truth_kind = "labels";
+    ARCO_ASSIGN_OR_RETURN(const Json lj, ReadJsonFile(r.truth));
+    if (!lj.contains("points") || !lj["points"].is_array())
+      return Status::Error(r.truth + ": no \"points\" array");
+    if (result_names.empty())
+      return Status::Error(JoinPath(r.result_dir, "result.json") + ": no keypoint_names");
+    const int64_t first =
+        result.contains("frames") ? result["frames"].value("first", int64_t{1}) : 1;
+    const int64_t count =
+        result.contains("frames") ? result["frames"].value("count", int64_t{0}) : 0;
+    const int64_t row = r.truth_frame - first;
+    if (row < 0 || row >= count) {
+      return Status::Error(r.truth + ": --truth-frame " + std::to_string(r.truth_frame) +
+                           " is outside the result's frames " + std::to_string(first) + ".." +
+                           std::to_string(first + count - 1));
+    }
+    truth_names = result_names;
+    truth = PointSequence(static_cast<int>(count), static_cast<int>(truth_names.size()));
+    std::map<std::string, int> index;
+    for (size_t i = 0; i < truth_names.size(); ++i) index[truth_names[i]] = static_cast<int>(i);
+    int matched = 0;
+    for (const Json& p : lj["points"]) {
+      if (!p.contains("name") || !p.contains("xyz")) continue;
+      auto it = index.find(CanonicalKeypointName(p["name"].get<std::string>()));
+      if (it == index.end()) continue;
+      const Eigen::Vector3d xyz(
+          JsonNumberOrNaN(p["xyz"][0]), JsonNumberOrNaN(p["xyz"][1]), JsonNumberOrNaN(p["xyz"][2]));
+      truth.set(static_cast<int>(row), it->second, xyz);
+      ++matched;
+    }
+    if (matched == 0)
+      return Status::Error(r.truth + ": no labelled point matches the result's keypoints");
+    if (lj.value("units", std::string()) != report.units) {
+      report.warnings.push_back("truth units '" + lj.value("units", std::string()) +
+                                "' differ from the result's");
+    }
+    truth_contact.string.assign(static_cast<size_t>(count), 0);
+    truth_contact.finger.assign(static_cast<size_t>(count), 0);
+    truth_contact.point_mm.assign(static_cast<size_t>(count), Eigen::Vector3d::Constant(NAN));
+    options.instrument_first = kNumWholeBody;
+    options.num_instrument_points =
+        std::max(0, static_cast<int>(truth_names.size()) - kNumWholeBody);
+  }
+  if (!options.limits) options.limits = DefaultLeftHandLimits();
+  options.joint_limit_tolerance_deg = r.joint_limit_tolerance_deg;
+  report.contact_frames = 0;
+  for (int f = 0; f < truth_contact.num_frames(); ++f)
+    report.contact_frames += truth_contact.pressed(f);
+
+  // Methods.
+  std::vector<std::string> stages;
+  for (const std::string& m : kMethodOrder) {
+    if (result["stages"].contains(m)) stages.push_back(m);
+  }
+  for (auto it = result["stages"].begin(); it != result["stages"].end(); ++it) {
+    if (std::find(stages.begin(), stages.end(), it.key()) == stages.end())
+      stages.push_back(it.key());
+  }
+  for (const std::string& stage : stages) {
+    const Json& sj = result["stages"][stage];
+    if (!sj.contains("files") || !sj["files"].contains("points3d")) continue;
+    const std::string dir = JoinPath(r.result_dir, sj.value("dir", stage));
+    const std::string path = JoinPath(dir, sj["files"]["points3d"].get<std::string>());
+    ARCO_ASSIGN_OR_RETURN(const NpyArray<double> rp, ReadNpy<double>(path));
+    std::vector<std::string> names = result_names;
+    if (sj.contains("keypoint_names")) names = sj["keypoint_names"].get<std::vector<std::string>>();
+    if (names.empty() && rp.shape.size() == 3 &&
+        rp.shape[1] <= static_cast<int64_t>(truth_names.size())) {
+      names.assign(truth_names.begin(), truth_names.begin() + rp.shape[1]);  // same layout prefix
+    }
+    ARCO_ASSIGN_OR_RETURN(const PointSequence rs, ToSequence(rp, names, truth_names, path));
+    if (rs.num_frames != truth.num_frames) {
+      return Status::Error(path + ": " + std::to_string(rs.num_frames) +
+                           " frames but the truth has " + std::to_string(truth.num_frames));
+    }
+    std::optional<ContactTrack> contact;
+    if (sj["files"].contains("contact")) {
+      ARCO_ASSIGN_OR_RETURN(contact,
+                            ReadContactCsv(JoinPath(dir, sj["files"]["contact"].get<std::string>()),
+                                           truth.num_frames));
+    }
+    report.methods.push_back(
+        EvaluateMethod(stage, truth, truth_contact, rs, contact ? &*contact : nullptr, options));
+  }
+  if (report.methods.empty())
+    return Status::Error(r.result_dir + ": no stage with 3D points to evaluate");
+  report.truth_frames = report.methods.front().frames;
+
+  // Pitch.
+  std::string pitch_path = r.pitch_csv;
+  if (pitch_path.empty() && FileExists(JoinPath(r.result_dir, "pitch.csv")))
+    pitch_path = JoinPath(r.result_dir, "pitch.csv");
+  if (!pitch_path.empty() && !truth_f0.empty()) {
+    ARCO_ASSIGN_OR_RETURN(const std::vector<audio::PitchFrame> est,
+                          audio::ReadPitchCsv(pitch_path));
+    std::vector<double> e(truth_f0.size(), 0.0);
+    for (const auto& f : est) {
+      if (f.frame >= 0 && f.frame < static_cast<int64_t>(e.size()) && f.voiced)
+        e[static_cast<size_t>(f.frame)] = f.f0_hz;
+    }
+    report.pitch = EvaluatePitch(truth_f0, e);
+  }
+  return report;
+}
+
+Json EvalReport::ToJson(const EvalOptions& options) const {
+  Json j;
+  j["format"] = "arco-eval";
+  j["version"] = 1;
+  j["truth"] = {{"kind", truth_kind},
+                {"frames", truth_frames},
+                {"contact_frames", contact_frames},
+                {"units", units}};
+  j["protocol"] = {
+      {"hand", "left hand, 20 joints after aligning the wrists by translation (Jin et al. 2024)"},
+      {"contact_frames",
+       "frames whose truth presses a note (rests, open strings, unvoiced excluded)"},
+      {"contact_deviation",
+       "playing fingertip (truth's finger) to the truth contact point, world frame"}};
+  j["methods"] = Json::object();
+  for (const MethodMetrics& m : methods) {
+    Json mj;
+    mj["frames"] = m.frames;
+    mj["mpjpe_hand_mm"] = JsonFromDouble(m.mpjpe_hand_mm);
+    mj["mpjpe_note_finger_mm"] = JsonFromDouble(m.mpjpe_note_finger_mm);
+    mj["contact_deviation_mm"] = JsonFromDouble(m.contact_deviation_mm);
+    mj["contact_deviation_median_mm"] = JsonFromDouble(m.contact_deviation_median_mm);
+    for (size_t i = 0; i < m.pck.size() && i < options.pck_thresholds_mm.size(); ++i) {
+      char key[32];
+      std::snprintf(key, sizeof(key), "pck_%gmm", options.pck_thresholds_mm[i]);
+      mj[key] = JsonFromDouble(m.pck[i]);
+    }
+    mj["string_accuracy"] = JsonFromDouble(m.string_accuracy);
+    mj["finger_accuracy"] = JsonFromDouble(m.finger_accuracy);
+    mj["joint_limit_violations"] =
+        m.joint_limit_violations < 0 ? Json(nullptr) : Json(m.joint_limit_violations);
+    mj["mpjpe_body_mm"] = JsonFromDouble(m.mpjpe_body_mm);
+    mj["instrument_error_mm"] = JsonFromDouble(m.instrument_error_mm);
+    mj["string_error_mm"] = JsonFromDouble(m.string_error_mm);
+    mj["missing_hand_fraction"] = m.missing_hand_fraction;
+    j["methods"][m.method] = mj;
+  }
+  if (pitch) {
+    j["pitch"] = {{"frames", pitch->frames},
+                  {"truth_voiced_frames", pitch->truth_voiced_frames},
+                  {"rpa50", JsonFromDouble(pitch->rpa50)},
+                  {"rpa25", JsonFromDouble(pitch->rpa25)},
+                  {"voicing_recall", JsonFromDouble(pitch->voicing_recall)},
+                  {"voicing_false_alarm", JsonFromDouble(pitch->voicing_false_alarm)},
+                  {"median_abs_cents", JsonFromDouble(pitch->median_abs_cents)}};
+  } else {
+    j["pitch"] = nullptr;
+  }
+  j["warnings"] = warnings;
+  return j;
+}
+
+std::string EvalReport::MarkdownTable(const EvalOptions& options) const {
+  std::ostringstream out;
+  out << "| method | hand MPJPE (mm) | note finger MPJPE (mm) | contact dev. (mm) |";
+  for (double t : options.pck_thresholds_mm) out << " PCK@" << t << " |";
+  out << " string acc. | finger acc. | limit violations | body MPJPE (mm) | instrument err. (mm) "
+         "|\n|---|---|---|---|";
+  for (size_t i = 0; i < options.pck_thresholds_mm.size(); ++i) out << "---|";
+  out << "---|---|---|---|---|\n";
+  for (const MethodMetrics& m : methods) {
+    out << "| " << m.method << " | " << Fmt(m.mpjpe_hand_mm) << " | " << Fmt(m.mpjpe_note_finger_mm)
+        << " | " << Fmt(m.contact_deviation_mm) << " |";
+    for (double p : m.pck) out << " " << Fmt(p, 3) << " |";
+    out << " " << Fmt(m.string_accuracy, 3) << " | " << Fmt(m.finger_accuracy, 3) << " | "
+        << (m.joint_limit_violations < 0 ? std::string("-")
+                                         : std::to_string(m.joint_limit_violations))
+        << " | " << Fmt(m.mpjpe_body_mm) << " | " << Fmt(m.instrument_error_mm) << " |\n";
+  }
+  if (pitch) {
+    out << "\npitch: RPA50 " << Fmt(pitch->rpa50, 3) << ", RPA25 " << Fmt(pitch->rpa25, 3)
+        << ", voicing recall " << Fmt(pitch->voicing_recall, 3) << ", false alarm "
+        << Fmt(pitch->voicing_false_alarm, 3) << ", median error " << Fmt(pitch->median_abs_cents)
+        << " cents\n";
+  }
+  return out.str();
+}
+
+}  // namespace arco::eval

@@ -1,0 +1,57 @@
+// `arco eval`: every method in a result folder scored against truth
+// (docs/evaluation.md).
+//
+// Methods: the stages of RESULT_DIR/result.json that have a points3d file
+// (triangulation, vision, paper, arco, ...; any subset), read in the result's
+// keypoint layout. A stage may also list a per-frame contact annotation
+// (files.contact, CSV with the columns frame, string, finger, contact_x_mm,
+// contact_y_mm, contact_z_mm as truth/contact.csv): then string and finger
+// identification are scored.
+// Truth: a synthetic truth folder (arco synth's truth/: points3d.npy, contact.csv,
+// pitch.csv) or a points JSON of `arco triangulate --view ...` (manually labelled
+// views triangulated: the paper's real-data protocol) for one frame.
+// Pitch: RESULT_DIR/pitch.csv (or --pitch FILE) against truth/pitch.csv.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "arco/eval/metrics.h"
+#include "arco/util/json_io.h"
+#include "arco/util/status.h"
+
+namespace arco::eval {
+
+struct EvalRequest {
+  std::string result_dir;
+  std::string truth;        // truth folder, or a points JSON
+  int64_t truth_frame = 0;  // for a points JSON: the frame number it labels (manifest numbering)
+  std::string pitch_csv;    // optional estimate; default RESULT_DIR/pitch.csv when present
+  EvalOptions metrics;
+  double joint_limit_tolerance_deg = 5.0;
+};
+
+struct EvalReport {
+  std::string truth_kind;  // "synthetic" or "labels"
+  int truth_frames = 0;    // frames with truth
+  int contact_frames = 0;
+  std::string units;
+  std::vector<MethodMetrics> methods;
+  std::optional<PitchMetrics> pitch;
+  std::vector<std::string> warnings;
+
+  Json ToJson(const EvalOptions& options) const;
+  std::string MarkdownTable(const EvalOptions& options) const;
+};
+
+StatusOr<EvalReport> Evaluate(const EvalRequest& request);
+
+// Reads a contact CSV (columns by header name; extra columns ignored).
+StatusOr<ContactTrack> ReadContactCsv(const std::string& path, int num_frames);
+
+// Joint limits of arco's default left hand as geometric PIP/DIP bounds, with the
+// rest pose's geometric angles (hand/hand_model.h).
+HandJointLimitsDeg DefaultLeftHandLimits();
+
+}  // namespace arco::eval

@@ -1,0 +1,153 @@
+// Evaluate() on files: a synthetic capture's truth scored against itself and
+// against a perturbed copy; malformed inputs.
+#include "arco/eval/evaluate.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "arco/camera/calibration_io.h"
+#include "arco/synth/capture_writer.h"
+#include "arco/util/file_io.h"
+#include "arco/util/npy.h"
+
+namespace arco::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A short synthetic capture (no audio) written once for all tests.
+const std::string& CaptureDir() {
+  static const std::string dir = [] {
+    const std::string d = ::testing::TempDir() + "/eval_capture";
+    auto text =
+        ReadFileToString(std::string(ARCO_SHARED_DATA_DIR) + "/spd/cello_1113_scale_camera.xml");
+    auto cal = ParseMetashapeXml(*text, "rig.xml");
+    synth::SynthOptions o;
+    o.max_duration_s = 2.0;
+    auto cap = synth::Generate(cal->rig, o);
+    EXPECT_TRUE(cap.ok()) << cap.status().message();
+    synth::WriteOptions w;
+    w.audio = false;
+    w.overwrite = true;
+    EXPECT_TRUE(synth::WriteCapture(*cap, d, w).ok());
+    return d;
+  }();
+  return dir;
+}
+
+// A result folder whose stage `name` holds `points` (and the truth's contact).
+std::string MakeResult(const std::string& name, const NpyArray<double>& points, bool with_contact) {
+  const std::string dir = ::testing::TempDir() + "/eval_result_" + name;
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/" + name);
+  EXPECT_TRUE(WriteNpy(dir + "/" + name + "/points3d.npy", points).ok());
+  Json files = {{"points3d", "points3d.npy"}};
+  if (with_contact) {
+    fs::copy_file(CaptureDir() + "/truth/contact.csv", dir + "/" + name + "/contact.csv");
+    files["contact"] = "contact.csv";
+  }
+  Json j = {{"format", "arco-result"},
+            {"units", "mm"},
+            {"stages", {{name, {{"dir", name}, {"files", files}}}}}};
+  EXPECT_TRUE(WriteJsonFile(dir + "/result.json", j).ok());
+  return dir;
+}
+
+TEST(Evaluate, TruthAgainstItselfGivesZeros) {
+  auto truth = ReadNpy<double>(CaptureDir() + "/truth/points3d.npy");
+  ASSERT_TRUE(truth.ok());
+  EvalRequest r;
+  r.result_dir = MakeResult("arco", *truth, true);
+  r.truth = CaptureDir() + "/truth";
+  auto report = Evaluate(r);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  ASSERT_EQ(report->methods.size(), 1u);
+  const MethodMetrics& m = report->methods[0];
+  EXPECT_EQ(m.method, "arco");
+  EXPECT_GT(report->contact_frames, 10);
+  EXPECT_EQ(m.mpjpe_hand_mm, 0.0);
+  EXPECT_EQ(m.mpjpe_note_finger_mm, 0.0);
+  EXPECT_LT(m.contact_deviation_mm, 1e-3);  // the truth tip is on the contact within IK precision
+  EXPECT_EQ(m.string_accuracy, 1.0);
+  EXPECT_EQ(m.finger_accuracy, 1.0);
+  EXPECT_EQ(m.joint_limit_violations, 0);
+  EXPECT_EQ(m.mpjpe_body_mm, 0.0);
+  EXPECT_EQ(m.instrument_error_mm, 0.0);
+  EXPECT_EQ(m.string_error_mm, 0.0);
+  const Json j = report->ToJson(r.metrics);
+  EXPECT_EQ(j["methods"]["arco"]["mpjpe_hand_mm"], 0.0);
+  EXPECT_EQ(j["methods"]["arco"]["pck_5mm"], 1.0);
+  EXPECT_NE(report->MarkdownTable(r.metrics).find("| arco | 0.00 | 0.00 |"), std::string::npos);
+}
+
+TEST(Evaluate, ShiftedLeftHandKeepsAlignedMpjpeButNotContactDeviation) {
+  auto truth = ReadNpy<double>(CaptureDir() + "/truth/points3d.npy");
+  ASSERT_TRUE(truth.ok());
+  NpyArray<double> moved = *truth;
+  for (int64_t f = 0; f < moved.shape[0]; ++f) {
+    for (int k = 91; k < 112; ++k) moved.at(f, k, 2) += 10.0;  // whole left hand 10 mm along z
+  }
+  // The result has only the capture layout (142 points), as triangulation writes.
+  NpyArray<double> cut;
+  cut.shape = {moved.shape[0], 142, 3};
+  for (int64_t f = 0; f < moved.shape[0]; ++f) {
+    for (int p = 0; p < 142; ++p) {
+      for (int c = 0; c < 3; ++c) cut.data.push_back(moved.at(f, p, c));
+    }
+  }
+  EvalRequest r;
+  r.result_dir = MakeResult("triangulation", cut, false);
+  r.truth = CaptureDir() + "/truth";
+  auto report = Evaluate(r);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  const MethodMetrics& m = report->methods[0];
+  EXPECT_NEAR(m.mpjpe_hand_mm, 0.0, 1e-9);
+  EXPECT_NEAR(m.contact_deviation_mm, 10.0, 1e-3);
+  EXPECT_NEAR(m.mpjpe_body_mm, 10.0 * 21 / 133, 1e-9);  // 133 body points, 21 moved
+  EXPECT_TRUE(std::isnan(m.string_accuracy));
+  EXPECT_TRUE(std::isnan(m.string_error_mm));  // no string points in the result
+}
+
+TEST(Evaluate, BadInput) {
+  EvalRequest r;
+  r.result_dir = ::testing::TempDir() + "/no_such_result";
+  r.truth = CaptureDir() + "/truth";
+  EXPECT_FALSE(Evaluate(r).ok());
+  auto truth = ReadNpy<double>(CaptureDir() + "/truth/points3d.npy");
+  NpyArray<double> short_result = *truth;
+  short_result.shape[0] = 1;
+  short_result.data.resize(static_cast<size_t>(short_result.shape[1] * 3));
+  r.result_dir = MakeResult("vision", short_result, false);
+  auto report = Evaluate(r);
+  ASSERT_FALSE(report.ok());
+  EXPECT_NE(report.status().message().find("frames but the truth has"), std::string::npos);
+  const std::string bad = ::testing::TempDir() + "/bad_contact.csv";
+  ASSERT_TRUE(AtomicWriteFile(bad, "frame,string,finger\n0,1,1\n").ok());
+  EXPECT_FALSE(ReadContactCsv(bad, 3).ok());
+  ASSERT_TRUE(AtomicWriteFile(
+                  bad, "frame,string,finger,contact_x_mm,contact_y_mm,contact_z_mm\n0,9,1,0,0,0\n")
+                  .ok());
+  EXPECT_FALSE(ReadContactCsv(bad, 3).ok());
+}
+
+TEST(DefaultLeftHandLimits, TruthHandsHaveNoViolationsAndBentFingersDo) {
+  auto truth = ReadNpy<double>(CaptureDir() + "/truth/points3d.npy");
+  ASSERT_TRUE(truth.ok());
+  PointSequence s(static_cast<int>(truth->shape[0]), static_cast<int>(truth->shape[1]));
+  s.xyz = truth->data;
+  const HandJointLimitsDeg limits = DefaultLeftHandLimits();
+  EXPECT_EQ(CountJointLimitViolations(s, kLeftHandFirst, true, limits, 5.0), 0);
+  // Reflect every index tip across the PIP->DIP line within its plane: the DIP
+  // flexion f becomes -f, a hyperextension beyond the limit for curled fingers.
+  for (int f = 0; f < s.num_frames; ++f) {
+    const Eigen::Vector3d pip = s.at(f, kLeftHandFirst + 6), dip = s.at(f, kLeftHandFirst + 7),
+                          tip = s.at(f, kLeftHandFirst + 8);
+    const Eigen::Vector3d u = (dip - pip).normalized();
+    s.set(f, kLeftHandFirst + 8, 2 * (dip + (tip - dip).dot(u) * u) - tip);
+  }
+  EXPECT_GT(CountJointLimitViolations(s, kLeftHandFirst, true, limits, 5.0), s.num_frames / 2);
+}
+
+}  // namespace
+}  // namespace arco::eval
