@@ -17,7 +17,10 @@ struct RefineArgs {
   double binding_cents = 30.0;
   double max_residual_mm = 3.0;
   double lift_max_mm = 0.0;
-  std::string joints = "all";
+  std::string joints = "mcp_flex_pip_dip";
+  double reference_weight = -1;  // < 0: the default
+  double temporal_weight = -1;
+  bool exact_reach = false;
 };
 
 int RunRefine(const RefineArgs& a) {
@@ -32,7 +35,10 @@ int RunRefine(const RefineArgs& a) {
   o.refine.ik.max_residual_mm = a.max_residual_mm;
   o.refine.ik.lift_max_distance_mm = a.lift_max_mm;
   if (a.joints == "pip_dip") o.refine.ik.joints = hand::FingerIkJoints::kPipDip;
-  if (a.joints == "mcp_flex_pip_dip") o.refine.ik.joints = hand::FingerIkJoints::kMcpFlexPipDip;
+  if (a.joints == "all") o.refine.ik.joints = hand::FingerIkJoints::kAll;
+  if (a.reference_weight >= 0) o.refine.ik.reference_weight_mm_per_rad = a.reference_weight;
+  if (a.temporal_weight >= 0) o.refine.ik.temporal_weight_mm_per_rad = a.temporal_weight;
+  if (a.exact_reach) o.refine.ik.exact_reach = true;
   const Status valid = o.refine.Validate();
   if (!valid.ok()) return PrintError(valid.message());
   auto summary = RefineResultDir(o);
@@ -80,6 +86,15 @@ std::function<int()> SetupRefine(CLI::App& app) {
   sub->add_option("--joints", a->joints, "arco: free joints of the playing finger")
       ->check(CLI::IsMember({"all", "mcp_flex_pip_dip", "pip_dip"}))
       ->capture_default_str();
+  sub->add_option("--reference-weight",
+                  a->reference_weight,
+                  "arco: IK prior toward the fitted angles (mm per rad; default 1)");
+  sub->add_option("--temporal-weight",
+                  a->temporal_weight,
+                  "arco: IK prior toward the previous frame's solution (mm per rad; default 4)");
+  sub->add_flag("--exact-reach",
+                a->exact_reach,
+                "arco: the hand IK's exact reach instead of one regularised (least change) solve");
   return [a]() { return RunRefine(*a); };
 }
 

@@ -6,7 +6,7 @@
 //   2. instrument    instrument/     rigid template over the clip, per-frame poses smoothed
 //                                    (instrument/template_fit.h, pose_smoothing.h); the
 //                                    metric scale; strings.npy (F, 4, 2, 3) and the placed
-//                                    instrument keypoints points3d.npy, both in mm
+//                                    instrument keypoints keypoints.npy, both in mm
 //   3. hands         hand/           per-performer bone lengths, then the multi-view hand
 //                                    model fit of the left hand (hand/fit.h) in chunks of
 //                                    frames solved in parallel; hand_params.npy (F, 26)

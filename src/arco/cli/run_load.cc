@@ -40,7 +40,7 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
   // Triangulated points (world units) -> mm; the instrument keypoints from the template.
   ARCO_ASSIGN_OR_RETURN(NpyArray<double> base, ReadResultPoints3d(result_dir, "triangulation"));
   const std::string strings_path = JoinPath(result_dir, "instrument/strings.npy");
-  const std::string placed_path = JoinPath(result_dir, "instrument/points3d.npy");
+  const std::string placed_path = JoinPath(result_dir, "instrument/keypoints.npy");
   const std::string hands_path = JoinPath(result_dir, "hand/hand_params.npy");
   const std::string bones_path = JoinPath(result_dir, "hand/bone_lengths_mm.npy");
   ARCO_ASSIGN_OR_RETURN(NpyArray<double> strings, ReadNpy<double>(strings_path));

@@ -134,7 +134,7 @@ StatusOr<StageReport> RunInstrumentStage(const RunOptions& options,
     }
   }
   const InstrumentFitSummary& fs = fit->summary;
-  Json entry = {{"files", {{"strings", "strings.npy"}, {"points3d", "points3d.npy"}}},
+  Json entry = {{"files", {{"strings", "strings.npy"}, {"keypoints", "keypoints.npy"}}},
                 {"instrument", model.name()},
                 {"a4_hz", capture.manifest.tuning_a4_hz},
                 {"world_units_per_mm", s},
@@ -153,7 +153,7 @@ StatusOr<StageReport> RunInstrumentStage(const RunOptions& options,
       "instrument",
       [&](const std::string& dir) -> Status {
         ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, "strings.npy"), strings));
-        return WriteNpy(JoinPath(dir, "points3d.npy"), placed);
+        return WriteNpy(JoinPath(dir, "keypoints.npy"), placed);
       },
       entry));
   StageReport report;

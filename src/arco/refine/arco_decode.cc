@@ -147,6 +147,50 @@ double TransitionCost(const NoteSpan& from_note,
   return factor * cost;
 }
 
+// The contact of one frame of a decoded note (state, string, finger) at pitch f0_hz.
+void AssignFrame(const DecodeContext& context,
+                 int string,
+                 int finger,
+                 double f0_hz,
+                 const PitchModelOptions& pitch_options,
+                 const std::array<double, 5>& lift_max_mm,
+                 int64_t f,
+                 FrameContact* fc) {
+  const size_t i = static_cast<size_t>(f);
+  if (finger == 0) {
+    fc->state = ContactState::kOpenString;
+    fc->reason = ContactReason::kNone;
+    fc->string = string;
+    return;
+  }
+  if (!context.has_strings[i]) {
+    fc->reason = ContactReason::kNoInstrument;
+    return;
+  }
+  Candidate cand;
+  if (!ContactOnString(*context.input->instrument,
+                       context.strings(static_cast<int>(f)),
+                       string,
+                       f0_hz,
+                       pitch_options.contact,
+                       &cand)) {
+    fc->reason = ContactReason::kUnplayable;
+    return;
+  }
+  SetPressed(cand, finger, fc);
+  const auto& points = context.vision_points[i];
+  if (!points) {
+    fc->reason = ContactReason::kNoHand;
+    return;
+  }
+  const int tip = hand::TipKeypoint(static_cast<hand::Finger>(finger));
+  fc->tip_distance_vision_mm = ((*points)[tip] - cand.point_in_world).norm();
+  if (fc->tip_distance_vision_mm > lift_max_mm[static_cast<size_t>(finger)]) {
+    fc->state = ContactState::kUncertain;  // lift test: string and finger kept as info
+    fc->reason = ContactReason::kOutOfReach;
+  }
+}
+
 }  // namespace
 
 double FingerOffsetSemitones(InstrumentKind kind, int finger) {
@@ -226,7 +270,6 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
   }
 
   // Frames of the decoded notes.
-  const InstrumentModel& model = *input.instrument;
   std::vector<uint8_t> decoded_note(notes.size(), 0);
   for (size_t c = 0; c < chain.size(); ++c) {
     const int note_index = usable[static_cast<size_t>(chain[c])];
@@ -235,40 +278,28 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
     const State& st = states[static_cast<size_t>(chain[c])][static_cast<size_t>(chosen[c])];
     for (int64_t f = note.first_frame; f <= note.last_frame; ++f) {
       const size_t i = static_cast<size_t>(f);
-      FrameContact& fc = out[i];
       if (context.analysis->frame_state[i] != FrameAudioState::kNote) continue;
-      if (st.finger == 0) {
-        fc.state = ContactState::kOpenString;
-        fc.reason = ContactReason::kNone;
-        fc.string = st.string;
-        continue;
-      }
-      if (!context.has_strings[i]) {
-        fc.reason = ContactReason::kNoInstrument;
-        continue;
-      }
-      Candidate cand;
-      if (!ContactOnString(model,
-                           context.strings(static_cast<int>(f)),
-                           st.string,
-                           fc.f0_hz,
-                           pitch_options.contact,
-                           &cand)) {
-        fc.reason = ContactReason::kUnplayable;
-        continue;
-      }
-      SetPressed(cand, st.finger, &fc);
-      const auto& points = context.vision_points[i];
-      if (!points) {
-        fc.reason = ContactReason::kNoHand;
-        continue;
-      }
-      const int tip = hand::TipKeypoint(static_cast<hand::Finger>(st.finger));
-      fc.tip_distance_vision_mm = ((*points)[tip] - cand.point_in_world).norm();
-      if (fc.tip_distance_vision_mm > lift_max_mm[static_cast<size_t>(st.finger)]) {
-        fc.state = ContactState::kUncertain;  // lift test: string and finger kept as info
-        fc.reason = ContactReason::kOutOfReach;
-      }
+      AssignFrame(
+          context, st.string, st.finger, out[i].f0_hz, pitch_options, lift_max_mm, f, &out[i]);
+    }
+    if (st.finger == 0) continue;
+    // The finger lands before the sound: untrusted frames just before the onset.
+    const double onset_hz = input.pitch[static_cast<size_t>(note.first_frame)].f0_hz;
+    for (int64_t f = note.first_frame - 1;
+         f >= 0 && f >= note.first_frame - options.onset_lead_frames;
+         --f) {
+      const size_t i = static_cast<size_t>(f);
+      const FrameAudioState a = context.analysis->frame_state[i];
+      const bool untrusted = a == FrameAudioState::kRest || a == FrameAudioState::kLowConfidence ||
+                             a == FrameAudioState::kOutlier || a == FrameAudioState::kShortNote;
+      if (!untrusted || out[i].state == ContactState::kPressed) break;
+      FrameContact lead = out[i];
+      lead.note = note_index;
+      AssignFrame(context, st.string, st.finger, onset_hz, pitch_options, lift_max_mm, f, &lead);
+      // Only where the fitted finger is already near its contact (not still on its way).
+      if (!lead.pressed() || !(lead.tip_distance_vision_mm <= options.onset_lead_max_mm)) break;
+      if (lead.reason == ContactReason::kNone) lead.reason = ContactReason::kBeforeOnset;
+      out[i] = lead;
     }
   }
   // Usable notes that no string can play.

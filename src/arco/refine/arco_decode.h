@@ -19,6 +19,9 @@
 // change of hand position (semitones of finger 1 above the open string, from the finger's
 // offset in the instrument's hand frame) + string_cross_cost x strings crossed; scaled by
 // rest_factor after a gap of rest_gap_s or more. Ties go to the lower state index.
+//
+// Up to onset_lead_frames untrusted frames right before a stopped note's first trusted
+// frame get the note's contact too (kBeforeOnset): the finger lands before the sound.
 #pragma once
 
 #include <array>

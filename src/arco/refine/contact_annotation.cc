@@ -61,6 +61,10 @@ const char* ContactReasonName(ContactReason reason) {
       return "no_hand";
     case ContactReason::kOutOfReach:
       return "out_of_reach";
+    case ContactReason::kBeforeOnset:
+      return "before_onset";
+    case ContactReason::kHandShifted:
+      return "hand_shifted";
   }
   return "?";
 }

@@ -55,6 +55,29 @@ std::vector<std::optional<hand::HandPose>> VisionHands(const DecodeContext& cont
   return context.input->vision_hand;
 }
 
+// arco's IK of one frame: options.joints of the playing finger, anchored at the fitted
+// pose and at the previous frame's solution of the same run (`prev`, temporal smoothness).
+FrameIk SolveArcoFrame(const DecodeContext& context,
+                       const FrameContact& c,
+                       int f,
+                       const ArcoIkOptions& options,
+                       const FrameIk* prev) {
+  hand::FingerIkOptions ik;
+  ik.joints = options.joints;
+  ik.reference_weight_mm_per_rad = options.reference_weight_mm_per_rad;
+  ik.exact_reach = options.exact_reach;
+  ik.max_iterations = options.max_iterations;
+  // Restart from the hand IK's grid only when the tip would otherwise end beyond
+  // max_residual_mm (a local minimum on a limit), not for the regularised solve's small
+  // residual.
+  ik.reach_tolerance_mm = options.max_residual_mm;
+  if (options.temporal_weight_mm_per_rad > 0 && prev != nullptr && prev->solved) {
+    ik.previous_pose = prev->pose;
+    ik.previous_weight_mm_per_rad = options.temporal_weight_mm_per_rad;
+  }
+  return Solve(context, c, f, ik);
+}
+
 }  // namespace
 
 std::vector<std::optional<hand::HandPose>> SolvePaperIk(const DecodeContext& context,
@@ -93,12 +116,6 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
                                                        IkStats* stats,
                                                        int num_threads) {
   const int n = context.num_frames();
-  hand::FingerIkOptions ik;
-  ik.joints = options.joints;
-  ik.reference_weight_mm_per_rad = options.reference_weight_mm_per_rad;
-  ik.exact_reach = true;
-  ik.max_iterations = options.max_iterations;
-
   // Runs: maximal stretches of consecutive frames to correct with the same note, string and
   // finger. Within a run the frames are solved in time order, each with a prior toward the
   // previous frame's solution; runs are independent and solved in parallel.
@@ -115,7 +132,6 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
     }
     runs.emplace_back(f, f);
   }
-  const bool temporal = options.temporal_weight_mm_per_rad > 0;
   std::vector<FrameIk> final_ik(static_cast<size_t>(n));
   ParallelFor(
       static_cast<int64_t>(runs.size()),
@@ -123,25 +139,9 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
       [&](int64_t r, int) {
         const auto [first, last] = runs[static_cast<size_t>(r)];
         for (int f = first; f <= last; ++f) {
-          const FrameContact& c = (*contacts)[static_cast<size_t>(f)];
           const FrameIk* prev = f > first ? &final_ik[static_cast<size_t>(f - 1)] : nullptr;
-          if (!temporal || prev == nullptr || !prev->solved) {
-            final_ik[static_cast<size_t>(f)] = Solve(context, c, f, ik);
-            continue;
-          }
-          // The cost is symmetric in its two anchors, so the solve starts from the previous
-          // frame's angles of this finger (near the answer: few iterations), anchored there
-          // with the temporal weight, and the fitted pose is the second anchor.
-          const hand::HandPose& vision = *context.input->vision_hand[static_cast<size_t>(f)];
-          hand::HandPose start = vision;
-          for (int s = 0; s < 4; ++s) {
-            start.angles_rad[4 * c.finger + s] = prev->pose.angles_rad[4 * c.finger + s];
-          }
-          hand::FingerIkOptions chained = ik;
-          chained.reference_weight_mm_per_rad = options.temporal_weight_mm_per_rad;
-          chained.previous_pose = vision;
-          chained.previous_weight_mm_per_rad = options.reference_weight_mm_per_rad;
-          final_ik[static_cast<size_t>(f)] = Solve(context, c, f, chained, &start);
+          final_ik[static_cast<size_t>(f)] =
+              SolveArcoFrame(context, (*contacts)[static_cast<size_t>(f)], f, options, prev);
         }
       },
       1);
@@ -152,13 +152,26 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
     if (!s.solved) continue;
     Accumulate(s, stats);
     FrameContact& c = (*contacts)[static_cast<size_t>(f)];
-    c.tip_distance_refined_mm = s.distance_mm;
-    if (s.distance_mm > options.max_residual_mm) {
-      c.state = ContactState::kUncertain;  // lift test: unreachable within the limits
-      c.reason = ContactReason::kOutOfReach;
-      continue;
+    hand::HandPose pose = s.pose;
+    double distance = s.distance_mm;
+    if (distance > options.max_residual_mm) {
+      const Eigen::Vector3d tip = hand::FingertipInWorld(
+          context.input->hand_model, pose, static_cast<hand::Finger>(c.finger));
+      if (distance > options.max_hand_shift_mm) {
+        c.tip_distance_refined_mm = distance;
+        c.state = ContactState::kUncertain;  // lift test: unreachable within the limits
+        c.reason = ContactReason::kOutOfReach;
+        continue;
+      }
+      pose.wrist_in_world_mm += c.point_in_world_mm - tip;  // the whole hand, rigidly
+      distance = (hand::FingertipInWorld(
+                      context.input->hand_model, pose, static_cast<hand::Finger>(c.finger)) -
+                  c.point_in_world_mm)
+                     .norm();
+      c.reason = ContactReason::kHandShifted;
     }
-    hands[static_cast<size_t>(f)] = s.pose;
+    c.tip_distance_refined_mm = distance;
+    hands[static_cast<size_t>(f)] = pose;
   }
   return hands;
 }

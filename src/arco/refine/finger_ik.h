@@ -7,15 +7,20 @@
 // rejected (the paper has no lift test).
 //
 // arco mode:
-//  1. bounded IK over MCP flexion and abduction, PIP and DIP (ArcoIkOptions::joints) with a
-//     prior toward the fitted (vision) angles and, for temporal smoothness, toward the
-//     previous frame's solution. Frames are chained in time order only within a run (the
-//     consecutive frames of one note with the same string and finger); runs are
-//     independent and solved in parallel, so results do not depend on the thread count;
-//  2. lift test: a solution whose tip stays farther than max_residual_mm from the contact
-//     is rejected (the finger cannot reach it), the frame flagged kOutOfReach and its hand
-//     left as fitted. (The decoder already rejected contacts beyond the lift distance.)
-// Other fingers, the thumb and the wrist are never changed.
+//  1. bounded IK over MCP flexion, PIP and DIP (ArcoIkOptions::joints), one regularised
+//     solve with a prior toward the fitted (vision) angles and, for temporal smoothness,
+//     toward the previous frame's solution: the least change that puts the tip on the
+//     contact (a sub-millimetre residual remains; exact_reach removes it at a cost in
+//     joint accuracy).
+//     Frames are chained in time order only within a run (the consecutive frames of one
+//     note with the same string and finger); runs are independent and solved in parallel,
+//     so results do not depend on the thread count;
+//  2. a solution whose tip stays farther than max_residual_mm from the contact moves the
+//     whole hand rigidly by the remaining offset when that is at most max_hand_shift_mm
+//     (kHandShifted: the fitted wrist is off, e.g. a fit lagging a shift); beyond that the
+//     lift test rejects the contact (kOutOfReach: the finger cannot reach it) and the hand
+//     stays as fitted. (The decoder already rejected contacts beyond the lift distance.)
+// Other fingers and the thumb keep their fitted angles; the wrist moves only in step 2.
 #pragma once
 
 #include <optional>

@@ -59,6 +59,8 @@ RefineSummary Summarise(RefineMode mode,
         break;
     }
     if (c.reason == ContactReason::kOutOfReach) ++s.rejected_out_of_reach;
+    if (c.reason == ContactReason::kHandShifted) ++s.hand_shifted;
+    if (c.reason == ContactReason::kBeforeOnset) ++s.before_onset;
     if (c.pressed() && Finite(c.tip_distance_refined_mm)) {
       ++s.corrected_frames;
       sum_vision += c.tip_distance_vision_mm;
@@ -135,6 +137,8 @@ Status ArcoDecodeOptions::Validate() const {
       return Status::Error("arco decode options: every weight and cost must be finite and >= 0");
     }
   }
+  if (onset_lead_frames < 0)
+    return Status::Error("arco decode options: onset_lead_frames must be >= 0");
   return Status::Ok();
 }
 
@@ -150,6 +154,9 @@ Status ArcoIkOptions::Validate() const {
   }
   if (!(max_residual_mm > 0 && Finite(max_residual_mm))) {
     return Status::Error("arco IK options: max_residual_mm must be > 0");
+  }
+  if (!(max_hand_shift_mm >= 0 && Finite(max_hand_shift_mm))) {
+    return Status::Error("arco IK options: max_hand_shift_mm must be >= 0");
   }
   if (max_iterations < 1) return Status::Error("arco IK options: max_iterations must be >= 1");
   return Status::Ok();

@@ -72,19 +72,36 @@ struct ArcoDecodeOptions {
   double rest_gap_s = 0.4;          // a gap this long between notes frees the hand ...
   double rest_factor = 0.3;         // ... and scales the transition costs by this
   double infeasible_cost = 1000.0;  // candidate beyond the lift distance; open with vibrato
+  // Up to this many untrusted frames (rest, low confidence, ...) right before a stopped
+  // note's first trusted frame are pressed too, with the note's first pitch: the finger
+  // lands before the bow speaks and the tracker locks on a frame or two late.
+  // Only where the fitted fingertip is already within onset_lead_max_mm of the contact.
+  int onset_lead_frames = 3;
+  double onset_lead_max_mm = 20.0;
   Status Validate() const;
 };
 
 // arco's IK (finger_ik.h).
 struct ArcoIkOptions {
-  hand::FingerIkJoints joints = hand::FingerIkJoints::kAll;  // MCP flex+abd, PIP, DIP
-  double reference_weight_mm_per_rad = 2.0;  // prior toward the fitted (vision) pose
+  // MCP flexion, PIP and DIP: the flexion chain that brings a lifted fingertip down onto
+  // the string. Abduction is seen well (the MCP-PIP direction) and, when left free, takes
+  // the redundancy and drifts to its limits (docs/accuracy.md, the IK ablation).
+  hand::FingerIkJoints joints = hand::FingerIkJoints::kMcpFlexPipDip;
+  // false: one regularised solve: the priors spread the change over the joints (least
+  // change) and leave a small residual (sub-millimetre at these weights); true: the hand
+  // IK's exact reach, where the priors only pick among exact solutions and drift along
+  // them (worse joints, docs/accuracy.md).
+  bool exact_reach = false;
+  double reference_weight_mm_per_rad = 1.0;  // prior toward the fitted (vision) pose
   double temporal_weight_mm_per_rad = 4.0;   // toward the previous frame's solution
   // Lift test: a contact farther than this from the fitted fingertip is rejected (0 = the
   // finger's tip-to-PIP length, the dataset authors' cello rule) ...
   double lift_max_distance_mm = 0.0;
-  // ... and so is one the bounded IK cannot bring the tip within this distance of.
+  // When the bounded IK leaves the tip farther than max_residual_mm from the contact, the
+  // whole hand is translated by the rest if that is at most max_hand_shift_mm (the fitted
+  // wrist is off: e.g. a hand fit lagging a shift); otherwise the contact is rejected.
   double max_residual_mm = 3.0;
+  double max_hand_shift_mm = 10.0;
   int max_iterations = 15;
   Status Validate() const;
 };
@@ -104,11 +121,13 @@ struct RefineSummary {
   int frames = 0;
   int frames_with_hand = 0;
   int pressed = 0, open_string = 0, rest = 0, uncertain = 0;
-  int uncertain_by_reason[9] = {};  // index = ContactReason
+  int uncertain_by_reason[kNumContactReasons] = {};  // index = ContactReason
   int notes = 0, usable_notes = 0;
   int corrected_frames = 0;  // pressed frames whose finger was moved by the IK
   int rejected_out_of_reach = 0;
-  double mean_tip_distance_vision_mm = kNaN;   // over corrected frames
+  int hand_shifted = 0;                       // corrected frames that needed a whole-hand shift
+  int before_onset = 0;                       // pressed frames added before a note's detected onset
+  double mean_tip_distance_vision_mm = kNaN;  // over corrected frames
   double mean_tip_distance_refined_mm = kNaN;  // over corrected frames
   double max_tip_distance_refined_mm = kNaN;
   int ik_solves = 0, ik_iterations = 0, ik_not_converged = 0;

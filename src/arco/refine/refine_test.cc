@@ -37,6 +37,24 @@ double ContactDeviation(const testing::Scene& scene,
   return n ? sum / n : NAN;
 }
 
+// Mean wrist-aligned error of the truth's playing finger (MCP .. tip) on pressed frames.
+double PlayingFingerError(const testing::Scene& scene,
+                          const std::vector<std::optional<hand::HandPose>>& hands) {
+  double sum = 0;
+  int n = 0;
+  for (size_t f = 0; f < hands.size(); ++f) {
+    if (scene.truth_finger[f] == 0 || !hands[f]) continue;
+    const auto p = hand::ForwardKinematics(scene.input.hand_model, *hands[f]);
+    const auto t = hand::ForwardKinematics(scene.input.hand_model, scene.truth_hand[f]);
+    for (int j = 0; j < 4; ++j) {
+      const int k = hand::KeypointIndex(static_cast<hand::Finger>(scene.truth_finger[f]), j);
+      sum += ((p[k] - p[0]) - (t[k] - t[0])).norm();
+      ++n;
+    }
+  }
+  return n ? sum / n : NAN;
+}
+
 testing::Scene Cello(const std::vector<SceneNote>& notes, testing::SceneOptions options = {}) {
   return testing::MakeScene(InstrumentKind::kCello, notes, options);
 }
@@ -94,21 +112,41 @@ TEST(Refine, ArcoFindsStringAndFingerAndPutsTheTipOnTheContact) {
   for (size_t f = 0; f < r.contacts.size(); ++f) {
     const FrameContact& c = r.contacts[f];
     if (scene.truth_finger[f] == 0) {
-      EXPECT_FALSE(c.pressed()) << "frame " << f;
+      // Only the onset lead may press before the sound, within 3 frames of a note.
+      const bool lead = f + 3 < r.contacts.size() && scene.truth_finger[f + 3] > 0;
+      EXPECT_TRUE(!c.pressed() || (lead && c.reason == ContactReason::kBeforeOnset))
+          << "frame " << f;
       continue;
     }
     ++pressed;
     if (!c.pressed()) continue;
     right += c.string == scene.truth_string[f] && c.finger == scene.truth_finger[f];
     EXPECT_LT((c.point_in_world_mm - scene.truth_contact[f]).norm(), 1e-6) << "frame " << f;
-    EXPECT_LT((Tip(scene.input, *r.hand[f], c.finger) - c.point_in_world_mm).norm(), 1e-3);
+    // One regularised solve of the flexion chain: the least change; what remains is mostly
+    // out of the finger's flexion plane (beyond max_residual_mm the hand would shift).
+    EXPECT_LT((Tip(scene.input, *r.hand[f], c.finger) - c.point_in_world_mm).norm(), 3.0);
   }
   EXPECT_EQ(right, pressed);
   const double before = ContactDeviation(scene, scene.input.vision_hand);
   const double after = ContactDeviation(scene, r.hand);
-  std::printf("[ arco ] contact deviation vision %.2f mm -> arco %.4f mm\n", before, after);
-  EXPECT_LT(after, 0.01);
+  const double finger_before = PlayingFingerError(scene, scene.input.vision_hand);
+  const double finger_after = PlayingFingerError(scene, r.hand);
+  std::printf(
+      "[ arco ] contact deviation vision %.2f mm -> arco %.3f mm; playing finger "
+      "%.2f -> %.2f mm\n",
+      before,
+      after,
+      finger_before,
+      finger_after);
+  EXPECT_LT(after, 1.0);
+  EXPECT_LT(finger_after, 0.5 * finger_before);
   EXPECT_EQ(r.summary.joint_limit_violations, 0);
+  // All four joints with the exact reach option put the tip on the contact.
+  RefineOptions exact = Options(RefineMode::kArco);
+  exact.ik.exact_reach = true;
+  exact.ik.joints = hand::FingerIkJoints::kAll;
+  const RefineResult e = Refine(scene.input, exact);
+  EXPECT_LT(ContactDeviation(scene, e.hand), 1e-3);
 }
 
 TEST(Refine, PaperBindsTheNearestFingerAndMovesOnlyItsPipAndDip) {
@@ -252,11 +290,11 @@ TEST(Refine, PolyphonicOrNoisyAudioIsFlaggedNotForced) {
   for (int f = 20; f < 60; ++f) {
     scene.input.pitch[static_cast<size_t>(f)] = {choices[(f * 7 + f / 3) % 4], 0.55};
   }
-  // Frames 60-64: a confident note with noise below the confidence threshold.
-  for (int f = 60; f < 65; ++f) scene.input.pitch[static_cast<size_t>(f)].confidence = 0.2;
+  // Frames 75-79 (the end): a note with noise below the confidence threshold.
+  for (int f = 75; f < 80; ++f) scene.input.pitch[static_cast<size_t>(f)].confidence = 0.2;
   for (RefineMode mode : {RefineMode::kArco, RefineMode::kPaper}) {
     const RefineResult r = Refine(scene.input, Options(mode));
-    for (int f = 60; f < 65; ++f) {
+    for (int f = 75; f < 80; ++f) {
       EXPECT_EQ(r.contacts[static_cast<size_t>(f)].reason, ContactReason::kLowConfidence);
       EXPECT_TRUE(SamePose(r.hand[static_cast<size_t>(f)],
                            scene.input.vision_hand[static_cast<size_t>(f)]));
@@ -269,6 +307,30 @@ TEST(Refine, PolyphonicOrNoisyAudioIsFlaggedNotForced) {
                            scene.input.vision_hand[static_cast<size_t>(f)]));
     }
     EXPECT_GE(r.summary.uncertain_by_reason[static_cast<int>(ContactReason::kUnstablePitch)], 30);
+  }
+}
+
+TEST(Refine, TheFingerLandsBeforeTheTrackerLocksOn) {
+  // The tracker misses the first frames of the second and last notes (no pitch, then low
+  // confidence) while the fitted finger is already on its place.
+  const std::vector<SceneNote> notes = {{2, 1, 2, 20}, {2, 3, 4, 20}, {0, 0, 0, 10}, {1, 4, 9, 20}};
+  testing::Scene scene = Cello(notes);
+  for (int f : {20, 21, 50, 51}) scene.input.pitch[static_cast<size_t>(f)] = {0.0, 0.0};
+  scene.input.pitch[22].confidence = 0.1;
+  const RefineResult r = Refine(scene.input, Options(RefineMode::kArco));
+  for (int f : {20, 21, 22, 50, 51}) {
+    const FrameContact& c = r.contacts[static_cast<size_t>(f)];
+    EXPECT_TRUE(c.pressed()) << "frame " << f;
+    EXPECT_EQ(c.reason, ContactReason::kBeforeOnset);
+    EXPECT_EQ(c.string, f < 50 ? 2 : 1);
+    EXPECT_EQ(c.finger, f < 50 ? 3 : 4);
+    EXPECT_LT((c.point_in_world_mm - scene.truth_contact[static_cast<size_t>(f)]).norm(), 1e-6);
+  }
+  EXPECT_EQ(r.summary.before_onset, 5);
+  // Frames 47-49 of the rest: the hand is still on the previous note, far from the next
+  // contact: they stay rests (a real silence is not turned into a contact).
+  for (int f = 47; f < 50; ++f) {
+    EXPECT_EQ(r.contacts[static_cast<size_t>(f)].state, ContactState::kRest) << "frame " << f;
   }
 }
 
