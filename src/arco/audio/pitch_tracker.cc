@@ -31,8 +31,10 @@ Status PitchTrackerOptions::Validate() const {
   if (!(fps > 0 && fps <= 1000)) {
     return Status::Error("--fps must be in (0, 1000], got " + std::to_string(fps));
   }
-  if (!std::isfinite(start_s) || std::abs(start_s) > 1e6) {
-    return Status::Error("--start-s must be a finite time within 1e6 s");
+  if (!std::isfinite(start_s) || start_s < -3600 || start_s > 1e6) {
+    return Status::Error(
+        "--start-s must be in [-3600, 1e6] s (video may start at most an hour "
+        "before the audio)");
   }
   if (hops_per_frame < 0 || hops_per_frame > 100) {
     return Status::Error("hops per frame must be in [0, 100]");

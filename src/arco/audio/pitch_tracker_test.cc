@@ -192,6 +192,10 @@ TEST(PitchTrackerOptions, AbsurdValuesAreErrors) {
   o = Options("cello");
   o.start_s = NAN;
   EXPECT_FALSE(o.Validate().ok());
+  o.start_s = -1e5;
+  EXPECT_FALSE(o.Validate().ok());
+  o.start_s = -2.5;  // video starts before the audio: allowed
+  EXPECT_TRUE(o.Validate().ok());
   o = Options("cello");
   o.range.min_f0_hz = 5000;
   EXPECT_FALSE(o.Validate().ok());
@@ -208,6 +212,32 @@ TEST(TrackPitch, StartPastTheEndIsAFlaggedEmptyResult) {
   EXPECT_TRUE(track.frames.empty());
   ASSERT_FALSE(summary.warnings.empty());
   EXPECT_NE(summary.warnings[0].find("empty"), std::string::npos);
+}
+
+TEST(TrackPitch, AnySampleRateAndChannelCount) {
+  for (int rate : {8000, 22050, 96000}) {
+    for (int channels : {1, 6}) {
+      testing::ToneOptions tone;
+      tone.sample_rate_hz = rate;
+      tone.harmonics = 8;
+      const auto mono = testing::RenderTone([](double) { return 196.0; }, 1.0, tone);
+      std::vector<float> interleaved;
+      for (float v : mono) {
+        for (int c = 0; c < channels; ++c) interleaved.push_back(c % 2 ? v : 0.5f * v);
+      }
+      const std::string path = testing::TempPath("multi.wav");
+      ASSERT_TRUE(testing::WriteWav(path, interleaved, rate, channels).ok());
+      PitchSummary summary;
+      const auto track = Track(path, Options("viola"), &summary);
+      EXPECT_EQ(summary.source_channels, channels);
+      EXPECT_NEAR(summary.duration_s, 1.0, 1e-3);
+      for (const auto& f : track.frames) {
+        if (f.time_s < 0.1 || f.time_s > 0.9) continue;
+        ASSERT_TRUE(f.voiced) << rate << " " << channels;
+        EXPECT_NEAR(Cents(f.f0_hz, 196.0), 0.0, 1.0) << rate << " " << channels;
+      }
+    }
+  }
 }
 
 TEST(TrackPitch, ZeroLengthAudioIsAFlaggedEmptyResult) {

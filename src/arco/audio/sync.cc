@@ -235,10 +235,10 @@ StatusOr<SyncEvent> FindVideoEvent(const std::string& path,
       break;
     }
   }
-  // Background motion: the median energy of the window.
+  // Background motion: the lower quartile of the window's energies.
   std::vector<double> window(e.begin() + lo, e.begin() + hi);
-  std::nth_element(window.begin(), window.begin() + window.size() / 2, window.end());
-  const double base = window[window.size() / 2];
+  std::nth_element(window.begin(), window.begin() + window.size() / 4, window.end());
+  const double base = window[window.size() / 4];
   double sum = 0, weighted = 0;
   for (int64_t j = std::max<int64_t>(1, best - 1); j <= std::min(n - 1, best + 1); ++j) {
     const double w = std::max(0.0, e[j] - base);
@@ -247,6 +247,20 @@ StatusOr<SyncEvent> FindVideoEvent(const std::string& path,
   }
   const double centroid = sum > 0 ? weighted / sum : static_cast<double>(best);
   event.time_s = (centroid - 0.5) / fps;
+  if (options.video_event == VideoEvent::kClap && e[best] > base) {
+    // The last frame of the burst still at (nearly) full motion.
+    const double full = e[best];
+    while (best + 1 < hi && e[best + 1] >= 0.9 * full) ++best;
+    // Motion left after the peak, in units of the peak frame's motion.
+    double left = 0;
+    for (int64_t j = best + 1; j < std::min(n, best + 4); ++j) {
+      const double w = std::max(0.0, e[j] - base);
+      if (w < 0.05 * (e[best] - base)) break;
+      left += w;
+    }
+    event.time_s = (best + left / (e[best] - base)) / fps;
+    event.strength = e[best];
+  }
   event.strength = e[best];
   event.frame = std::lround(event.time_s * fps);
   return event;

@@ -16,8 +16,13 @@
 // t inside frame k's exposure [(k - 1/2)/fps, (k + 1/2)/fps) with a fully open
 // shutter, E[k] : E[k+1] = (1 - phi) : phi where t = (k - 1/2 + phi)/fps, so the
 // event time is (c - 1/2)/fps with c the E-weighted centroid around the peak.
-// A clap's hands move fastest just before contact: expect up to half a frame
-// early for claps; a flash or slate is exact.
+// Claps (VideoEvent::kClap, the default) end a burst of motion instead: hands
+// moving at speed v stop at contact time t inside frame m. With the peak frame K
+// the last one moving all through its exposure, the energy left after it is
+// sum_{k>K} E[k] = (1/2 + phi) E[K] (image shift of a partly moving exposure),
+// so t = (K + sum_{k>K} E[k] / E[K]) / fps: exact for hands at constant speed
+// (tests: within 0.03 frame), and within 0.1 frame in the tests with hands still
+// accelerating at contact.
 #pragma once
 
 #include <cmath>
@@ -28,8 +33,11 @@
 
 namespace arco::audio {
 
+enum class VideoEvent { kClap, kFlash };
+
 struct SyncOptions {
-  double video_fps = 0;        // 0: the stream's average frame rate
+  VideoEvent video_event = VideoEvent::kClap;  // how the video event is timed
+  double video_fps = 0;                        // 0: the stream's average frame rate
   double audio_near_s = NAN;   // look for the audio event near this time (NaN: anywhere)
   double video_near_s = NAN;   // likewise for the video (seconds of video time)
   double search_s = 3.0;       // half-width of the windows above

@@ -41,10 +41,58 @@ TEST(FindVideoEvent, FlashTimedBelowATenthOfAFrame) {
     const std::string path = testing::TempPath("flash.mkv");
     ASSERT_TRUE(testing::WriteTestVideo(path, video).ok());
     double fps = 0;
-    auto event = FindVideoEvent(path, SyncOptions(), &fps);
+    SyncOptions flash;
+    flash.video_event = VideoEvent::kFlash;
+    auto event = FindVideoEvent(path, flash, &fps);
     ASSERT_TRUE(event.ok()) << event.status().message();
     EXPECT_DOUBLE_EQ(fps, 30.0);
     EXPECT_NEAR(event->time_s, on_s, 0.1 / 30.0) << on_s;
+  }
+}
+
+// Two bright hands close at constant speed (or accelerating) and stop at
+// contact_s; each frame integrates its exposure (16 sub-samples), as a camera
+// with an open shutter does.
+void DrawClap(int k, double contact_s, bool accelerate, std::vector<double>* grey) {
+  const int w = 160, h = 120;
+  std::fill(grey->begin(), grey->end(), 30.0);
+  for (int sub = 0; sub < 16; ++sub) {
+    const double t = (k - 0.5 + (sub + 0.5) / 16.0) / 30.0;
+    const double before = std::max(0.0, contact_s - t);  // seconds until contact
+    // Accelerating: speed grows from 10 px/s at 0.4 s before contact to 250 px/s.
+    const double b = std::min(before, 0.4);
+    const double gap =
+        accelerate ? 250.0 * b - 300.0 * b * b + 10.0 * (before - b) : 150.0 * before;  // px
+    const double left_edge = 80.0 - gap / 2.0;  // right edge of the left hand
+    for (int y = 40; y < 80; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const double left = std::clamp(left_edge - x, 0.0, 1.0) * (x >= left_edge - 25.0);
+        const double right =
+            std::clamp(x + 1 - (160.0 - left_edge), 0.0, 1.0) * (x < 160.0 - left_edge + 25.0);
+        (*grey)[static_cast<size_t>(y) * w + x] += 200.0 / 16.0 * std::min(1.0, left + right);
+      }
+    }
+  }
+  (void)h;
+}
+
+TEST(FindVideoEvent, ClapContactTimedBelowAFrame) {
+  for (bool accelerate : {false, true}) {
+    for (double contact_s : {1.3137, 1.5, 1.6833}) {
+      testing::TestVideo video;
+      video.frames = 75;
+      video.draw = [&](int k, std::vector<double>* grey) {
+        DrawClap(k, contact_s, accelerate, grey);
+      };
+      const std::string path = testing::TempPath("clap.mkv");
+      ASSERT_TRUE(testing::WriteTestVideo(path, video).ok());
+      auto event = FindVideoEvent(path, SyncOptions(), nullptr);
+      ASSERT_TRUE(event.ok()) << event.status().message();
+      // Constant speed: exact up to pixel quantisation; accelerating hands are
+      // timed a little late (the model assumes constant speed).
+      EXPECT_NEAR(event->time_s, contact_s, (accelerate ? 0.25 : 0.15) / 30.0)
+          << contact_s << (accelerate ? " accelerating" : " constant speed");
+    }
   }
 }
 
@@ -74,6 +122,7 @@ TEST(SyncAudioToVideo, RecoversTheOffsetAndTheNearOptionPicksAnEvent) {
   const std::string audio_path = testing::TempPath("take.wav");
   ASSERT_TRUE(testing::WriteWav(audio_path, audio, 48000).ok());
   SyncOptions options;
+  options.video_event = VideoEvent::kFlash;
   options.audio_near_s = 3.0;
   auto sync = SyncAudioToVideo(audio_path, video_path, options);
   ASSERT_TRUE(sync.ok()) << sync.status().message();

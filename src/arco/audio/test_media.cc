@@ -123,15 +123,18 @@ Status WriteTestVideo(const std::string& path, const TestVideo& v) {
       av_frame_free(&a);
     }
   };
+  std::vector<double> grey(static_cast<size_t>(v.width) * v.height, 0.0);
   for (int k = 0; k < v.frames && ok; ++k) {
     write_audio_until(static_cast<double>(k) / v.fps, false);
     av_frame_make_writable(frame);
-    const double level = v.brightness(k);
+    if (v.draw) v.draw(k, &grey);
+    const double level = v.draw ? 0.0 : v.brightness(k);
     for (int y = 0; y < v.height; ++y) {
       uint8_t* row = frame->data[0] + y * frame->linesize[0];
       for (int x = 0; x < v.width; ++x) {
-        const double texture = 20.0 * (((x / 8) + (y / 8)) % 2);
-        row[x] = static_cast<uint8_t>(std::clamp(level + texture, 0.0, 255.0));
+        const double value = v.draw ? grey[static_cast<size_t>(y) * v.width + x]
+                                    : level + 20.0 * (((x / 8) + (y / 8)) % 2);
+        row[x] = static_cast<uint8_t>(std::clamp(std::lround(value), 0L, 255L));
       }
     }
     frame->pts = k;

@@ -17,6 +17,9 @@ struct TestVideo {
   int frames = 90;
   // Grey level (0..255) of frame k; pixels get this value plus a fixed texture.
   std::function<double(int frame)> brightness = [](int) { return 64.0; };
+  // When set, draws frame k itself (row-major grey levels, width x height) and
+  // `brightness` is ignored.
+  std::function<void(int frame, std::vector<double>* grey)> draw;
   std::vector<float> audio;  // mono samples at audio_rate_hz; empty: no audio track
   int audio_rate_hz = 48000;
   std::string audio_codec = "pcm_s16le";  // or "flac", "aac"

@@ -114,13 +114,15 @@ TEST(RunSyncThenPitch, OffsetGoesThroughTheCaptureManifest) {
   auto audio = testing::RenderTone([](double t) { return t > 2.2 ? 98.0 : 0.0; }, 4.0, tone);
   std::mt19937 rng(3);
   std::normal_distribution<double> gauss(0, 1);
-  for (int i = 0; i < 60; ++i) audio[88200 + i] += static_cast<float>(0.9 * std::exp(-i / 20.0) * gauss(rng));
+  for (int i = 0; i < 60; ++i)
+    audio[88200 + i] += static_cast<float>(0.9 * std::exp(-i / 20.0) * gauss(rng));
   const std::string wav = JoinPath(dir, "take.wav");
   ASSERT_TRUE(testing::WriteWav(wav, audio, 44100).ok());
   SyncRunOptions s;
   s.audio = wav;
   s.video = JoinPath(dir, "cam0.mkv");
   s.capture_dir = dir;
+  s.sync.video_event = audio::VideoEvent::kFlash;  // a light switching on
   auto sync = RunSync(s);
   ASSERT_TRUE(sync.ok()) << sync.status().message();
   // The light is on from frame 15's exposure start, (15 - 1/2)/30 s.

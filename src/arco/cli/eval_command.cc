@@ -4,6 +4,8 @@
 
 #include "arco/cli/command.h"
 #include "arco/eval/evaluate.h"
+#include "arco/eval/plot.h"
+#include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
 
 namespace arco::cli {
@@ -11,10 +13,17 @@ namespace {
 
 struct Args {
   eval::EvalRequest r;
-  std::string output;
+  std::vector<std::string> truths;
+  std::string output, plot;
 };
 
-int Run(const Args& a) {
+int Run(Args& a) {
+  // One truth without --truth-frame: a synthetic truth folder; else labelled frames.
+  if (a.truths.size() == 1 && a.r.truth_frames.empty()) {
+    a.r.truth = a.truths[0];
+  } else {
+    a.r.labels = a.truths;
+  }
   auto report = eval::Evaluate(a.r);
   if (!report.ok()) return PrintError(report.status().message());
   if (!a.output.empty()) {
@@ -30,6 +39,11 @@ int Run(const Args& a) {
   for (const auto& w : report->warnings)
     std::fprintf(stderr, "arco eval: warning: %s\n", w.c_str());
   if (!a.output.empty()) std::printf("\nwrote %s\n", a.output.c_str());
+  if (!a.plot.empty()) {
+    const Status st = AtomicWriteFile(a.plot, eval::EvalPlotSvg(*report, report->fps));
+    if (!st.ok()) return PrintError(st.message());
+    std::printf("wrote %s\n", a.plot.c_str());
+  }
   return 0;
 }
 
@@ -39,15 +53,14 @@ std::function<int()> SetupEval(CLI::App& app) {
   auto a = std::make_shared<Args>();
   cmd->add_option("result_dir", a->r.result_dir, "Result folder (result.json with stages)")
       ->required();
-  cmd->add_option(
-         "--truth",
-         a->r.truth,
-         "Truth: an `arco synth` truth folder, or a points JSON from `arco triangulate --view ...`")
+  cmd->add_option("--truth",
+                  a->truths,
+                  "Truth: an `arco synth` truth folder, or points JSONs from `arco triangulate "
+                  "--view ...` (repeat, one per labelled frame, each with a --truth-frame)")
       ->required();
   cmd->add_option("--truth-frame",
-                  a->r.truth_frame,
-                  "Frame number (capture numbering, from 1) a points JSON labels")
-      ->capture_default_str();
+                  a->r.truth_frames,
+                  "Frame number (capture numbering, from 1) each points JSON labels, in order");
   cmd->add_option("--pitch",
                   a->r.pitch_csv,
                   "Estimated pitch.csv (default: RESULT_DIR/pitch.csv when present)");
@@ -58,6 +71,8 @@ std::function<int()> SetupEval(CLI::App& app) {
                   "Tolerance before a geometric joint angle counts as a limit violation (deg)")
       ->capture_default_str();
   cmd->add_option("-o,--output", a->output, "Write the metrics as JSON here");
+  cmd->add_option(
+      "--plot", a->plot, "Write an SVG plot (pitch; hand error and contact deviation per frame)");
   return [a] { return Run(*a); };
 }
 

@@ -25,10 +25,18 @@ std::function<int()> SetupSync(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--max-s", o->sync.max_seconds, "Scan at most this much of each file (s)")
       ->capture_default_str();
+  auto event = std::make_shared<std::string>("clap");
+  cmd->add_option("--event",
+                  *event,
+                  "clap: the end of a burst of motion (hands meeting); flash: a light or "
+                  "slate switching on (a step in brightness)")
+      ->check(CLI::IsMember({"clap", "flash"}))
+      ->capture_default_str();
   cmd->add_option("--capture",
                   o->capture_dir,
                   "Capture folder: store the offset as audio.offset_s in its capture.json");
-  return [o] {
+  return [o, event] {
+    o->sync.video_event = *event == "flash" ? audio::VideoEvent::kFlash : audio::VideoEvent::kClap;
     auto result = RunSync(*o);
     if (!result.ok()) return PrintError(result.status().message());
     std::fputs(FormatSyncReport(*o, *result).c_str(), stdout);

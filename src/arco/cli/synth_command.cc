@@ -194,6 +194,11 @@ std::function<int()> SetupSynth(CLI::App& app) {
          a->o.detection.finger_bias_mm,
          "3D offset of the playing fingertip off the string as the detector sees it (mm; DIP half)")
       ->capture_default_str();
+  cmd->add_option("--jitter-mm",
+                  a->o.detection.jitter_mm,
+                  "View-consistent 3D detector error per axis for hand points (mm; body x1.5, "
+                  "instrument x0.3)")
+      ->capture_default_str();
   cmd->add_option("--mm-per-unit",
                   a->o.stage.mm_per_unit,
                   "Millimetres per calibration unit (0 = automatic: from the units, else the SPD "

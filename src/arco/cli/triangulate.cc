@@ -239,7 +239,12 @@ StatusOr<CaptureRunSummary> TriangulateCapture(const CaptureOptions& o,
       return Status::Error("filter group \"" + group + "\" is not in layout " + layout.name +
                            " (groups: " + known + ")");
     }
-    ARCO_RETURN_IF_ERROR(filter.Validate(manifest.fps));
+    const Status valid = filter.Validate(manifest.fps);
+    if (!valid.ok()) {
+      return Status::Error("filter " + group + "=" + FilterSpecToString(filter) + " at " +
+                           std::to_string(manifest.fps) + " fps (" + manifest_path +
+                           "): " + valid.message());
+    }
     filters.emplace_back(indices, filter);
   }
   const std::string calibration_path = ResolveCapturePath(o.capture_dir, manifest.calibration);

@@ -148,8 +148,7 @@ std::function<int()> Setup(CLI::App& app) {
   sub->add_option("--filter",
                   a->filters,
                   "GROUP=SPEC temporal filter, e.g. body=butterworth:6:4, left_hand=savgol:9:2, "
-                  "instrument=oneeuro:1:0.5, all=none; repeatable, later wins")
-      ->capture_default_str();
+                  "instrument=oneeuro:1:0.5, all=none; repeatable, later wins");
   sub->add_option("--max-gap-frames",
                   a->max_gap_frames,
                   "Fill NaN gaps up to this many frames before filtering (0 = none)")

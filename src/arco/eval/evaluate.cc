@@ -150,6 +150,7 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
   if (result.contains("keypoint_names"))
     result_names = result["keypoint_names"].get<std::vector<std::string>>();
   report.units = result.value("units", std::string("unknown"));
+  report.fps = result.value("fps", 30.0);
   if (report.units != "mm")
     report.warnings.push_back("result units are '" + report.units + "', not mm");
 
@@ -159,7 +160,11 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
   std::vector<std::string> truth_names;
   std::vector<double> truth_f0;
   EvalOptions options = r.metrics;
-  const bool folder = std::filesystem::is_directory(r.truth);
+  const bool folder = r.labels.empty();
+  if (folder && !std::filesystem::is_directory(r.truth)) {
+    return Status::Error(r.truth +
+                         ": not a truth folder (give labelled frames as JSON with --truth-frame)");
+  }
   if (folder) {
     report.truth_kind = "synthetic";
     ARCO_ASSIGN_OR_RETURN(const Json tj, ReadJsonFile(JoinPath(r.truth, "truth.json")));
@@ -185,42 +190,55 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
       for (const auto& f : *pitch) truth_f0.push_back(f.voiced ? f.f0_hz : 0.0);
     }
   } else {
-    // Labelled views triangulated by `arco triangulate --view`: one frame.
+    // Labelled views triangulated by `arco triangulate --view`: one JSON per frame.
     report.truth_kind = "labels";
-    ARCO_ASSIGN_OR_RETURN(const Json lj, ReadJsonFile(r.truth));
-    if (!lj.contains("points") || !lj["points"].is_array())
-      return Status::Error(r.truth + ": no \"points\" array");
-    if (result_names.empty())
+    if (r.truth_frames.size() != r.labels.size()) {
+      return Status::Error("give one --truth-frame per labels JSON (" +
+                           std::to_string(r.labels.size()) + " files, " +
+                           std::to_string(r.truth_frames.size()) + " frames)");
+    }
+    if (result_names.empty()) {
       return Status::Error(JoinPath(r.result_dir, "result.json") + ": no keypoint_names");
+    }
     const int64_t first =
         result.contains("frames") ? result["frames"].value("first", int64_t{1}) : 1;
     const int64_t count =
         result.contains("frames") ? result["frames"].value("count", int64_t{0}) : 0;
-    const int64_t row = r.truth_frame - first;
-    if (row < 0 || row >= count) {
-      return Status::Error(r.truth + ": --truth-frame " + std::to_string(r.truth_frame) +
-                           " is outside the result's frames " + std::to_string(first) + ".." +
-                           std::to_string(first + count - 1));
-    }
     truth_names = result_names;
     truth = PointSequence(static_cast<int>(count), static_cast<int>(truth_names.size()));
     std::map<std::string, int> index;
     for (size_t i = 0; i < truth_names.size(); ++i) index[truth_names[i]] = static_cast<int>(i);
-    int matched = 0;
-    for (const Json& p : lj["points"]) {
-      if (!p.contains("name") || !p.contains("xyz")) continue;
-      auto it = index.find(CanonicalKeypointName(p["name"].get<std::string>()));
-      if (it == index.end()) continue;
-      const Eigen::Vector3d xyz(
-          JsonNumberOrNaN(p["xyz"][0]), JsonNumberOrNaN(p["xyz"][1]), JsonNumberOrNaN(p["xyz"][2]));
-      truth.set(static_cast<int>(row), it->second, xyz);
-      ++matched;
-    }
-    if (matched == 0)
-      return Status::Error(r.truth + ": no labelled point matches the result's keypoints");
-    if (lj.value("units", std::string()) != report.units) {
-      report.warnings.push_back("truth units '" + lj.value("units", std::string()) +
-                                "' differ from the result's");
+    for (size_t k = 0; k < r.labels.size(); ++k) {
+      const std::string& path = r.labels[k];
+      ARCO_ASSIGN_OR_RETURN(const Json lj, ReadJsonFile(path));
+      if (!lj.contains("points") || !lj["points"].is_array())
+        return Status::Error(path + ": no \"points\" array");
+      const int64_t row = r.truth_frames[k] - first;
+      if (row < 0 || row >= count) {
+        return Status::Error(path + ": --truth-frame " + std::to_string(r.truth_frames[k]) +
+                             " is outside the result's frames " + std::to_string(first) + ".." +
+                             std::to_string(first + count - 1));
+      }
+      int matched = 0;
+      for (const Json& p : lj["points"]) {
+        if (!p.is_object() || !p.contains("name") || !p["name"].is_string() || !p.contains("xyz") ||
+            !p["xyz"].is_array() || p["xyz"].size() != 3) {
+          continue;
+        }
+        auto it = index.find(CanonicalKeypointName(p["name"].get<std::string>()));
+        if (it == index.end()) continue;
+        const Eigen::Vector3d xyz(JsonNumberOrNaN(p["xyz"][0]),
+                                  JsonNumberOrNaN(p["xyz"][1]),
+                                  JsonNumberOrNaN(p["xyz"][2]));
+        truth.set(static_cast<int>(row), it->second, xyz);
+        ++matched;
+      }
+      if (matched == 0)
+        return Status::Error(path + ": no labelled point matches the result's keypoints");
+      if (lj.value("units", std::string()) != report.units) {
+        report.warnings.push_back(path + ": truth units '" + lj.value("units", std::string()) +
+                                  "' differ from the result's");
+      }
     }
     truth_contact.string.assign(static_cast<size_t>(count), 0);
     truth_contact.finger.assign(static_cast<size_t>(count), 0);
@@ -287,6 +305,8 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
         e[static_cast<size_t>(f.frame)] = f.f0_hz;
     }
     report.pitch = EvaluatePitch(truth_f0, e);
+    report.truth_f0_hz = truth_f0;
+    report.estimate_f0_hz = e;
   }
   return report;
 }

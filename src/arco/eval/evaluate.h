@@ -8,8 +8,8 @@
 // contact_y_mm, contact_z_mm as truth/contact.csv): then string and finger
 // identification are scored.
 // Truth: a synthetic truth folder (arco synth's truth/: points3d.npy, contact.csv,
-// pitch.csv) or a points JSON of `arco triangulate --view ...` (manually labelled
-// views triangulated: the paper's real-data protocol) for one frame.
+// pitch.csv), or points JSONs of `arco triangulate --view ...` (manually labelled
+// views triangulated: the paper's real-data protocol), one per labelled frame.
 // Pitch: RESULT_DIR/pitch.csv (or --pitch FILE) against truth/pitch.csv.
 #pragma once
 
@@ -25,9 +25,10 @@ namespace arco::eval {
 
 struct EvalRequest {
   std::string result_dir;
-  std::string truth;        // truth folder, or a points JSON
-  int64_t truth_frame = 0;  // for a points JSON: the frame number it labels (manifest numbering)
-  std::string pitch_csv;    // optional estimate; default RESULT_DIR/pitch.csv when present
+  std::string truth;                  // synthetic truth folder, or empty when `labels` are given
+  std::vector<std::string> labels;    // points JSONs of labelled views, one frame each ...
+  std::vector<int64_t> truth_frames;  // ... and the frame number each labels (manifest numbering)
+  std::string pitch_csv;  // optional estimate; default RESULT_DIR/pitch.csv when present
   EvalOptions metrics;
   double joint_limit_tolerance_deg = 5.0;
 };
@@ -39,6 +40,8 @@ struct EvalReport {
   std::string units;
   std::vector<MethodMetrics> methods;
   std::optional<PitchMetrics> pitch;
+  std::vector<double> truth_f0_hz, estimate_f0_hz;  // per frame, 0 = unvoiced (plots)
+  double fps = 30;
   std::vector<std::string> warnings;
 
   Json ToJson(const EvalOptions& options) const;

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "arco/camera/calibration_io.h"
+#include "arco/mocap/keypoint_layout.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
@@ -147,6 +148,63 @@ TEST(DefaultLeftHandLimits, TruthHandsHaveNoViolationsAndBentFingersDo) {
     s.set(f, kLeftHandFirst + 8, 2 * (dip + (tip - dip).dot(u) * u) - tip);
   }
   EXPECT_GT(CountJointLimitViolations(s, kLeftHandFirst, true, limits, 5.0), s.num_frames / 2);
+}
+
+}  // namespace
+}  // namespace arco::eval
+
+namespace arco::eval {
+namespace {
+
+// Real-data mode: labelled frames (as `arco triangulate --view` writes them)
+// become the truth of those frames only; points are matched by name.
+TEST(Evaluate, LabelledFramesAsTruth) {
+  auto truth = ReadNpy<double>(CaptureDir() + "/truth/points3d.npy");
+  ASSERT_TRUE(truth.ok());
+  NpyArray<double> cut;
+  const int64_t frames = truth->shape[0];
+  cut.shape = {frames, 142, 3};
+  for (int64_t f = 0; f < frames; ++f) {
+    for (int p = 0; p < 142; ++p) {
+      for (int c = 0; c < 3; ++c) cut.data.push_back(truth->at(f, p, c));
+    }
+  }
+  const std::string dir = MakeResult("triangulation", cut, false);
+  // The result manifest needs the keypoint names and frame numbering.
+  auto rj = ReadJsonFile(dir + "/result.json");
+  ASSERT_TRUE(rj.ok());
+  Json j = *rj;
+  j["frames"] = {{"first", 1}, {"count", frames}};
+  j["keypoint_names"] = FindKeypointLayout("spd_cello")->names;
+  ASSERT_TRUE(WriteJsonFile(dir + "/result.json", j).ok());
+  // Frame 11 labels two instrument points; one is 3 mm off the result.
+  const Eigen::Vector3d nut(truth->at(10, 134, 0), truth->at(10, 134, 1), truth->at(10, 134, 2));
+  const Eigen::Vector3d tip(
+      truth->at(10, 141, 0), truth->at(10, 141, 1), truth->at(10, 141, 2) + 3.0);
+  const Json labels = {{"units", "mm"},
+                       {"points",
+                        {{{"name", "nut_l"}, {"xyz", {nut.x(), nut.y(), nut.z()}}},
+                         {{"name", "tip_plate"}, {"xyz", {tip.x(), tip.y(), tip.z()}}},
+                         {{"name", "not_a_keypoint"}, {"xyz", {0, 0, 0}}}}}};
+  const std::string path = ::testing::TempDir() + "/labels11.json";
+  ASSERT_TRUE(WriteJsonFile(path, labels).ok());
+  EvalRequest r;
+  r.result_dir = dir;
+  r.labels = {path};
+  r.truth_frames = {11};
+  auto report = Evaluate(r);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  EXPECT_EQ(report->truth_kind, "labels");
+  EXPECT_EQ(report->truth_frames, 1);
+  EXPECT_EQ(report->contact_frames, 0);
+  const MethodMetrics& m = report->methods[0];
+  EXPECT_NEAR(m.instrument_error_mm, 1.5, 1e-9);  // (0 + 3) / 2
+  EXPECT_TRUE(std::isnan(m.mpjpe_hand_mm));
+  EXPECT_TRUE(std::isnan(m.contact_deviation_mm));
+  r.truth_frames = {frames + 5};
+  EXPECT_FALSE(Evaluate(r).ok());
+  r.truth_frames = {};
+  EXPECT_FALSE(Evaluate(r).ok());
 }
 
 }  // namespace

@@ -138,12 +138,16 @@ MethodMetrics EvaluateMethod(const std::string& method,
   std::vector<double> hand_err, finger_err, contact_err, body_err, instrument_err, string_err;
   std::vector<int> pck_hits(options.pck_thresholds_mm.size(), 0);
   int hand_truth_valid = 0, hand_missing = 0, string_hits = 0, finger_hits = 0;
+  m.frame_hand_mm.assign(static_cast<size_t>(truth.num_frames), kNaN);
+  m.frame_contact_mm.assign(static_cast<size_t>(truth.num_frames), kNaN);
   for (int fr = 0; fr < truth.num_frames; ++fr) {
-    bool any_truth = false;
+    double frame_sum = 0;
+    int frame_count = 0;
+    bool any_truth = false;  // any truth point at all in this frame
+    for (int p = 0; p < truth.num_points && !any_truth; ++p) any_truth = truth.valid(fr, p);
     // Whole body without alignment.
     for (int p = 0; p < std::min(num_points, kNumWholeBody); ++p) {
       if (!truth.valid(fr, p)) continue;
-      any_truth = true;
       if (result.valid(fr, p)) body_err.push_back((truth.at(fr, p) - result.at(fr, p)).norm());
     }
     // Left hand after aligning the wrists by translation (the paper's protocol).
@@ -160,6 +164,8 @@ MethodMetrics EvaluateMethod(const std::string& method,
       }
       const double e = (truth.at(fr, w + k) - (result.at(fr, w + k) + shift)).norm();
       hand_err.push_back(e);
+      frame_sum += e;
+      ++frame_count;
       for (size_t t = 0; t < options.pck_thresholds_mm.size(); ++t) {
         if (e <= options.pck_thresholds_mm[t]) ++pck_hits[t];
       }
@@ -180,6 +186,7 @@ MethodMetrics EvaluateMethod(const std::string& method,
       }
     }
     if (any_truth) ++m.frames;
+    if (frame_count > 0) m.frame_hand_mm[static_cast<size_t>(fr)] = frame_sum / frame_count;
     // Contact metrics only on frames where the truth presses a note.
     if (!truth_contact.pressed(fr)) continue;
     ++m.contact_frames;
@@ -188,6 +195,7 @@ MethodMetrics EvaluateMethod(const std::string& method,
     if (tip < num_points && result.valid(fr, tip)) {
       contact_err.push_back(
           (result.at(fr, tip) - truth_contact.point_mm[static_cast<size_t>(fr)]).norm());
+      m.frame_contact_mm[static_cast<size_t>(fr)] = contact_err.back();
     }
     if (wrists) {
       for (int j = 0; j < 4; ++j) {

@@ -91,6 +91,9 @@ struct MethodMetrics {
   double instrument_error_mm = NAN;
   double string_error_mm = NAN;
   double missing_hand_fraction = 0;  // truth-valid hand joints the method left NaN
+  // Per frame (NaN where not measured): wrist-aligned left-hand error and
+  // contact deviation, for plots.
+  std::vector<double> frame_hand_mm, frame_contact_mm;
 };
 
 // Metrics of one method. `contact` may be null (the method writes none).

@@ -44,7 +44,7 @@ struct CaptureManifest {
   double tuning_a4_hz = 440.0;
   std::string calibration;                  // calibration file (any format arco reads)
   std::string audio;                        // optional audio file
-  double audio_offset_s = 0.0;              // audio time at the start of frame `frame_first`
+  double audio_offset_s = 0.0;  // audio time of frame `frame_first`'s timestamp (mid-exposure)
   std::string keypoints2d;                  // optional .npy of 2D keypoints
   std::string layout;                       // keypoint layout name, or "custom" with keypoint_names
   std::vector<std::string> keypoint_names;  // only for layout "custom"

@@ -1,6 +1,12 @@
 #include "arco/mocap/triangulate_point.h"
 
-#include <ceres/ceres.h>
+// TinySolver::Solve reads its cost before checking the first evaluation, which GCC
+// flags; our cost functor always succeeds.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <ceres/tiny_solver.h>
+#include <ceres/tiny_solver_autodiff_function.h>
+#pragma GCC diagnostic pop
 
 #include <algorithm>
 #include <cmath>
@@ -15,18 +21,39 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Reprojection residual with distortion, scaled by sqrt(weight).
-struct ReprojectionCost {
-  const Camera* camera;
-  Eigen::Vector2d pixel;
-  double sqrt_weight;
+// Reprojection residuals of one point in several views, with distortion, scaled by
+// sqrt(weight) and robustified so that |r_i'|^2 = rho(|r_i|^2) for the soft-L1 loss
+// rho(s) = 2 b^2 (sqrt(1 + s / b^2) - 1) (the loss Ceres calls SoftLOneLoss):
+// r_i' = r_i sqrt(rho(s) / s) with rho(s) / s = 2 / (1 + sqrt(1 + s / b^2)), smooth at 0.
+// Minimising sum |r_i'|^2 by Levenberg-Marquardt minimises the robust cost.
+struct RobustReprojection {
+  const TriangulationScratch* scratch;  // views
+  const std::vector<int>* used;         // indices into scratch->views
+  const Rig* rig;
+  bool weight_by_score;
+  double inv_b2;
+
+  int NumResiduals() const { return 2 * static_cast<int>(used->size()); }
 
   template <typename T>
-  bool operator()(const T* point_in_world, T* residual) const {
-    T projected[2];
-    if (!camera->ProjectToPixel(point_in_world, projected)) return false;
-    residual[0] = T(sqrt_weight) * (projected[0] - T(pixel.x()));
-    residual[1] = T(sqrt_weight) * (projected[1] - T(pixel.y()));
+  bool operator()(const T* point_in_world, T* residuals) const {
+    for (size_t i = 0; i < used->size(); ++i) {
+      const auto& v = scratch->views[(*used)[i]];
+      T projected[2];
+      if (!rig->cameras[v.camera].ProjectToPixel(point_in_world, projected)) {
+        // Behind the camera: a huge constant cost, so the solver rejects the step (the
+        // tiny solver ignores a false return when it evaluates a trial step).
+        residuals[2 * i] = residuals[2 * i + 1] = T(1e6);
+        continue;
+      }
+      const double sqrt_w = weight_by_score ? std::sqrt(v.score) : 1.0;
+      const T rx = T(sqrt_w) * (projected[0] - T(v.pixel.x()));
+      const T ry = T(sqrt_w) * (projected[1] - T(v.pixel.y()));
+      using std::sqrt;
+      const T scale = sqrt(T(2) / (T(1) + sqrt(T(1) + (rx * rx + ry * ry) * T(inv_b2))));
+      residuals[2 * i] = rx * scale;
+      residuals[2 * i + 1] = ry * scale;
+    }
     return true;
   }
 };
@@ -194,32 +221,30 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
   if (!xc) return std::nullopt;
   Eigen::Vector3d x_world = conditioning_.center + conditioning_.scale * *xc;
 
-  // 4. Robust Levenberg-Marquardt on the distorted reprojection error.
+  // 4. Robust Levenberg-Marquardt (Ceres' tiny solver: dense, allocation-light, 3
+  //    parameters) on the distorted reprojection error of the inliers.
   TriangulatedPoint result;
   if (options_.refine) {
-    ceres::Problem::Options problem_options;
-    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    ceres::Problem problem(problem_options);
-    ceres::SoftLOneLoss loss(options_.robust_loss_scale_px);
-    Eigen::Vector3d x = x_world;
+    s.used.clear();
     for (int k = 0; k < n; ++k) {
-      if (!s.best_inlier[k]) continue;
-      const double w = options_.weight_by_score ? s.views[k].score : 1.0;
-      auto* cost = new ceres::AutoDiffCostFunction<ReprojectionCost, 2, 3>(
-          new ReprojectionCost{&rig_.cameras[s.views[k].camera], s.views[k].pixel, std::sqrt(w)});
-      problem.AddResidualBlock(cost, &loss, x.data());
+      if (s.best_inlier[k]) s.used.push_back(k);
     }
-    ceres::Solver::Options solver_options;
-    solver_options.minimizer_type = ceres::TRUST_REGION;
-    solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-    solver_options.linear_solver_type = ceres::DENSE_QR;
-    solver_options.max_num_iterations = options_.max_refine_iterations;
-    solver_options.logging_type = ceres::SILENT;
-    solver_options.minimizer_progress_to_stdout = false;
-    solver_options.num_threads = 1;
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver_options, &problem, &summary);
-    if (summary.IsSolutionUsable() && x.allFinite() && summary.final_cost <= summary.initial_cost) {
+    const RobustReprojection cost{
+        &s,
+        &s.used,
+        &rig_,
+        options_.weight_by_score,
+        1.0 / (options_.robust_loss_scale_px * options_.robust_loss_scale_px)};
+    using AutoDiff = ceres::TinySolverAutoDiffFunction<RobustReprojection, Eigen::Dynamic, 3>;
+    const AutoDiff function(cost);
+    ceres::TinySolver<AutoDiff> solver;
+    solver.options.max_num_iterations = options_.max_refine_iterations;
+    solver.options.gradient_tolerance = 1e-12;
+    solver.options.parameter_tolerance = 1e-10;
+    solver.options.function_tolerance = 1e-8;  // absolute, in px^2
+    Eigen::Vector3d x = x_world;
+    const auto& summary = solver.Solve(function, &x);
+    if (x.allFinite() && summary.final_cost <= summary.initial_cost) {
       x_world = x;
       result.refined = true;
     }

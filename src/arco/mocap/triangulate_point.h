@@ -5,8 +5,8 @@
 //      then seeded random pairs, at most max_ransac_trials, adaptive stop) with a pixel
 //      gate and a cheirality test (the point must lie in front of both cameras);
 //   3. confidence-weighted, conditioned DLT on the inliers, re-gated once;
-//   4. Levenberg-Marquardt (Ceres) on the distorted reprojection error of the inliers
-//      with a soft-L1 robust loss.
+//   4. Levenberg-Marquardt (ceres::TinySolver, autodiff through Camera::ProjectToPixel)
+//      on the distorted reprojection error of the inliers with a soft-L1 robust loss.
 // Deterministic: views are ordered by (score, pixel) so results do not depend on the
 // order of cameras in the rig, and the sampler is seeded.
 //
@@ -50,7 +50,7 @@ struct TriangulatedPoint {
   std::vector<int> inlier_cameras;  // rig camera indices, ascending
   int num_views = 0;                // usable views (finite pixel, score >= min_score)
   double rms_reprojection_px = 0;   // over inlier views, with distortion
-  bool refined = false;             // true when the Ceres refinement was accepted
+  bool refined = false;             // true when the LM refinement was accepted
 };
 
 // Per-thread working memory so the per-point call does not allocate in steady state
@@ -66,7 +66,7 @@ struct TriangulationScratch {
   std::vector<View> views;
   std::vector<char> inlier, best_inlier;
   std::vector<DltObservation> dlt;
-  std::vector<double> errors_px;
+  std::vector<int> used;  // views entering the refinement
 };
 
 // Immutable triangulation set-up for one rig: options are validated, projection

@@ -55,6 +55,9 @@ Status DetectionOptions::Validate() const {
   if (!(finger_bias_mm >= 0 && finger_bias_mm < 200)) {
     return Status::Error("finger_bias_mm must be in [0, 200)");
   }
+  if (!(jitter_mm >= 0 && jitter_mm < 100) || !(jitter_time_s >= 0)) {
+    return Status::Error("jitter_mm must be in [0, 100) and jitter_time_s >= 0");
+  }
   if (!(instrument_noise_scale >= 0) || !(bow_noise_scale >= 0)) {
     return Status::Error("noise scales must be >= 0");
   }
@@ -65,6 +68,7 @@ NpyArray<float> EmulateDetections(const Rig& rig,
                                   const std::vector<DetectionFrame>& frames,
                                   const DetectionLayout& layout,
                                   const DetectionOptions& o,
+                                  double fps,
                                   uint64_t seed,
                                   int num_threads) {
   const int num_frames = static_cast<int>(frames.size());
@@ -77,6 +81,27 @@ NpyArray<float> EmulateDetections(const Rig& rig,
   std::vector<bool> is_torso(static_cast<size_t>(num_points), false);
   for (int b : layout.bow_points) is_bow[static_cast<size_t>(b)] = true;
   for (int b : layout.torso_points) is_torso[static_cast<size_t>(b)] = true;
+
+  // View-consistent 3D error, AR(1) in time per keypoint and axis.
+  std::vector<Eigen::Vector3d> jitter(
+      static_cast<size_t>(num_frames) * static_cast<size_t>(num_points), Eigen::Vector3d::Zero());
+  if (o.jitter_mm > 0) {
+    Rng rng = Rng::Stream(seed, 999);
+    const double a = o.jitter_time_s > 0 ? std::exp(-1.0 / (fps * o.jitter_time_s)) : 0.0;
+    const double b = std::sqrt(1 - a * a);
+    for (int p = 0; p < num_points; ++p) {
+      double scale = 1.5;  // body, feet, face
+      if (p >= layout.left_hand_first && p < layout.right_hand_first + 21) scale = 1.0;
+      if (p >= layout.instrument_first) scale = is_bow[static_cast<size_t>(p)] ? 1.0 : 0.3;
+      Eigen::Vector3d state(rng.Normal(), rng.Normal(), rng.Normal());
+      for (int fr = 0; fr < num_frames; ++fr) {
+        if (fr > 0)
+          state = a * state + b * Eigen::Vector3d(rng.Normal(), rng.Normal(), rng.Normal());
+        jitter[static_cast<size_t>(fr) * static_cast<size_t>(num_points) + static_cast<size_t>(p)] =
+            o.jitter_mm * scale * state;
+      }
+    }
+  }
 
   ParallelFor(num_views, num_threads, [&](int64_t view, int) {
     const Camera& cam = rig.cameras[static_cast<size_t>(view)];
@@ -93,7 +118,7 @@ NpyArray<float> EmulateDetections(const Rig& rig,
       for (int p = 0; p < num_points; ++p) {
         // Draw every random number for every point so one point's fate does not
         // shift the stream of the next.
-        const double nx = rng.Normal(), ny = rng.Normal(), jitter = rng.Normal();
+        const double nx = rng.Normal(), ny = rng.Normal(), score_jitter = rng.Normal();
         const bool dropout = rng.Bernoulli(o.occlusion_rate);
         const bool outlier = rng.Bernoulli(o.outlier_rate);
         const double angle = rng.Uniform(0, 2 * kPi);
@@ -101,6 +126,8 @@ NpyArray<float> EmulateDetections(const Rig& rig,
         const double occl_score = rng.Uniform(0.05, 0.45), outlier_score = rng.Uniform(0.4, 0.9);
         Eigen::Vector3d x = f.points[static_cast<size_t>(p)];
         if (!x.allFinite()) continue;
+        x += jitter[static_cast<size_t>(fr) * static_cast<size_t>(num_points) +
+                    static_cast<size_t>(p)];
         if (p == f.bias_tip) x += o.finger_bias_mm * f.bias_direction;
         if (p == f.bias_dip) x += 0.5 * o.finger_bias_mm * f.bias_direction;
         const auto pixel = cam.Project(x);
@@ -127,7 +154,7 @@ NpyArray<float> EmulateDetections(const Rig& rig,
           score = occl_score;
         } else {
           const double e = err.norm() / std::max(o.noise_px, 1e-9);
-          score = std::clamp(0.98 - 0.06 * e + 0.02 * jitter, 0.5, 1.0);
+          score = std::clamp(0.98 - 0.06 * e + 0.02 * score_jitter, 0.5, 1.0);
         }
         float* s = slot(p);
         s[0] = static_cast<float>(pixel->x() + err.x());

@@ -3,6 +3,12 @@
 //
 // Per keypoint and view, in this order (each draw from the view's own seeded
 // stream, so views can run in parallel and results do not depend on threads):
+//  0. View-consistent error (before projection, in 3D): every keypoint carries an
+//     offset that all views agree on, as a real detector's errors largely are
+//     (a wrong finger pose is wrong in every view), so triangulation cannot
+//     average it away: Gaussian, `jitter_mm` per axis for hand points (x1.5 for
+//     body and face, x0.3 for instrument points, x1 for the bow), smooth in time
+//     (first-order autoregressive with time constant `jitter_time_s`).
 //  1. Finger bias (before projection, in 3D): on frames with a pressed note the
 //     playing finger's tip moves `finger_bias_mm` off the string along the
 //     instrument's front normal and its DIP half as far: the detector sees an
@@ -38,6 +44,8 @@ struct DetectionOptions {
   double outlier_rate = 0.01;
   double occlusion_rate = 0.05;
   double finger_bias_mm = 12.0;
+  double jitter_mm = 4.0;               // view-consistent 3D error per axis (hand points)
+  double jitter_time_s = 0.15;          // its correlation time
   double instrument_noise_scale = 0.5;  // instrument points (tracked, TAPIR-like)
   double bow_noise_scale = 1.5;         // frog and tip (a dedicated detector)
   bool geometric_occlusion = true;
@@ -70,6 +78,7 @@ NpyArray<float> EmulateDetections(const Rig& rig_mm,
                                   const std::vector<DetectionFrame>& frames,
                                   const DetectionLayout& layout,
                                   const DetectionOptions& options,
+                                  double fps,
                                   uint64_t seed,
                                   int num_threads = 0);
 

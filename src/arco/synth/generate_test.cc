@@ -170,6 +170,7 @@ TEST(Generate, CleanDetectionsAreTheProjectionsExceptTheBiasedFinger) {
   o.detection.outlier_rate = 0;
   o.detection.occlusion_rate = 0;
   o.detection.geometric_occlusion = false;
+  o.detection.jitter_mm = 0;
   auto c = Generate(SpdRig(), o);
   ASSERT_TRUE(c.ok());
   int biased = 0;

@@ -37,7 +37,7 @@ hand::HandPose FingerPose(const hand::HandModel& model, double mcp, double pip, 
 }  // namespace
 
 Status LeftHandOptions::Validate() const {
-  for (double v : {relax_s, shift_s, change_s}) {
+  for (double v : {relax_s, shift_s, change_s, hover_mm}) {
     if (!(v >= 0) || !std::isfinite(v)) {
       return Status::Error("left hand: distances and durations must be finite and >= 0");
     }
@@ -186,6 +186,22 @@ LeftHandFrame LeftHandAnimator::Next(double t) {
       const int k = 4 * f + d;
       pose.angles_rad[k] =
           curl_pose_.angles_rad[k] + keep * (pose.angles_rad[k] - curl_pose_.angles_rad[k]);
+    }
+  }
+  if (options_.ik_idle_fingers) {
+    hand::FingerIkOptions hover;
+    hover.joints = hand::FingerIkJoints::kAll;
+    hover.exact_reach = false;
+    hover.seed_levels = 0;
+    hover.max_iterations = 25;
+    const int position = hn.fingering.position_semitones;
+    for (const FingerSpan& span : HandFrameFor(instrument_.name())) {
+      if (span.extended || (pressed && span.finger == hn.fingering.finger)) continue;
+      const double x = PlaceX(position + span.offset_semitones);
+      const Eigen::Vector3d target(x, StringY(hand_string, x), options_.hover_mm);
+      pose = hand::SolveFingertipIk(
+                 model_, pose, static_cast<hand::Finger>(span.finger), target, hover)
+                 .pose;
     }
   }
   hand::FingerIkOptions press;

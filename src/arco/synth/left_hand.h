@@ -40,6 +40,10 @@ struct LeftHandOptions {
   // Pressing posture of the playing finger (degrees): MCP, PIP, DIP flexion.
   double press_mcp_deg = 45, press_pip_deg = 70, press_dip_deg = 30;
   bool rock_with_vibrato = true;
+  // Also place every idle fingertip by IK `hover_mm` above its own place on the
+  // string (about 5x slower; the benchmark's baseline). Off: idle fingers relax.
+  bool ik_idle_fingers = false;
+  double hover_mm = 12;
   Status Validate() const;
 };
 

@@ -224,8 +224,13 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
   layout.instrument_first = kNumBodyPoints;
   layout.bow_points = {frog, tip};
   layout.torso_points = {5, 6, 11, 12};
-  cap.keypoints2d = EmulateDetections(
-      cap.rig_mm, det_frames, layout, options.detection, options.seed, options.num_threads);
+  cap.keypoints2d = EmulateDetections(cap.rig_mm,
+                                      det_frames,
+                                      layout,
+                                      options.detection,
+                                      options.fps,
+                                      options.seed,
+                                      options.num_threads);
   return cap;
 }
 

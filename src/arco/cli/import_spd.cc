@@ -1,0 +1,123 @@
+#include "arco/cli/import_spd.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+
+#include "arco/io/calibration_file.h"
+#include "arco/mocap/capture.h"
+#include "arco/util/file_io.h"
+
+namespace arco::cli {
+namespace {
+namespace fs = std::filesystem;
+}  // namespace
+
+StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
+  if (o.output_dir.empty()) return Status::Error("no output folder given");
+  std::error_code ec;
+  if (fs::exists(o.output_dir, ec) &&
+      (!fs::is_directory(o.output_dir, ec) || !fs::is_empty(o.output_dir, ec))) {
+    return Status::Error(o.output_dir + ": exists and is not an empty folder");
+  }
+  ARCO_ASSIGN_OR_RETURN(Calibration calibration, LoadCalibration(o.calibration));
+  SpdImportOptions spd;
+  spd.instrument = o.instrument;
+  spd.human_dir = o.human_dir;
+  spd.instrument_dir = o.instrument_dir;
+  spd.frame_first = o.frame_first;
+  spd.frame_last = o.frame_last;
+  if (!o.summary.empty()) {
+    ARCO_ASSIGN_OR_RETURN(SpdSummary summary, ReadSpdSummary(o.summary));
+    spd.frame_drops = summary.frame_drops;
+    if (spd.frame_first == 0) spd.frame_first = summary.start_frame;
+    if (spd.frame_last == 0) spd.frame_last = summary.end_frame;
+  }
+  if (spd.frame_first <= 0 || spd.frame_last <= 0) {
+    return Status::Error(
+        "give the frame range (--first/--last) or a summary with StartFrame and "
+        "EndFrame");
+  }
+  // Views: the serials given, else every calibrated camera with a keypoint folder.
+  std::vector<int> cameras;
+  if (o.serials.empty()) {
+    for (size_t c = 0; c < calibration.rig.cameras.size(); ++c) {
+      const std::string& serial = calibration.rig.cameras[c].serial;
+      if (!serial.empty() && fs::is_directory(JoinPath(o.human_dir, serial), ec)) {
+        cameras.push_back(static_cast<int>(c));
+      }
+    }
+    if (cameras.empty()) {
+      return Status::Error(o.human_dir + ": no <serial> folder of any camera in " + o.calibration);
+    }
+  } else {
+    for (const std::string& s : o.serials) {
+      const int c = calibration.rig.FindCamera(s);
+      if (c < 0) return Status::Error("camera \"" + s + "\" is not in " + o.calibration);
+      cameras.push_back(c);
+    }
+  }
+  for (int c : cameras) {
+    const Camera& cam = calibration.rig.cameras[c];
+    spd.serials.push_back(cam.serial.empty() ? cam.name : cam.serial);
+  }
+  ImportSpdSummary out;
+  ARCO_ASSIGN_OR_RETURN(NpyArray<double> keypoints, ImportSpdKeypoints(spd, &out.files));
+
+  CaptureManifest m;
+  m.name = o.name.empty() ? fs::path(o.output_dir).filename().string() : o.name;
+  m.instrument = o.instrument;
+  m.fps = o.fps;
+  m.frame_first = spd.frame_first;
+  m.frame_count = spd.frame_last - spd.frame_first + 1;
+  m.calibration = "calibration" + fs::path(o.calibration).extension().string();
+  m.keypoints2d = "keypoints2d.npy";
+  m.layout = o.instrument == "violin" ? "spd_violin" : "spd_cello";
+  if (!o.audio.empty()) {
+    m.audio = "audio" + fs::path(o.audio).extension().string();
+    m.audio_offset_s = o.audio_offset_s;
+  }
+  for (size_t v = 0; v < cameras.size(); ++v) {
+    const Camera& cam = calibration.rig.cameras[cameras[v]];
+    CaptureCamera cc{cam.name, cam.serial, "", {}};
+    if (auto it = spd.frame_drops.find(spd.serials[v]); it != spd.frame_drops.end()) {
+      cc.dropped_frames = it->second;
+    }
+    m.cameras.push_back(cc);
+  }
+  ARCO_RETURN_IF_ERROR(ParseCaptureManifest(CaptureManifestToJson(m).dump(), "capture.json")
+                           .status());  // the manifest we write must read back
+
+  // Build in a temporary sibling folder, then rename into place.
+  const std::string tmp = o.output_dir + ".tmp-" + std::to_string(::getpid());
+  fs::remove_all(tmp, ec);
+  auto write_all = [&]() -> Status {
+    ARCO_RETURN_IF_ERROR(MakeDirectories(tmp));
+    NpyArray<float> k32;
+    k32.shape = keypoints.shape;
+    k32.data.assign(keypoints.data.begin(), keypoints.data.end());
+    ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp, m.keypoints2d), k32));
+    fs::copy_file(o.calibration, JoinPath(tmp, m.calibration), ec);
+    if (ec) return Status::Error(o.calibration + ": cannot copy (" + ec.message() + ")");
+    if (!m.audio.empty()) {
+      fs::copy_file(o.audio, JoinPath(tmp, m.audio), ec);
+      if (ec) return Status::Error(o.audio + ": cannot copy (" + ec.message() + ")");
+    }
+    ARCO_RETURN_IF_ERROR(WriteCaptureManifest(tmp, m));
+    if (fs::exists(o.output_dir, ec)) fs::remove(o.output_dir, ec);  // empty folder
+    fs::rename(tmp, o.output_dir, ec);
+    if (ec) return Status::Error(o.output_dir + ": cannot create (" + ec.message() + ")");
+    return Status::Ok();
+  };
+  const Status status = write_all();
+  if (!status.ok()) {
+    fs::remove_all(tmp, ec);
+    return status;
+  }
+  out.frames = keypoints.shape[0];
+  out.views = keypoints.shape[1];
+  out.points = keypoints.shape[2];
+  return out;
+}
+
+}  // namespace arco::cli
