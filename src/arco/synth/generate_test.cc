@@ -55,6 +55,8 @@ TEST_P(GenerateTruth, FingertipOnTheStringAtThePitchesContactPoint) {
   auto model = InstrumentModel::Create(instrument);
   ASSERT_TRUE(model.ok());
   const int n_capture = static_cast<int>(c.points3d.shape[1]) - 13;
+  ASSERT_EQ(static_cast<int>(c.keypoint_names.size()), n_capture);
+  EXPECT_EQ(c.keypoint_names[kNumBodyPoints + 1], "nut_l");
   ASSERT_GT(c.pressed_frames, c.num_frames / 4);
   for (int f = 0; f < c.num_frames; ++f) {
     const ContactTruth& ct = c.contact[static_cast<size_t>(f)];
@@ -91,6 +93,18 @@ TEST_P(GenerateTruth, HandsWithinJointLimitsAndConsistentWithTheirModel) {
     const auto pts = hand::ForwardKinematics(left, c.left_hand[static_cast<size_t>(f)]);
     for (int k = 0; k < 21; ++k) EXPECT_LT((pts[k] - Point(c, f, kLeftHandFirst + k)).norm(), 1e-9);
     EXPECT_LT((Point(c, f, 9) - pts[0]).norm(), 1e-9);  // body wrist = hand wrist
+    // Idle fingertips hover above the string plane, never through it.
+    const Eigen::Matrix4d& m = c.world_from_instrument[static_cast<size_t>(f)];
+    for (int finger = 1; finger <= 4; ++finger) {
+      if (finger == c.contact[static_cast<size_t>(f)].finger) continue;
+      const Eigen::Vector3d tip = pts[hand::TipKeypoint(static_cast<hand::Finger>(finger))];
+      const Eigen::Vector3d in_instrument =
+          m.topLeftCorner<3, 3>().transpose() * (tip - m.topRightCorner<3, 1>());
+      EXPECT_GT(in_instrument.z(), 0.0)
+          << "frame " << f << " finger " << finger << " z " << in_instrument.z() << " playing "
+          << c.contact[static_cast<size_t>(f)].finger << " note "
+          << c.contact[static_cast<size_t>(f)].note_index;
+    }
   }
 }
 

@@ -129,10 +129,15 @@ Eigen::Vector3d LeftHandAnimator::AnchorAt(double t) const {
   while (next < notes.size() && notes[next].note.onset_s <= t) ++next;
   if (next == 0) return anchors_.front();
   if (next == notes.size()) return anchors_.back();
-  const double start = notes[next].note.onset_s - glide_s_[next];
-  if (t <= start || glide_s_[next] <= 0) return anchors_[next - 1];
+  // A pressing finger holds the hand until its note ends; after an open string
+  // the hand is free to travel during the end of the note.
+  const PerformedNote& prev = notes[next - 1];
+  double start = notes[next].note.onset_s - glide_s_[next];
+  if (prev.fingering.finger > 0) start = std::max(start, prev.note.offset_s);
+  const double glide = notes[next].note.onset_s - start;
+  if (t <= start || glide <= 0) return anchors_[next - 1];
   return anchors_[next - 1] +
-         (anchors_[next] - anchors_[next - 1]) * SmoothStep((t - start) / glide_s_[next]);
+         (anchors_[next] - anchors_[next - 1]) * SmoothStep((t - start) / glide);
 }
 
 LeftHandFrame LeftHandAnimator::Next(double t) {

@@ -7,7 +7,10 @@
 // at the middle of the hand position's four finger places on that string. The
 // fingers come from the high-string side of the neck on every bowed instrument.
 // Between notes the anchor glides (smoothstep) over `shift_s` when the hand
-// position changes and over `change_s` otherwise, arriving at the next onset.
+// position changes and over `change_s` otherwise, arriving at the next onset;
+// a pressing finger holds the hand until its note ends, so after a stopped note
+// the glide fits in the articulation gap (a fast shift), after an open string
+// it starts earlier.
 // Per frame:
 //  1. Vibrato: the anchor moves with the contact point between the note's centre
 //     pitch and the pitch at this instant, so the hand rocks along the string in

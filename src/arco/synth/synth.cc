@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "arco/hand/kinematics.h"
+#include "arco/mocap/keypoint_layout.h"
 #include "arco/synth/midi_reader.h"
 #include "arco/synth/synth_instrument.h"
 
@@ -88,7 +89,8 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
   const bool violin_like = kind == InstrumentKind::kViolin || kind == InstrumentKind::kViola;
   cap.layout = violin_like ? "spd_violin" : "spd_cello";
   cap.truth_layout = cap.layout + "_contact";
-  cap.keypoint_names.clear();
+  if (const KeypointLayout* layout = FindKeypointLayout(cap.layout))
+    cap.keypoint_names = layout->names;
   ARCO_ASSIGN_OR_RETURN(const InstrumentTemplate tmpl, MakeInstrumentTemplate(model));
   const auto& inst_names = model.keypoint_names();
   cap.num_instrument_points = static_cast<int>(inst_names.size());
@@ -217,7 +219,10 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     df.torso_a = world_from_performer * (torso * Eigen::Vector3d(0, 80, -30));
     df.torso_b = world_from_performer * (torso * Eigen::Vector3d(0, 520, -20));
   }
-  cap.keypoint_names.reserve(static_cast<size_t>(num_capture_points));
+  if (static_cast<int>(cap.keypoint_names.size()) != num_capture_points) {
+    return Status::Error("internal: layout " + cap.layout +
+                         " does not match the instrument's keypoints");
+  }
 
   DetectionLayout layout;
   layout.num_points = num_capture_points;
