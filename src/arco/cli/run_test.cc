@@ -1,0 +1,161 @@
+// `arco run` / `arco refine` end to end on a short synthetic capture (arco synth, the real
+// SPD rig), scored with arco eval's library.
+#include "arco/cli/run.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "arco/eval/evaluate.h"
+#include "arco/io/calibration_file.h"
+#include "arco/mocap/capture.h"
+#include "arco/mocap/test_dir.h"
+#include "arco/refine/method_result.h"
+#include "arco/synth/capture_writer.h"
+#include "arco/synth/synth.h"
+#include "arco/util/file_io.h"
+
+namespace arco::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Removes the shared capture when the test binary ends.
+struct RemoveAtExit {
+  std::string path;
+  ~RemoveAtExit() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
+// A 4-second cello scale with audio (soundfont tuning off: faster), once per test binary.
+const std::string& SyntheticCapture() {
+  static const RemoveAtExit dir{[] {
+    const std::string path =
+        (fs::temp_directory_path() / ("arco_run_test_capture_" + std::to_string(::getpid())))
+            .string();
+    fs::remove_all(path);
+    auto calibration =
+        LoadCalibration(std::string(ARCO_SHARED_DATA_DIR) + "/spd/cello_1113_scale_camera.xml");
+    EXPECT_TRUE(calibration.ok()) << calibration.status().message();
+    synth::SynthOptions o;
+    o.max_duration_s = 4.0;
+    o.num_threads = 2;
+    auto capture = synth::Generate(calibration->rig, o);
+    EXPECT_TRUE(capture.ok()) << capture.status().message();
+    synth::WriteOptions w;
+    w.audio_render.tune_soundfont = false;
+    const Status written = synth::WriteCapture(*capture, path, w);
+    EXPECT_TRUE(written.ok()) << written.message();
+    return path;
+  }()};
+  return dir.path;
+}
+
+TEST(RunCapture, EveryStageAndThreeMethodsThatEvalScores) {
+  arco::testing::TempDir out;
+  const std::string result = out / "result";
+  RunOptions o;
+  o.capture_dir = SyntheticCapture();
+  o.result_dir = result;
+  o.num_threads = 2;
+  std::vector<std::string> stages;
+  RunProgress progress;
+  progress.on_stage = [&](int, int, const std::string& name) { stages.push_back(name); };
+  auto summary = RunCapture(o, progress);
+  ASSERT_TRUE(summary.ok()) << summary.status().message();
+  EXPECT_EQ(stages,
+            (std::vector<std::string>{"triangulate", "instrument", "hands", "pitch", "refine"}));
+  ASSERT_EQ(summary->methods.size(), 3u);
+  for (const char* f : {"triangulation/points3d.npy",
+                        "instrument/strings.npy",
+                        "hand/hand_params.npy",
+                        "pitch.csv",
+                        "notes.csv",
+                        "vision/points3d.npy",
+                        "paper/contacts.csv",
+                        "arco/contacts.csv",
+                        "arco/fingering.csv"}) {
+    EXPECT_TRUE(FileExists(JoinPath(result, f))) << f;
+  }
+  auto points = ReadResultPoints3d(result, "arco");
+  ASSERT_TRUE(points.ok());
+  EXPECT_EQ(points->shape[1], 155);
+
+  eval::EvalRequest request;
+  request.result_dir = result;
+  request.truth = JoinPath(SyntheticCapture(), "truth");
+  auto report = eval::Evaluate(request);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  std::map<std::string, eval::MethodMetrics> m;
+  for (const auto& method : report->methods) m[method.method] = method;
+  ASSERT_TRUE(m.count("vision") && m.count("paper") && m.count("arco"));
+  std::printf(
+      "[ run ] contact deviation vision %.2f paper %.2f arco %.2f mm; note finger "
+      "%.2f / %.2f / %.2f mm; arco string %.3f finger %.3f\n",
+      m["vision"].contact_deviation_mm,
+      m["paper"].contact_deviation_mm,
+      m["arco"].contact_deviation_mm,
+      m["vision"].mpjpe_note_finger_mm,
+      m["paper"].mpjpe_note_finger_mm,
+      m["arco"].mpjpe_note_finger_mm,
+      m["arco"].string_accuracy,
+      m["arco"].finger_accuracy);
+  EXPECT_LT(m["arco"].contact_deviation_mm, 0.3 * m["vision"].contact_deviation_mm);
+  EXPECT_LT(m["arco"].mpjpe_note_finger_mm, 0.85 * m["vision"].mpjpe_note_finger_mm);
+  EXPECT_LE(m["arco"].mpjpe_hand_mm, m["vision"].mpjpe_hand_mm);
+  EXPECT_GE(m["arco"].string_accuracy, 0.95);
+  EXPECT_GE(m["arco"].finger_accuracy, 0.95);
+  EXPECT_EQ(m["arco"].joint_limit_violations, 0);
+
+  // `arco refine` reproduces the run's paper folder bit for bit.
+  auto before = ReadFileToString(JoinPath(result, "paper/contacts.csv"));
+  auto before_points = ReadFileToString(JoinPath(result, "paper/points3d.npy"));
+  RefineDirOptions r;
+  r.result_dir = result;
+  r.refine.mode = refine::RefineMode::kPaper;
+  r.refine.num_threads = 1;
+  ASSERT_TRUE(RefineResultDir(r).ok());
+  EXPECT_EQ(*before, *ReadFileToString(JoinPath(result, "paper/contacts.csv")));
+  EXPECT_EQ(*before_points, *ReadFileToString(JoinPath(result, "paper/points3d.npy")));
+}
+
+TEST(RunCapture, BadInputIsOneClearError) {
+  arco::testing::TempDir out;
+  RunOptions o;
+  o.capture_dir = out / "missing";
+  o.result_dir = out / "result";
+  auto missing = RunCapture(o);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.status().message().find("missing"), std::string::npos);
+  EXPECT_FALSE(FileExists(out / "result"));
+
+  RefineDirOptions r;
+  r.result_dir = out.path();
+  auto empty = RefineResultDir(r);
+  ASSERT_FALSE(empty.ok());
+  EXPECT_NE(empty.status().message().find("arco run"), std::string::npos)
+      << empty.status().message();
+
+  // A capture without audio: the vision method only, and a warning.
+  const std::string capture = out / "capture";
+  fs::copy(SyntheticCapture(), capture, fs::copy_options::recursive);
+  auto manifest = ReadCaptureManifest(capture);
+  ASSERT_TRUE(manifest.ok());
+  manifest->audio.clear();
+  ASSERT_TRUE(WriteCaptureManifest(capture, *manifest).ok());
+  o.capture_dir = capture;
+  auto silent = RunCapture(o);
+  ASSERT_TRUE(silent.ok()) << silent.status().message();
+  EXPECT_EQ(silent->methods.size(), 1u);
+  ASSERT_FALSE(silent->warnings.empty());
+  r.result_dir = o.result_dir;
+  r.refine.mode = refine::RefineMode::kArco;
+  auto no_pitch = RefineResultDir(r);
+  ASSERT_FALSE(no_pitch.ok());
+  EXPECT_NE(no_pitch.status().message().find("pitch"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace arco::cli

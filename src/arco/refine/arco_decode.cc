@@ -1,0 +1,319 @@
+#include "arco/refine/arco_decode.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+
+#include "arco/util/parallel.h"
+
+namespace arco::refine {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct State {
+  int string = 0;
+  int finger = 0;                 // 0 = open string
+  double position_semitones = 0;  // finger 1's semitone above the open string (stopped)
+  double cost = 0;                // emission
+};
+
+double Median(std::vector<double>& v) {
+  const size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  double m = v[mid];
+  if (v.size() % 2 == 0) {
+    m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
+  }
+  return m;
+}
+
+// Distance and finger-order cost of finger k at a candidate (header comment).
+void FrameCosts(const hand::HandPointsMm& points,
+                const StringFrame& sf,
+                const Eigen::Vector3d& contact,
+                int finger,
+                const ArcoDecodeOptions& options,
+                double* distance,
+                double* order) {
+  const Eigen::Vector3d v = points[hand::TipKeypoint(static_cast<hand::Finger>(finger))] - contact;
+  const double a = v.dot(sf.along);
+  const double n = v.dot(sf.normal);
+  const double l = (v - a * sf.along - n * sf.normal).norm();
+  *distance = std::sqrt(a * a + l * l + options.normal_weight * options.normal_weight * n * n);
+  double violation = 0;
+  for (int j = 1; j <= 4; ++j) {
+    if (j == finger) continue;
+    const double aj =
+        (points[hand::TipKeypoint(static_cast<hand::Finger>(j))] - contact).dot(sf.along);
+    violation += j < finger ? std::max(0.0, -aj - options.order_margin_mm)
+                            : std::max(0.0, aj - options.order_margin_mm);
+  }
+  *order = violation;
+}
+
+// The states of one note and their emission costs.
+std::vector<State> NoteStates(const DecodeContext& context,
+                              const NoteSpan& note,
+                              const ArcoDecodeOptions& options,
+                              const PitchModelOptions& pitch_options,
+                              const std::array<double, 5>& lift_max_mm) {
+  const InstrumentModel& model = *context.input->instrument;
+  std::vector<State> states;
+  std::vector<double> distances, orders;
+  for (int s = 1; s <= model.num_strings(); ++s) {
+    const Contact median_contact = ContactPoint(model, s, note.f0_hz, pitch_options.contact);
+    if (median_contact.kind == ContactKind::kOpenString) {
+      State open;
+      open.string = s;
+      open.cost = options.open_cost_mm;
+      if (note.modulation_cents > pitch_options.vibrato_min_cents)
+        open.cost += options.infeasible_cost;
+      states.push_back(open);
+      continue;
+    }
+    if (!median_contact.stopped()) continue;
+    for (int k = 1; k <= 4; ++k) {
+      distances.clear();
+      orders.clear();
+      for (int64_t f = note.first_frame; f <= note.last_frame; ++f) {
+        const size_t i = static_cast<size_t>(f);
+        if (context.analysis->frame_state[i] != FrameAudioState::kNote) continue;
+        if (!context.has_strings[i] || !context.vision_points[i]) continue;
+        Candidate cand;
+        if (!ContactOnString(model,
+                             context.strings(static_cast<int>(f)),
+                             s,
+                             context.input->pitch[i].f0_hz,
+                             pitch_options.contact,
+                             &cand)) {
+          continue;
+        }
+        double d = 0, o = 0;
+        FrameCosts(*context.vision_points[i],
+                   StringFrameOf(context.strings(static_cast<int>(f)), s),
+                   cand.point_in_world,
+                   k,
+                   options,
+                   &d,
+                   &o);
+        distances.push_back(d);
+        orders.push_back(o);
+      }
+      State st;
+      st.string = s;
+      st.finger = k;
+      st.position_semitones =
+          median_contact.cents_from_open / 100.0 - FingerOffsetSemitones(model.kind(), k);
+      if (!distances.empty()) {
+        const double d = Median(distances);
+        st.cost = d + options.order_weight * Median(orders);
+        if (d > lift_max_mm[static_cast<size_t>(k)]) st.cost += options.infeasible_cost;
+      }
+      states.push_back(st);
+      if (std::getenv("ARCO_DEBUG_DECODE")) {
+        std::fprintf(stderr,
+                     "note %lld-%lld s%d f%d cost %.1f pos %.1f\n",
+                     (long long)note.first_frame,
+                     (long long)note.last_frame,
+                     s,
+                     k,
+                     st.cost,
+                     st.position_semitones);
+      }
+    }
+  }
+  return states;
+}
+
+double TransitionCost(const NoteSpan& from_note,
+                      const NoteSpan& to_note,
+                      const State& a,
+                      const State& b,
+                      const ArcoDecodeOptions& options,
+                      double fps) {
+  const bool same_state = a.string == b.string && a.finger == b.finger;
+  if (same_state) return 0.0;
+  const double gap_s = static_cast<double>(to_note.first_frame - from_note.last_frame - 1) / fps;
+  const double factor = gap_s >= options.rest_gap_s ? options.rest_factor : 1.0;
+  const double interval_cents = std::abs(1200.0 * std::log2(to_note.f0_hz / from_note.f0_hz));
+  if (interval_cents < options.same_pitch_cents) return factor * options.same_pitch_change_cost;
+  double cost = options.string_cross_cost * std::abs(a.string - b.string);
+  if (a.finger > 0 && b.finger > 0) {
+    cost += options.shift_cost_per_semitone * std::abs(a.position_semitones - b.position_semitones);
+  }
+  return factor * cost;
+}
+
+// The contact of one frame of a decoded note (state, string, finger) at pitch f0_hz.
+void AssignFrame(const DecodeContext& context,
+                 int string,
+                 int finger,
+                 double f0_hz,
+                 const PitchModelOptions& pitch_options,
+                 const std::array<double, 5>& lift_max_mm,
+                 int64_t f,
+                 FrameContact* fc) {
+  const size_t i = static_cast<size_t>(f);
+  if (finger == 0) {
+    fc->state = ContactState::kOpenString;
+    fc->reason = ContactReason::kNone;
+    fc->string = string;
+    return;
+  }
+  if (!context.has_strings[i]) {
+    fc->reason = ContactReason::kNoInstrument;
+    return;
+  }
+  Candidate cand;
+  if (!ContactOnString(*context.input->instrument,
+                       context.strings(static_cast<int>(f)),
+                       string,
+                       f0_hz,
+                       pitch_options.contact,
+                       &cand)) {
+    fc->reason = ContactReason::kUnplayable;
+    return;
+  }
+  SetPressed(cand, finger, fc);
+  const auto& points = context.vision_points[i];
+  if (!points) {
+    fc->reason = ContactReason::kNoHand;
+    return;
+  }
+  const int tip = hand::TipKeypoint(static_cast<hand::Finger>(finger));
+  fc->tip_distance_vision_mm = ((*points)[tip] - cand.point_in_world).norm();
+  if (fc->tip_distance_vision_mm > lift_max_mm[static_cast<size_t>(finger)]) {
+    fc->state = ContactState::kUncertain;  // lift test: string and finger kept as info
+    fc->reason = ContactReason::kOutOfReach;
+  }
+}
+
+}  // namespace
+
+double FingerOffsetSemitones(InstrumentKind kind, int finger) {
+  static const double kCello[5] = {0, 0, 1, 2, 3};
+  static const double kViolin[5] = {0, 0, 2, 4, 5};
+  const bool violin_like = kind == InstrumentKind::kViolin || kind == InstrumentKind::kViola;
+  const int k = finger < 0 ? 0 : (finger > 4 ? 4 : finger);
+  return (violin_like ? kViolin : kCello)[k];
+}
+
+std::vector<FrameContact> DecodeArco(const DecodeContext& context,
+                                     const ArcoDecodeOptions& options,
+                                     const PitchModelOptions& pitch_options,
+                                     const std::array<double, 5>& lift_max_mm,
+                                     int num_threads) {
+  const RefineInput& input = *context.input;
+  const int n = context.num_frames();
+  std::vector<FrameContact> out(static_cast<size_t>(n));
+  for (int f = 0; f < n; ++f) out[static_cast<size_t>(f)] = AudioOnlyContact(context, f);
+
+  const std::vector<NoteSpan>& notes = context.analysis->notes;
+  std::vector<int> usable;
+  for (int i = 0; i < static_cast<int>(notes.size()); ++i) {
+    if (notes[static_cast<size_t>(i)].usable) usable.push_back(i);
+  }
+  // Emissions, note by note in parallel (each note writes its own slot).
+  std::vector<std::vector<State>> states(usable.size());
+  ParallelFor(
+      static_cast<int64_t>(usable.size()),
+      num_threads,
+      [&](int64_t u, int) {
+        states[static_cast<size_t>(u)] =
+            NoteStates(context,
+                       notes[static_cast<size_t>(usable[static_cast<size_t>(u)])],
+                       options,
+                       pitch_options,
+                       lift_max_mm);
+      },
+      1);
+
+  // Viterbi over the usable notes (notes without any state are skipped: unplayable).
+  std::vector<int> chain;
+  for (size_t u = 0; u < usable.size(); ++u) {
+    if (!states[u].empty()) chain.push_back(static_cast<int>(u));
+  }
+  std::vector<std::vector<double>> cost(chain.size());
+  std::vector<std::vector<int>> back(chain.size());
+  for (size_t c = 0; c < chain.size(); ++c) {
+    const std::vector<State>& cur = states[static_cast<size_t>(chain[c])];
+    cost[c].assign(cur.size(), kInf);
+    back[c].assign(cur.size(), -1);
+    for (size_t j = 0; j < cur.size(); ++j) {
+      if (c == 0) {
+        cost[c][j] = cur[j].cost;
+        continue;
+      }
+      const std::vector<State>& prev = states[static_cast<size_t>(chain[c - 1])];
+      const NoteSpan& from = notes[static_cast<size_t>(usable[static_cast<size_t>(chain[c - 1])])];
+      const NoteSpan& to = notes[static_cast<size_t>(usable[static_cast<size_t>(chain[c])])];
+      for (size_t i = 0; i < prev.size(); ++i) {
+        const double total =
+            cost[c - 1][i] + TransitionCost(from, to, prev[i], cur[j], options, input.fps);
+        if (total < cost[c][j]) {
+          cost[c][j] = total;
+          back[c][j] = static_cast<int>(i);
+        }
+      }
+      cost[c][j] += cur[j].cost;
+    }
+  }
+  std::vector<int> chosen(chain.size(), -1);
+  if (!chain.empty()) {
+    const std::vector<double>& last = cost.back();
+    chosen.back() = static_cast<int>(std::min_element(last.begin(), last.end()) - last.begin());
+    for (size_t c = chain.size() - 1; c > 0; --c)
+      chosen[c - 1] = back[c][static_cast<size_t>(chosen[c])];
+  }
+
+  // Frames of the decoded notes.
+  std::vector<uint8_t> decoded_note(notes.size(), 0);
+  for (size_t c = 0; c < chain.size(); ++c) {
+    const int note_index = usable[static_cast<size_t>(chain[c])];
+    decoded_note[static_cast<size_t>(note_index)] = 1;
+    const NoteSpan& note = notes[static_cast<size_t>(note_index)];
+    const State& st = states[static_cast<size_t>(chain[c])][static_cast<size_t>(chosen[c])];
+    for (int64_t f = note.first_frame; f <= note.last_frame; ++f) {
+      const size_t i = static_cast<size_t>(f);
+      if (context.analysis->frame_state[i] != FrameAudioState::kNote) continue;
+      AssignFrame(
+          context, st.string, st.finger, out[i].f0_hz, pitch_options, lift_max_mm, f, &out[i]);
+    }
+    if (st.finger == 0) continue;
+    // The finger lands before the sound: untrusted frames just before the onset.
+    const double onset_hz = input.pitch[static_cast<size_t>(note.first_frame)].f0_hz;
+    for (int64_t f = note.first_frame - 1;
+         f >= 0 && f >= note.first_frame - options.onset_lead_frames;
+         --f) {
+      const size_t i = static_cast<size_t>(f);
+      const FrameAudioState a = context.analysis->frame_state[i];
+      const bool untrusted = a == FrameAudioState::kRest || a == FrameAudioState::kLowConfidence ||
+                             a == FrameAudioState::kOutlier || a == FrameAudioState::kShortNote;
+      if (!untrusted || out[i].state == ContactState::kPressed) break;
+      FrameContact lead = out[i];
+      lead.note = note_index;
+      AssignFrame(context, st.string, st.finger, onset_hz, pitch_options, lift_max_mm, f, &lead);
+      // Only where the fitted finger is already near its contact (not still on its way).
+      if (!lead.pressed() || !(lead.tip_distance_vision_mm <= options.onset_lead_max_mm)) break;
+      if (lead.reason == ContactReason::kNone) lead.reason = ContactReason::kBeforeOnset;
+      out[i] = lead;
+    }
+  }
+  // Usable notes that no string can play.
+  for (int note_index : usable) {
+    if (decoded_note[static_cast<size_t>(note_index)]) continue;
+    const NoteSpan& note = notes[static_cast<size_t>(note_index)];
+    for (int64_t f = note.first_frame; f <= note.last_frame; ++f) {
+      FrameContact& fc = out[static_cast<size_t>(f)];
+      if (fc.state == ContactState::kUncertain && fc.reason == ContactReason::kNone) {
+        fc.reason = ContactReason::kUnplayable;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace arco::refine

@@ -1,0 +1,48 @@
+// arco's choice of string and finger: a Viterbi decode over the notes of the audio
+// (pitch_model.h), with one state per (string, finger) candidate and one per matching open
+// string, so the decision is made once per note from all of its frames and a single noisy
+// frame cannot flip the string.
+//
+// Emission cost of a note for state (string s, finger k), in mm-equivalents: the median
+// over the note's frames of
+//   D = sqrt(a^2 + l^2 + (w_n n)^2),  (a, l, n) = tip_k - contact on that frame's string s
+//       along the string, across it and along the string plane's normal (w_n =
+//       normal_weight: detectors see a lifted, unloaded finger off the string),
+// plus order_weight x the median finger-order violation: the other fingertips projected on
+// the string must lie on the nut side of the contact for lower fingers (index is nearest
+// the nut) and on the bridge side for higher ones, within order_margin_mm. A state whose
+// median D exceeds the lift distance costs infeasible_cost more. An open string costs
+// open_cost_mm, plus infeasible_cost when the note vibrates (an open string cannot).
+//
+// Transition between consecutive notes: none for the same state; for (nearly) the same
+// pitch, same_pitch_change_cost for any change; otherwise shift_cost_per_semitone x the
+// change of hand position (semitones of finger 1 above the open string, from the finger's
+// offset in the instrument's hand frame) + string_cross_cost x strings crossed; scaled by
+// rest_factor after a gap of rest_gap_s or more. Ties go to the lower state index.
+//
+// Up to onset_lead_frames untrusted frames right before a stopped note's first trusted
+// frame get the note's contact too (kBeforeOnset): the finger lands before the sound.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "arco/refine/contact_annotation.h"
+#include "arco/refine/decode_context.h"
+
+namespace arco::refine {
+
+// Semitones from finger 1's stop to finger k's in the instrument's closed hand frame:
+// cello and double bass 0/1/2/3, violin and viola 0/2/4/5 (approximate).
+double FingerOffsetSemitones(InstrumentKind kind, int finger);
+
+// lift_max_mm[k] for finger k = 1..4 (entry 0 unused). One FrameContact per frame (before
+// IK). Frames of a note whose contact fails the lift test come back kUncertain with
+// kOutOfReach, the decoded string and finger kept for information.
+std::vector<FrameContact> DecodeArco(const DecodeContext& context,
+                                     const ArcoDecodeOptions& options,
+                                     const PitchModelOptions& pitch_options,
+                                     const std::array<double, 5>& lift_max_mm,
+                                     int num_threads);
+
+}  // namespace arco::refine

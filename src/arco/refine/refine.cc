@@ -1,0 +1,203 @@
+#include "arco/refine/refine.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "arco/refine/arco_decode.h"
+#include "arco/refine/decode_context.h"
+#include "arco/refine/finger_ik.h"
+#include "arco/refine/paper_decode.h"
+#include "arco/refine/transcription.h"
+
+namespace arco::refine {
+namespace {
+
+bool Finite(double v) { return std::isfinite(v); }
+
+void ThrowIfError(const Status& status) {
+  if (!status.ok()) throw std::invalid_argument(status.message());
+}
+
+// Lift distance per finger (ArcoIkOptions::lift_max_distance_mm, 0 = tip-to-PIP length).
+std::array<double, 5> LiftMaxMm(const hand::HandModel& model, const ArcoIkOptions& options) {
+  std::array<double, 5> out{};
+  for (int k = 1; k <= 4; ++k) {
+    const hand::Finger finger = static_cast<hand::Finger>(k);
+    out[static_cast<size_t>(k)] = options.lift_max_distance_mm > 0
+                                      ? options.lift_max_distance_mm
+                                      : model.bone_length_mm(hand::KeypointIndex(finger, 2)) +
+                                            model.bone_length_mm(hand::KeypointIndex(finger, 3));
+  }
+  return out;
+}
+
+RefineSummary Summarise(RefineMode mode,
+                        const RefineInput& input,
+                        const RefineResult& result,
+                        const IkStats& ik) {
+  RefineSummary s;
+  s.mode = mode;
+  s.frames = static_cast<int>(input.pitch.size());
+  for (const auto& h : input.vision_hand) s.frames_with_hand += h.has_value() ? 1 : 0;
+  s.notes = static_cast<int>(result.analysis.notes.size());
+  for (const NoteSpan& n : result.analysis.notes) s.usable_notes += n.usable ? 1 : 0;
+  double sum_vision = 0, sum_refined = 0;
+  for (const FrameContact& c : result.contacts) {
+    switch (c.state) {
+      case ContactState::kPressed:
+        ++s.pressed;
+        break;
+      case ContactState::kOpenString:
+        ++s.open_string;
+        break;
+      case ContactState::kRest:
+        ++s.rest;
+        break;
+      case ContactState::kUncertain:
+        ++s.uncertain;
+        ++s.uncertain_by_reason[static_cast<int>(c.reason)];
+        break;
+    }
+    if (c.reason == ContactReason::kOutOfReach) ++s.rejected_out_of_reach;
+    if (c.reason == ContactReason::kHandShifted) ++s.hand_shifted;
+    if (c.reason == ContactReason::kBeforeOnset) ++s.before_onset;
+    if (c.pressed() && Finite(c.tip_distance_refined_mm)) {
+      ++s.corrected_frames;
+      sum_vision += c.tip_distance_vision_mm;
+      sum_refined += c.tip_distance_refined_mm;
+      if (!(c.tip_distance_refined_mm <= s.max_tip_distance_refined_mm)) {
+        s.max_tip_distance_refined_mm = c.tip_distance_refined_mm;
+      }
+    }
+  }
+  if (s.corrected_frames > 0) {
+    s.mean_tip_distance_vision_mm = sum_vision / s.corrected_frames;
+    s.mean_tip_distance_refined_mm = sum_refined / s.corrected_frames;
+  }
+  s.ik_solves = ik.solves;
+  s.ik_iterations = ik.iterations;
+  s.ik_not_converged = ik.not_converged;
+  for (const auto& h : result.hand) {
+    if (h) s.joint_limit_violations += hand::CountLimitViolations(input.hand_model, *h);
+  }
+  return s;
+}
+
+}  // namespace
+
+Status RefineInput::Validate() const {
+  if (instrument == nullptr) return Status::Error("refine input: no instrument model");
+  if (hand_model.side() != hand::HandSide::kLeft) {
+    return Status::Error("refine input: the hand model must be a left hand");
+  }
+  const size_t n = pitch.size();
+  if (strings_in_world_mm.size() != n || vision_hand.size() != n) {
+    return Status::Error("refine input: " + std::to_string(n) + " pitch frames but " +
+                         std::to_string(strings_in_world_mm.size()) + " string frames and " +
+                         std::to_string(vision_hand.size()) + " hand frames");
+  }
+  for (size_t f = 0; f < n; ++f) {
+    const size_t count = strings_in_world_mm[f].size();
+    if (count != 0 && static_cast<int>(count) != instrument->num_strings()) {
+      return Status::Error("refine input: frame " + std::to_string(f) + " has " +
+                           std::to_string(count) + " strings, the " + instrument->name() + " has " +
+                           std::to_string(instrument->num_strings()));
+    }
+  }
+  if (!(fps > 0 && Finite(fps))) return Status::Error("refine input: fps must be > 0");
+  if (!(a4_hz > 0 && Finite(a4_hz))) return Status::Error("refine input: a4_hz must be > 0");
+  return Status::Ok();
+}
+
+Status PaperOptions::Validate() const {
+  if (!(binding_cents > 0 && Finite(binding_cents))) {
+    return Status::Error("paper options: binding_cents must be > 0");
+  }
+  if (!(reference_weight_mm_per_rad >= 0 && Finite(reference_weight_mm_per_rad))) {
+    return Status::Error("paper options: reference_weight_mm_per_rad must be >= 0");
+  }
+  if (max_iterations < 1) return Status::Error("paper options: max_iterations must be >= 1");
+  return Status::Ok();
+}
+
+Status ArcoDecodeOptions::Validate() const {
+  const double values[] = {normal_weight,
+                           order_margin_mm,
+                           order_weight,
+                           open_cost_mm,
+                           shift_cost_per_semitone,
+                           string_cross_cost,
+                           same_pitch_change_cost,
+                           same_pitch_cents,
+                           rest_gap_s,
+                           rest_factor,
+                           infeasible_cost};
+  for (double v : values) {
+    if (!(v >= 0 && Finite(v))) {
+      return Status::Error("arco decode options: every weight and cost must be finite and >= 0");
+    }
+  }
+  if (onset_lead_frames < 0)
+    return Status::Error("arco decode options: onset_lead_frames must be >= 0");
+  return Status::Ok();
+}
+
+Status ArcoIkOptions::Validate() const {
+  if (!(reference_weight_mm_per_rad >= 0 && Finite(reference_weight_mm_per_rad))) {
+    return Status::Error("arco IK options: reference_weight_mm_per_rad must be >= 0");
+  }
+  if (!(temporal_weight_mm_per_rad >= 0 && Finite(temporal_weight_mm_per_rad))) {
+    return Status::Error("arco IK options: temporal_weight_mm_per_rad must be >= 0");
+  }
+  if (!(lift_max_distance_mm >= 0 && Finite(lift_max_distance_mm))) {
+    return Status::Error("arco IK options: lift_max_distance_mm must be >= 0 (0 = automatic)");
+  }
+  if (!(max_residual_mm > 0 && Finite(max_residual_mm))) {
+    return Status::Error("arco IK options: max_residual_mm must be > 0");
+  }
+  if (!(max_hand_shift_mm >= 0 && Finite(max_hand_shift_mm))) {
+    return Status::Error("arco IK options: max_hand_shift_mm must be >= 0");
+  }
+  if (max_iterations < 1) return Status::Error("arco IK options: max_iterations must be >= 1");
+  return Status::Ok();
+}
+
+Status RefineOptions::Validate() const {
+  ARCO_RETURN_IF_ERROR(pitch.Validate());
+  ARCO_RETURN_IF_ERROR(paper.Validate());
+  ARCO_RETURN_IF_ERROR(decode.Validate());
+  ARCO_RETURN_IF_ERROR(ik.Validate());
+  if (num_threads < 0) return Status::Error("refine options: num_threads must be >= 0");
+  return Status::Ok();
+}
+
+RefineResult Refine(const RefineInput& input, const RefineOptions& options) {
+  ThrowIfError(input.Validate());
+  ThrowIfError(options.Validate());
+  RefineResult result;
+  IkStats ik;
+  if (options.mode == RefineMode::kVision) {
+    result.hand = input.vision_hand;
+    result.summary = Summarise(options.mode, input, result, ik);
+    return result;
+  }
+  result.analysis = AnalysePitch(input.pitch, options.pitch);
+  const DecodeContext context = MakeDecodeContext(input, result.analysis, options.num_threads);
+  if (options.mode == RefineMode::kPaper) {
+    result.contacts = DecodePaper(context, options.paper, options.pitch.contact);
+    result.hand = SolvePaperIk(context, options.paper, &result.contacts, &ik, options.num_threads);
+  } else {
+    result.contacts = DecodeArco(context,
+                                 options.decode,
+                                 options.pitch,
+                                 LiftMaxMm(input.hand_model, options.ik),
+                                 options.num_threads);
+    result.hand = SolveArcoIk(context, options.ik, &result.contacts, &ik, options.num_threads);
+  }
+  result.fingering =
+      Transcribe(*input.instrument, result.analysis, result.contacts, input.fps, input.a4_hz);
+  result.summary = Summarise(options.mode, input, result, ik);
+  return result;
+}
+
+}  // namespace arco::refine

@@ -1,0 +1,148 @@
+// Audio-guided refinement of the left hand: from the pitch to a finger contact to a
+// corrected hand (Jin et al. 2024, sections 5-6; DOMAIN.md sections 1, 2, 5).
+//
+//   PitchAnalysis   pitch_model.h: rest / uncertain / notes, candidates per string (Eq. 2)
+//   decoding        paper_decode.h (the paper: per frame, wrist-nearest candidate, nearest
+//                   fingertip, +-30 cents binding) or arco_decode.h (Viterbi over
+//                   (string, finger) per note)
+//   finger IK       finger_ik.h: the playing finger's tip to the contact; the paper's PIP +
+//                   DIP, or arco's bounded MCP + PIP + DIP with a prior toward the fitted
+//                   pose, temporal smoothing and a lift test
+//   transcription   one NoteFingering per note
+//
+// Inputs are per frame and already in millimetres: the strings (from the smoothed rigid
+// instrument pose of that frame, so contacts are never computed on stale strings), the
+// vision hand (the fitted left hand, no audio) and the pitch. Frames are independent in
+// the IK, which runs in parallel; results do not depend on the thread count.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "arco/hand/hand_model.h"
+#include "arco/hand/ik.h"
+#include "arco/instrument/instrument_model.h"
+#include "arco/instrument/strings.h"
+#include "arco/refine/contact_annotation.h"
+#include "arco/refine/pitch_model.h"
+#include "arco/util/status.h"
+
+namespace arco::refine {
+
+struct RefineInput {
+  const InstrumentModel* instrument = nullptr;
+  hand::HandModel hand_model = hand::HandModel::Default(hand::HandSide::kLeft);
+  // Per frame (all three the same length): the strings in the world, index = string - 1
+  // (empty: no instrument pose this frame); the fitted left hand; the pitch.
+  std::vector<std::vector<StringSegment>> strings_in_world_mm;
+  std::vector<std::optional<hand::HandPose>> vision_hand;
+  std::vector<FramePitch> pitch;
+  double fps = 30.0;
+  double a4_hz = 440.0;  // for the transcription's note names and cents
+
+  // Errors: no instrument, a right-hand model, sizes that differ, fps <= 0, a strings entry
+  // with a wrong string count or non-finite ends.
+  Status Validate() const;
+};
+
+// The paper's choices (paper_decode.h).
+struct PaperOptions {
+  double binding_cents = 30.0;  // keep the binding while the pitch stays this close
+  // IK of Eq. 3: PIP and DIP of the bound finger, a weak pull toward the fitted pose (the
+  // paper has none; it only selects among equally good solutions).
+  double reference_weight_mm_per_rad = 0.01;
+  int max_iterations = 15;
+  Status Validate() const;
+};
+
+// arco's decoding (arco_decode.h). Costs are in millimetre-equivalents.
+struct ArcoDecodeOptions {
+  // Hand-to-candidate distance: the component along the front normal of the string plane
+  // (a lifted, unloaded finger; detectors see fingers off the string) counts this much.
+  double normal_weight = 0.5;
+  // Finger order on the string: index nearest the nut, little nearest the bridge. Other
+  // fingertips on the wrong side of the contact by more than the margin cost this much per mm.
+  double order_margin_mm = 5.0;
+  double order_weight = 0.5;
+  double open_cost_mm = 12.0;            // an open string instead of a fingered candidate
+  double shift_cost_per_semitone = 1.0;  // hand position change between notes
+  double string_cross_cost = 3.0;        // per string crossed between notes
+  double same_pitch_change_cost = 40.0;  // other string/finger for (nearly) the same pitch
+  double same_pitch_cents = 50.0;
+  double rest_gap_s = 0.4;          // a gap this long between notes frees the hand ...
+  double rest_factor = 0.3;         // ... and scales the transition costs by this
+  double infeasible_cost = 1000.0;  // candidate beyond the lift distance; open with vibrato
+  // Up to this many untrusted frames (rest, low confidence, ...) right before a stopped
+  // note's first trusted frame are pressed too, with the note's first pitch: the finger
+  // lands before the bow speaks and the tracker locks on a frame or two late.
+  // Only where the fitted fingertip is already within onset_lead_max_mm of the contact.
+  int onset_lead_frames = 3;
+  double onset_lead_max_mm = 20.0;
+  Status Validate() const;
+};
+
+// arco's IK (finger_ik.h).
+struct ArcoIkOptions {
+  // MCP flexion, PIP and DIP: the flexion chain that brings a lifted fingertip down onto
+  // the string. Abduction is seen well (the MCP-PIP direction) and, when left free, takes
+  // the redundancy and drifts to its limits (docs/accuracy.md, the IK ablation).
+  hand::FingerIkJoints joints = hand::FingerIkJoints::kMcpFlexPipDip;
+  // false: one regularised solve: the priors spread the change over the joints (least
+  // change) and leave a small residual (sub-millimetre at these weights); true: the hand
+  // IK's exact reach, where the priors only pick among exact solutions and drift along
+  // them (worse joints, docs/accuracy.md).
+  bool exact_reach = false;
+  double reference_weight_mm_per_rad = 1.0;  // prior toward the fitted (vision) pose
+  double temporal_weight_mm_per_rad = 4.0;   // toward the previous frame's solution
+  // Lift test: a contact farther than this from the fitted fingertip is rejected (0 = the
+  // finger's tip-to-PIP length, the dataset authors' cello rule) ...
+  double lift_max_distance_mm = 0.0;
+  // When the bounded IK leaves the tip farther than max_residual_mm from the contact, the
+  // whole hand is translated by the rest if that is at most max_hand_shift_mm (the fitted
+  // wrist is off: e.g. a hand fit lagging a shift); otherwise the contact is rejected.
+  double max_residual_mm = 3.0;
+  double max_hand_shift_mm = 10.0;
+  int max_iterations = 15;
+  Status Validate() const;
+};
+
+struct RefineOptions {
+  RefineMode mode = RefineMode::kArco;
+  PitchModelOptions pitch;
+  PaperOptions paper;
+  ArcoDecodeOptions decode;
+  ArcoIkOptions ik;
+  int num_threads = 0;  // 0 = all cores; results do not depend on it
+  Status Validate() const;
+};
+
+struct RefineSummary {
+  RefineMode mode = RefineMode::kArco;
+  int frames = 0;
+  int frames_with_hand = 0;
+  int pressed = 0, open_string = 0, rest = 0, uncertain = 0;
+  int uncertain_by_reason[kNumContactReasons] = {};  // index = ContactReason
+  int notes = 0, usable_notes = 0;
+  int corrected_frames = 0;  // pressed frames whose finger was moved by the IK
+  int rejected_out_of_reach = 0;
+  int hand_shifted = 0;                       // corrected frames that needed a whole-hand shift
+  int before_onset = 0;                       // pressed frames added before a note's detected onset
+  double mean_tip_distance_vision_mm = kNaN;  // over corrected frames
+  double mean_tip_distance_refined_mm = kNaN;  // over corrected frames
+  double max_tip_distance_refined_mm = kNaN;
+  int ik_solves = 0, ik_iterations = 0, ik_not_converged = 0;
+  int joint_limit_violations = 0;  // refined poses outside the limits (must stay 0)
+};
+
+struct RefineResult {
+  std::vector<std::optional<hand::HandPose>> hand;  // refined left hand per frame
+  std::vector<FrameContact> contacts;               // empty for kVision
+  std::vector<NoteFingering> fingering;             // empty for kVision
+  PitchAnalysis analysis;
+  RefineSummary summary;
+};
+
+// Throws std::invalid_argument for invalid input or options (Validate() messages).
+RefineResult Refine(const RefineInput& input, const RefineOptions& options);
+
+}  // namespace arco::refine

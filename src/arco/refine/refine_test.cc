@@ -1,0 +1,405 @@
+#include "arco/refine/refine.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "arco/hand/kinematics.h"
+#include "arco/refine/test_scene.h"
+
+namespace arco::refine {
+namespace {
+
+using testing::SceneNote;
+
+RefineOptions Options(RefineMode mode, int threads = 1) {
+  RefineOptions o;
+  o.mode = mode;
+  o.num_threads = threads;
+  return o;
+}
+
+Eigen::Vector3d Tip(const RefineInput& input, const hand::HandPose& pose, int finger) {
+  return hand::FingertipInWorld(input.hand_model, pose, static_cast<hand::Finger>(finger));
+}
+
+// Mean distance over the truth's pressed frames from a method's playing fingertip (the
+// truth's finger) to the truth contact.
+double ContactDeviation(const testing::Scene& scene,
+                        const std::vector<std::optional<hand::HandPose>>& hands) {
+  double sum = 0;
+  int n = 0;
+  for (size_t f = 0; f < hands.size(); ++f) {
+    if (scene.truth_finger[f] == 0 || !hands[f]) continue;
+    sum += (Tip(scene.input, *hands[f], scene.truth_finger[f]) - scene.truth_contact[f]).norm();
+    ++n;
+  }
+  return n ? sum / n : NAN;
+}
+
+// Mean wrist-aligned error of the truth's playing finger (MCP .. tip) on pressed frames.
+double PlayingFingerError(const testing::Scene& scene,
+                          const std::vector<std::optional<hand::HandPose>>& hands) {
+  double sum = 0;
+  int n = 0;
+  for (size_t f = 0; f < hands.size(); ++f) {
+    if (scene.truth_finger[f] == 0 || !hands[f]) continue;
+    const auto p = hand::ForwardKinematics(scene.input.hand_model, *hands[f]);
+    const auto t = hand::ForwardKinematics(scene.input.hand_model, scene.truth_hand[f]);
+    for (int j = 0; j < 4; ++j) {
+      const int k = hand::KeypointIndex(static_cast<hand::Finger>(scene.truth_finger[f]), j);
+      sum += ((p[k] - p[0]) - (t[k] - t[0])).norm();
+      ++n;
+    }
+  }
+  return n ? sum / n : NAN;
+}
+
+testing::Scene Cello(const std::vector<SceneNote>& notes, testing::SceneOptions options = {}) {
+  return testing::MakeScene(InstrumentKind::kCello, notes, options);
+}
+
+bool SamePose(const std::optional<hand::HandPose>& a, const std::optional<hand::HandPose>& b) {
+  if (a.has_value() != b.has_value()) return false;
+  if (!a) return true;
+  return a->angles_rad == b->angles_rad && a->wrist_in_world_mm == b->wrist_in_world_mm &&
+         a->world_from_wrist_rotation == b->world_from_wrist_rotation;
+}
+
+// Frames [first, last] of the scene note `index` (notes laid out back to back).
+std::pair<int, int> NoteFrames(const std::vector<SceneNote>& notes, int index) {
+  int first = 0;
+  for (int i = 0; i < index; ++i) first += notes[static_cast<size_t>(i)].frames;
+  return {first, first + notes[static_cast<size_t>(index)].frames - 1};
+}
+
+// A short piece: first position on the D string, a string crossing, a shift, vibrato, an
+// open string, rests.
+std::vector<SceneNote> Piece() {
+  return {{0, 0, 0, 6},
+          {2, 1, 2, 15},
+          {2, 2, 3, 15},
+          {2, 4, 5, 15},
+          {1, 1, 2, 15},
+          {1, 3, 4, 20, 25},
+          {0, 0, 0, 8},
+          {1, 2, 8, 30, 20},
+          {1, 0, 0, 15},
+          {3, 1, 2, 15},
+          {3, 4, 5, 20, 15},
+          {0, 0, 0, 5}};
+}
+
+TEST(TestScene, TruthFingertipIsOnTheStringAtTheContact) {
+  const testing::Scene scene = Cello(Piece());
+  int pressed = 0;
+  for (size_t f = 0; f < scene.truth_hand.size(); ++f) {
+    if (scene.truth_finger[f] == 0) continue;
+    ++pressed;
+    EXPECT_LT(
+        (Tip(scene.input, scene.truth_hand[f], scene.truth_finger[f]) - scene.truth_contact[f])
+            .norm(),
+        1e-3);
+    EXPECT_EQ(hand::CountLimitViolations(scene.input.hand_model, scene.truth_hand[f]), 0);
+  }
+  EXPECT_GT(pressed, 100);
+}
+
+TEST(Refine, ArcoFindsStringAndFingerAndPutsTheTipOnTheContact) {
+  const testing::Scene scene = Cello(Piece());
+  const RefineResult r = Refine(scene.input, Options(RefineMode::kArco));
+  int pressed = 0, right = 0;
+  for (size_t f = 0; f < r.contacts.size(); ++f) {
+    const FrameContact& c = r.contacts[f];
+    if (scene.truth_finger[f] == 0) {
+      // Only the onset lead may press before the sound, within 3 frames of a note.
+      const bool lead = f + 3 < r.contacts.size() && scene.truth_finger[f + 3] > 0;
+      EXPECT_TRUE(!c.pressed() || (lead && c.reason == ContactReason::kBeforeOnset))
+          << "frame " << f;
+      continue;
+    }
+    ++pressed;
+    if (!c.pressed()) continue;
+    right += c.string == scene.truth_string[f] && c.finger == scene.truth_finger[f];
+    EXPECT_LT((c.point_in_world_mm - scene.truth_contact[f]).norm(), 1e-6) << "frame " << f;
+    // One regularised solve of the flexion chain: the least change; what remains is mostly
+    // out of the finger's flexion plane (beyond max_residual_mm the hand would shift).
+    EXPECT_LT((Tip(scene.input, *r.hand[f], c.finger) - c.point_in_world_mm).norm(), 3.0);
+  }
+  EXPECT_EQ(right, pressed);
+  const double before = ContactDeviation(scene, scene.input.vision_hand);
+  const double after = ContactDeviation(scene, r.hand);
+  const double finger_before = PlayingFingerError(scene, scene.input.vision_hand);
+  const double finger_after = PlayingFingerError(scene, r.hand);
+  std::printf(
+      "[ arco ] contact deviation vision %.2f mm -> arco %.3f mm; playing finger "
+      "%.2f -> %.2f mm\n",
+      before,
+      after,
+      finger_before,
+      finger_after);
+  EXPECT_LT(after, 1.0);
+  EXPECT_LT(finger_after, 0.5 * finger_before);
+  EXPECT_EQ(r.summary.joint_limit_violations, 0);
+  // All four joints with the exact reach option put the tip on the contact.
+  RefineOptions exact = Options(RefineMode::kArco);
+  exact.ik.exact_reach = true;
+  exact.ik.joints = hand::FingerIkJoints::kAll;
+  const RefineResult e = Refine(scene.input, exact);
+  EXPECT_LT(ContactDeviation(scene, e.hand), 1e-3);
+}
+
+TEST(Refine, PaperBindsTheNearestFingerAndMovesOnlyItsPipAndDip) {
+  const testing::Scene scene = Cello(Piece());
+  const RefineResult r = Refine(scene.input, Options(RefineMode::kPaper));
+  int pressed = 0;
+  for (size_t f = 0; f < r.contacts.size(); ++f) {
+    const FrameContact& c = r.contacts[f];
+    if (!c.pressed()) continue;
+    ++pressed;
+    const hand::HandPose& v = *scene.input.vision_hand[f];
+    for (int d = 0; d < hand::kNumJointDofs; ++d) {
+      const bool free = d == 4 * c.finger + 2 || d == 4 * c.finger + 3;
+      if (!free) {
+        EXPECT_EQ(r.hand[f]->angles_rad[d], v.angles_rad[d]);
+      }
+    }
+    EXPECT_LE(c.tip_distance_refined_mm, c.tip_distance_vision_mm + 1e-9);
+  }
+  int truth_pressed = 0;
+  for (int finger : scene.truth_finger) truth_pressed += finger > 0;
+  EXPECT_EQ(pressed, truth_pressed);
+  const double before = ContactDeviation(scene, scene.input.vision_hand);
+  const double after = ContactDeviation(scene, r.hand);
+  std::printf("[ paper ] contact deviation vision %.2f mm -> paper %.2f mm\n", before, after);
+  EXPECT_LT(after, before);
+  EXPECT_EQ(r.summary.joint_limit_violations, 0);
+}
+
+TEST(Refine, OpenStringsAndRestsHaveNoContactAndKeepTheFittedHand) {
+  const std::vector<SceneNote> notes = Piece();
+  const testing::Scene scene = Cello(notes);
+  for (RefineMode mode : {RefineMode::kPaper, RefineMode::kArco}) {
+    const RefineResult r = Refine(scene.input, Options(mode));
+    const auto [open_first, open_last] = NoteFrames(notes, 8);  // {1, 0, 0, 15}: open A
+    for (int f = open_first; f <= open_last; ++f) {
+      const FrameContact& c = r.contacts[static_cast<size_t>(f)];
+      EXPECT_EQ(c.state, ContactState::kOpenString) << RefineModeName(mode) << " frame " << f;
+      EXPECT_EQ(c.string, 1);
+      EXPECT_EQ(c.finger, 0);
+      EXPECT_FALSE(c.point_in_world_mm.allFinite()) << "an open string is not a contact at the nut";
+      EXPECT_TRUE(SamePose(r.hand[static_cast<size_t>(f)],
+                           scene.input.vision_hand[static_cast<size_t>(f)]));
+    }
+    const auto [rest_first, rest_last] = NoteFrames(notes, 6);
+    for (int f = rest_first; f <= rest_last; ++f) {
+      const FrameContact& c = r.contacts[static_cast<size_t>(f)];
+      EXPECT_EQ(c.state, ContactState::kRest);
+      EXPECT_EQ(c.reason, ContactReason::kUnvoiced);
+      EXPECT_TRUE(SamePose(r.hand[static_cast<size_t>(f)],
+                           scene.input.vision_hand[static_cast<size_t>(f)]));
+    }
+  }
+}
+
+TEST(Refine, VibratoKeepsTheBindingAndTheContactFollowsThePitch) {
+  const std::vector<SceneNote> notes = {{0, 0, 0, 3}, {2, 2, 5, 60, 28}, {0, 0, 0, 3}};
+  const testing::Scene scene = Cello(notes);
+  for (RefineMode mode : {RefineMode::kPaper, RefineMode::kArco}) {
+    const RefineResult r = Refine(scene.input, Options(mode));
+    double min_from_nut = 1e9, max_from_nut = -1e9;
+    for (int f = 3; f < 63; ++f) {
+      const FrameContact& c = r.contacts[static_cast<size_t>(f)];
+      ASSERT_TRUE(c.pressed()) << RefineModeName(mode) << " frame " << f;
+      EXPECT_EQ(c.string, 2);
+      EXPECT_EQ(c.finger, 2);
+      EXPECT_LT((c.point_in_world_mm - scene.truth_contact[static_cast<size_t>(f)]).norm(), 1e-6);
+      min_from_nut = std::min(min_from_nut, c.from_nut_mm);
+      max_from_nut = std::max(max_from_nut, c.from_nut_mm);
+    }
+    // +-28 cents at 5 semitones on a cello: the contact rocks by about +-8 mm.
+    EXPECT_GT(max_from_nut - min_from_nut, 12.0) << RefineModeName(mode);
+  }
+}
+
+TEST(Refine, StringChangesAndShiftsAreFollowedOnTheViolinToo) {
+  const std::vector<SceneNote> notes = {{4, 1, 2, 12},
+                                        {4, 3, 5, 12},
+                                        {3, 1, 2, 12},
+                                        {2, 2, 4, 12},
+                                        {1, 1, 2, 12},
+                                        {1, 4, 7, 12},
+                                        {1, 1, 9, 15},
+                                        {1, 3, 13, 15},
+                                        {2, 4, 6, 12}};
+  const testing::Scene scene = testing::MakeScene(InstrumentKind::kViolin, notes);
+  const RefineResult r = Refine(scene.input, Options(RefineMode::kArco));
+  int right = 0, pressed = 0;
+  for (size_t f = 0; f < r.contacts.size(); ++f) {
+    if (scene.truth_finger[f] == 0) continue;
+    ++pressed;
+    const FrameContact& c = r.contacts[f];
+    right += c.pressed() && c.string == scene.truth_string[f] && c.finger == scene.truth_finger[f];
+  }
+  EXPECT_EQ(right, pressed);
+  ASSERT_EQ(r.fingering.size(), notes.size());
+  for (size_t i = 0; i < notes.size(); ++i) {
+    EXPECT_EQ(r.fingering[i].string, notes[i].string) << "note " << i;
+    EXPECT_EQ(r.fingering[i].finger, notes[i].finger) << "note " << i;
+  }
+}
+
+TEST(Refine, AnOpenStringPitchThatVibratesIsStopped) {
+  // E5 on the violin: the open E string, or the A string's fourth finger in first position.
+  // Without vibrato arco takes the open string; an open string cannot vibrate.
+  const std::vector<SceneNote> notes = {{2, 1, 2, 12}, {2, 4, 7, 40, 20}, {2, 2, 4, 12}};
+  const testing::Scene scene = testing::MakeScene(InstrumentKind::kViolin, notes);
+  const RefineResult r = Refine(scene.input, Options(RefineMode::kArco));
+  ASSERT_EQ(r.fingering.size(), 3u);
+  EXPECT_EQ(r.fingering[1].state, "pressed");
+  EXPECT_EQ(r.fingering[1].string, 2);
+  EXPECT_EQ(r.fingering[1].finger, 4);
+}
+
+TEST(Refine, OneNoisyFrameCannotFlipTheString) {
+  const std::vector<SceneNote> notes = {{2, 1, 2, 30}};
+  testing::Scene scene = Cello(notes);
+  // Frame 15 reads a fifth higher: the same pitch as the A string's first finger.
+  scene.input.pitch[15].f0_hz *= std::exp2(7.0 / 12.0);
+  const RefineResult r = Refine(scene.input, Options(RefineMode::kArco));
+  for (int f = 0; f < 30; ++f) {
+    const FrameContact& c = r.contacts[static_cast<size_t>(f)];
+    if (f == 15) {
+      EXPECT_EQ(c.state, ContactState::kUncertain);
+      EXPECT_EQ(c.reason, ContactReason::kUnstablePitch);
+      EXPECT_TRUE(SamePose(r.hand[15], scene.input.vision_hand[15]));
+      continue;
+    }
+    EXPECT_TRUE(c.pressed());
+    EXPECT_EQ(c.string, 2);
+    EXPECT_EQ(c.finger, 1);
+  }
+}
+
+TEST(Refine, PolyphonicOrNoisyAudioIsFlaggedNotForced) {
+  const std::vector<SceneNote> notes = {{2, 1, 2, 20}, {2, 3, 4, 40}, {2, 1, 2, 20}};
+  testing::Scene scene = Cello(notes);
+  // Frames 20-59: a double stop (D string F#3 with the A string's C#4) seen by a
+  // monophonic tracker that jumps between the two and their octaves at middling confidence.
+  const double choices[4] = {185.0, 277.2, 370.0, 554.4};
+  for (int f = 20; f < 60; ++f) {
+    scene.input.pitch[static_cast<size_t>(f)] = {choices[(f * 7 + f / 3) % 4], 0.55};
+  }
+  // Frames 75-79 (the end): a note with noise below the confidence threshold.
+  for (int f = 75; f < 80; ++f) scene.input.pitch[static_cast<size_t>(f)].confidence = 0.2;
+  for (RefineMode mode : {RefineMode::kArco, RefineMode::kPaper}) {
+    const RefineResult r = Refine(scene.input, Options(mode));
+    for (int f = 75; f < 80; ++f) {
+      EXPECT_EQ(r.contacts[static_cast<size_t>(f)].reason, ContactReason::kLowConfidence);
+      EXPECT_TRUE(SamePose(r.hand[static_cast<size_t>(f)],
+                           scene.input.vision_hand[static_cast<size_t>(f)]));
+    }
+    if (mode == RefineMode::kPaper) continue;  // the paper forces a contact on every frame
+    for (int f = 20; f < 60; ++f) {
+      const FrameContact& c = r.contacts[static_cast<size_t>(f)];
+      EXPECT_EQ(c.state, ContactState::kUncertain) << "frame " << f;
+      EXPECT_TRUE(SamePose(r.hand[static_cast<size_t>(f)],
+                           scene.input.vision_hand[static_cast<size_t>(f)]));
+    }
+    EXPECT_GE(r.summary.uncertain_by_reason[static_cast<int>(ContactReason::kUnstablePitch)], 30);
+  }
+}
+
+TEST(Refine, TheFingerLandsBeforeTheTrackerLocksOn) {
+  // The tracker misses the first frames of the second and last notes (no pitch, then low
+  // confidence) while the fitted finger is already on its place.
+  const std::vector<SceneNote> notes = {{2, 1, 2, 20}, {2, 3, 4, 20}, {0, 0, 0, 10}, {1, 4, 9, 20}};
+  testing::Scene scene = Cello(notes);
+  for (int f : {20, 21, 50, 51}) scene.input.pitch[static_cast<size_t>(f)] = {0.0, 0.0};
+  scene.input.pitch[22].confidence = 0.1;
+  const RefineResult r = Refine(scene.input, Options(RefineMode::kArco));
+  for (int f : {20, 21, 22, 50, 51}) {
+    const FrameContact& c = r.contacts[static_cast<size_t>(f)];
+    EXPECT_TRUE(c.pressed()) << "frame " << f;
+    EXPECT_EQ(c.reason, ContactReason::kBeforeOnset);
+    EXPECT_EQ(c.string, f < 50 ? 2 : 1);
+    EXPECT_EQ(c.finger, f < 50 ? 3 : 4);
+    EXPECT_LT((c.point_in_world_mm - scene.truth_contact[static_cast<size_t>(f)]).norm(), 1e-6);
+  }
+  EXPECT_EQ(r.summary.before_onset, 5);
+  // Frames 47-49 of the rest: the hand is still on the previous note, far from the next
+  // contact: they stay rests (a real silence is not turned into a contact).
+  for (int f = 47; f < 50; ++f) {
+    EXPECT_EQ(r.contacts[static_cast<size_t>(f)].state, ContactState::kRest) << "frame " << f;
+  }
+}
+
+TEST(Refine, UnplayablePitchAndMissingStringsGiveNoContact) {
+  const std::vector<SceneNote> notes = {{2, 1, 2, 20}, {2, 2, 3, 20}};
+  testing::Scene scene = Cello(notes);
+  for (int f = 0; f < 20; ++f) scene.input.pitch[static_cast<size_t>(f)].f0_hz = 50.0;  // below C2
+  for (int f = 25; f < 30; ++f) scene.input.strings_in_world_mm[static_cast<size_t>(f)].clear();
+  for (RefineMode mode : {RefineMode::kArco, RefineMode::kPaper}) {
+    const RefineResult r = Refine(scene.input, Options(mode));
+    for (int f = 0; f < 20; ++f) {
+      EXPECT_EQ(r.contacts[static_cast<size_t>(f)].state, ContactState::kUncertain);
+      EXPECT_EQ(r.contacts[static_cast<size_t>(f)].reason, ContactReason::kUnplayable);
+    }
+    for (int f = 25; f < 30; ++f) {
+      EXPECT_EQ(r.contacts[static_cast<size_t>(f)].reason, ContactReason::kNoInstrument);
+      EXPECT_TRUE(SamePose(r.hand[static_cast<size_t>(f)],
+                           scene.input.vision_hand[static_cast<size_t>(f)]));
+    }
+    EXPECT_TRUE(r.contacts[22].pressed());
+  }
+}
+
+TEST(Refine, LiftTestRejectsContactsTheFingerCannotReach) {
+  const std::vector<SceneNote> notes = {{2, 1, 2, 20}, {2, 2, 3, 20}};
+  testing::Scene scene = Cello(notes);
+  // The fitted hand of the second note sits 70 mm away from the strings.
+  for (int f = 20; f < 40; ++f) {
+    hand::HandPose& h = *scene.input.vision_hand[static_cast<size_t>(f)];
+    h.wrist_in_world_mm += scene.pose[static_cast<size_t>(f)].rotation * Eigen::Vector3d(0, 0, 70);
+  }
+  const RefineResult r = Refine(scene.input, Options(RefineMode::kArco));
+  for (int f = 20; f < 40; ++f) {
+    const FrameContact& c = r.contacts[static_cast<size_t>(f)];
+    EXPECT_EQ(c.state, ContactState::kUncertain);
+    EXPECT_EQ(c.reason, ContactReason::kOutOfReach);
+    EXPECT_TRUE(
+        SamePose(r.hand[static_cast<size_t>(f)], scene.input.vision_hand[static_cast<size_t>(f)]));
+  }
+  EXPECT_TRUE(r.contacts[10].pressed());
+  EXPECT_EQ(r.summary.rejected_out_of_reach, 20);
+}
+
+TEST(Refine, FingeringTranscription) {
+  const std::vector<SceneNote> notes = Piece();
+  const testing::Scene scene = Cello(notes);
+  const RefineResult r = Refine(scene.input, Options(RefineMode::kArco));
+  // Sounding notes of the piece: all but the rests.
+  std::vector<SceneNote> sounding;
+  for (const SceneNote& n : notes) {
+    if (n.string > 0) sounding.push_back(n);
+  }
+  ASSERT_EQ(r.fingering.size(), sounding.size());
+  for (size_t i = 0; i < sounding.size(); ++i) {
+    const NoteFingering& row = r.fingering[i];
+    const SceneNote& n = sounding[i];
+    const int open_midi[5] = {0, 57, 50, 43, 36};  // cello A3 D3 G2 C2
+    EXPECT_EQ(row.midi_note,
+              open_midi[n.string] + (n.finger > 0 ? static_cast<int>(n.semitones) : 0));
+    EXPECT_NEAR(row.cents_off, 0.0, n.vibrato_cents > 0 ? 6.0 : 1e-6);
+    EXPECT_EQ(row.string, n.string);
+    EXPECT_EQ(row.finger, n.finger);
+    EXPECT_EQ(row.state, n.finger > 0 ? "pressed" : "open");
+    if (n.finger > 0) EXPECT_NEAR(row.position_semitones, n.semitones - (n.finger - 1), 0.1);
+  }
+  EXPECT_EQ(MidiNoteName(57), "A3");
+  EXPECT_EQ(MidiNoteName(36), "C2");
+  EXPECT_EQ(MidiNoteName(61), "C#4");
+}
+
+}  // namespace
+}  // namespace arco::refine

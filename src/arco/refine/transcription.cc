@@ -1,0 +1,88 @@
+#include "arco/refine/transcription.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+
+#include "arco/refine/arco_decode.h"
+
+namespace arco::refine {
+
+std::vector<NoteFingering> Transcribe(const InstrumentModel& model,
+                                      const PitchAnalysis& analysis,
+                                      const std::vector<FrameContact>& contacts,
+                                      double fps,
+                                      double a4_hz) {
+  std::vector<NoteFingering> out;
+  out.reserve(analysis.notes.size());
+  for (size_t i = 0; i < analysis.notes.size(); ++i) {
+    const NoteSpan& note = analysis.notes[i];
+    NoteFingering row;
+    row.note = static_cast<int>(i);
+    row.first_frame = note.first_frame;
+    row.last_frame = note.last_frame;
+    row.onset_s = static_cast<double>(note.first_frame) / fps;
+    row.duration_s = static_cast<double>(note.num_frames()) / fps;
+    row.f0_hz = note.f0_hz;
+    const double midi = 69.0 + 12.0 * std::log2(note.f0_hz / a4_hz);
+    row.midi_note = static_cast<int>(std::lround(midi));
+    row.cents_off = 100.0 * (midi - row.midi_note);
+    std::map<std::pair<int, int>, int> pressed_votes;  // (string, finger) -> frames
+    std::map<int, int> open_votes;
+    std::vector<double> from_nut;
+    for (int64_t f = note.first_frame; f <= note.last_frame; ++f) {
+      const FrameContact& c = contacts[static_cast<size_t>(f)];
+      if (c.note != static_cast<int>(i)) continue;
+      if (c.state == ContactState::kPressed) {
+        ++row.pressed_frames;
+        ++pressed_votes[{c.string, c.finger}];
+      } else if (c.state == ContactState::kOpenString) {
+        ++row.open_frames;
+        ++open_votes[c.string];
+      } else {
+        ++row.uncertain_frames;
+      }
+    }
+    if (row.pressed_frames > 0 && row.pressed_frames >= row.open_frames &&
+        row.pressed_frames >= row.uncertain_frames) {
+      row.state = "pressed";
+      int best = -1;
+      for (const auto& [key, votes] : pressed_votes) {  // ordered: ties to the lower key
+        if (votes > best) {
+          best = votes;
+          row.string = key.first;
+          row.finger = key.second;
+        }
+      }
+      for (int64_t f = note.first_frame; f <= note.last_frame; ++f) {
+        const FrameContact& c = contacts[static_cast<size_t>(f)];
+        if (c.pressed() && c.string == row.string && c.finger == row.finger &&
+            std::isfinite(c.from_nut_mm)) {
+          from_nut.push_back(c.from_nut_mm);
+        }
+      }
+      if (!from_nut.empty()) {
+        std::sort(from_nut.begin(), from_nut.end());
+        row.from_nut_mm = from_nut[from_nut.size() / 2];
+      }
+      const double semitones = CentsBetween(model.open_hz(row.string), note.f0_hz) / 100.0;
+      row.position_semitones = semitones - FingerOffsetSemitones(model.kind(), row.finger);
+    } else if (row.open_frames > 0 && row.open_frames >= row.uncertain_frames) {
+      row.state = "open";
+      int best = -1;
+      for (const auto& [string, votes] : open_votes) {
+        if (votes > best) {
+          best = votes;
+          row.string = string;
+        }
+      }
+    } else {
+      row.state = "uncertain";
+    }
+    out.push_back(row);
+  }
+  return out;
+}
+
+}  // namespace arco::refine
