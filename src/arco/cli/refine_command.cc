@@ -17,6 +17,7 @@ struct RefineArgs {
   double binding_cents = 30.0;
   double max_residual_mm = 3.0;
   double lift_max_mm = 0.0;
+  double max_hand_shift_mm = 10.0;
   std::string joints = "mcp_flex_pip_dip";
   double reference_weight = -1;  // < 0: the default
   double temporal_weight = -1;
@@ -34,6 +35,7 @@ int RunRefine(const RefineArgs& a) {
   o.refine.paper.binding_cents = a.binding_cents;
   o.refine.ik.max_residual_mm = a.max_residual_mm;
   o.refine.ik.lift_max_distance_mm = a.lift_max_mm;
+  o.refine.ik.max_hand_shift_mm = a.max_hand_shift_mm;
   if (a.joints == "pip_dip") o.refine.ik.joints = hand::FingerIkJoints::kPipDip;
   if (a.joints == "all") o.refine.ik.joints = hand::FingerIkJoints::kAll;
   if (a.reference_weight >= 0) o.refine.ik.reference_weight_mm_per_rad = a.reference_weight;
@@ -77,6 +79,11 @@ std::function<int()> SetupRefine(CLI::App& app) {
                   a->max_residual_mm,
                   "arco: reject a contact the bounded IK cannot bring the tip within this "
                   "distance of (mm)")
+      ->capture_default_str();
+  sub->add_option("--max-hand-shift-mm",
+                  a->max_hand_shift_mm,
+                  "arco: when the finger alone cannot reach, move the whole hand up to this far "
+                  "(mm); beyond it the contact is rejected")
       ->capture_default_str();
   sub->add_option("--lift-max-mm",
                   a->lift_max_mm,

@@ -290,14 +290,20 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
          --f) {
       const size_t i = static_cast<size_t>(f);
       const FrameAudioState a = context.analysis->frame_state[i];
+      // Weak frames that merely continued the previous note are the transition too.
+      const bool weak_member =
+          a == FrameAudioState::kNote && input.pitch[i].confidence < pitch_options.min_confidence;
       const bool untrusted = a == FrameAudioState::kRest || a == FrameAudioState::kLowConfidence ||
-                             a == FrameAudioState::kOutlier || a == FrameAudioState::kShortNote;
-      if (!untrusted || out[i].state == ContactState::kPressed) break;
+                             a == FrameAudioState::kOutlier || a == FrameAudioState::kShortNote ||
+                             weak_member;
+      if (!untrusted) break;
       FrameContact lead = out[i];
       lead.note = note_index;
       AssignFrame(context, st.string, st.finger, onset_hz, pitch_options, lift_max_mm, f, &lead);
-      // Only where the fitted finger is already near its contact (not still on its way).
+      // Only where the fitted finger is already near its contact (not still on its way),
+      // and nearer than to the previous note's contact.
       if (!lead.pressed() || !(lead.tip_distance_vision_mm <= options.onset_lead_max_mm)) break;
+      if (out[i].pressed() && out[i].tip_distance_vision_mm <= lead.tip_distance_vision_mm) break;
       if (lead.reason == ContactReason::kNone) lead.reason = ContactReason::kBeforeOnset;
       out[i] = lead;
     }

@@ -78,6 +78,36 @@ FrameIk SolveArcoFrame(const DecodeContext& context,
   return Solve(context, c, f, ik);
 }
 
+// Takes an arco IK result for one frame: the refined pose when the tip is within
+// max_residual_mm, the whole hand shifted when within max_hand_shift_mm, otherwise the
+// contact is rejected (kOutOfReach) and `hand` left alone. True when taken.
+bool ApplyArcoIk(const DecodeContext& context,
+                 const ArcoIkOptions& options,
+                 const FrameIk& s,
+                 FrameContact* c,
+                 std::optional<hand::HandPose>* hand_out) {
+  hand::HandPose pose = s.pose;
+  double distance = s.distance_mm;
+  const hand::Finger finger = static_cast<hand::Finger>(c->finger);
+  if (distance > options.max_residual_mm) {
+    if (distance > options.max_hand_shift_mm) {
+      c->tip_distance_refined_mm = distance;
+      c->state = ContactState::kUncertain;  // lift test: unreachable within the limits
+      c->reason = ContactReason::kOutOfReach;
+      return false;
+    }
+    const Eigen::Vector3d tip = hand::FingertipInWorld(context.input->hand_model, pose, finger);
+    pose.wrist_in_world_mm += c->point_in_world_mm - tip;  // the whole hand, rigidly
+    distance =
+        (hand::FingertipInWorld(context.input->hand_model, pose, finger) - c->point_in_world_mm)
+            .norm();
+    c->reason = ContactReason::kHandShifted;
+  }
+  c->tip_distance_refined_mm = distance;
+  *hand_out = pose;
+  return true;
+}
+
 }  // namespace
 
 std::vector<std::optional<hand::HandPose>> SolvePaperIk(const DecodeContext& context,
@@ -112,6 +142,8 @@ std::vector<std::optional<hand::HandPose>> SolvePaperIk(const DecodeContext& con
 
 std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& context,
                                                        const ArcoIkOptions& options,
+                                                       const PitchModelOptions& pitch_options,
+                                                       int lead_frames,
                                                        std::vector<FrameContact>* contacts,
                                                        IkStats* stats,
                                                        int num_threads) {
@@ -151,26 +183,46 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
     const FrameIk& s = final_ik[static_cast<size_t>(f)];
     if (!s.solved) continue;
     Accumulate(s, stats);
+    ApplyArcoIk(
+        context, options, s, &(*contacts)[static_cast<size_t>(f)], &hands[static_cast<size_t>(f)]);
+  }
+
+  // The sound lags the hand at note changes: a rejected frame just before the next note
+  // starts gets the next note's contact when that finger can reach it.
+  const InstrumentModel& model = *context.input->instrument;
+  for (int f = 0; f < n; ++f) {
     FrameContact& c = (*contacts)[static_cast<size_t>(f)];
-    hand::HandPose pose = s.pose;
-    double distance = s.distance_mm;
-    if (distance > options.max_residual_mm) {
-      const Eigen::Vector3d tip = hand::FingertipInWorld(
-          context.input->hand_model, pose, static_cast<hand::Finger>(c.finger));
-      if (distance > options.max_hand_shift_mm) {
-        c.tip_distance_refined_mm = distance;
-        c.state = ContactState::kUncertain;  // lift test: unreachable within the limits
-        c.reason = ContactReason::kOutOfReach;
-        continue;
-      }
-      pose.wrist_in_world_mm += c.point_in_world_mm - tip;  // the whole hand, rigidly
-      distance = (hand::FingertipInWorld(
-                      context.input->hand_model, pose, static_cast<hand::Finger>(c.finger)) -
-                  c.point_in_world_mm)
-                     .norm();
-      c.reason = ContactReason::kHandShifted;
+    if (c.reason != ContactReason::kOutOfReach || !context.has_strings[static_cast<size_t>(f)] ||
+        !context.input->vision_hand[static_cast<size_t>(f)]) {
+      continue;
     }
-    c.tip_distance_refined_mm = distance;
+    const FrameContact* next = nullptr;
+    for (int g = f + 1; g < n && g <= f + lead_frames; ++g) {
+      const FrameContact& cg = (*contacts)[static_cast<size_t>(g)];
+      if (cg.pressed() && cg.note != c.note) {
+        next = &cg;
+        break;
+      }
+    }
+    if (next == nullptr) continue;
+    Candidate cand;
+    if (!ContactOnString(
+            model, context.strings(f), next->string, next->f0_hz, pitch_options.contact, &cand)) {
+      continue;
+    }
+    FrameContact alt = c;
+    alt.note = next->note;
+    SetPressed(cand, next->finger, &alt);
+    const int tip = hand::TipKeypoint(static_cast<hand::Finger>(alt.finger));
+    alt.tip_distance_vision_mm =
+        ((*context.vision_points[static_cast<size_t>(f)])[tip] - cand.point_in_world).norm();
+    const FrameIk s = SolveArcoFrame(context, alt, f, options, nullptr);
+    if (!s.solved) continue;
+    Accumulate(s, stats);
+    std::optional<hand::HandPose> pose = hands[static_cast<size_t>(f)];
+    if (!ApplyArcoIk(context, options, s, &alt, &pose)) continue;
+    if (alt.reason == ContactReason::kNone) alt.reason = ContactReason::kBeforeOnset;
+    c = alt;
     hands[static_cast<size_t>(f)] = pose;
   }
   return hands;

@@ -20,6 +20,8 @@
 //     (kHandShifted: the fitted wrist is off, e.g. a fit lagging a shift); beyond that the
 //     lift test rejects the contact (kOutOfReach: the finger cannot reach it) and the hand
 //     stays as fitted. (The decoder already rejected contacts beyond the lift distance.)
+//  3. the sound lags the hand at note changes: a rejected frame just before the next note
+//     gets that note's contact (kBeforeOnset) when its finger can reach it.
 // Other fingers and the thumb keep their fitted angles; the wrist moves only in step 2.
 #pragma once
 
@@ -44,8 +46,12 @@ std::vector<std::optional<hand::HandPose>> SolvePaperIk(const DecodeContext& con
                                                         IkStats* stats,
                                                         int num_threads);
 
+// lead_frames: a contact rejected this close before the next note's first pressed frame is
+// tried again with that note's contact (the sound lags the hand at note changes).
 std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& context,
                                                        const ArcoIkOptions& options,
+                                                       const PitchModelOptions& pitch_options,
+                                                       int lead_frames,
                                                        std::vector<FrameContact>* contacts,
                                                        IkStats* stats,
                                                        int num_threads);

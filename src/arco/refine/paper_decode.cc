@@ -26,7 +26,8 @@ int NearestFinger(const hand::HandPointsMm& points, const Eigen::Vector3d& p) {
 
 std::vector<FrameContact> DecodePaper(const DecodeContext& context,
                                       const PaperOptions& options,
-                                      const ContactOptions& contact_options) {
+                                      const PitchModelOptions& pitch_options) {
+  const ContactOptions& contact_options = pitch_options.contact;
   const RefineInput& input = *context.input;
   const InstrumentModel& model = *input.instrument;
   const int n = context.num_frames();
@@ -41,7 +42,15 @@ std::vector<FrameContact> DecodePaper(const DecodeContext& context,
     FrameContact& c = out[static_cast<size_t>(f)];
     c = AudioOnlyContact(context, f);
     const FrameAudioState audio = context.analysis->frame_state[static_cast<size_t>(f)];
-    if (audio == FrameAudioState::kRest || audio == FrameAudioState::kLowConfidence) {
+    // The paper's voicing: the tracker's confidence alone (no hysteresis, no notes).
+    const bool weak =
+        context.input->pitch[static_cast<size_t>(f)].confidence < pitch_options.min_confidence;
+    if (audio == FrameAudioState::kRest || audio == FrameAudioState::kLowConfidence || weak) {
+      if (audio != FrameAudioState::kRest) {
+        c.state = ContactState::kUncertain;
+        c.reason = ContactReason::kLowConfidence;
+        c.note = -1;
+      }
       unbind();
       continue;
     }

@@ -24,6 +24,6 @@ namespace arco::refine {
 // One FrameContact per frame (before IK: tip distances from the vision hand only).
 std::vector<FrameContact> DecodePaper(const DecodeContext& context,
                                       const PaperOptions& options,
-                                      const ContactOptions& contact_options);
+                                      const PitchModelOptions& pitch_options);
 
 }  // namespace arco::refine

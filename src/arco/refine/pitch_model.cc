@@ -36,6 +36,15 @@ class Segmenter {
             PitchAnalysis* out)
       : pitch_(pitch), options_(options), out_(out) {}
 
+  // A weak frame (low confidence) continues the open note when it agrees with it; true when
+  // it was taken.
+  bool Continue(int64_t f, double cents) {
+    if (members_.empty() || !pending_.empty()) return false;
+    if (std::abs(cents - Centre(members_cents_)) > options_.note_change_cents) return false;
+    Add(f, cents);
+    return true;
+  }
+
   void Push(int64_t f, double cents) {
     if (members_.empty()) {
       Add(f, cents);
@@ -73,7 +82,7 @@ class Segmenter {
 
   // Ends the current note (a rest, an untrusted frame, the end of the clip).
   void Close() {
-    DropPendingAsOutliers();
+    DropPendingAsOutliers(/*count=*/false);
     if (members_.empty()) return;
     NoteSpan note;
     note.first_frame = members_.front();
@@ -115,10 +124,12 @@ class Segmenter {
     }
   }
   double Centre(const std::vector<double>& window) const { return Median(window); }
-  void DropPendingAsOutliers() {
+  // Pending frames that never became a note: outliers. They count against the note's
+  // stability only when the note went on after them (not when a rest ends it).
+  void DropPendingAsOutliers(bool count = true) {
     for (int64_t f : pending_)
       out_->frame_state[static_cast<size_t>(f)] = FrameAudioState::kOutlier;
-    outliers_ += static_cast<int>(pending_.size());
+    if (count) outliers_ += static_cast<int>(pending_.size());
     pending_.clear();
     pending_cents_.clear();
   }
@@ -140,6 +151,9 @@ Status PitchModelOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(contact.Validate());
   if (!(min_confidence >= 0 && min_confidence <= 1)) {
     return Status::Error("pitch model: min_confidence must be in [0, 1]");
+  }
+  if (!(min_confidence_in_note >= 0 && min_confidence_in_note <= min_confidence)) {
+    return Status::Error("pitch model: min_confidence_in_note must be in [0, min_confidence]");
   }
   if (!(note_change_cents > 0 && std::isfinite(note_change_cents))) {
     return Status::Error("pitch model: note_change_cents must be > 0");
@@ -228,6 +242,10 @@ PitchAnalysis AnalysePitch(const std::vector<FramePitch>& pitch, const PitchMode
       trusted[f] = 0;
     }
     if (!trusted[f]) {
+      // Hysteresis: a weak but agreeing frame continues a note; anything else ends it.
+      const bool weak = out.frame_state[f] == FrameAudioState::kLowConfidence &&
+                        pitch[f].confidence >= options.min_confidence_in_note;
+      if (weak && segmenter.Continue(static_cast<int64_t>(f), Cents(pitch[f].f0_hz))) continue;
       segmenter.Close();
       continue;
     }

@@ -42,12 +42,15 @@ struct FramePitch {
 
 struct PitchModelOptions {
   ContactOptions contact;       // open-string and range tolerances (instrument/contact.h)
-  double min_confidence = 0.5;  // voiced frames below this are uncertain
+  double min_confidence = 0.5;  // voiced frames below this are uncertain ...
+  // ... unless they continue an open note at a pitch that agrees with it (hysteresis: fast
+  // passages blur the tracker's confidence between notes).
+  double min_confidence_in_note = 0.2;
   // Note segmentation (header comment).
   double note_change_cents = 70.0;     // farther than this from the note's running median ...
   int note_change_frames = 2;          // ... for this many consecutive agreeing frames: new note
   int median_window_frames = 15;       // the running median looks at this many latest frames
-  int min_note_frames = 3;             // shorter notes are uncertain
+  int min_note_frames = 2;             // shorter notes are uncertain (one frame never counts)
   double max_outlier_fraction = 0.25;  // more outlier frames than this: the note is unstable
   // Pitch that keeps jumping (polyphony, a tracker torn between two notes): a frame lying in
   // any window of jump_window_frames frames with more than max_jumps_in_window jumps of at

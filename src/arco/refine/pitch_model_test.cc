@@ -84,12 +84,14 @@ TEST(AnalysePitch, OneNoisyFrameIsAnOutlierAndDoesNotSplitTheNote) {
   EXPECT_EQ(a.frame_state[21], FrameAudioState::kNote);
 }
 
-TEST(AnalysePitch, TwoFrameBlipIsAShortUncertainNote) {
+TEST(AnalysePitch, NotesShorterThanTheMinimumAreUncertain) {
   std::vector<FramePitch> track;
   AddNote(&track, 45, 40);
   track[20].f0_hz *= 2;
   track[21].f0_hz *= 2;
-  const PitchAnalysis a = AnalysePitch(track, {});
+  PitchModelOptions o;
+  o.min_note_frames = 3;
+  const PitchAnalysis a = AnalysePitch(track, o);
   ASSERT_EQ(a.notes.size(), 3u);
   EXPECT_TRUE(a.notes[0].usable);
   EXPECT_FALSE(a.notes[1].usable);
@@ -121,12 +123,28 @@ TEST(AnalysePitch, FastPassageIsNotMistakenForPolyphony) {
   for (const NoteSpan& n : a.notes) EXPECT_TRUE(n.usable);
 }
 
-TEST(AnalysePitch, ShortClipAndEmptyClip) {
+TEST(AnalysePitch, WeakFramesContinueANoteButNeverStartOne) {
   std::vector<FramePitch> track;
-  AddNote(&track, 45, 2);
+  AddNote(&track, 45, 10);
+  AddNote(&track, 45, 4, 0, 0.3);  // the tracker loses confidence mid-note
+  AddNote(&track, 45, 10);
+  AddNote(&track, 52, 6, 0, 0.3);  // a weak new pitch: no note
+  AddNote(&track, 45, 3, 0, 0.1);  // below min_confidence_in_note: ends the note
   const PitchAnalysis a = AnalysePitch(track, {});
   ASSERT_EQ(a.notes.size(), 1u);
-  EXPECT_FALSE(a.notes[0].usable);  // 2 frames < min_note_frames
+  EXPECT_EQ(a.notes[0].first_frame, 0);
+  EXPECT_EQ(a.notes[0].last_frame, 23);
+  EXPECT_EQ(a.frame_state[12], FrameAudioState::kNote);
+  EXPECT_EQ(a.frame_state[26], FrameAudioState::kLowConfidence);
+  EXPECT_EQ(a.frame_state[31], FrameAudioState::kLowConfidence);
+}
+
+TEST(AnalysePitch, ShortClipAndEmptyClip) {
+  std::vector<FramePitch> track;
+  AddNote(&track, 45, 1);
+  const PitchAnalysis a = AnalysePitch(track, {});
+  ASSERT_EQ(a.notes.size(), 1u);
+  EXPECT_FALSE(a.notes[0].usable);  // 1 frame < min_note_frames
   EXPECT_EQ(a.frame_state[0], FrameAudioState::kShortNote);
   EXPECT_TRUE(AnalysePitch({}, {}).notes.empty());
 }
@@ -150,6 +168,9 @@ TEST(PitchModelOptions, ValidateRejectsBadValues) {
   EXPECT_FALSE(o.Validate().ok());
   o = {};
   o.vibrato_min_cents = NAN;
+  EXPECT_FALSE(o.Validate().ok());
+  o = {};
+  o.min_confidence_in_note = 0.6;  // above min_confidence
   EXPECT_FALSE(o.Validate().ok());
   o = {};
   o.jump_window_frames = 1;

@@ -184,7 +184,7 @@ RefineResult Refine(const RefineInput& input, const RefineOptions& options) {
   result.analysis = AnalysePitch(input.pitch, options.pitch);
   const DecodeContext context = MakeDecodeContext(input, result.analysis, options.num_threads);
   if (options.mode == RefineMode::kPaper) {
-    result.contacts = DecodePaper(context, options.paper, options.pitch.contact);
+    result.contacts = DecodePaper(context, options.paper, options.pitch);
     result.hand = SolvePaperIk(context, options.paper, &result.contacts, &ik, options.num_threads);
   } else {
     result.contacts = DecodeArco(context,
@@ -192,7 +192,13 @@ RefineResult Refine(const RefineInput& input, const RefineOptions& options) {
                                  options.pitch,
                                  LiftMaxMm(input.hand_model, options.ik),
                                  options.num_threads);
-    result.hand = SolveArcoIk(context, options.ik, &result.contacts, &ik, options.num_threads);
+    result.hand = SolveArcoIk(context,
+                              options.ik,
+                              options.pitch,
+                              options.decode.onset_lead_frames,
+                              &result.contacts,
+                              &ik,
+                              options.num_threads);
   }
   result.fingering =
       Transcribe(*input.instrument, result.analysis, result.contacts, input.fps, input.a4_hz);

@@ -290,8 +290,8 @@ TEST(Refine, PolyphonicOrNoisyAudioIsFlaggedNotForced) {
   for (int f = 20; f < 60; ++f) {
     scene.input.pitch[static_cast<size_t>(f)] = {choices[(f * 7 + f / 3) % 4], 0.55};
   }
-  // Frames 75-79 (the end): a note with noise below the confidence threshold.
-  for (int f = 75; f < 80; ++f) scene.input.pitch[static_cast<size_t>(f)].confidence = 0.2;
+  // Frames 75-79 (the end): a note with noise below both confidence thresholds.
+  for (int f = 75; f < 80; ++f) scene.input.pitch[static_cast<size_t>(f)].confidence = 0.1;
   for (RefineMode mode : {RefineMode::kArco, RefineMode::kPaper}) {
     const RefineResult r = Refine(scene.input, Options(mode));
     for (int f = 75; f < 80; ++f) {
