@@ -134,7 +134,8 @@ StatusOr<PitchTrack> TrackPitch(std::unique_ptr<AudioReader> reader,
     }
     summary->voiced_fraction =
         track.frames.empty() ? 0.0 : static_cast<double>(voiced) / track.frames.size();
-    if (info.frames > 0 && stream.source_samples() < info.frames) {
+    // Only a source that ran out early is truncated; stopping at max_frames is not.
+    if (stream.finished() && info.frames > 0 && stream.source_samples() < info.frames) {
       summary->warnings.push_back("truncated: the header promises " + std::to_string(info.frames) +
                                   " samples, only " + std::to_string(stream.source_samples()) +
                                   " decoded");

@@ -362,3 +362,23 @@ TEST(TrackPitchRealCello, AgreesWithCrepeUpToItsOctaveErrors) {
 
 }  // namespace
 }  // namespace arco::audio
+
+namespace arco::audio {
+namespace {
+
+// Stopping at max_frames reads less than the file holds: that is not truncation.
+TEST(TrackPitch, MaxFramesDoesNotWarnOfTruncation) {
+  PitchTrackerOptions o;
+  o.range = *InstrumentRangeByName("cello");
+  o.fps = 30;
+  o.max_frames = 30;  // 1 s of a 20 s file
+  PitchSummary summary;
+  auto track =
+      TrackPitchFile(std::string(ARCO_SHARED_DATA_DIR) + "/spd/background.wav", o, &summary);
+  ASSERT_TRUE(track.ok()) << track.status().message();
+  EXPECT_EQ(track->frames.size(), 30u);
+  for (const auto& w : summary.warnings) EXPECT_EQ(w.find("truncated"), std::string::npos) << w;
+}
+
+}  // namespace
+}  // namespace arco::audio
