@@ -159,6 +159,7 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
   ContactTrack truth_contact;
   std::vector<std::string> truth_names;
   std::vector<double> truth_f0;
+  std::vector<bool> truth_scored;
   EvalOptions options = r.metrics;
   const bool folder = r.labels.empty();
   if (folder && !std::filesystem::is_directory(r.truth)) {
@@ -187,7 +188,10 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
     }
     auto pitch = audio::ReadPitchCsv(JoinPath(r.truth, "pitch.csv"));
     if (pitch.ok()) {
-      for (const auto& f : *pitch) truth_f0.push_back(f.voiced ? f.f0_hz : 0.0);
+      for (const auto& f : *pitch) {
+        truth_f0.push_back(f.voiced ? f.f0_hz : 0.0);
+        truth_scored.push_back(f.confidence > 0);  // confidence 0: not scored
+      }
     }
   } else {
     // Labelled views triangulated by `arco triangulate --view`: one JSON per frame.
@@ -304,7 +308,7 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
       if (f.frame >= 0 && f.frame < static_cast<int64_t>(e.size()) && f.voiced)
         e[static_cast<size_t>(f.frame)] = f.f0_hz;
     }
-    report.pitch = EvaluatePitch(truth_f0, e);
+    report.pitch = EvaluatePitch(truth_f0, e, &truth_scored);
     report.truth_f0_hz = truth_f0;
     report.estimate_f0_hz = e;
   }

@@ -2,6 +2,11 @@
 // against a perturbed copy; malformed inputs.
 #include "arco/eval/evaluate.h"
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -15,12 +20,23 @@
 namespace arco::eval {
 namespace {
 
+// A temporary folder of this test process only: ctest runs the tests of one binary
+// as separate processes, possibly at the same time.
+inline std::string PerProcessTempDir() {
+  static const std::string dir = [] {
+    const std::string d = ::testing::TempDir() + "/arco-" + std::to_string(::getpid());
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
 namespace fs = std::filesystem;
 
 // A short synthetic capture (no audio) written once for all tests.
 const std::string& CaptureDir() {
   static const std::string dir = [] {
-    const std::string d = ::testing::TempDir() + "/eval_capture";
+    const std::string d = PerProcessTempDir() + "/eval_capture";
     auto text =
         ReadFileToString(std::string(ARCO_SHARED_DATA_DIR) + "/spd/cello_1113_scale_camera.xml");
     auto cal = ParseMetashapeXml(*text, "rig.xml");
@@ -39,7 +55,7 @@ const std::string& CaptureDir() {
 
 // A result folder whose stage `name` holds `points` (and the truth's contact).
 std::string MakeResult(const std::string& name, const NpyArray<double>& points, bool with_contact) {
-  const std::string dir = ::testing::TempDir() + "/eval_result_" + name;
+  const std::string dir = PerProcessTempDir() + "/eval_result_" + name;
   fs::remove_all(dir);
   fs::create_directories(dir + "/" + name);
   EXPECT_TRUE(WriteNpy(dir + "/" + name + "/points3d.npy", points).ok());
@@ -112,7 +128,7 @@ TEST(Evaluate, ShiftedLeftHandKeepsAlignedMpjpeButNotContactDeviation) {
 
 TEST(Evaluate, BadInput) {
   EvalRequest r;
-  r.result_dir = ::testing::TempDir() + "/no_such_result";
+  r.result_dir = PerProcessTempDir() + "/no_such_result";
   r.truth = CaptureDir() + "/truth";
   EXPECT_FALSE(Evaluate(r).ok());
   auto truth = ReadNpy<double>(CaptureDir() + "/truth/points3d.npy");
@@ -123,7 +139,7 @@ TEST(Evaluate, BadInput) {
   auto report = Evaluate(r);
   ASSERT_FALSE(report.ok());
   EXPECT_NE(report.status().message().find("frames but the truth has"), std::string::npos);
-  const std::string bad = ::testing::TempDir() + "/bad_contact.csv";
+  const std::string bad = PerProcessTempDir() + "/bad_contact.csv";
   ASSERT_TRUE(AtomicWriteFile(bad, "frame,string,finger\n0,1,1\n").ok());
   EXPECT_FALSE(ReadContactCsv(bad, 3).ok());
   ASSERT_TRUE(AtomicWriteFile(
@@ -186,7 +202,7 @@ TEST(Evaluate, LabelledFramesAsTruth) {
                         {{{"name", "nut_l"}, {"xyz", {nut.x(), nut.y(), nut.z()}}},
                          {{"name", "tip_plate"}, {"xyz", {tip.x(), tip.y(), tip.z()}}},
                          {{"name", "not_a_keypoint"}, {"xyz", {0, 0, 0}}}}}};
-  const std::string path = ::testing::TempDir() + "/labels11.json";
+  const std::string path = PerProcessTempDir() + "/labels11.json";
   ASSERT_TRUE(WriteJsonFile(path, labels).ok());
   EvalRequest r;
   r.result_dir = dir;

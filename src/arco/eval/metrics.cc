@@ -234,15 +234,18 @@ MethodMetrics EvaluateMethod(const std::string& method,
 }
 
 PitchMetrics EvaluatePitch(const std::vector<double>& truth_f0_hz,
-                           const std::vector<double>& estimate_f0_hz) {
-  if (truth_f0_hz.size() != estimate_f0_hz.size()) {
-    throw std::invalid_argument("EvaluatePitch: truth and estimate differ in length");
+                           const std::vector<double>& estimate_f0_hz,
+                           const std::vector<bool>* scored) {
+  if (truth_f0_hz.size() != estimate_f0_hz.size() ||
+      (scored && scored->size() != truth_f0_hz.size())) {
+    throw std::invalid_argument("EvaluatePitch: truth, estimate and mask differ in length");
   }
   PitchMetrics m;
-  m.frames = static_cast<int>(truth_f0_hz.size());
   int hit50 = 0, hit25 = 0, recalled = 0, unvoiced = 0, false_alarms = 0;
   std::vector<double> abs_cents;
   for (size_t i = 0; i < truth_f0_hz.size(); ++i) {
+    if (scored && !(*scored)[i]) continue;
+    ++m.frames;
     const bool tv = truth_f0_hz[i] > 0;  // false for NaN too
     const bool ev = estimate_f0_hz[i] > 0;
     if (!tv) {

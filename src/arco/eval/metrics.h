@@ -123,7 +123,7 @@ int CountJointLimitViolations(const PointSequence& points,
                               double tolerance_deg);
 
 struct PitchMetrics {
-  int frames = 0;
+  int frames = 0;  // scored frames
   int truth_voiced_frames = 0;
   double rpa50 = NAN;  // raw pitch accuracy within 50 cents, over truth-voiced frames
   double rpa25 = NAN;
@@ -132,8 +132,11 @@ struct PitchMetrics {
   double median_abs_cents = NAN;     // over frames voiced in both
 };
 
-// f0 in Hz per frame; <= 0 or NaN = unvoiced. Sizes must match (else throws).
+// f0 in Hz per frame; <= 0 or NaN = unvoiced. `scored` (optional, same size)
+// leaves frames out of every pitch metric, e.g. note attacks and release tails.
+// Sizes must match (else throws).
 PitchMetrics EvaluatePitch(const std::vector<double>& truth_f0_hz,
-                           const std::vector<double>& estimate_f0_hz);
+                           const std::vector<double>& estimate_f0_hz,
+                           const std::vector<bool>* scored = nullptr);
 
 }  // namespace arco::eval

@@ -172,6 +172,12 @@ TEST(EvaluatePitch, HandComputedAccuracyAndVoicing) {
   EXPECT_EQ(self.voicing_false_alarm, 0.0);
   EXPECT_EQ(self.median_abs_cents, 0.0);
   EXPECT_THROW(EvaluatePitch({1.0}, {}), std::invalid_argument);
+  // Leaving out the octave error and the false alarm.
+  const std::vector<bool> scored = {true, true, true, false, true, true, false};
+  const PitchMetrics masked = EvaluatePitch(truth, est, &scored);
+  EXPECT_EQ(masked.frames, 5);
+  EXPECT_NEAR(masked.rpa50, 3.0 / 4, 1e-12);
+  EXPECT_NEAR(masked.voicing_false_alarm, 0.0, 1e-12);
 }
 
 }  // namespace

@@ -1,6 +1,11 @@
 // Rendered audio against the truth pitch, tracked by arco's own tracker.
 #include "arco/synth/audio_render.h"
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,6 +17,17 @@
 
 namespace arco::synth {
 namespace {
+
+// A temporary folder of this test process only: ctest runs the tests of one binary
+// as separate processes, possibly at the same time.
+inline std::string PerProcessTempDir() {
+  static const std::string dir = [] {
+    const std::string d = ::testing::TempDir() + "/arco-" + std::to_string(::getpid());
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
 
 struct Case {
   const char* instrument;
@@ -31,7 +47,7 @@ TEST_P(RenderedAudio, TrackedPitchMatchesTruthWithinFiveCents) {
   ASSERT_TRUE(plan.ok());
   auto perf = MakePerformance(s, *plan, {}, 5);
   ASSERT_TRUE(perf.ok());
-  const std::string dir = ::testing::TempDir() + "/render_" + c.instrument;
+  const std::string dir = PerProcessTempDir() + "/render_" + c.instrument;
   std::filesystem::create_directories(dir);
   AudioRenderSummary summary;
   const Status st = RenderPerformanceAudio(

@@ -182,11 +182,19 @@ Status WriteAll(const SyntheticCapture& c,
   ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(truth, "instrument_pose.npy"), poses));
   ARCO_RETURN_IF_ERROR(AtomicWriteFile(JoinPath(truth, "contact.csv"), ContactCsv(c)));
   ARCO_RETURN_IF_ERROR(AtomicWriteFile(JoinPath(truth, "notes.csv"), NotesCsv(c)));
+  // Confidence marks what a pitch evaluation should score: 0 for the first
+  // 60 ms of a note (the sample speaks) and for release tails (0.7 s after a
+  // note's end, the rendered sample still rings), 1 elsewhere.
   std::vector<audio::PitchFrame> pitch;
   for (int f = 0; f < c.num_frames; ++f) {
     const double t = f / c.options.fps;
     const double f0 = c.performance.F0HzAt(t);
-    pitch.push_back({f, t, f0, f0 > 0 ? 1.0 : 0.0, f0 > 0});
+    bool scored = true;
+    for (const PerformedNote& n : c.performance.notes) {
+      if (t >= n.note.onset_s && t < n.note.onset_s + 0.06) scored = false;
+      if (f0 <= 0 && t >= n.note.offset_s && t < n.note.offset_s + 0.7) scored = false;
+    }
+    pitch.push_back({f, t, f0, scored ? 1.0 : 0.0, f0 > 0});
   }
   ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(JoinPath(truth, "pitch.csv"), pitch));
   ARCO_RETURN_IF_ERROR(WriteJsonFile(JoinPath(truth, "truth.json"), TruthJson(c, w, *s)));

@@ -1,5 +1,10 @@
 #include "arco/synth/midi_reader.h"
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -11,6 +16,17 @@
 
 namespace arco::synth {
 namespace {
+
+// A temporary folder of this test process only: ctest runs the tests of one binary
+// as separate processes, possibly at the same time.
+inline std::string PerProcessTempDir() {
+  static const std::string dir = [] {
+    const std::string d = ::testing::TempDir() + "/arco-" + std::to_string(::getpid());
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
 
 // Builds SMF bytes by hand so the reader is tested independently of any writer.
 std::string Be(uint32_t v, int n) {
@@ -115,14 +131,14 @@ TEST(ReadMidiScore, NamesTheNoteOutsideTheRange) {
   const std::string bytes =
       Header(0, 1, 480) + Track(Ev(0, {0x90, 57, 80}) + Ev(480, {0x80, 57, 0}) +
                                 Ev(0, {0x90, 90, 80}) + Ev(480, {0x80, 90, 0}));
-  const std::string path = ::testing::TempDir() + "/high.mid";
+  const std::string path = PerProcessTempDir() + "/high.mid";
   ASSERT_TRUE(AtomicWriteFile(path, bytes).ok());
   auto score = ReadMidiScore(path, testing::Cello());
   ASSERT_FALSE(score.ok());
   EXPECT_EQ(score.status().message(),
             path + ": note 90 (F#6) at 0.500 s is outside the cello's range C2 (36) to A5 (81)");
   EXPECT_TRUE(ReadMidiScore(path, testing::Violin()).ok());
-  EXPECT_FALSE(ReadMidiScore(::testing::TempDir() + "/missing.mid", testing::Cello()).ok());
+  EXPECT_FALSE(ReadMidiScore(PerProcessTempDir() + "/missing.mid", testing::Cello()).ok());
 }
 
 }  // namespace

@@ -4,17 +4,33 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
 #include <gtest/gtest.h>
 
 namespace arco {
 namespace {
+
+// A temporary folder of this test process only: ctest runs the tests of one binary
+// as separate processes, possibly at the same time.
+inline std::string PerProcessTempDir() {
+  static const std::string dir = [] {
+    const std::string d = ::testing::TempDir() + "/arco-" + std::to_string(::getpid());
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
 
 TEST(Npy, RoundTripsFloatArrayWithNaN) {
   NpyArray<float> a;
   a.shape = {2, 3, 3};
   for (int i = 0; i < 18; ++i) a.data.push_back(static_cast<float>(i) * 0.5f);
   a.data[4] = NAN;
-  const std::string path = ::testing::TempDir() + "/a.npy";
+  const std::string path = PerProcessTempDir() + "/a.npy";
   ASSERT_TRUE(WriteNpy(path, a).ok());
   auto b = ReadNpy<float>(path);
   ASSERT_TRUE(b.ok()) << b.status().message();
