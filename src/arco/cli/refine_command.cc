@@ -17,7 +17,7 @@ struct RefineArgs {
   double binding_cents = 30.0;
   double max_residual_mm = 3.0;
   double lift_max_mm = 0.0;
-  double max_hand_shift_mm = 10.0;
+  double max_hand_shift_mm = 15.0;
   std::string joints = "mcp_flex_pip_dip";
   double reference_weight = -1;  // < 0: the default
   double temporal_weight = -1;

@@ -39,7 +39,13 @@ struct RunOptions {
   SequenceTriangulationOptions triangulation;
   std::vector<std::pair<std::string, TemporalFilterOptions>> filters;  // (group, filter)
   InstrumentFitOptions instrument;
-  PoseSmoothingOptions smoothing;  // default: fills gaps up to 15 frames (see run.cc)
+  // Gaussian pose smoothing; frames without a pose within 15 frames of posed frames on both
+  // sides get one.
+  PoseSmoothingOptions smoothing = [] {
+    PoseSmoothingOptions o;
+    o.max_fill_gap_frames = 15;
+    return o;
+  }();
   hand::BoneLengthOptions bones;
   hand::HandFitOptions hand_fit;
   // The hand fit carries a temporal prior from frame to frame; the clip is cut into chunks

@@ -283,7 +283,17 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
           context, st.string, st.finger, out[i].f0_hz, pitch_options, lift_max_mm, f, &out[i]);
     }
     if (st.finger == 0) continue;
-    // The finger lands before the sound: untrusted frames just before the onset.
+    // The finger lands before the sound: untrusted frames just before the onset, where the
+    // fitted fingertip is about as near the contact as during the note itself.
+    std::vector<double> note_distances;
+    for (int64_t f = note.first_frame; f <= note.last_frame; ++f) {
+      const double d = out[static_cast<size_t>(f)].tip_distance_vision_mm;
+      if (out[static_cast<size_t>(f)].note == note_index && std::isfinite(d))
+        note_distances.push_back(d);
+    }
+    if (note_distances.empty()) continue;
+    const double lead_max_mm = std::min(lift_max_mm[static_cast<size_t>(st.finger)],
+                                        Median(note_distances) + options.onset_lead_margin_mm);
     const double onset_hz = input.pitch[static_cast<size_t>(note.first_frame)].f0_hz;
     for (int64_t f = note.first_frame - 1;
          f >= 0 && f >= note.first_frame - options.onset_lead_frames;
@@ -296,14 +306,22 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
       const bool untrusted = a == FrameAudioState::kRest || a == FrameAudioState::kLowConfidence ||
                              a == FrameAudioState::kOutlier || a == FrameAudioState::kShortNote ||
                              weak_member;
-      if (!untrusted) break;
+      // The sound lags the hand by up to a frame at a note change: the previous note's last
+      // frame goes to this note when the fitted hand clearly plays this one already.
+      const bool handover = f == note.first_frame - 1 && a == FrameAudioState::kNote &&
+                            out[i].pressed() && out[i].note != note_index;
+      if (!untrusted && !handover) break;
       FrameContact lead = out[i];
       lead.note = note_index;
       AssignFrame(context, st.string, st.finger, onset_hz, pitch_options, lift_max_mm, f, &lead);
       // Only where the fitted finger is already near its contact (not still on its way),
       // and nearer than to the previous note's contact.
-      if (!lead.pressed() || !(lead.tip_distance_vision_mm <= options.onset_lead_max_mm)) break;
-      if (out[i].pressed() && out[i].tip_distance_vision_mm <= lead.tip_distance_vision_mm) break;
+      if (!lead.pressed() || !(lead.tip_distance_vision_mm <= lead_max_mm)) break;
+      const double margin = untrusted ? 0.0 : options.handover_margin_mm;
+      if (out[i].pressed() &&
+          !(lead.tip_distance_vision_mm < out[i].tip_distance_vision_mm - margin)) {
+        break;
+      }
       if (lead.reason == ContactReason::kNone) lead.reason = ContactReason::kBeforeOnset;
       out[i] = lead;
     }

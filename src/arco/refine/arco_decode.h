@@ -22,6 +22,8 @@
 //
 // Up to onset_lead_frames untrusted frames right before a stopped note's first trusted
 // frame get the note's contact too (kBeforeOnset): the finger lands before the sound.
+// Only where the fitted tip is no more than onset_lead_margin_mm farther from the contact
+// than its median over the note (the hand is already in place).
 #pragma once
 
 #include <array>

@@ -131,11 +131,15 @@ Status ArcoDecodeOptions::Validate() const {
                            same_pitch_cents,
                            rest_gap_s,
                            rest_factor,
-                           infeasible_cost};
+                           infeasible_cost,
+                           onset_lead_margin_mm};
   for (double v : values) {
     if (!(v >= 0 && Finite(v))) {
       return Status::Error("arco decode options: every weight and cost must be finite and >= 0");
     }
+  }
+  if (!(handover_margin_mm >= 0)) {
+    return Status::Error("arco decode options: handover_margin_mm must be >= 0 (infinity: off)");
   }
   if (onset_lead_frames < 0)
     return Status::Error("arco decode options: onset_lead_frames must be >= 0");

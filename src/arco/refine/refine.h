@@ -75,9 +75,14 @@ struct ArcoDecodeOptions {
   // Up to this many untrusted frames (rest, low confidence, ...) right before a stopped
   // note's first trusted frame are pressed too, with the note's first pitch: the finger
   // lands before the bow speaks and the tracker locks on a frame or two late.
-  // Only where the fitted fingertip is already within onset_lead_max_mm of the contact.
+  // Only where the fitted fingertip is at most onset_lead_margin_mm farther from the
+  // contact than its median over the note (the finger is already there, not on its way).
   int onset_lead_frames = 3;
-  double onset_lead_max_mm = 20.0;
+  double onset_lead_margin_mm = 10.0;
+  // The previous note's last (trusted) frame is handed over to the next note when the
+  // next finger's fitted tip is nearer its contact by more than this (the sound lags the
+  // hand by up to a frame); infinity disables it.
+  double handover_margin_mm = 5.0;
   Status Validate() const;
 };
 
@@ -101,7 +106,7 @@ struct ArcoIkOptions {
   // whole hand is translated by the rest if that is at most max_hand_shift_mm (the fitted
   // wrist is off: e.g. a hand fit lagging a shift); otherwise the contact is rejected.
   double max_residual_mm = 3.0;
-  double max_hand_shift_mm = 10.0;
+  double max_hand_shift_mm = 15.0;
   int max_iterations = 15;
   Status Validate() const;
 };
