@@ -394,7 +394,9 @@ TEST(Refine, FingeringTranscription) {
     EXPECT_EQ(row.string, n.string);
     EXPECT_EQ(row.finger, n.finger);
     EXPECT_EQ(row.state, n.finger > 0 ? "pressed" : "open");
-    if (n.finger > 0) EXPECT_NEAR(row.position_semitones, n.semitones - (n.finger - 1), 0.1);
+    if (n.finger > 0) {
+      EXPECT_NEAR(row.position_semitones, n.semitones - (n.finger - 1), 0.1);
+    }
   }
   EXPECT_EQ(MidiNoteName(57), "A3");
   EXPECT_EQ(MidiNoteName(36), "C2");
