@@ -1,26 +1,34 @@
 #!/usr/bin/python3
 """Pitch trackers side by side on fluidsynth-rendered music with known truth.
 
-usage: pitch_peers.py BUILD_DIR [NOTES] [RUNS]
+usage: pitch_peers.py BUILD_DIR [NOTES] [RUNS] [SEEDS]
 Renders the benchmark music (BUILD_DIR/bin/render_test_music: cello, violin,
-viola, contrabass from the FluidR3 soundfont; NOTES notes each), then runs on
-every file, with the same pitch range and a 10 ms hop:
+viola, contrabass from the FluidR3 soundfont; NOTES notes each) once per seed
+(SEEDS: comma-separated, default 11 to 18), then runs on every file, with the
+same pitch range and a 10 ms hop:
   arco pitch   --fps 100 (one row per 10 ms, pYIN + HMM)
   Praat        To Pitch (ac), default parameters apart from floor/ceiling
   aubiopitch   -p yinfft -H 441 (buffer 2048, 4096 for the bass)
-Accuracy (score_pitch.py): raw pitch accuracy within 50 and 25 cents, voicing
-recall and false alarms; each peer's timestamps are shifted by the lag in
-[-50, 50] ms that maximises its RPA50 (generous to peers whose frame times
-mark the window start). Speed: CPU seconds (user + sys of the child process,
-minimum over RUNS runs) minus the same tool's CPU seconds on a 0.5 s file
-(start-up, loading), as times real time on one core.
-Prints a markdown table.
+Accuracy (score_pitch.py), pooled over the seeds, against two truths on the
+same frames: the MIDI score (INSTRUMENT_truth.csv) and the score corrected by
+each key's measured sound (INSTRUMENT_truth_sound.csv, sound_truth.h). Raw
+pitch accuracy within 50 and 25 cents, voicing recall and false alarms; each
+peer's timestamps are shifted by the lag in [-50, 50] ms (5 ms steps) that
+maximises its pooled RPA50 against that truth (generous to peers whose frame
+times mark the window start; arco's are used as they are). Speed, on the
+first seed: CPU seconds (user + sys of the child process, minimum over RUNS
+runs) minus the same tool's CPU seconds on a 0.5 s file (start-up, loading),
+as times real time on one core.
+Prints two markdown tables.
 """
 import os
 import resource
 import subprocess
 import sys
 import wave
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from score_pitch import counts, read_track, read_truth  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RANGES = {'cello': (60, 2000), 'violin': (180, 4200), 'viola': (120, 2800), 'bass': (38, 1200)}
@@ -65,30 +73,15 @@ def commands(tool, build, instrument, wav, out, work):
     return ['sh', '-c', 'aubiopitch -i "%s" -p yinfft -B %s -H 441 -u Hz > "%s"' % (wav, buf, out)]
 
 
-def shifted(path, shift_s, out_path):
-    with open(path) as f, open(out_path, 'w') as g:
-        for line in f:
-            parts = line.replace(',', ' ').split()
-            try:
-                g.write('%.4f %s\n' % (float(parts[0]) + shift_s, parts[1]))
-            except (ValueError, IndexError):
-                pass
-
-
-def score(truth, track, fmt):
-    out = subprocess.run(['/usr/bin/python3', os.path.join(HERE, 'score_pitch.py'), truth, track,
-                          '--format', fmt], check=True, capture_output=True, text=True).stdout
-    return [float(x) for x in out.split()]
-
-
-def best_shift_score(truth, track, work):
+def best_shift(truths, tracks, shifts):
+    """(shift_ms, pooled counts) maximising pooled hits within 50 cents (ties: 25 cents)."""
     best = None
-    for ms in range(-50, 51, 5):
-        tmp = os.path.join(work, 'shifted.txt')
-        shifted(track, ms / 1000.0, tmp)
-        s = score(truth, tmp, 'pairs')
-        if best is None or s[0] > best[1][0]:
-            best = (ms, s)
+    for ms in shifts:
+        total = [0] * 6
+        for truth, (times, f0s) in zip(truths, tracks):
+            total = [x + y for x, y in zip(total, counts(truth, times, f0s, ms / 1000.0))]
+        if best is None or total[:2] > best[1][:2]:
+            best = (ms, total)
     return best
 
 
@@ -101,37 +94,56 @@ def main():
     build = os.path.abspath(sys.argv[1] if len(sys.argv) > 1 else 'build')
     notes = sys.argv[2] if len(sys.argv) > 2 else '60'
     runs = int(sys.argv[3]) if len(sys.argv) > 3 else 3
-    work = os.path.join(build, 'pitch_peers')
-    os.makedirs(work, exist_ok=True)
-    with open(os.path.join(work, 'pitch.praat'), 'w') as f:
+    seeds = (sys.argv[4] if len(sys.argv) > 4 else '11,12,13,14,15,16,17,18').split(',')
+    root = os.path.join(build, 'pitch_peers')
+    os.makedirs(root, exist_ok=True)
+    with open(os.path.join(root, 'pitch.praat'), 'w') as f:
         f.write(PRAAT_SCRIPT)
-    subprocess.run([os.path.join(build, 'bin', 'render_test_music'), work, notes], check=True,
-                   stdout=subprocess.DEVNULL)
+    works = []
+    for seed in seeds:
+        work = os.path.join(root, 'seed' + seed)
+        os.makedirs(work, exist_ok=True)
+        subprocess.run([os.path.join(build, 'bin', 'render_test_music'), work, notes, seed],
+                       check=True, stdout=subprocess.DEVNULL)
+        works.append(work)
     # A 0.5 s file measures each tool's start-up cost.
-    short = os.path.join(work, 'short.wav')
-    with wave.open(os.path.join(work, 'cello.wav')) as w, wave.open(short, 'w') as s:
+    short = os.path.join(root, 'short.wav')
+    with wave.open(os.path.join(works[0], 'cello.wav')) as w, wave.open(short, 'w') as s:
         s.setparams(w.getparams())
         s.writeframes(w.readframes(w.getframerate() // 2))
-    print('| instrument | tool | RPA 50 c | RPA 25 c | voicing recall | voicing false alarms '
-          '| time shift (ms) | speed (x real time, 1 core) |')
-    print('|---|---|---|---|---|---|---|---|')
+    rows = {'score': [], 'sound': []}
     for instrument in ['cello', 'violin', 'viola', 'bass']:
-        wav = os.path.join(work, instrument + '.wav')
-        truth = os.path.join(work, instrument + '_truth.csv')
-        seconds = duration_s(wav)
         for tool in ['arco', 'praat', 'aubio']:
-            out = os.path.join(work, '%s.%s.txt' % (instrument, tool))
-            cpu = min(cpu_of(commands(tool, build, instrument, wav, out, work)) for _ in range(runs))
-            startup = min(cpu_of(commands(tool, build, instrument, short, out + '.short', work))
-                          for _ in range(runs))
-            if tool == 'arco':
-                shift, s = 0, score(truth, out, 'arco')
-            else:
-                shift, s = best_shift_score(truth, out, work)
-            net = max(cpu - startup, 1e-3)
-            print('| %s | %s | %.3f | %.3f | %.3f | %.3f | %+d | %.0f |' %
-                  (instrument, tool, s[0], s[1], s[2], s[3], shift, seconds / net))
-            sys.stdout.flush()
+            tracks = []
+            for k, work in enumerate(works):
+                wav = os.path.join(work, instrument + '.wav')
+                out = os.path.join(work, '%s.%s.txt' % (instrument, tool))
+                cmd = commands(tool, build, instrument, wav, out, root)
+                if k == 0:
+                    cpu = min(cpu_of(cmd) for _ in range(runs))
+                    startup = min(cpu_of(commands(tool, build, instrument, short, out + '.short',
+                                                  root)) for _ in range(runs))
+                    speed = duration_s(wav) / max(cpu - startup, 1e-3)
+                else:
+                    cpu_of(cmd)
+                tracks.append(read_track(out, 'arco' if tool == 'arco' else 'pairs'))
+            for kind, suffix in [('score', '_truth.csv'), ('sound', '_truth_sound.csv')]:
+                truths = [read_truth(os.path.join(w, instrument + suffix)) for w in works]
+                shift, c = best_shift(truths, tracks, [0] if tool == 'arco' else
+                                      range(-50, 51, 5))
+                hit50, hit25, recalled, voiced, false_alarms, unvoiced = c
+                rows[kind].append('| %s | %s | %.4f | %.4f | %d / %d of %d | %.3f | %.3f | %+d |%s' % (
+                    instrument, tool, hit50 / voiced, hit25 / voiced, voiced - hit50,
+                    voiced - hit25, voiced, recalled / voiced, false_alarms / max(unvoiced, 1), shift,
+                    ' %.0f |' % speed if kind == 'score' else ''))
+    for kind, title in [('score', 'truth = MIDI score'),
+                        ('sound', 'truth = score corrected by each key\'s measured sound')]:
+        print('\n%s (seeds %s, pooled)\n' % (title, ','.join(seeds)))
+        print('| instrument | tool | RPA 50 c | RPA 25 c | misses 50 / 25 c of voiced | voicing recall '
+              '| voicing false alarms | time shift (ms) |%s' %
+              (' speed (x real time, 1 core) |' if kind == 'score' else ''))
+        print('|---|---|---|---|---|---|---|---|%s' % ('---|' if kind == 'score' else ''))
+        print('\n'.join(rows[kind]))
 
 
 if __name__ == '__main__':

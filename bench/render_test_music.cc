@@ -1,6 +1,8 @@
 // Writes the benchmark music for bench/pitch_peers.sh: for each instrument a
 // seeded melody (test_music.h) as MIDI, its per-frame truth CSV and the
-// fluidsynth rendering. usage: render_test_music OUT_DIR [NOTES] [SEED]
+// fluidsynth rendering, plus INSTRUMENT_truth_sound.csv: the same frames with
+// f0 corrected by each key's measured sound (sound_truth.h). usage: render_test_music OUT_DIR
+// [NOTES] [SEED]
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -24,6 +26,10 @@ int main(int argc, char** argv) {
     if (s.ok()) s = arco::audio::testing::RenderWithFluidsynth(base + ".mid", base + ".wav");
     if (s.ok()) s = arco::audio::testing::MarkSilentNotes(base + ".wav", &music);
     if (s.ok()) s = arco::audio::testing::WriteTruthCsv(base + "_truth.csv", music, 100.0);
+    if (s.ok()) s = arco::audio::testing::MeasureKeyContours(dir, &music);
+    if (s.ok()) {
+      s = arco::audio::testing::WriteTruthCsv(base + "_truth_sound.csv", music, 100.0, true);
+    }
     if (!s.ok()) {
       std::fprintf(stderr, "render_test_music: %s\n", s.message().c_str());
       return 1;

@@ -40,6 +40,43 @@ def read_track(path, fmt):
     return times, f0s
 
 
+def read_truth(path):
+    """Scored rows (time_s, f0_hz, code) of a truth CSV; code 1 voiced, 0 unvoiced."""
+    rows = []
+    with open(path) as f:
+        next(f)
+        for line in f:
+            t, f0, code = line.strip().split(',')
+            if int(code) >= 0:
+                rows.append((float(t), float(f0), int(code)))
+    return rows
+
+
+def counts(truth, times, f0s, shift_s=0.0):
+    """[hit50, hit25, recalled, voiced, false_alarms, unvoiced] of a track whose
+    timestamps are shifted by shift_s."""
+    c = [0] * 6
+    if not times:
+        return c
+    for t, f0, code in truth:
+        t -= shift_s  # track time + shift = truth time
+        i = bisect.bisect_left(times, t)
+        if i > 0 and (i == len(times) or t - times[i - 1] <= times[i] - t):
+            i -= 1
+        est = f0s[i]
+        if code == 0:
+            c[5] += 1
+            c[4] += est > 0
+            continue
+        c[3] += 1
+        if est > 0:
+            c[2] += 1
+            cents = abs(1200 * math.log2(est / f0))
+            c[0] += cents <= 50
+            c[1] += cents <= 25
+    return c
+
+
 def main():
     truth_path, track_path = sys.argv[1], sys.argv[2]
     fmt = sys.argv[4] if len(sys.argv) > 4 and sys.argv[3] == '--format' else 'arco'
@@ -47,28 +84,8 @@ def main():
     if not times:
         print('0 0 0 0 0 0')
         return
-    voiced = unvoiced = hit50 = hit25 = recalled = false_alarms = 0
-    with open(truth_path) as f:
-        next(f)
-        for line in f:
-            t, f0, code = line.strip().split(',')
-            t, f0, code = float(t), float(f0), int(code)
-            if code < 0:
-                continue
-            i = bisect.bisect_left(times, t)
-            if i > 0 and (i == len(times) or t - times[i - 1] <= times[i] - t):
-                i -= 1
-            est = f0s[i]
-            if code == 0:
-                unvoiced += 1
-                false_alarms += est > 0
-                continue
-            voiced += 1
-            if est > 0:
-                recalled += 1
-                cents = abs(1200 * math.log2(est / f0))
-                hit50 += cents <= 50
-                hit25 += cents <= 25
+    hit50, hit25, recalled, voiced, false_alarms, unvoiced = counts(read_truth(truth_path), times,
+                                                                    f0s)
     print('%.4f %.4f %.4f %.4f %d %d' % (hit50 / max(voiced, 1), hit25 / max(voiced, 1),
                                          recalled / max(voiced, 1),
                                          false_alarms / max(unvoiced, 1), voiced, unvoiced))

@@ -95,6 +95,28 @@ TEST_P(RenderedInstrument, TracksTruthWithinCents) {
   EXPECT_GE(matched, static_cast<int>(0.9 * truth.size()));
 }
 
+// Each key's own sound (the reference of bench/pitch_peers.sh's second table):
+// measured nearly everywhere it is scored (from 60 ms after the onset; the
+// attack before that is not), and within a semitone of the key.
+TEST_P(RenderedInstrument, KeyContoursAreMeasured) {
+  const std::string instrument = GetParam();
+  auto music = testing::MakeTestMusic(instrument, 24, 7);
+  ASSERT_TRUE(testing::MeasureKeyContours(testing::TempPath(""), &music).ok());
+  ASSERT_FALSE(music.key_contours.empty());
+  for (const auto& [key, contour] : music.key_contours) {
+    int finite = 0, scored = 0;
+    for (size_t i = 0; i < contour.cents.size(); ++i) {
+      if (i * contour.step_s < 0.06) continue;
+      ++scored;
+      const double c = contour.cents[i];
+      if (!std::isfinite(c)) continue;
+      ++finite;
+      EXPECT_LT(std::abs(c), 100.0) << instrument << " key " << key;
+    }
+    EXPECT_GE(finite, 0.9 * scored) << instrument << " key " << key;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(FluidR3,
                          RenderedInstrument,
                          ::testing::Values("cello", "violin", "viola", "bass"));

@@ -115,15 +115,42 @@ double TestMusic::F0Hz(double time_s) const {
   return 0.0;
 }
 
-Status WriteTruthCsv(const std::string& path, const TestMusic& music, double rate_hz) {
+double TestMusic::SoundF0Hz(double time_s) const {
+  const double f0 = F0Hz(time_s);
+  if (f0 <= 0) return 0.0;
+  const double t = time_s - kFluidsynthLatencyS;
+  const auto& track = midi.tracks[0];
+  for (const auto& n : track.notes) {
+    if (t < n.onset_s || t >= n.offset_s) continue;
+    auto it = key_contours.find(n.midi_note);
+    if (it == key_contours.end()) return 0.0;
+    // tau = integral of 2^(bend / 12) from the onset (bends are steps).
+    double tau = 0, from = n.onset_s, bend = BendAt(track, n.onset_s);
+    for (const auto& b : track.bends) {
+      if (b.time_s <= n.onset_s + 1e-9) continue;
+      if (b.time_s > t) break;
+      tau += (b.time_s - from) * std::exp2(bend / 12.0);
+      from = b.time_s;
+      bend = b.semitones;
+    }
+    tau += (t - from) * std::exp2(bend / 12.0);
+    const double cents = it->second.At(tau);
+    return std::isfinite(cents) ? f0 * std::exp2(cents / 1200.0) : 0.0;
+  }
+  return 0.0;
+}
+
+Status WriteTruthCsv(const std::string& path, const TestMusic& music, double rate_hz, bool sound) {
   return AtomicWriteWith(path, [&](std::ostream& out) {
     out << "time_s,f0_hz,voicing\n";
     char line[96];
     for (int64_t i = 0; i / rate_hz < music.duration_s; ++i) {
       const double t = i / rate_hz;
       const TruthVoicing v = music.Voicing(t);
-      const int code = v == TruthVoicing::kVoiced ? 1 : (v == TruthVoicing::kUnvoiced ? 0 : -1);
-      std::snprintf(line, sizeof(line), "%.6f,%.4f,%d\n", t, music.F0Hz(t), code);
+      int code = v == TruthVoicing::kVoiced ? 1 : (v == TruthVoicing::kUnvoiced ? 0 : -1);
+      const double f0 = sound ? music.SoundF0Hz(t) : music.F0Hz(t);
+      if (code == 1 && f0 <= 0) code = -1;
+      std::snprintf(line, sizeof(line), "%.6f,%.4f,%d\n", t, f0, code);
       out << line;
     }
     return Status::Ok();

@@ -12,10 +12,12 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "arco/audio/midi_file.h"
+#include "arco/audio/sound_truth.h"
 #include "arco/util/status.h"
 
 namespace arco::audio::testing {
@@ -35,6 +37,12 @@ struct TestMusic {
   // Notes the soundfont did not sound (FluidR3's violin has no sample for some
   // high keys, e.g. A#6): not scored. Filled by MarkSilentNotes.
   std::vector<char> silent;
+  // Each key's own pitch contour (sound_truth.h), filled by MeasureKeyContours.
+  std::map<int, KeyContour> key_contours;
+  // "Sound" truth: F0Hz corrected by the key's contour at the sample time tau
+  // since the note started (tau runs at 2^(bend/12) per second, as fluidsynth
+  // plays a bent sample faster). 0 unless voiced and the contour is measured.
+  double SoundF0Hz(double time_s) const;
 };
 
 // Marks notes whose rendering stays below -45 dBFS RMS over their scored span.
@@ -45,8 +53,18 @@ Status MarkSilentNotes(const std::string& wav_path, TestMusic* music);
 // notes, a rest of >= 1 s after every sixth note.
 TestMusic MakeTestMusic(const std::string& instrument, int notes, uint32_t seed);
 
-// time_s,f0_hz,voicing (1 voiced, 0 unvoiced, -1 unscored) every 1/rate_hz.
-Status WriteTruthCsv(const std::string& path, const TestMusic& music, double rate_hz);
+// Renders every key of the music alone (same program and velocity, no bends,
+// into WORK_DIR/INSTRUMENT_keys.wav) and measures its contour with
+// HarmonicPeakFit every 10 ms over the longest duration the key is played.
+Status MeasureKeyContours(const std::string& work_dir, TestMusic* music);
+
+// time_s,f0_hz,voicing (1 voiced, 0 unvoiced, -1 unscored) every 1/rate_hz;
+// f0 from SoundF0Hz when `sound` (voiced rows without a measured contour are
+// then unscored).
+Status WriteTruthCsv(const std::string& path,
+                     const TestMusic& music,
+                     double rate_hz,
+                     bool sound = false);
 
 // fluidsynth -ni -R 0 -C 0 -r RATE -F wav soundfont midi; error if it fails.
 Status RenderWithFluidsynth(const std::string& midi_path,

@@ -58,6 +58,9 @@ YinAnalyzer::YinAnalyzer(const YinOptions& options) : options_(options) {
   if (!(o.subharmonic_ratio >= 0.0 && o.subharmonic_ratio <= 1.0)) {
     throw std::invalid_argument("YinOptions: subharmonic_ratio must be in [0, 1]");
   }
+  if (!(o.submultiple_probability >= 0.0 && o.submultiple_probability <= 0.1)) {
+    throw std::invalid_argument("YinOptions: submultiple_probability must be in [0, 0.1]");
+  }
   const double fs = o.sample_rate_hz;
   min_lag_ = std::max(2, static_cast<int>(std::floor(fs / o.max_f0_hz)));
   max_lag_ = static_cast<int>(std::ceil(fs / o.min_f0_hz)) + 1;
@@ -88,6 +91,7 @@ YinAnalyzer::YinAnalyzer(const YinOptions& options) : options_(options) {
   minima_.reserve(max_lag_);
   minima_prob_.reserve(max_lag_);
   minima_value_.reserve(max_lag_);
+  minima_submultiple_.reserve(max_lag_);
   std::lock_guard<std::mutex> lock(PlannerMutex());
   time_ = fftw_alloc_real(n);
   auto* spectrum = fftw_alloc_complex(n / 2 + 1);
@@ -156,6 +160,7 @@ void YinAnalyzer::Analyze(const float* window, FrameCandidates* out) {
   minima_.clear();
   minima_prob_.clear();
   minima_value_.clear();
+  minima_submultiple_.clear();
   int global = -1;
   for (int tau = std::max(min_lag_, 2); tau < max_lag_; ++tau) {
     if (cmndf_[tau] < cmndf_[tau - 1] && cmndf_[tau] <= cmndf_[tau + 1]) {
@@ -168,6 +173,7 @@ void YinAnalyzer::Analyze(const float* window, FrameCandidates* out) {
       minima_.push_back(tau);
       minima_value_.push_back(std::clamp(vertex, 0.0, b));
       minima_prob_.push_back(0.0);
+      minima_submultiple_.push_back(0);
       if (global < 0 || minima_value_.back() < minima_value_[global]) {
         global = static_cast<int>(minima_.size()) - 1;
       }
@@ -219,6 +225,36 @@ void YinAnalyzer::Analyze(const float* window, FrameCandidates* out) {
     }
   }
 
+  // Sub-multiple candidates (YinOptions::submultiple_probability): the deepest
+  // dip near 2x / 3x the lag of each threshold candidate that has no mass of
+  // its own gets a small one (not refined by Newton steps: it is a fallback
+  // for the HMM, and the parabolic lag is good to a few cents at these long
+  // lags). Marked negative until the pass ends, so a sub-multiple does not
+  // spawn its own (6x, 9x).
+  const double submultiple = options_.submultiple_probability;
+  if (submultiple > 0) {
+    const size_t found = minima_.size();
+    for (size_t k = 0; k < found; ++k) {
+      if (!(minima_prob_[k] > 0)) continue;
+      for (int mult = 2; mult <= 3; ++mult) {
+        const double target = static_cast<double>(minima_[k]) * mult;
+        const double tolerance = std::max(2.0, 0.03 * target);
+        int best = -1;
+        for (size_t q = k + 1; q < found; ++q) {
+          if (std::abs(minima_[q] - target) <= tolerance &&
+              (best < 0 || minima_value_[q] < minima_value_[best])) {
+            best = static_cast<int>(q);
+          }
+        }
+        if (best >= 0 && minima_prob_[best] == 0 && minima_value_[best] < 1.0) {
+          minima_prob_[best] = -submultiple * (1.0 - minima_value_[best]);
+          minima_submultiple_[best] = 1;
+        }
+      }
+    }
+    for (double& p : minima_prob_) p = std::abs(p);
+  }
+
   // Keep the most probable dips, refine their lags, store as f0 candidates.
   for (int slot = 0; slot < kMaxPitchCandidates; ++slot) {
     int best = -1;
@@ -229,8 +265,8 @@ void YinAnalyzer::Analyze(const float* window, FrameCandidates* out) {
     }
     if (best < 0) break;
     // Newton refinement costs O(N); weak candidates keep a parabolic estimate.
-    const double lag =
-        minima_prob_[best] >= 0.02 ? RefineLag(minima_[best]) : ParabolicLag(minima_[best]);
+    const bool refine = minima_prob_[best] >= 0.02 && !minima_submultiple_[best];
+    const double lag = refine ? RefineLag(minima_[best]) : ParabolicLag(minima_[best]);
     PitchCandidate& c = out->candidates[out->count++];
     c.f0_hz = options_.sample_rate_hz / lag;
     c.probability = minima_prob_[best];

@@ -43,6 +43,16 @@ struct YinOptions {
   // better in CMNDF (pure-YIN's first-dip rule makes octave-up errors on low
   // notes whose fundamental is weak in the recording).
   double subharmonic_ratio = 0.2;
+  // Sub-multiple candidates: the deepest dip near 2x and 3x the lag of each
+  // candidate gets this prior mass (times 1 - d') when the threshold rule gave
+  // it none. pYIN's first-dip rule leaves a low note no candidate at all in
+  // frames where its 2nd or 3rd harmonic briefly dominates (bow changes,
+  // re-attacks), and the HMM then leaves the note for the harmonic and comes
+  // back (two jumps, 2 ln(p_jump / bins) ~ -20 at 100 Hz). With mass m on the
+  // note, staying costs ln(1 / m) = 3.5 per frame instead, so a harmonic that
+  // dominates for up to ~5 frames (50 ms at 100 Hz) no longer pulls the track
+  // off the note, while a longer one (a real note) still does.
+  double submultiple_probability = 0.03;
 };
 
 struct PitchCandidate {
@@ -102,6 +112,7 @@ class YinAnalyzer {
   std::vector<int> minima_;
   std::vector<double> minima_prob_;
   std::vector<double> minima_value_;  // d' at the dip's parabolic vertex
+  std::vector<char> minima_submultiple_;  // mass from the sub-multiple rule only
 };
 
 }  // namespace arco::audio
