@@ -112,7 +112,7 @@ class YinAnalyzer {
   std::vector<double> diff_, cmndf_;
   std::vector<int> minima_;
   std::vector<double> minima_prob_;
-  std::vector<double> minima_value_;  // d' at the dip's parabolic vertex
+  std::vector<double> minima_value_;      // d' at the dip's parabolic vertex
   std::vector<char> minima_submultiple_;  // mass from the sub-multiple rule only
 };
 
