@@ -49,10 +49,11 @@ struct YinOptions {
   // frames where its 2nd or 3rd harmonic briefly dominates (bow changes,
   // re-attacks), and the HMM then leaves the note for the harmonic and comes
   // back (two jumps, 2 ln(p_jump / bins) ~ -20 at 100 Hz). With mass m on the
-  // note, staying costs ln(1 / m) = 3.5 per frame instead, so a harmonic that
-  // dominates for up to ~5 frames (50 ms at 100 Hz) no longer pulls the track
-  // off the note, while a longer one (a real note) still does.
-  double submultiple_probability = 0.03;
+  // note, staying costs about ln(1 / m) = 3 per frame instead, so a harmonic
+  // that dominates for up to ~50-70 ms no longer pulls the track off the note,
+  // while a longer one (a real note) still does. 0.05: the smallest value that
+  // keeps FluidR3's viola and bass re-attacks (40-80 ms) on the note.
+  double submultiple_probability = 0.05;
 };
 
 struct PitchCandidate {
@@ -111,7 +112,7 @@ class YinAnalyzer {
   std::vector<double> diff_, cmndf_;
   std::vector<int> minima_;
   std::vector<double> minima_prob_;
-  std::vector<double> minima_value_;  // d' at the dip's parabolic vertex
+  std::vector<double> minima_value_;      // d' at the dip's parabolic vertex
   std::vector<char> minima_submultiple_;  // mass from the sub-multiple rule only
 };
 
