@@ -25,6 +25,7 @@ struct RefineArgs {
   bool no_audio_onsets = false;
   double onset_tolerance_s = -1;  // < 0: the default
   double straddle_s = -1;
+  int neighbour_shift_frames = -1;
   double normal_weight = -1;
   double lateral_weight = -1;
   double hand_lateral_weight = -1;
@@ -53,6 +54,7 @@ int RunRefine(const RefineArgs& a) {
   if (a.lateral_weight >= 0) o.refine.decode.lateral_weight = a.lateral_weight;
   if (a.hand_lateral_weight >= 0) o.refine.decode.hand_lateral_weight = a.hand_lateral_weight;
   if (a.shift_cost >= 0) o.refine.decode.shift_cost_per_semitone = a.shift_cost;
+  if (a.neighbour_shift_frames >= 0) o.refine.ik.neighbour_shift_frames = a.neighbour_shift_frames;
   if (a.straddle_s >= 0) o.refine.decode.boundaries.straddle_s = a.straddle_s;
   if (a.onset_tolerance_s >= 0) o.refine.decode.boundaries.onset_tolerance_s = a.onset_tolerance_s;
   const Status valid = o.refine.Validate();
@@ -124,6 +126,11 @@ std::function<int()> SetupRefine(CLI::App& app) {
                   a->onset_tolerance_s,
                   "arco: a frame this long before an audio onset belongs to the new note (s; "
                   "default 0.017)");
+  sub->add_option("--neighbour-shift-frames",
+                  a->neighbour_shift_frames,
+                  "arco: a frame the lift test rejected starts from the hand shift of its "
+                  "accepted neighbours of the same note within this many frames (0: off; "
+                  "default 2)");
   sub->add_option("--straddle-s",
                   a->straddle_s,
                   "arco: a note's frames this soon after its audio onset whose pitch is off "

@@ -61,7 +61,8 @@ FrameIk SolveArcoFrame(const DecodeContext& context,
                        const FrameContact& c,
                        int f,
                        const ArcoIkOptions& options,
-                       const FrameIk* prev) {
+                       const FrameIk* prev,
+                       const hand::HandPose* start = nullptr) {
   hand::FingerIkOptions ik;
   ik.joints = options.joints;
   ik.reference_weight_mm_per_rad = options.reference_weight_mm_per_rad;
@@ -75,7 +76,7 @@ FrameIk SolveArcoFrame(const DecodeContext& context,
     ik.previous_pose = prev->pose;
     ik.previous_weight_mm_per_rad = options.temporal_weight_mm_per_rad;
   }
-  return Solve(context, c, f, ik);
+  return Solve(context, c, f, ik, start);
 }
 
 // Takes an arco IK result for one frame: the refined pose when the tip is within
@@ -186,6 +187,70 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
     Accumulate(s, stats);
     ApplyArcoIk(
         context, options, s, &(*contacts)[static_cast<size_t>(f)], &hands[static_cast<size_t>(f)]);
+  }
+
+  // The fitted hand lags fast shifts: a frame the lift test rejected inside a note whose
+  // nearest accepted frames of the same note, string and finger (within
+  // neighbour_shift_frames on either side) moved the whole hand starts from the fitted
+  // hand moved by their mean shift, and is accepted when the rest is within
+  // max_hand_shift_mm. A wrong decode has no accepted neighbours, so the lift test still
+  // rejects it. Decided from the first pass only (independent of the frame order).
+  if (options.neighbour_shift_frames > 0) {
+    const std::vector<FrameContact> first_pass = *contacts;
+    const std::vector<std::optional<hand::HandPose>> first_hands = hands;
+    const int k = options.neighbour_shift_frames;
+    std::vector<int> retried;
+    for (int f = 0; f < n; ++f) {
+      const FrameContact& c = first_pass[static_cast<size_t>(f)];
+      if (c.reason == ContactReason::kOutOfReach && c.finger > 0 &&
+          c.point_in_world_mm.allFinite() && context.input->vision_hand[static_cast<size_t>(f)]) {
+        retried.push_back(f);
+      }
+    }
+    std::vector<FrameIk> retry_ik(retried.size());
+    std::vector<uint8_t> has_start(retried.size(), 0);
+    ParallelFor(static_cast<int64_t>(retried.size()), num_threads, [&](int64_t r, int) {
+      const int f = retried[static_cast<size_t>(r)];
+      const FrameContact& c = first_pass[static_cast<size_t>(f)];
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int count = 0;
+      for (int side : {-1, 1}) {
+        for (int d = 1; d <= k; ++d) {
+          const int g = f + side * d;
+          if (g < 0 || g >= n) break;
+          const FrameContact& cg = first_pass[static_cast<size_t>(g)];
+          if (cg.note != c.note || cg.string != c.string || cg.finger != c.finger) break;
+          if (!cg.pressed() || !first_hands[static_cast<size_t>(g)] ||
+              !context.input->vision_hand[static_cast<size_t>(g)]) {
+            continue;
+          }
+          sum += first_hands[static_cast<size_t>(g)]->wrist_in_world_mm -
+                 context.input->vision_hand[static_cast<size_t>(g)]->wrist_in_world_mm;
+          ++count;
+          break;
+        }
+      }
+      if (count == 0) return;
+      hand::HandPose start = *context.input->vision_hand[static_cast<size_t>(f)];
+      start.wrist_in_world_mm += sum / count;
+      FrameContact alt = c;
+      alt.state = ContactState::kPressed;
+      retry_ik[static_cast<size_t>(r)] = SolveArcoFrame(context, alt, f, options, nullptr, &start);
+      has_start[static_cast<size_t>(r)] = 1;
+    });
+    for (size_t r = 0; r < retried.size(); ++r) {
+      if (!has_start[r] || !retry_ik[r].solved) continue;
+      const int f = retried[r];
+      Accumulate(retry_ik[r], stats);
+      FrameContact alt = first_pass[static_cast<size_t>(f)];
+      alt.state = ContactState::kPressed;
+      alt.reason = ContactReason::kNone;
+      std::optional<hand::HandPose> pose = hands[static_cast<size_t>(f)];
+      if (!ApplyArcoIk(context, options, retry_ik[r], &alt, &pose)) continue;
+      alt.reason = ContactReason::kHandShifted;  // moved with its neighbours
+      (*contacts)[static_cast<size_t>(f)] = alt;
+      hands[static_cast<size_t>(f)] = pose;
+    }
   }
 
   // The sound lags the hand at note changes: a rejected frame just before the next note

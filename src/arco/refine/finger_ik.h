@@ -20,9 +20,13 @@
 //     (kHandShifted: the fitted wrist is off, e.g. a fit lagging a shift); beyond that the
 //     lift test rejects the contact (kOutOfReach: the finger cannot reach it) and the hand
 //     stays as fitted. (The decoder already rejected contacts beyond the lift distance.)
-//  3. the sound lags the hand at note changes: a rejected frame just before the next note
+//  3. the fitted hand lags fast shifts: a rejected frame whose nearest accepted frames of
+//     the same note, string and finger (within neighbour_shift_frames) moved the whole
+//     hand starts again from the fitted hand moved by their mean shift (kHandShifted when
+//     the rest is within max_hand_shift_mm); a wrong decode has no accepted neighbours;
+//  4. the sound lags the hand at note changes: a rejected frame just before the next note
 //     gets that note's contact (kBeforeOnset) when its finger can reach it.
-// Other fingers and the thumb keep their fitted angles; the wrist moves only in step 2.
+// Other fingers and the thumb keep their fitted angles; the wrist moves only in steps 2-3.
 #pragma once
 
 #include <optional>

@@ -1,5 +1,6 @@
 // arco mode at note changes and under a lateral fingertip error: the audio's onsets
-// (note_boundaries.h) and the decoder's emission weights (arco_decode.h).
+// (note_boundaries.h), the decoder's emission weights (arco_decode.h) and the
+// neighbours' hand shift for a frame the lift test rejected (finger_ik.h).
 #include "arco/refine/note_boundaries.h"
 
 #include <gtest/gtest.h>
@@ -211,6 +212,34 @@ TEST(ArcoEmission, ALateralTipErrorDoesNotMoveTheFingerToItsNeighbour) {
   old.decode.hand_lateral_weight = 0.0;
   const Score o = Identification(scene, Refine(scene.input, old));
   EXPECT_LT(o.right, o.pressed - 20);
+}
+
+// The fitted hand lags a fast shift: along one note the fitted wrist trails by 12 mm (the
+// whole-hand shift takes up about 11), on one frame by 22 mm (beyond the shift alone).
+TEST(ArcoIk, ARejectedFrameStartsFromItsNeighboursHandShift) {
+  const std::vector<SceneNote> notes = {{2, 1, 2, 20}, {2, 1, 5, 20}, {2, 3, 7, 20}};
+  testing::Scene scene = testing::MakeScene(InstrumentKind::kCello, notes);
+  for (int f = 20; f < 40; ++f) {
+    const Eigen::Vector3d toward_nut = scene.pose[static_cast<size_t>(f)].rotation.col(0);
+    scene.input.vision_hand[static_cast<size_t>(f)]->wrist_in_world_mm -=
+        (f == 30 ? 22.0 : 12.0) * toward_nut;
+  }
+  const RefineResult r = Refine(scene.input, Arco());
+  const FrameContact& c = r.contacts[30];
+  EXPECT_TRUE(c.pressed());
+  EXPECT_EQ(c.reason, ContactReason::kHandShifted);
+  EXPECT_EQ(c.finger, 1);
+  EXPECT_LT(c.tip_distance_refined_mm, 3.0);
+  EXPECT_LT((c.point_in_world_mm - scene.truth_contact[30]).norm(), 1e-6);
+  EXPECT_EQ(r.summary.joint_limit_violations, 0);
+  RefineOptions off = Arco();
+  off.ik.neighbour_shift_frames = 0;
+  const RefineResult o = Refine(scene.input, off);
+  EXPECT_EQ(o.contacts[30].reason, ContactReason::kOutOfReach);
+  for (int f = 20; f < 40; ++f) {
+    if (f == 30) continue;
+    EXPECT_TRUE(o.contacts[static_cast<size_t>(f)].pressed()) << "frame " << f;
+  }
 }
 
 TEST(NoteBoundaries, ResultsDoNotDependOnTheThreadCount) {

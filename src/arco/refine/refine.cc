@@ -189,6 +189,9 @@ Status ArcoIkOptions::Validate() const {
     return Status::Error("arco IK options: max_hand_shift_mm must be >= 0");
   }
   if (max_iterations < 1) return Status::Error("arco IK options: max_iterations must be >= 1");
+  if (neighbour_shift_frames < 0) {
+    return Status::Error("arco IK options: neighbour_shift_frames must be >= 0");
+  }
   return Status::Ok();
 }
 

@@ -124,6 +124,10 @@ struct ArcoIkOptions {
   // wrist is off: e.g. a hand fit lagging a shift); otherwise the contact is rejected.
   double max_residual_mm = 3.0;
   double max_hand_shift_mm = 15.0;
+  // A frame the lift test rejected inside a note starts from the fitted hand moved by the
+  // whole-hand shift of its nearest accepted frames of the same note, string and finger
+  // within this many frames (the fitted hand lags fast shifts); 0: off.
+  int neighbour_shift_frames = 2;
   int max_iterations = 15;
   Status Validate() const;
 };
