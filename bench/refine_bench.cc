@@ -11,7 +11,7 @@ namespace arco::refine {
 namespace {
 
 // 5400 frames: a repeated phrase with string crossings, shifts, vibrato, open strings,
-// rests (about 75% of the frames pressed).
+// rests (about 75% of the frames pressed), with the audio's notes for arco mode.
 const testing::Scene& Piece() {
   static const testing::Scene scene = [] {
     const std::vector<testing::SceneNote> phrase = {{2, 1, 2, 15},
@@ -43,7 +43,10 @@ const testing::Scene& Piece() {
         total += n.frames;
       }
     }
-    return testing::MakeScene(InstrumentKind::kCello, notes);
+    testing::Scene out = testing::MakeScene(InstrumentKind::kCello, notes);
+    // The audio layer's notes (onsets a quarter frame late): arco's note boundaries run.
+    out.input.audio_notes = testing::AudioNotesOf(*out.model, notes, 30.0, 1.0 / 120.0);
+    return out;
   }();
   return scene;
 }

@@ -22,6 +22,13 @@ struct RefineArgs {
   double reference_weight = -1;  // < 0: the default
   double temporal_weight = -1;
   bool exact_reach = false;
+  bool no_audio_onsets = false;
+  double onset_tolerance_s = -1;  // < 0: the default
+  double straddle_s = -1;
+  double normal_weight = -1;
+  double lateral_weight = -1;
+  double hand_lateral_weight = -1;
+  double shift_cost = -1;
 };
 
 int RunRefine(const RefineArgs& a) {
@@ -41,6 +48,13 @@ int RunRefine(const RefineArgs& a) {
   if (a.reference_weight >= 0) o.refine.ik.reference_weight_mm_per_rad = a.reference_weight;
   if (a.temporal_weight >= 0) o.refine.ik.temporal_weight_mm_per_rad = a.temporal_weight;
   if (a.exact_reach) o.refine.ik.exact_reach = true;
+  if (a.no_audio_onsets) o.refine.decode.audio_onsets = false;
+  if (a.normal_weight >= 0) o.refine.decode.normal_weight = a.normal_weight;
+  if (a.lateral_weight >= 0) o.refine.decode.lateral_weight = a.lateral_weight;
+  if (a.hand_lateral_weight >= 0) o.refine.decode.hand_lateral_weight = a.hand_lateral_weight;
+  if (a.shift_cost >= 0) o.refine.decode.shift_cost_per_semitone = a.shift_cost;
+  if (a.straddle_s >= 0) o.refine.decode.boundaries.straddle_s = a.straddle_s;
+  if (a.onset_tolerance_s >= 0) o.refine.decode.boundaries.onset_tolerance_s = a.onset_tolerance_s;
   const Status valid = o.refine.Validate();
   if (!valid.ok()) return PrintError(valid.message());
   auto summary = RefineResultDir(o);
@@ -102,6 +116,32 @@ std::function<int()> SetupRefine(CLI::App& app) {
   sub->add_flag("--exact-reach",
                 a->exact_reach,
                 "arco: the hand IK's exact reach instead of one regularised (least change) solve");
+  sub->add_flag("--no-audio-onsets",
+                a->no_audio_onsets,
+                "arco: assign the frames at note changes by their own pitch only, not by the "
+                "onsets of the audio's notes (notes.csv)");
+  sub->add_option("--onset-tolerance-s",
+                  a->onset_tolerance_s,
+                  "arco: a frame this long before an audio onset belongs to the new note (s; "
+                  "default 0.017)");
+  sub->add_option("--straddle-s",
+                  a->straddle_s,
+                  "arco: a note's frames this soon after its audio onset whose pitch is off "
+                  "the note's take the note's pitch (s; default 0.034, 0: off)");
+  sub->add_option("--normal-weight",
+                  a->normal_weight,
+                  "arco decoding: weight of the tip-to-contact distance along the string "
+                  "plane's normal");
+  sub->add_option("--lateral-weight",
+                  a->lateral_weight,
+                  "arco decoding: weight of the tip-to-contact distance across the string");
+  sub->add_option("--hand-lateral-weight",
+                  a->hand_lateral_weight,
+                  "arco decoding: weight of the hand's median fingertip offset across the "
+                  "strings");
+  sub->add_option("--shift-cost",
+                  a->shift_cost,
+                  "arco decoding: cost per semitone of hand-position change between notes");
   return [a]() { return RunRefine(*a); };
 }
 

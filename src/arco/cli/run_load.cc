@@ -1,6 +1,7 @@
 // Stage 5 of `arco run` and all of `arco refine` (run.h): the refinement's input read back
 // from the result folder, so both commands refine exactly the same data.
 #include <cmath>
+#include <sstream>
 
 #include "arco/audio/pitch_tracker.h"
 #include "arco/cli/run_stages.h"
@@ -13,6 +14,32 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 Status Expect(bool ok, const std::string& path, const std::string& what) {
   return ok ? Status::Ok() : Status::Error(path + ": " + what);
+}
+
+// The note rows of the audio layer's notes.csv (audio::WriteNotesCsv): onset, offset and
+// median pitch; glides and other kinds are skipped.
+StatusOr<std::vector<refine::AudioNote>> ReadAudioNotes(const std::string& path) {
+  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
+  std::istringstream in(text);
+  std::string line;
+  if (!std::getline(in, line) || line.rfind("kind,onset_s,offset_s,median_f0_hz", 0) != 0) {
+    return Status::Error(path + ": not a notes.csv (bad header)");
+  }
+  std::vector<refine::AudioNote> notes;
+  int line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.empty() || line.rfind("note,", 0) != 0) continue;
+    refine::AudioNote n;
+    if (std::sscanf(line.c_str(), "note,%lf,%lf,%lf", &n.onset_s, &n.offset_s, &n.f0_hz) != 3 ||
+        !(std::isfinite(n.onset_s) && std::isfinite(n.offset_s) && n.offset_s >= n.onset_s &&
+          n.f0_hz > 0 && std::isfinite(n.f0_hz)) ||
+        (!notes.empty() && n.onset_s < notes.back().onset_s)) {
+      return Status::Error(path + ": line " + std::to_string(line_number) + ": malformed note row");
+    }
+    notes.push_back(n);
+  }
+  return notes;
 }
 
 }  // namespace
@@ -118,6 +145,13 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
       const audio::PitchFrame& p = pitch[static_cast<size_t>(f)];
       out.input.pitch[static_cast<size_t>(f)] = {p.voiced ? p.f0_hz : 0.0, p.confidence};
     }
+    if (!pitch.empty()) out.input.start_s = pitch.front().time_s;
+    // notes.csv: the onsets for arco's note boundaries (result folders of older versions
+    // have none: frames are then assigned by their own pitch).
+    const std::string notes_path = JoinPath(result_dir, "notes.csv");
+    if (FileExists(notes_path)) {
+      ARCO_ASSIGN_OR_RETURN(out.input.audio_notes, ReadAudioNotes(notes_path));
+    }
   }
   out.spd.instrument = out.instrument.get();
   out.spd.hand_model = *hand_model;
@@ -150,7 +184,10 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
                   hand::FingerIkJointsName(options.mode == refine::RefineMode::kPaper
                                                ? hand::FingerIkJoints::kPipDip
                                                : options.ik.joints)},
-                 {"max_residual_mm", options.ik.max_residual_mm}};
+                 {"max_residual_mm", options.ik.max_residual_mm},
+                 {"audio_onsets",
+                  options.mode == refine::RefineMode::kArco && options.decode.audio_onsets &&
+                      !inputs.input.audio_notes.empty()}};
   out.summary = {{"frames", s.frames},
                  {"frames_with_hand", s.frames_with_hand},
                  {"pressed", s.pressed},
@@ -161,6 +198,8 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
                  {"usable_notes", s.usable_notes},
                  {"corrected_frames", s.corrected_frames},
                  {"rejected_out_of_reach", s.rejected_out_of_reach},
+                 {"before_onset", s.before_onset},
+                 {"note_boundary", s.note_boundary},
                  {"mean_tip_distance_vision_mm", JsonFromDouble(s.mean_tip_distance_vision_mm)},
                  {"mean_tip_distance_refined_mm", JsonFromDouble(s.mean_tip_distance_refined_mm)},
                  {"joint_limit_violations", s.joint_limit_violations}};

@@ -119,6 +119,22 @@ TEST(RunCapture, EveryStageAndThreeMethodsThatEvalScores) {
   ASSERT_TRUE(RefineResultDir(r).ok());
   EXPECT_EQ(*before, *ReadFileToString(JoinPath(result, "paper/contacts.csv")));
   EXPECT_EQ(*before_points, *ReadFileToString(JoinPath(result, "paper/points3d.npy")));
+  // ... and its arco folder (which reads notes.csv for the note boundaries).
+  auto arco_before = ReadFileToString(JoinPath(result, "arco/contacts.csv"));
+  ASSERT_TRUE(arco_before.ok());
+  EXPECT_NE(arco_before->find("note_boundary"), std::string::npos);
+  r.refine.mode = refine::RefineMode::kArco;
+  ASSERT_TRUE(RefineResultDir(r).ok());
+  EXPECT_EQ(*arco_before, *ReadFileToString(JoinPath(result, "arco/contacts.csv")));
+  // A malformed notes.csv is one clear error naming the file; the folder stays as it was.
+  ASSERT_TRUE(AtomicWriteFile(JoinPath(result, "notes.csv"),
+                              "kind,onset_s,offset_s,median_f0_hz\nnote,0.5,x,220\n")
+                  .ok());
+  auto bad = RefineResultDir(r);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("notes.csv: line 2"), std::string::npos)
+      << bad.status().message();
+  EXPECT_EQ(*arco_before, *ReadFileToString(JoinPath(result, "arco/contacts.csv")));
 }
 
 TEST(RunCapture, BadInputIsOneClearError) {

@@ -42,7 +42,20 @@ void FrameCosts(const hand::HandPointsMm& points,
   const double a = v.dot(sf.along);
   const double n = v.dot(sf.normal);
   const double l = (v - a * sf.along - n * sf.normal).norm();
-  *distance = std::sqrt(a * a + l * l + options.normal_weight * options.normal_weight * n * n);
+  // Which string: where the hand is across the neck, the median over the four fingertips of
+  // their signed offsets across the strings (one finger's lift-induced error cannot move it).
+  const Eigen::Vector3d across = sf.along.cross(sf.normal);
+  std::array<double, 4> offsets{};
+  for (int j = 1; j <= 4; ++j) {
+    offsets[static_cast<size_t>(j - 1)] =
+        (points[hand::TipKeypoint(static_cast<hand::Finger>(j))] - contact).dot(across);
+  }
+  std::sort(offsets.begin(), offsets.end());
+  const double hand_across = 0.5 * (offsets[1] + offsets[2]);
+  const double wl = options.lateral_weight, wn = options.normal_weight;
+  const double wh = options.hand_lateral_weight;
+  *distance =
+      std::sqrt(a * a + wl * wl * l * l + wn * wn * n * n + wh * wh * hand_across * hand_across);
   double violation = 0;
   for (int j = 1; j <= 4; ++j) {
     if (j == finger) continue;
@@ -212,6 +225,7 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
   for (int f = 0; f < n; ++f) out[static_cast<size_t>(f)] = AudioOnlyContact(context, f);
 
   const std::vector<NoteSpan>& notes = context.analysis->notes;
+  const bool audio_onsets = options.audio_onsets && !input.audio_notes.empty();
   std::vector<int> usable;
   for (int i = 0; i < static_cast<int>(notes.size()); ++i) {
     if (notes[static_cast<size_t>(i)].usable) usable.push_back(i);
@@ -278,9 +292,16 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
     const State& st = states[static_cast<size_t>(chain[c])][static_cast<size_t>(chosen[c])];
     for (int64_t f = note.first_frame; f <= note.last_frame; ++f) {
       const size_t i = static_cast<size_t>(f);
-      if (context.analysis->frame_state[i] != FrameAudioState::kNote) continue;
-      AssignFrame(
-          context, st.string, st.finger, out[i].f0_hz, pitch_options, lift_max_mm, f, &out[i]);
+      const FrameAudioState a = context.analysis->frame_state[i];
+      if (a == FrameAudioState::kNote) {
+        AssignFrame(
+            context, st.string, st.finger, out[i].f0_hz, pitch_options, lift_max_mm, f, &out[i]);
+      } else if (a == FrameAudioState::kBoundary) {
+        // The frame's own pitch straddles the change: the note's pitch instead.
+        AssignFrame(
+            context, st.string, st.finger, note.f0_hz, pitch_options, lift_max_mm, f, &out[i]);
+        if (out[i].reason == ContactReason::kNone) out[i].reason = ContactReason::kNoteBoundary;
+      }
     }
     if (st.finger == 0) continue;
     // The finger lands before the sound: untrusted frames just before the onset, where the
@@ -294,22 +315,32 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
     if (note_distances.empty()) continue;
     const double lead_max_mm = std::min(lift_max_mm[static_cast<size_t>(st.finger)],
                                         Median(note_distances) + options.onset_lead_margin_mm);
-    const double onset_hz = input.pitch[static_cast<size_t>(note.first_frame)].f0_hz;
+    // The pitch of the note's first trusted frame (boundary frames before it have none).
+    double onset_hz = note.f0_hz;
+    for (int64_t f = note.first_frame; f <= note.last_frame; ++f) {
+      if (context.analysis->frame_state[static_cast<size_t>(f)] == FrameAudioState::kNote) {
+        onset_hz = input.pitch[static_cast<size_t>(f)].f0_hz;
+        break;
+      }
+    }
     for (int64_t f = note.first_frame - 1;
          f >= 0 && f >= note.first_frame - options.onset_lead_frames;
          --f) {
       const size_t i = static_cast<size_t>(f);
       const FrameAudioState a = context.analysis->frame_state[i];
       // Weak frames that merely continued the previous note are the transition too.
-      const bool weak_member =
-          a == FrameAudioState::kNote && input.pitch[i].confidence < pitch_options.min_confidence;
+      // With the audio's onsets the note boundaries are known (note_boundaries.h): the
+      // frames still with the previous note sound it, so neither rule below applies.
+      const bool weak_member = !audio_onsets && a == FrameAudioState::kNote &&
+                               input.pitch[i].confidence < pitch_options.min_confidence;
       const bool untrusted = a == FrameAudioState::kRest || a == FrameAudioState::kLowConfidence ||
                              a == FrameAudioState::kOutlier || a == FrameAudioState::kShortNote ||
                              weak_member;
       // The sound lags the hand by up to a frame at a note change: the previous note's last
       // frame goes to this note when the fitted hand clearly plays this one already.
-      const bool handover = f == note.first_frame - 1 && a == FrameAudioState::kNote &&
-                            out[i].pressed() && out[i].note != note_index;
+      const bool handover = !audio_onsets && f == note.first_frame - 1 &&
+                            a == FrameAudioState::kNote && out[i].pressed() &&
+                            out[i].note != note_index;
       if (!untrusted && !handover) break;
       FrameContact lead = out[i];
       lead.note = note_index;

@@ -4,10 +4,15 @@
 // frame cannot flip the string.
 //
 // Emission cost of a note for state (string s, finger k), in mm-equivalents: the median
-// over the note's frames of
-//   D = sqrt(a^2 + l^2 + (w_n n)^2),  (a, l, n) = tip_k - contact on that frame's string s
-//       along the string, across it and along the string plane's normal (w_n =
-//       normal_weight: detectors see a lifted, unloaded finger off the string),
+// over the note's trusted frames (not boundary frames, note_boundaries.h) of
+//   D = sqrt(a^2 + (w_l l)^2 + (w_n n)^2 + (w_h H)^2),  (a, l, n) = tip_k - contact on that
+//       frame's string s along the string, across it and along the string plane's normal;
+//       H = the median over the four fingertips of their signed offsets across the
+//       strings from the contact. Which finger plays is told along the string; the tip's
+//       own l and n are mostly detector error (a lifted, unloaded finger that the hand fit
+//       follows partly sideways: w_l = lateral_weight, w_n = normal_weight); which string
+//       is told by the whole hand (w_h = hand_lateral_weight: one finger's error cannot
+//       move the median),
 // plus order_weight x the median finger-order violation: the other fingertips projected on
 // the string must lie on the nut side of the contact for lower fingers (index is nearest
 // the nut) and on the bridge side for higher ones, within order_margin_mm. A state whose
@@ -20,8 +25,11 @@
 // offset in the instrument's hand frame) + string_cross_cost x strings crossed; scaled by
 // rest_factor after a gap of rest_gap_s or more. Ties go to the lower state index.
 //
+// Boundary frames (the audio's onsets place them in a note, their own pitch is not
+// trusted) get the note's contact at the note's median pitch (kNoteBoundary).
 // Up to onset_lead_frames untrusted frames right before a stopped note's first trusted
 // frame get the note's contact too (kBeforeOnset): the finger lands before the sound.
+// With the audio's onsets, frames still with the previous note are not handed over.
 // Only where the fitted tip is no more than onset_lead_margin_mm farther from the contact
 // than its median over the note (the hand is already in place).
 #pragma once

@@ -65,6 +65,8 @@ const char* ContactReasonName(ContactReason reason) {
       return "before_onset";
     case ContactReason::kHandShifted:
       return "hand_shifted";
+    case ContactReason::kNoteBoundary:
+      return "note_boundary";
   }
   return "?";
 }

@@ -44,11 +44,13 @@ enum class ContactReason {
   kNoHand,         // no fitted hand in this frame (pressed: contact known, hand not corrected)
   kOutOfReach,     // lift test: the finger cannot reach the contact (arco mode)
   // Informational reasons on pressed frames (arco mode):
-  kBeforeOnset,  // just before the note's first trusted pitch: the finger lands before the
-                 // sound, and a tracker needs a frame or two to lock onto a new note
-  kHandShifted,  // the finger alone could not reach: the whole hand moved (bounded)
+  kBeforeOnset,   // just before the note's first trusted pitch: the finger lands before the
+                  // sound, and a tracker needs a frame or two to lock onto a new note
+  kHandShifted,   // the finger alone could not reach: the whole hand moved (bounded)
+  kNoteBoundary,  // the frame's own pitch is not trusted (a note change), the audio's onset
+                  // places it in this note: a lower-confidence contact (note_boundaries.h)
 };
-constexpr int kNumContactReasons = 11;
+constexpr int kNumContactReasons = 12;
 const char* ContactReasonName(ContactReason reason);
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();

@@ -56,6 +56,7 @@ FrameContact AudioOnlyContact(const DecodeContext& context, int frame) {
       out.reason = ContactReason::kShortNote;
       break;
     case FrameAudioState::kNote:
+    case FrameAudioState::kBoundary:
       out.state = ContactState::kUncertain;
       out.reason = ContactReason::kNone;
       break;

@@ -101,7 +101,8 @@ bool ApplyArcoIk(const DecodeContext& context,
     distance =
         (hand::FingertipInWorld(context.input->hand_model, pose, finger) - c->point_in_world_mm)
             .norm();
-    c->reason = ContactReason::kHandShifted;
+    // A timing annotation (before_onset, note_boundary) says more than the shift.
+    if (c->reason == ContactReason::kNone) c->reason = ContactReason::kHandShifted;
   }
   c->tip_distance_refined_mm = distance;
   *hand_out = pose;

@@ -195,6 +195,8 @@ const char* FrameAudioStateName(FrameAudioState state) {
       return "unstable_note";
     case FrameAudioState::kNote:
       return "note";
+    case FrameAudioState::kBoundary:
+      return "boundary";
   }
   return "?";
 }

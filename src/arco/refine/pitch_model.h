@@ -74,6 +74,11 @@ enum class FrameAudioState {
   kShortNote,      // in a note shorter than min_note_frames
   kUnstableNote,   // in a note with too many outliers
   kNote,           // a usable note frame
+  // A frame at a note change whose own pitch is not trusted (the analysis window straddles
+  // the onset, the confidence collapses between notes) but which the audio's onsets place
+  // inside a usable note (note_boundaries.h, arco mode): it belongs to that note, with the
+  // note's pitch, but it never counts as evidence for the note's string and finger.
+  kBoundary,
 };
 const char* FrameAudioStateName(FrameAudioState state);
 
@@ -86,6 +91,14 @@ struct NoteSpan {
   int outlier_frames = 0;
   bool usable = false;  // long and stable enough (frames then have state kNote)
   int64_t num_frames() const { return last_frame - first_frame + 1; }
+};
+
+// A note found by the audio layer on the fine pitch track (audio/notes.h, `notes.csv`):
+// its onset is known to a fraction of a video frame. Seconds on the audio's clock.
+struct AudioNote {
+  double onset_s = 0;
+  double offset_s = 0;
+  double f0_hz = 0;  // median
 };
 
 struct PitchAnalysis {

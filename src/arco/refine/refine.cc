@@ -61,6 +61,7 @@ RefineSummary Summarise(RefineMode mode,
     if (c.reason == ContactReason::kOutOfReach) ++s.rejected_out_of_reach;
     if (c.reason == ContactReason::kHandShifted) ++s.hand_shifted;
     if (c.reason == ContactReason::kBeforeOnset) ++s.before_onset;
+    if (c.pressed() && c.reason == ContactReason::kNoteBoundary) ++s.note_boundary;
     if (c.pressed() && Finite(c.tip_distance_refined_mm)) {
       ++s.corrected_frames;
       sum_vision += c.tip_distance_vision_mm;
@@ -106,6 +107,19 @@ Status RefineInput::Validate() const {
   }
   if (!(fps > 0 && Finite(fps))) return Status::Error("refine input: fps must be > 0");
   if (!(a4_hz > 0 && Finite(a4_hz))) return Status::Error("refine input: a4_hz must be > 0");
+  if (!Finite(start_s)) return Status::Error("refine input: start_s must be finite");
+  for (size_t i = 0; i < audio_notes.size(); ++i) {
+    const AudioNote& a = audio_notes[i];
+    if (!(Finite(a.onset_s) && Finite(a.offset_s) && a.offset_s >= a.onset_s && a.f0_hz > 0 &&
+          Finite(a.f0_hz))) {
+      return Status::Error("refine input: audio note " + std::to_string(i) +
+                           " needs finite onset <= offset and f0 > 0");
+    }
+    if (i > 0 && a.onset_s < audio_notes[i - 1].onset_s) {
+      return Status::Error("refine input: audio notes must be in time order (note " +
+                           std::to_string(i) + ")");
+    }
+  }
   return Status::Ok();
 }
 
@@ -122,6 +136,8 @@ Status PaperOptions::Validate() const {
 
 Status ArcoDecodeOptions::Validate() const {
   const double values[] = {normal_weight,
+                           lateral_weight,
+                           hand_lateral_weight,
                            order_margin_mm,
                            order_weight,
                            open_cost_mm,
@@ -143,6 +159,16 @@ Status ArcoDecodeOptions::Validate() const {
   }
   if (onset_lead_frames < 0)
     return Status::Error("arco decode options: onset_lead_frames must be >= 0");
+  if (!(boundaries.onset_tolerance_s >= 0 && Finite(boundaries.onset_tolerance_s))) {
+    return Status::Error("arco decode options: onset_tolerance_s must be finite and >= 0");
+  }
+  if (!(boundaries.straddle_s >= 0 && Finite(boundaries.straddle_s) &&
+        boundaries.straddle_cents >= 0 && Finite(boundaries.straddle_cents))) {
+    return Status::Error("arco decode options: straddle_s and straddle_cents must be >= 0");
+  }
+  if (!(boundaries.match_cents > 0 && Finite(boundaries.match_cents))) {
+    return Status::Error("arco decode options: match_cents must be > 0");
+  }
   return Status::Ok();
 }
 
@@ -186,6 +212,15 @@ RefineResult Refine(const RefineInput& input, const RefineOptions& options) {
     return result;
   }
   result.analysis = AnalysePitch(input.pitch, options.pitch);
+  if (options.mode == RefineMode::kArco && options.decode.audio_onsets) {
+    ApplyAudioNoteBoundaries(input.audio_notes,
+                             input.start_s,
+                             input.fps,
+                             input.pitch,
+                             options.pitch,
+                             options.decode.boundaries,
+                             &result.analysis);
+  }
   const DecodeContext context = MakeDecodeContext(input, result.analysis, options.num_threads);
   if (options.mode == RefineMode::kPaper) {
     result.contacts = DecodePaper(context, options.paper, options.pitch);

@@ -24,6 +24,7 @@
 #include "arco/instrument/instrument_model.h"
 #include "arco/instrument/strings.h"
 #include "arco/refine/contact_annotation.h"
+#include "arco/refine/note_boundaries.h"
 #include "arco/refine/pitch_model.h"
 #include "arco/util/status.h"
 
@@ -39,6 +40,12 @@ struct RefineInput {
   std::vector<FramePitch> pitch;
   double fps = 30.0;
   double a4_hz = 440.0;  // for the transcription's note names and cents
+  // The audio layer's notes (audio/notes.h, notes.csv: onsets from the fine pitch track) in
+  // time order, and the audio time of frame 0 (pitch.csv's time_s of row 0; frame f is at
+  // start_s + f / fps). arco mode assigns the frames at note changes by these onsets
+  // (note_boundaries.h); empty: by each frame's own pitch only.
+  std::vector<AudioNote> audio_notes;
+  double start_s = 0;
 
   // Errors: no instrument, a right-hand model, sizes that differ, fps <= 0, a strings entry
   // with a wrong string count or non-finite ends.
@@ -59,7 +66,14 @@ struct PaperOptions {
 struct ArcoDecodeOptions {
   // Hand-to-candidate distance: the component along the front normal of the string plane
   // (a lifted, unloaded finger; detectors see fingers off the string) counts this much.
-  double normal_weight = 0.5;
+  double normal_weight = 0.25;
+  // ... and the component across the string (within the string plane) this much: which
+  // finger plays is told by the position along the string; across it the fitted tips
+  // scatter with the detector's lift (the string plane is tilted against the top plate).
+  double lateral_weight = 0.25;
+  // Which string is told by the whole hand: the median over the four fingertips of their
+  // offsets across the strings from the contact counts this much.
+  double hand_lateral_weight = 1.0;
   // Finger order on the string: index nearest the nut, little nearest the bridge. Other
   // fingertips on the wrong side of the contact by more than the margin cost this much per mm.
   double order_margin_mm = 5.0;
@@ -83,6 +97,9 @@ struct ArcoDecodeOptions {
   // next finger's fitted tip is nearer its contact by more than this (the sound lags the
   // hand by up to a frame); infinity disables it.
   double handover_margin_mm = 5.0;
+  // Note boundaries from the audio's onsets (note_boundaries.h), when the input has them.
+  bool audio_onsets = true;
+  NoteBoundaryOptions boundaries;
   Status Validate() const;
 };
 
@@ -130,9 +147,10 @@ struct RefineSummary {
   int notes = 0, usable_notes = 0;
   int corrected_frames = 0;  // pressed frames whose finger was moved by the IK
   int rejected_out_of_reach = 0;
-  int hand_shifted = 0;                       // corrected frames that needed a whole-hand shift
-  int before_onset = 0;                       // pressed frames added before a note's detected onset
-  double mean_tip_distance_vision_mm = kNaN;  // over corrected frames
+  int hand_shifted = 0;   // corrected frames that needed a whole-hand shift
+  int before_onset = 0;   // pressed frames added before a note's detected onset
+  int note_boundary = 0;  // pressed frames placed in their note by the audio's onsets
+  double mean_tip_distance_vision_mm = kNaN;   // over corrected frames
   double mean_tip_distance_refined_mm = kNaN;  // over corrected frames
   double max_tip_distance_refined_mm = kNaN;
   int ik_solves = 0, ik_iterations = 0, ik_not_converged = 0;

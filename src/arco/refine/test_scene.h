@@ -34,6 +34,9 @@ struct SceneOptions {
   // The vision hand's playing fingertip sits this far off the string along the front normal
   // (a detector sees an unloaded finger; the hand fit follows it with the finger's joints).
   double lift_mm = 12;
+  // ... and this far across the strings (the hand fit follows a lifted tip partly with the
+  // finger's abduction: a lateral error of the playing fingertip alone).
+  double lift_across_mm = 0;
   double angle_noise_deg = 1;  // on every angle of the vision hand
   double wrist_noise_mm = 0.5;
   uint64_t seed = 1;
@@ -171,12 +174,13 @@ inline Scene MakeScene(InstrumentKind kind,
       scene.truth_finger.push_back(stopped ? note.finger : 0);
       scene.truth_contact.push_back(stopped ? p.ToWorld(contact) : contact);
       hand::HandPose vision = truth;
-      if (stopped && options.lift_mm > 0) {
+      if (stopped && (options.lift_mm > 0 || options.lift_across_mm != 0)) {
         hand::FingerIkOptions lift;
         lift.joints = hand::FingerIkJoints::kAll;
         const hand::Finger f = static_cast<hand::Finger>(note.finger);
-        const Eigen::Vector3d lifted =
-            hand::FingertipInWorld(hand_model, truth, f) + options.lift_mm * p.rotation.col(2);
+        const Eigen::Vector3d lifted = hand::FingertipInWorld(hand_model, truth, f) +
+                                       options.lift_mm * p.rotation.col(2) +
+                                       options.lift_across_mm * p.rotation.col(1);
         vision = hand::SolveFingertipIk(hand_model, truth, f, lifted, lift).pose;
       }
       for (double& angle : vision.angles_rad)
@@ -191,6 +195,29 @@ inline Scene MakeScene(InstrumentKind kind,
   scene.input.hand_model = hand_model;
   scene.input.fps = fps;
   return scene;
+}
+
+// The audio layer's notes for a scene (audio/notes.h): one per sounding scene note, its
+// onset `lag_s` after the note's first frame (the fine track's own lag), its offset at the
+// note's end, frame 0 at time 0.
+inline std::vector<AudioNote> AudioNotesOf(const InstrumentModel& model,
+                                           const std::vector<SceneNote>& notes,
+                                           double fps,
+                                           double lag_s) {
+  std::vector<AudioNote> out;
+  int frame = 0;
+  for (const SceneNote& note : notes) {
+    if (note.string > 0) {
+      AudioNote a;
+      a.onset_s = frame / fps + lag_s;
+      a.offset_s = (frame + note.frames) / fps;
+      a.f0_hz =
+          model.open_hz(note.string) * std::exp2((note.finger > 0 ? note.semitones : 0) / 12.0);
+      out.push_back(a);
+    }
+    frame += note.frames;
+  }
+  return out;
 }
 
 }  // namespace arco::refine::testing
