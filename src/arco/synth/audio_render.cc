@@ -9,7 +9,8 @@
 #include <tuple>
 #include <vector>
 
-#include "arco/audio/pitch_tracker.h"
+#include "arco/audio/audio_reader.h"
+#include "arco/audio/harmonic_fit.h"
 #include "arco/synth/random.h"
 #include "arco/util/file_io.h"
 
@@ -36,10 +37,24 @@ Status RunFluidsynth(const AudioRenderOptions& o, const std::string& midi, const
   return Status::Ok();
 }
 
-// Pitch contour of each key's sample, rendered alone (unbent) and tracked.
+StatusOr<std::vector<float>> ReadMonoSamples(const std::string& wav, int* sample_rate_hz) {
+  ARCO_ASSIGN_OR_RETURN(auto reader, audio::OpenAudio(wav));
+  *sample_rate_hz = reader->info().sample_rate_hz;
+  std::vector<float> samples, block(1 << 15);
+  while (true) {
+    ARCO_ASSIGN_OR_RETURN(const int64_t got, reader->ReadMono(block.data(), 1 << 15));
+    if (got == 0) break;
+    samples.insert(samples.end(), block.begin(), block.begin() + got);
+  }
+  return samples;
+}
+
+// Pitch contour of each key's sample, rendered alone (unbent) and measured with
+// the harmonic-peak fit (audio/harmonic_fit.h), not with arco's pitch tracker:
+// the rendered audio is the truth arco's tracker is scored against, so its
+// tuning must not depend on that tracker's own biases.
 StatusOr<std::map<int, SampleContour>> MeasureContours(const std::map<int, double>& key_duration_s,
                                                        int program,
-                                                       const std::string& instrument,
                                                        double a4_hz,
                                                        const AudioRenderOptions& o,
                                                        const std::string& work_dir) {
@@ -60,30 +75,27 @@ StatusOr<std::map<int, SampleContour>> MeasureContours(const std::map<int, doubl
   const std::string wav = JoinPath(work_dir, "tuning_probe.wav");
   ARCO_RETURN_IF_ERROR(audio::WriteMidiFile(midi, probe));
   ARCO_RETURN_IF_ERROR(RunFluidsynth(o, midi, wav));
-  audio::PitchTrackerOptions po;
-  ARCO_ASSIGN_OR_RETURN(
-      po.range, audio::InstrumentRangeByName(instrument == "double_bass" ? "bass" : instrument));
-  po.fps = 1.0 / SampleContour().step_s;
-  po.a4_hz = a4_hz;
-  audio::PitchSummary summary;
-  ARCO_ASSIGN_OR_RETURN(audio::PitchTrack tracked, audio::TrackPitchFile(wav, po, &summary));
+  int rate = 0;
+  ARCO_ASSIGN_OR_RETURN(const std::vector<float> samples, ReadMonoSamples(wav, &rate));
   std::map<int, SampleContour> contours;
   for (const auto& [key, onset, dur] : probes) {
     SampleContour c;
     const double expected = a4_hz * std::pow(2.0, (key - 69) / 12.0);
     const int n = static_cast<int>(dur / c.step_s);
     c.cents.assign(static_cast<size_t>(n), NAN);
+    const int window = audio::HarmonicFitWindow(rate, expected);
+    audio::HarmonicPeakFit fit(rate, window);
     std::vector<double> valid;
     for (int j = 0; j < n; ++j) {
-      // Sample time tau is heard at onset + latency + tau.
+      if (j * c.step_s < 0.06) continue;  // the attack is unreliable
+      // Sample time tau is heard at onset + latency + tau (window centred there).
       const double time = onset + o.latency_s + j * c.step_s;
-      const auto row = static_cast<size_t>(std::lround(time / c.step_s));
-      if (row >= tracked.frames.size() || j * c.step_s < 0.06)
-        continue;  // the attack is unreliable
-      const audio::PitchFrame& f = tracked.frames[row];
-      if (!f.voiced) continue;
-      const double cents = 1200 * std::log2(f.f0_hz / expected);
-      if (std::abs(cents) > 60) continue;  // octave errors and slides
+      const int64_t start = std::llround(time * rate) - window / 2;
+      if (start < 0 || start + window > static_cast<int64_t>(samples.size())) continue;
+      const double f0 = fit.F0Hz(samples.data() + start, window, expected);
+      if (!std::isfinite(f0)) continue;
+      const double cents = 1200 * std::log2(f0 / expected);
+      if (std::abs(cents) > 60) continue;  // slides into the note
       c.cents[static_cast<size_t>(j)] = cents;
       valid.push_back(cents);
     }
@@ -201,7 +213,6 @@ audio::MidiFile PerformanceToMidi(const Performance& perf,
 
 Status RenderPerformanceAudio(const Performance& perf,
                               int gm_program,
-                              const std::string& instrument,
                               const AudioRenderOptions& o,
                               const std::string& work_dir,
                               const std::string& midi_path,
@@ -217,8 +228,8 @@ Status RenderPerformanceAudio(const Performance& perf,
       double& d = key_duration_s[n.note.midi_note];
       d = std::max(d, n.note.offset_s - n.note.onset_s);
     }
-    ARCO_ASSIGN_OR_RETURN(
-        contours, MeasureContours(key_duration_s, gm_program, instrument, perf.a4_hz, o, work_dir));
+    ARCO_ASSIGN_OR_RETURN(contours,
+                          MeasureContours(key_duration_s, gm_program, perf.a4_hz, o, work_dir));
   }
   ARCO_RETURN_IF_ERROR(
       audio::WriteMidiFile(midi_path, PerformanceToMidi(perf, gm_program, contours, o)));

@@ -12,7 +12,9 @@
 // steady: FluidR3's string samples were recorded with the player's own vibrato
 // (+-10-15 cents at ~5 Hz; its SF2 zones carry no LFO). With `tune_soundfont`,
 // each distinct key is first rendered alone for as long as its longest note and
-// tracked by arco's pitch tracker: its pitch contour c_k(tau) in cents against
+// measured with the harmonic-peak fit (audio/harmonic_fit.h; deliberately not
+// arco's pitch tracker, which is scored against this audio): its pitch contour
+// c_k(tau) in cents against
 // equal temperament, tau = time into the sample. The bends then subtract
 // c_k(tau_s(t)), where tau_s advances at the bent playback rate 2^(bend/12), so
 // the rendered audio sounds the truth pitch.
@@ -63,10 +65,8 @@ audio::MidiFile PerformanceToMidi(const Performance& performance,
 
 // Renders `performance` to `wav_path` (16-bit PCM, stereo as fluidsynth writes
 // it), leaving the MIDI file at `midi_path`. `work_dir` holds temporary files.
-// `instrument` names the pitch-tracker range for the tuning probe.
 Status RenderPerformanceAudio(const Performance& performance,
                               int gm_program,
-                              const std::string& instrument,
                               const AudioRenderOptions& options,
                               const std::string& work_dir,
                               const std::string& midi_path,

@@ -145,7 +145,6 @@ Status WriteAll(const SyntheticCapture& c,
   if (w.audio) {
     ARCO_RETURN_IF_ERROR(RenderPerformanceAudio(c.performance,
                                                 GmProgramFor(c.instrument_kind),
-                                                c.options.instrument,
                                                 w.audio_render,
                                                 dir,
                                                 JoinPath(dir, "performance.mid"),
