@@ -8,7 +8,7 @@
 #include "arco/cli/triangulate.h"
 #include "arco/io/calibration_file.h"
 #include "arco/mocap/synthetic_views.h"
-#include "arco/mocap/test_dir.h"
+#include "arco/util/test_dir.h"
 #include "arco/util/file_io.h"
 
 namespace arco::cli {

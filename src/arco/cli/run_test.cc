@@ -9,7 +9,7 @@
 #include "arco/eval/evaluate.h"
 #include "arco/io/calibration_file.h"
 #include "arco/mocap/capture.h"
-#include "arco/mocap/test_dir.h"
+#include "arco/util/test_dir.h"
 #include "arco/refine/method_result.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"

@@ -2,34 +2,23 @@
 // against a perturbed copy; malformed inputs.
 #include "arco/eval/evaluate.h"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <string>
-
-#include <gtest/gtest.h>
-
-#include <filesystem>
 
 #include "arco/camera/calibration_io.h"
 #include "arco/mocap/keypoint_layout.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
+#include "arco/util/test_dir.h"
 
 namespace arco::eval {
 namespace {
 
-// A temporary folder of this test process only: ctest runs the tests of one binary
-// as separate processes, possibly at the same time.
-inline std::string PerProcessTempDir() {
-  static const std::string dir = [] {
-    const std::string d = ::testing::TempDir() + "/arco-" + std::to_string(::getpid());
-    std::filesystem::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
+using arco::testing::PerProcessTempDir;
 
 namespace fs = std::filesystem;
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "arco/mocap/test_dir.h"
+#include "arco/util/test_dir.h"
 #include "arco/util/file_io.h"
 
 namespace arco {

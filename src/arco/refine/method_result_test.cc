@@ -8,7 +8,7 @@
 #include "arco/hand/kinematics.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/keypoint_layout.h"
-#include "arco/mocap/test_dir.h"
+#include "arco/util/test_dir.h"
 #include "arco/refine/refine.h"
 #include "arco/refine/test_scene.h"
 #include "arco/util/file_io.h"

@@ -15,20 +15,12 @@
 #include "arco/audio/harmonic_fit.h"
 #include "arco/audio/pitch_tracker.h"
 #include "arco/synth/test_instruments.h"
+#include "arco/util/test_dir.h"
 
 namespace arco::synth {
 namespace {
 
-// A temporary folder of this test process only: ctest runs the tests of one binary
-// as separate processes, possibly at the same time.
-inline std::string PerProcessTempDir() {
-  static const std::string dir = [] {
-    const std::string d = ::testing::TempDir() + "/arco-" + std::to_string(::getpid());
-    std::filesystem::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
+using arco::testing::PerProcessTempDir;
 
 struct Case {
   const char* instrument;

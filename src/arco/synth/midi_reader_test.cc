@@ -1,32 +1,21 @@
 #include "arco/synth/midi_reader.h"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
-#include <filesystem>
-#include <string>
-
-#include <gtest/gtest.h>
-
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "arco/synth/test_instruments.h"
 #include "arco/util/file_io.h"
+#include "arco/util/test_dir.h"
 
 namespace arco::synth {
 namespace {
 
-// A temporary folder of this test process only: ctest runs the tests of one binary
-// as separate processes, possibly at the same time.
-inline std::string PerProcessTempDir() {
-  static const std::string dir = [] {
-    const std::string d = ::testing::TempDir() + "/arco-" + std::to_string(::getpid());
-    std::filesystem::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
+using arco::testing::PerProcessTempDir;
 
 // Builds SMF bytes by hand so the reader is tested independently of any writer.
 std::string Be(uint32_t v, int n) {

@@ -1,29 +1,19 @@
 #include "arco/util/npy.h"
 
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-
-#include <unistd.h>
-
-#include <filesystem>
 #include <string>
 
-#include <gtest/gtest.h>
+#include "arco/util/test_dir.h"
 
 namespace arco {
 namespace {
 
-// A temporary folder of this test process only: ctest runs the tests of one binary
-// as separate processes, possibly at the same time.
-inline std::string PerProcessTempDir() {
-  static const std::string dir = [] {
-    const std::string d = ::testing::TempDir() + "/arco-" + std::to_string(::getpid());
-    std::filesystem::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
+using arco::testing::PerProcessTempDir;
 
 TEST(Npy, RoundTripsFloatArrayWithNaN) {
   NpyArray<float> a;

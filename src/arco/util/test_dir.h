@@ -1,4 +1,5 @@
-// A fresh, empty temporary folder per test (removed at the end).
+// Temporary folders for tests. ctest runs the tests of one binary as separate
+// processes, possibly at the same time, so every folder carries the process id.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 
 namespace arco::testing {
 
+// A fresh, empty temporary folder per test (removed at the end).
 class TempDir {
  public:
   TempDir() {
@@ -30,5 +32,15 @@ class TempDir {
  private:
   std::string path_;
 };
+
+// One temporary folder for the whole test process (created on first use, kept).
+inline std::string PerProcessTempDir() {
+  static const std::string dir = [] {
+    const std::string d = ::testing::TempDir() + "/arco-" + std::to_string(::getpid());
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
 
 }  // namespace arco::testing
