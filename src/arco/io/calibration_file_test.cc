@@ -40,7 +40,9 @@ void ExpectSameRig(const Rig& a, const Rig& b, double tolerance, bool names_kept
     const int j = b.FindCamera(x.serial);
     ASSERT_GE(j, 0) << x.serial;
     const Camera& y = b.cameras[j];
-    if (names_kept) EXPECT_EQ(x.name, y.name);
+    if (names_kept) {
+      EXPECT_EQ(x.name, y.name);
+    }
     EXPECT_EQ(x.width, y.width);
     EXPECT_EQ(x.height, y.height);
     EXPECT_LE((x.K() - y.K()).cwiseAbs().maxCoeff(), tolerance) << x.name;
@@ -107,7 +109,9 @@ TEST_P(RoundTrip, ReadWriteReadKeepsTheRig) {
     ASSERT_TRUE(SaveCalibration(again, back->rig, format).ok());
     ASSERT_TRUE(SaveCalibration(again2, LoadCalibration(again)->rig, format).ok());
     EXPECT_TRUE(*ReadFileToString(again) == *ReadFileToString(again2)) << source;
-    if (!spd) EXPECT_TRUE(*ReadFileToString(path) == *ReadFileToString(again)) << source;
+    if (!spd) {
+      EXPECT_TRUE(*ReadFileToString(path) == *ReadFileToString(again)) << source;
+    }
   }
 }
 

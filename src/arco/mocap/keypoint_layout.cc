@@ -1,7 +1,7 @@
 #include "arco/mocap/keypoint_layout.h"
 
-#include <cstdio>
 #include <map>
+#include <string>
 
 namespace arco {
 namespace {
@@ -32,9 +32,7 @@ KeypointLayout Wholebody() {
              "left_ankle",    "right_ankle",     "left_big_toe", "left_small_toe", "left_heel",
              "right_big_toe", "right_small_toe", "right_heel"};
   for (int i = 0; i < 68; ++i) {
-    char buf[16];
-    std::snprintf(buf, sizeof(buf), "face_%02d", i);
-    l.names.push_back(buf);
+    l.names.push_back((i < 10 ? "face_0" : "face_") + std::to_string(i));
   }
   for (const auto& n : HandNames("left_hand_")) l.names.push_back(n);
   for (const auto& n : HandNames("right_hand_")) l.names.push_back(n);

@@ -3,7 +3,9 @@
 // TinySolver::Solve reads its cost before checking the first evaluation, which GCC
 // flags; our cost functor always succeeds.
 #pragma GCC diagnostic push
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <ceres/tiny_solver.h>
 #include <ceres/tiny_solver_autodiff_function.h>
 #pragma GCC diagnostic pop

@@ -8,10 +8,10 @@
 #include "arco/hand/kinematics.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/keypoint_layout.h"
-#include "arco/util/test_dir.h"
 #include "arco/refine/refine.h"
 #include "arco/refine/test_scene.h"
 #include "arco/util/file_io.h"
+#include "arco/util/test_dir.h"
 
 namespace arco::refine {
 namespace {

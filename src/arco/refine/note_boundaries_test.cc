@@ -90,7 +90,9 @@ TEST(NoteBoundaries, FramesAtNoteChangesGoToTheNoteSoundingAtTheirTime) {
     if (scene.truth_finger[f] == 0) {
       // The rest (frames 26-33) stays a rest: an audio note's window ends at its offset
       // (the onset lead may press the last three frames before the next note).
-      if (f >= 26 && f < 31) EXPECT_EQ(c.state, ContactState::kRest) << "frame " << f;
+      if (f >= 26 && f < 31) {
+        EXPECT_EQ(c.state, ContactState::kRest) << "frame " << f;
+      }
       continue;
     }
     EXPECT_LT((c.point_in_world_mm - scene.truth_contact[f]).norm(), 1e-6) << "frame " << f;

@@ -44,7 +44,9 @@ void ExpectSameResult(const RefineResult& a, const RefineResult& b) {
     EXPECT_EQ(ca.string, cb.string);
     EXPECT_EQ(ca.finger, cb.finger);
     EXPECT_EQ(ca.point_in_world_mm.allFinite(), cb.point_in_world_mm.allFinite());
-    if (ca.point_in_world_mm.allFinite()) EXPECT_EQ(ca.point_in_world_mm, cb.point_in_world_mm);
+    if (ca.point_in_world_mm.allFinite()) {
+      EXPECT_EQ(ca.point_in_world_mm, cb.point_in_world_mm);
+    }
     EXPECT_EQ(std::isnan(ca.tip_distance_refined_mm), std::isnan(cb.tip_distance_refined_mm));
     if (!std::isnan(ca.tip_distance_refined_mm)) {
       EXPECT_EQ(ca.tip_distance_refined_mm, cb.tip_distance_refined_mm);
@@ -69,7 +71,9 @@ TEST(Refine, NeverViolatesAJointLimitEvenOnHarshInput) {
       const RefineResult r = Refine(scene.input, o);
       EXPECT_EQ(r.summary.joint_limit_violations, 0);
       for (const auto& h : r.hand) {
-        if (h) EXPECT_EQ(hand::CountLimitViolations(scene.input.hand_model, *h, 0.0), 0);
+        if (h) {
+          EXPECT_EQ(hand::CountLimitViolations(scene.input.hand_model, *h, 0.0), 0);
+        }
       }
       if (mode == RefineMode::kArco) {
         for (const FrameContact& c : r.contacts) {
