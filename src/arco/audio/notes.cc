@@ -6,20 +6,10 @@
 #include <stdexcept>
 
 #include "arco/util/file_io.h"
+#include "arco/util/stats.h"
 
 namespace arco::audio {
 namespace {
-
-double Median(std::vector<double>* v) {
-  if (v->empty()) return NAN;
-  const size_t mid = v->size() / 2;
-  std::nth_element(v->begin(), v->begin() + mid, v->end());
-  double m = (*v)[mid];
-  if (v->size() % 2 == 0) {
-    m = 0.5 * (m + *std::max_element(v->begin(), v->begin() + mid));
-  }
-  return m;
-}
 
 struct Vibrato {
   double rate_hz = 0, extent_cents = 0;
@@ -119,7 +109,7 @@ NoteAnalysis SegmentNotes(const std::vector<PitchFrame>& fine, double fps, const
       if (!std::isnan(semis[k])) previous = semis[k];
       curve.push_back(previous);
     }
-    const double median = Median(&values);
+    const double median = Median(values);
     Note note;
     note.onset_s = fine[first].time_s;
     note.offset_s = fine[last].time_s + 1.0 / fps;
@@ -154,7 +144,7 @@ NoteAnalysis SegmentNotes(const std::vector<PitchFrame>& fine, double fps, const
       for (int q = std::max(a, a + k - half); q <= std::min(b, a + k + half); ++q) {
         if (!std::isnan(semis[q])) scratch.push_back(semis[q]);
       }
-      smooth[k] = scratch.empty() ? (k > 0 ? smooth[k - 1] : semis[a]) : Median(&scratch);
+      smooth[k] = scratch.empty() ? (k > 0 ? smooth[k - 1] : semis[a]) : Median(scratch);
     }
     // Glides: sustained steep slope of the smoothed pitch.
     std::vector<char> gliding(len, 0);

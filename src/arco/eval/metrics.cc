@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "arco/util/stats.h"
+
 namespace arco::eval {
 namespace {
 
@@ -16,16 +18,6 @@ double Mean(const std::vector<double>& v) {
   double s = 0;
   for (double x : v) s += x;
   return s / static_cast<double>(v.size());
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return kNaN;
-  const size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(m), v.end());
-  const double hi = v[m];
-  if (v.size() % 2 == 1) return hi;
-  const double lo = *std::max_element(v.begin(), v.begin() + static_cast<long>(m));
-  return 0.5 * (lo + hi);
 }
 
 bool Finite(const Eigen::Vector3d& p) { return p.allFinite(); }

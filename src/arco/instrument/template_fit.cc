@@ -8,21 +8,12 @@
 
 #include "arco/instrument/rigid_align.h"
 #include "arco/util/parallel.h"
+#include "arco/util/stats.h"
 
 namespace arco {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// Median of a copy (mean of the two middle values for even sizes); NaN when empty.
-double Median(std::vector<double> v) {
-  if (v.empty()) return kNaN;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  const double upper = v[mid];
-  if (v.size() % 2 == 1) return upper;
-  return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + mid));
-}
 
 double Mad(const std::vector<double>& v, double median) {
   std::vector<double> dev(v.size());

@@ -8,6 +8,7 @@
 #include <limits>
 #include <set>
 
+#include "arco/util/atomic_dir.h"
 #include "arco/util/file_io.h"
 
 namespace arco {
@@ -284,13 +285,7 @@ Status WriteTriangulationResult(const std::string& result_dir,
                                 const TriangulationStageInfo& info) {
   ARCO_ASSIGN_OR_RETURN(Json result, ReadResultManifest(result_dir));
   ARCO_RETURN_IF_ERROR(MakeDirectories(result_dir));
-  const std::string final_dir = JoinPath(result_dir, "triangulation");
-  const std::string tmp_dir =
-      JoinPath(result_dir, ".triangulation.tmp-" + std::to_string(::getpid()));
-  std::error_code ec;
-  fs::remove_all(tmp_dir, ec);
-  ARCO_RETURN_IF_ERROR(MakeDirectories(tmp_dir));
-  auto write_all = [&]() -> Status {
+  auto write_all = [&](const std::string& tmp_dir) -> Status {
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, "points3d.npy"), points3d_filtered));
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, "points3d_raw.npy"), raw.points3d));
     ARCO_RETURN_IF_ERROR(
@@ -300,17 +295,7 @@ Status WriteTriangulationResult(const std::string& result_dir,
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, "inlier_mask.npy"), raw.inlier_mask));
     return Status::Ok();
   };
-  Status status = write_all();
-  if (status.ok()) {
-    fs::remove_all(final_dir, ec);
-    fs::rename(tmp_dir, final_dir, ec);
-    if (ec)
-      status = Status::Error(final_dir + ": cannot move results into place (" + ec.message() + ")");
-  }
-  if (!status.ok()) {
-    fs::remove_all(tmp_dir, ec);
-    return status;
-  }
+  ARCO_RETURN_IF_ERROR(AtomicWriteDirectory(JoinPath(result_dir, "triangulation"), write_all));
 
   result["format"] = "arco-result";
   result["version"] = 1;

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "arco/util/parallel.h"
+#include "arco/util/stats.h"
 
 namespace arco::refine {
 namespace {
@@ -19,16 +20,6 @@ struct State {
   double position_semitones = 0;  // finger 1's semitone above the open string (stopped)
   double cost = 0;                // emission
 };
-
-double Median(std::vector<double>& v) {
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-  double m = v[mid];
-  if (v.size() % 2 == 0) {
-    m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
-  }
-  return m;
-}
 
 // Distance and finger-order cost of finger k at a candidate (header comment).
 void FrameCosts(const hand::HandPointsMm& points,

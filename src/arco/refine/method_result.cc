@@ -11,6 +11,7 @@
 #include "arco/hand/kinematics.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/keypoint_layout.h"
+#include "arco/util/atomic_dir.h"
 #include "arco/util/file_io.h"
 
 namespace arco::refine {
@@ -196,23 +197,7 @@ Status WriteStageFolder(const std::string& result_dir,
                         Json entry) {
   ARCO_RETURN_IF_ERROR(ReadResultManifest(result_dir).status());  // not some other JSON
   ARCO_RETURN_IF_ERROR(MakeDirectories(result_dir));
-  const std::string final_dir = JoinPath(result_dir, stage);
-  const std::string tmp_dir =
-      JoinPath(result_dir, "." + stage + ".tmp-" + std::to_string(::getpid()));
-  std::error_code ec;
-  fs::remove_all(tmp_dir, ec);
-  ARCO_RETURN_IF_ERROR(MakeDirectories(tmp_dir));
-  Status status = write(tmp_dir);
-  if (status.ok()) {
-    fs::remove_all(final_dir, ec);
-    fs::rename(tmp_dir, final_dir, ec);
-    if (ec)
-      status = Status::Error(final_dir + ": cannot move results into place (" + ec.message() + ")");
-  }
-  if (!status.ok()) {
-    fs::remove_all(tmp_dir, ec);
-    return status;
-  }
+  ARCO_RETURN_IF_ERROR(AtomicWriteDirectory(JoinPath(result_dir, stage), write));
   entry["dir"] = stage;
   return RecordStage(result_dir, stage, entry);
 }

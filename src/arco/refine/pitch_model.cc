@@ -4,21 +4,12 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "arco/util/stats.h"
+
 namespace arco::refine {
 namespace {
 
 double Cents(double f0_hz) { return 1200.0 * std::log2(f0_hz / 440.0); }
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-  double m = v[mid];
-  if (v.size() % 2 == 0) {
-    m = 0.5 * (m + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
-  }
-  return m;
-}
 
 double Percentile(std::vector<double> v, double q) {
   std::sort(v.begin(), v.end());
