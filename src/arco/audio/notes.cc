@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "arco/registry/instruments.h"
 #include "arco/util/file_io.h"
 #include "arco/util/stats.h"
 
@@ -242,10 +243,9 @@ MidiFile NotesToMidi(const NoteAnalysis& analysis,
 }
 
 int GmProgramForInstrument(const std::string& instrument) {
-  if (instrument == "violin") return 40;
-  if (instrument == "viola") return 41;
-  if (instrument == "bass" || instrument == "contrabass" || instrument == "double-bass") return 43;
-  return 42;  // cello (and "any")
+  const StatusOr<InstrumentKind> kind = ParseInstrumentKind(instrument);
+  // "any" and unknown names sound as a cello.
+  return GetInstrumentInfo(kind.ok() ? *kind : InstrumentKind::kCello).gm_program;
 }
 
 Status WriteNotesCsv(const std::string& path, const NoteAnalysis& analysis) {

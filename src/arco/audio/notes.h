@@ -71,7 +71,8 @@ MidiFile NotesToMidi(const NoteAnalysis& analysis,
                      int gm_program,
                      double bend_range_semitones = 2.0);
 
-// GM program for an instrument name: cello 42, violin 40, viola 41, bass 43.
+// GM program (registry/instruments.h) for any name ParseInstrumentKind accepts: violin 40,
+// viola 41, cello 42, double bass 43; "any" and unknown names get the cello's.
 int GmProgramForInstrument(const std::string& instrument);
 
 // "C2", "F#4", ... for a MIDI note number.

@@ -7,24 +7,33 @@
 #include <sstream>
 
 #include "arco/audio/sample_stream.h"
+#include "arco/registry/instruments.h"
 #include "arco/util/file_io.h"
 
 namespace arco::audio {
 
 StatusOr<InstrumentRange> InstrumentRangeByName(const std::string& name) {
-  // Lowest open string minus about a semitone and a half; the top leaves room for
-  // high positions and harmonics (violin above E7 = 2637 Hz, issue: >= 3.5 kHz).
-  // Analysis rates keep the shortest period >= 6 samples and the harmonics that
-  // matter below Nyquist.
-  if (name == "violin") return InstrumentRange{"violin", 180.0, 4200.0, 32000};
-  if (name == "viola") return InstrumentRange{"viola", 120.0, 2800.0, 24000};
-  if (name == "cello") return InstrumentRange{"cello", 60.0, 2000.0, 16000};
-  if (name == "bass" || name == "contrabass" || name == "double-bass") {
-    return InstrumentRange{"bass", 38.0, 1200.0, 16000};
+  if (name == "any") {
+    InstrumentRange any{"any", 0, 0, 0};
+    for (const InstrumentInfo& info : AllInstruments()) {
+      const PitchSearchRange& r = info.pitch_search;
+      any.min_f0_hz =
+          any.analysis_rate_hz == 0 ? r.min_f0_hz : std::min(any.min_f0_hz, r.min_f0_hz);
+      any.max_f0_hz = std::max(any.max_f0_hz, r.max_f0_hz);
+      any.analysis_rate_hz = std::max(any.analysis_rate_hz, r.analysis_rate_hz);
+    }
+    return any;
   }
-  if (name == "any") return InstrumentRange{"any", 38.0, 4200.0, 32000};
-  return Status::Error("unknown instrument '" + name +
-                       "' (expected violin, viola, cello, bass or any)");
+  const StatusOr<InstrumentKind> kind = ParseInstrumentKind(name);
+  if (!kind.ok()) {
+    return Status::Error("unknown instrument '" + name +
+                         "' (expected violin, viola, cello, double_bass or any)");
+  }
+  const InstrumentInfo& info = GetInstrumentInfo(*kind);
+  return InstrumentRange{info.name,
+                         info.pitch_search.min_f0_hz,
+                         info.pitch_search.max_f0_hz,
+                         info.pitch_search.analysis_rate_hz};
 }
 
 Status PitchTrackerOptions::Validate() const {

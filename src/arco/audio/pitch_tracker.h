@@ -19,15 +19,16 @@
 
 namespace arco::audio {
 
-// Playing range and analysis rate of an instrument (DOMAIN.md, Instruments).
+// Search range and analysis rate of an instrument (registry/instruments.h,
+// PitchSearchRange).
 struct InstrumentRange {
-  std::string name;
+  std::string name;  // canonical instrument name (ParseInstrumentKind) or "any"
   double min_f0_hz = 0;
   double max_f0_hz = 0;
   int analysis_rate_hz = 0;
 };
-// "violin", "viola", "cello", "bass" (or "contrabass", "double-bass"); "any"
-// covers them all. Error for unknown names.
+// Any name ParseInstrumentKind accepts ("violin", "viola", "cello", "double_bass" and
+// the aliases, e.g. "bass"); "any" covers them all. Error for unknown names.
 StatusOr<InstrumentRange> InstrumentRangeByName(const std::string& name);
 
 struct PitchTrackerOptions {

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "arco/audio/audio_reader.h"
+#include "arco/registry/instruments.h"
 #include "arco/util/file_io.h"
 
 namespace arco::audio::testing {
@@ -17,11 +18,17 @@ struct Range {
   int low, high, program;
 };
 
+// From the lowest open string (registry/instruments.h) to a top note that keeps the
+// music in the soundfont's well-sampled range.
 Range RangeOf(const std::string& instrument) {
-  if (instrument == "violin") return {55, 98, 40};  // G3 .. D7 (2349 Hz)
-  if (instrument == "viola") return {48, 84, 41};   // C3 .. C6
-  if (instrument == "bass") return {28, 55, 43};    // E1 .. G3
-  return {36, 76, 42};                              // cello C2 .. E5
+  const StatusOr<InstrumentKind> parsed = ParseInstrumentKind(instrument);
+  const InstrumentKind kind = parsed.ok() ? *parsed : InstrumentKind::kCello;
+  const InstrumentInfo& info = GetInstrumentInfo(kind);
+  int high = 76;                                       // cello E5
+  if (kind == InstrumentKind::kViolin) high = 98;      // D7 (2349 Hz)
+  if (kind == InstrumentKind::kViola) high = 84;       // C6
+  if (kind == InstrumentKind::kDoubleBass) high = 55;  // G3
+  return {info.open_midi_low_to_high[0], high, info.gm_program};
 }
 
 // Bend (semitones) in effect at time t: the last bend event at or before t.

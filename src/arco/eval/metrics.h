@@ -16,12 +16,16 @@
 #include <string>
 #include <vector>
 
+#include "arco/registry/keypoint_layout.h"
+
 namespace arco::eval {
 
-constexpr int kLeftHandFirst = 91;  // COCO-WholeBody left-hand wrist
-constexpr int kRightHandFirst = 112;
-constexpr int kNumWholeBody = 133;
-constexpr int kNumHand = 21;
+// The COCO-WholeBody offsets are the registry's (registry/keypoint_layout.h); the short
+// names below are what the evaluation code and its tests use.
+using wholebody::kLeftHandFirst;  // left-hand wrist
+using wholebody::kRightHandFirst;
+constexpr int kNumWholeBody = wholebody::kNumPoints;
+constexpr int kNumHand = wholebody::kNumHandPoints;
 
 // Hand keypoint (0..20) of a finger's joint: finger 1 = index .. 4 = little,
 // 0 = thumb; joint 0 = MCP (thumb CMC) .. 3 = tip.

@@ -5,19 +5,10 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "arco/util/stats.h"
+
 namespace arco::hand {
-namespace {
-
-double MedianInPlace(std::vector<double>* v) {
-  const size_t mid = v->size() / 2;
-  std::nth_element(v->begin(), v->begin() + mid, v->end());
-  const double upper = (*v)[mid];
-  if (v->size() % 2 == 1) return upper;
-  const double lower = *std::max_element(v->begin(), v->begin() + mid);
-  return 0.5 * (lower + upper);
-}
-
-}  // namespace
+namespace {}  // namespace
 
 Status BoneLengthOptions::Validate() const {
   auto bad = [](const std::string& m) { return Status::Error("BoneLengthOptions: " + m); };
@@ -50,16 +41,15 @@ StatusOr<BoneLengthEstimate> EstimateBoneLengths(const std::vector<HandPointsMm>
     }
     out.samples[k] = static_cast<int>(samples.size());
     if (out.samples[k] < options.min_samples) continue;
-    std::vector<double> work = samples;
-    const double median = MedianInPlace(&work);
-    for (size_t i = 0; i < samples.size(); ++i) work[i] = std::abs(samples[i] - median);
-    const double sigma = std::max(1.4826 * MedianInPlace(&work), options.min_mad_mm);
+    const double median = Median(samples);
+    const double sigma =
+        std::max(kMadToSigma * MedianAbsDeviation(samples, median), options.min_mad_mm);
     std::vector<double> inliers;
     for (double d : samples) {
       if (std::abs(d - median) <= options.mad_gate * sigma) inliers.push_back(d);
     }
     out.inliers[k] = static_cast<int>(inliers.size());
-    out.lengths_mm[k] = MedianInPlace(&inliers);
+    out.lengths_mm[k] = Median(inliers);
     out.from_data[k] = 1;
     ratios.push_back(out.lengths_mm[k] / prior_mm);
   }
@@ -69,7 +59,7 @@ StatusOr<BoneLengthEstimate> EstimateBoneLengths(const std::vector<HandPointsMm>
         << " frames with both keypoints triangulated (" << frames.size() << " frames)";
     return Status::Error(msg.str());
   }
-  out.hand_scale = MedianInPlace(&ratios);
+  out.hand_scale = Median(ratios);
   if (out.hand_scale < options.min_ratio || out.hand_scale > options.max_ratio) {
     std::ostringstream msg;
     msg << "bone lengths: the hand measures " << out.hand_scale

@@ -8,6 +8,7 @@
 #include "arco/geometry/alignment.h"
 #include "arco/geometry/triangulation.h"
 #include "arco/hand/fit_costs.h"
+#include "arco/util/stats.h"
 
 namespace arco::hand {
 namespace {
@@ -66,13 +67,6 @@ ceres::Solver::Options SolverOptions(int max_iterations) {
 
 bool Usable(const HandKeypoints2d& view, int k, double min_score) {
   return view.scores[k] >= min_score && view.pixels[k].allFinite();
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return kNaN;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return v[mid];
 }
 
 // Unweighted pixel error of every observation at `pose` (inf when behind).
@@ -320,7 +314,7 @@ HandFitResult FitHandMultiView(const HandModel& model,
   int trusted = 0;
   for (int v = 0; v < num_views; ++v) {
     if (!usable[v]) continue;
-    result.view_residual_px[v] = Median(per_view[v]);
+    result.view_residual_px[v] = UpperMedian(per_view[v]);
     result.trusted_views[v] = result.view_residual_px[v] <= options.view_gate_px;
     trusted += result.trusted_views[v];
   }
@@ -339,7 +333,7 @@ HandFitResult FitHandMultiView(const HandModel& model,
   double sum2 = 0;
   for (double e : errors) sum2 += e * e;
   result.rms_residual_px = errors.empty() ? kNaN : std::sqrt(sum2 / errors.size());
-  result.median_residual_px = Median(errors);
+  result.median_residual_px = UpperMedian(errors);
   if (trusted < options.min_views) {
     std::ostringstream msg;
     msg << "only " << trusted << " of " << result.num_views_with_hand << " views agree within "

@@ -5,17 +5,12 @@
 #include <stdexcept>
 
 #include "arco/geometry/rotation.h"
+#include "arco/util/stats.h"
 
 namespace arco::hand {
 namespace {
 
 const double kNaN = std::nan("");
-
-double MedianOf(std::vector<double> v) {
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return v[mid];
-}
 
 }  // namespace
 
@@ -86,7 +81,7 @@ FusedHand FuseViewHands(const HandModel& model,
         if (std::isfinite(len) && len > 1e-9) ratios.push_back(model.bone_length_mm(k) / len);
       }
       if (ratios.size() < 3) continue;
-      const double s = MedianOf(ratios);
+      const double s = UpperMedian(ratios);
       for (auto& x : q) x *= s;
     }
     const HandFit3dResult fit = FitHandToPoints3d(model, q, HandFit3dOptions{});

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "arco/registry/keypoint_layout.h"
+
 namespace arco {
 namespace {
 
@@ -16,57 +18,22 @@ namespace {
 // fingerboard end: cello 4.0-5.5 mm (A) and 6.5-8.0 mm (C) depending on steel or gut
 // strings (ICS cello setup notes), violin about 3.5 (E) and 5.5 mm (G); at the nut
 // 0.5-0.75 mm on cello. All of these vary per instrument: override them in the options.
+// Open strings, names and keypoint layouts: registry/instruments.h.
 struct Spec {
   InstrumentKind kind;
-  const char* name;
-  int midi_low_to_high[4];
-  const char* notes_low_to_high[4];
   double string_length_mm;
   double nut_spacing_mm;
   double bridge_spacing_mm;
   StringSetup setup;
-  bool has_end_pin;  // SPD cello layout (tail_gut, end_pin) vs violin layout
 };
 
 // StringSetup fields: nut height, end height high, end height low, fingerboard length,
 // EA/T, pad centre offset.
 const Spec kSpecs[] = {
-    {InstrumentKind::kViolin,
-     "violin",
-     {55, 62, 69, 76},
-     {"G3", "D4", "A4", "E5"},
-     328.0,
-     16.5,
-     34.0,
-     {0.4, 3.5, 5.5, 270.0, 100.0, 4.0},
-     false},
-    {InstrumentKind::kViola,
-     "viola",
-     {48, 55, 62, 69},
-     {"C3", "G3", "D4", "A4"},
-     370.0,
-     17.5,
-     37.0,
-     {0.5, 4.0, 6.0, 290.0, 100.0, 4.5},
-     false},
-    {InstrumentKind::kCello,
-     "cello",
-     {36, 43, 50, 57},
-     {"C2", "G2", "D3", "A3"},
-     695.0,
-     23.0,
-     47.0,
-     {0.6, 4.5, 7.0, 580.0, 100.0, 5.0},
-     true},
-    {InstrumentKind::kDoubleBass,
-     "double_bass",
-     {28, 33, 38, 43},
-     {"E1", "A1", "D2", "G2"},
-     1050.0,
-     31.0,
-     85.0,
-     {1.0, 6.0, 9.0, 880.0, 100.0, 6.0},
-     true},
+    {InstrumentKind::kViolin, 328.0, 16.5, 34.0, {0.4, 3.5, 5.5, 270.0, 100.0, 4.0}},
+    {InstrumentKind::kViola, 370.0, 17.5, 37.0, {0.5, 4.0, 6.0, 290.0, 100.0, 4.5}},
+    {InstrumentKind::kCello, 695.0, 23.0, 47.0, {0.6, 4.5, 7.0, 580.0, 100.0, 5.0}},
+    {InstrumentKind::kDoubleBass, 1050.0, 31.0, 85.0, {1.0, 6.0, 9.0, 880.0, 100.0, 6.0}},
 };
 
 const Spec& SpecFor(InstrumentKind kind) {
@@ -74,12 +41,6 @@ const Spec& SpecFor(InstrumentKind kind) {
     if (spec.kind == kind) return spec;
   }
   throw std::invalid_argument("unknown InstrumentKind value");
-}
-
-std::string Lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return out;
 }
 
 Status CheckPerString(const std::vector<double>& values,
@@ -111,21 +72,6 @@ double MidiToHz(double midi_note, double a4_hz) {
 double CentsBetween(double reference_hz, double f_hz) {
   return 1200.0 * std::log2(f_hz / reference_hz);
 }
-
-StatusOr<InstrumentKind> ParseInstrumentKind(std::string_view name) {
-  const std::string n = Lower(name);
-  if (n == "violin") return InstrumentKind::kViolin;
-  if (n == "viola") return InstrumentKind::kViola;
-  if (n == "cello" || n == "violoncello") return InstrumentKind::kCello;
-  if (n == "double_bass" || n == "double-bass" || n == "doublebass" || n == "bass" ||
-      n == "contrabass") {
-    return InstrumentKind::kDoubleBass;
-  }
-  return Status::Error("unknown instrument '" + std::string(name) +
-                       "' (known: violin, viola, cello, double_bass)");
-}
-
-const char* InstrumentKindName(InstrumentKind kind) { return SpecFor(kind).name; }
 
 Status TuningOptions::Validate(int num_strings) const {
   if (!(a4_hz >= 300.0 && a4_hz <= 600.0)) {
@@ -173,6 +119,7 @@ Status InstrumentOptions::Validate() const {
 StatusOr<InstrumentModel> InstrumentModel::Create(const InstrumentOptions& options) {
   ARCO_RETURN_IF_ERROR(options.Validate());
   const Spec& spec = SpecFor(options.kind);
+  const InstrumentInfo& info = GetInstrumentInfo(options.kind);
   InstrumentModel m;
   m.kind_ = options.kind;
   const int n = 4;
@@ -181,7 +128,8 @@ StatusOr<InstrumentModel> InstrumentModel::Create(const InstrumentOptions& optio
   m.open_note_names_.resize(n);
   for (int s = 1; s <= n; ++s) {
     const int low_index = n - s;  // string 4 is the lowest
-    double f = MidiToHz(spec.midi_low_to_high[low_index], options.tuning.a4_hz);
+    double f =
+        MidiToHz(info.open_midi_low_to_high[static_cast<size_t>(low_index)], options.tuning.a4_hz);
     if (!options.tuning.offset_cents.empty()) {
       f *= std::pow(2.0, options.tuning.offset_cents[s - 1] / 1200.0);
     }
@@ -189,7 +137,7 @@ StatusOr<InstrumentModel> InstrumentModel::Create(const InstrumentOptions& optio
       f = options.tuning.open_hz[s - 1];
     }
     m.open_hz_[s - 1] = f;
-    m.open_note_names_[s - 1] = spec.notes_low_to_high[low_index];
+    m.open_note_names_[s - 1] = info.open_notes_low_to_high[static_cast<size_t>(low_index)];
     double top = f * std::pow(2.0, options.range.semitones_above_open / 12.0);
     if (!options.range.max_hz.empty() && options.range.max_hz[s - 1] > 0) {
       top = options.range.max_hz[s - 1];
@@ -219,23 +167,13 @@ StatusOr<InstrumentModel> InstrumentModel::Create(const InstrumentOptions& optio
         "instrument options: fingerboard_length_mm must be shorter than the "
         "string length");
   }
-  if (spec.has_end_pin) {
-    m.keypoint_names_ = {"scroll_top",
-                         "nut_l",
-                         "nut_r",
-                         "bridge_l",
-                         "bridge_r",
-                         "tail_gut",
-                         "end_pin",
-                         "frog",
-                         "tip"};
-  } else {
-    m.keypoint_names_ = {"scroll_top", "nut_l", "nut_r", "bridge_l", "bridge_r", "frog", "tip"};
-  }
-  for (int k = 0; k < static_cast<int>(m.keypoint_names_.size()); ++k) {
-    if (m.keypoint_names_[k] != "frog" && m.keypoint_names_[k] != "tip") {
-      m.rigid_keypoints_.push_back(k);
-    }
+  // The instrument's points follow the body in its SPD layout; the bow's frog and tip
+  // are the "bow" group, the rigid ones the "instrument" group.
+  const KeypointLayout* layout = FindKeypointLayout(info.spd_layout);
+  if (!layout) throw std::logic_error(std::string("no keypoint layout ") + info.spd_layout);
+  m.keypoint_names_.assign(layout->names.begin() + wholebody::kNumPoints, layout->names.end());
+  for (int index : *layout->Group("instrument")) {
+    m.rigid_keypoints_.push_back(index - wholebody::kNumPoints);
   }
   return m;
 }

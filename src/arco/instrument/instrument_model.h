@@ -18,17 +18,12 @@
 #include <string_view>
 #include <vector>
 
+#include "arco/registry/instruments.h"
 #include "arco/util/status.h"
 
 namespace arco {
 
-enum class InstrumentKind { kViolin, kViola, kCello, kDoubleBass };
-
-// Accepts "violin", "viola", "cello", "double_bass" (also "double-bass", "doublebass",
-// "bass", "contrabass"), case-insensitive. Unknown names: an error listing the known ones.
-StatusOr<InstrumentKind> ParseInstrumentKind(std::string_view name);
-// "violin", "viola", "cello", "double_bass".
-const char* InstrumentKindName(InstrumentKind kind);
+// InstrumentKind, ParseInstrumentKind and InstrumentKindName: registry/instruments.h.
 
 // Open-string tuning. Standard tuning is equal temperament from `a4_hz`; scordatura per
 // string either as an offset in cents or as an explicit frequency.
@@ -116,9 +111,10 @@ class InstrumentModel {
   // the fingerboard end, constant beyond), interpolated between high and low strings.
   double StringHeightMm(int string, double from_nut_mm) const;
 
-  // SPD instrument keypoints, in SPD order (DOMAIN.md section 3). Cello and double bass:
-  // scroll_top, nut_l, nut_r, bridge_l, bridge_r, tail_gut, end_pin, frog, tip; violin and
-  // viola: scroll_top, nut_l, nut_r, bridge_l, bridge_r, frog, tip.
+  // SPD instrument keypoints, in SPD order (DOMAIN.md section 3): the points after the
+  // body in the instrument's spd_* keypoint layout (registry/keypoint_layout.h). Cello and
+  // double bass: scroll_top, nut_l, nut_r, bridge_l, bridge_r, tail_gut, end_pin, frog,
+  // tip; violin and viola: scroll_top, nut_l, nut_r, bridge_l, bridge_r, frog, tip.
   const std::vector<std::string>& keypoint_names() const { return keypoint_names_; }
   // Index into keypoint_names(), or -1.
   int KeypointIndex(std::string_view name) const;

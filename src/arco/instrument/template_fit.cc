@@ -15,12 +15,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-double Mad(const std::vector<double>& v, double median) {
-  std::vector<double> dev(v.size());
-  for (size_t i = 0; i < v.size(); ++i) dev[i] = std::abs(v[i] - median);
-  return Median(dev);
-}
-
 std::string Percent(double fraction) {
   std::ostringstream s;
   s.setf(std::ios::fixed);
@@ -192,7 +186,8 @@ StatusOr<InstrumentFit> FitInstrument(const InstrumentModel& model,
     if (frame_rms.empty()) return Status::Error("instrument fit: no frame could be aligned");
     const double med = Median(frame_rms);
     const double frame_gate = std::max(
-        options.min_point_gate_mm, med + options.frame_gate_sigmas * 1.4826 * Mad(frame_rms, med));
+        options.min_point_gate_mm,
+        med + options.frame_gate_sigmas * kMadToSigma * MedianAbsDeviation(frame_rms, med));
     std::vector<double> point_residuals;
     summary.frames_in_template = 0;
     for (int f = 0; f < num_frames; ++f) {
@@ -289,7 +284,7 @@ StatusOr<InstrumentFit> FitInstrument(const InstrumentModel& model,
   InstrumentTemplate& instrument = fit.instrument;
   instrument.scale_frames = static_cast<int>(inlier_distances.size());
   instrument.nut_bridge_spread_rel =
-      1.4826 * Mad(inlier_distances, final_distance) / final_distance;
+      kMadToSigma * MedianAbsDeviation(inlier_distances, final_distance) / final_distance;
   if (options.scale == InstrumentFitOptions::Scale::kFromStringLength) {
     const double u_final = final_distance / length_mm;
     shape *= u / u_final;  // template mm under the refined scale
@@ -349,8 +344,9 @@ StatusOr<InstrumentFit> FitInstrument(const InstrumentModel& model,
   summary.median_rms_residual_mm = Median(frame_rms);
   const double frame_gate =
       std::max(options.min_point_gate_mm,
-               summary.median_rms_residual_mm + options.frame_gate_sigmas * 1.4826 *
-                                                    Mad(frame_rms, summary.median_rms_residual_mm));
+               summary.median_rms_residual_mm +
+                   options.frame_gate_sigmas * kMadToSigma *
+                       MedianAbsDeviation(frame_rms, summary.median_rms_residual_mm));
   for (InstrumentFramePose& p : fit.frames) {
     if (!p.has_pose()) continue;
     ++summary.frames_with_pose;

@@ -5,15 +5,22 @@
 #include <cstdio>
 #include <limits>
 
+#include "arco/registry/instruments.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
 
 namespace arco {
 namespace {
 
-constexpr int kBodyPoints = 133;
+constexpr int kBodyPoints = wholebody::kNumPoints;
 
-int InstrumentPoints(const std::string& instrument) { return instrument == "violin" ? 7 : 9; }
+// The instrument's points in its SPD layout (registry): cello 9, violin 7.
+int InstrumentPoints(const std::string& instrument) {
+  const KeypointLayout* layout =
+      FindKeypointLayout(GetInstrumentInfo(*ParseInstrumentKind(instrument)).spd_layout);
+  return layout->size() - kBodyPoints;
+}
 
 std::string FramePath(const std::string& dir, const std::string& serial, int64_t number) {
   return JoinPath(JoinPath(dir, serial), std::to_string(number) + ".json");

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "arco/util/parallel.h"
+#include "arco/util/stats.h"
 
 namespace arco {
 
@@ -113,13 +114,7 @@ SequenceTriangulationSummary Summarize(const SequenceTriangulation& result) {
   if (rms.empty()) {
     s.median_rms_reprojection_px = std::numeric_limits<double>::quiet_NaN();
   } else {
-    const size_t mid = rms.size() / 2;
-    std::nth_element(rms.begin(), rms.begin() + mid, rms.end());
-    double median = rms[mid];
-    if (rms.size() % 2 == 0) {
-      median = 0.5 * (median + *std::max_element(rms.begin(), rms.begin() + mid));
-    }
-    s.median_rms_reprojection_px = median;
+    s.median_rms_reprojection_px = MedianInPlace(rms.begin(), rms.end());
     s.mean_inliers = static_cast<double>(inliers) / static_cast<double>(rms.size());
   }
   return s;

@@ -8,11 +8,10 @@
 
 #include "arco/util/parallel.h"
 #include "arco/util/stats.h"
+#include "arco/util/viterbi.h"
 
 namespace arco::refine {
 namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 struct State {
   int string = 0;
@@ -41,8 +40,7 @@ void FrameCosts(const hand::HandPointsMm& points,
     offsets[static_cast<size_t>(j - 1)] =
         (points[hand::TipKeypoint(static_cast<hand::Finger>(j))] - contact).dot(across);
   }
-  std::sort(offsets.begin(), offsets.end());
-  const double hand_across = 0.5 * (offsets[1] + offsets[2]);
+  const double hand_across = MedianInPlace(offsets.begin(), offsets.end());
   const double wl = options.lateral_weight, wn = options.normal_weight;
   const double wh = options.hand_lateral_weight;
   *distance =
@@ -197,14 +195,6 @@ void AssignFrame(const DecodeContext& context,
 
 }  // namespace
 
-double FingerOffsetSemitones(InstrumentKind kind, int finger) {
-  static const double kCello[5] = {0, 0, 1, 2, 3};
-  static const double kViolin[5] = {0, 0, 2, 4, 5};
-  const bool violin_like = kind == InstrumentKind::kViolin || kind == InstrumentKind::kViola;
-  const int k = finger < 0 ? 0 : (finger > 4 ? 4 : finger);
-  return (violin_like ? kViolin : kCello)[k];
-}
-
 std::vector<FrameContact> DecodeArco(const DecodeContext& context,
                                      const ArcoDecodeOptions& options,
                                      const PitchModelOptions& pitch_options,
@@ -241,38 +231,25 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
   for (size_t u = 0; u < usable.size(); ++u) {
     if (!states[u].empty()) chain.push_back(static_cast<int>(u));
   }
-  std::vector<std::vector<double>> cost(chain.size());
-  std::vector<std::vector<int>> back(chain.size());
+  std::vector<int> num_states(chain.size());
   for (size_t c = 0; c < chain.size(); ++c) {
-    const std::vector<State>& cur = states[static_cast<size_t>(chain[c])];
-    cost[c].assign(cur.size(), kInf);
-    back[c].assign(cur.size(), -1);
-    for (size_t j = 0; j < cur.size(); ++j) {
-      if (c == 0) {
-        cost[c][j] = cur[j].cost;
-        continue;
-      }
-      const std::vector<State>& prev = states[static_cast<size_t>(chain[c - 1])];
-      const NoteSpan& from = notes[static_cast<size_t>(usable[static_cast<size_t>(chain[c - 1])])];
-      const NoteSpan& to = notes[static_cast<size_t>(usable[static_cast<size_t>(chain[c])])];
-      for (size_t i = 0; i < prev.size(); ++i) {
-        const double total =
-            cost[c - 1][i] + TransitionCost(from, to, prev[i], cur[j], options, input.fps);
-        if (total < cost[c][j]) {
-          cost[c][j] = total;
-          back[c][j] = static_cast<int>(i);
-        }
-      }
-      cost[c][j] += cur[j].cost;
-    }
+    num_states[c] = static_cast<int>(states[static_cast<size_t>(chain[c])].size());
   }
-  std::vector<int> chosen(chain.size(), -1);
-  if (!chain.empty()) {
-    const std::vector<double>& last = cost.back();
-    chosen.back() = static_cast<int>(std::min_element(last.begin(), last.end()) - last.begin());
-    for (size_t c = chain.size() - 1; c > 0; --c)
-      chosen[c - 1] = back[c][static_cast<size_t>(chosen[c])];
-  }
+  auto state_at = [&](size_t c, int k) -> const State& {
+    return states[static_cast<size_t>(chain[c])][static_cast<size_t>(k)];
+  };
+  auto note_at = [&](size_t c) -> const NoteSpan& {
+    return notes[static_cast<size_t>(usable[static_cast<size_t>(chain[c])])];
+  };
+  const std::vector<int> chosen =
+      DecodeViterbi(
+          num_states,
+          [&](size_t c, int k) { return state_at(c, k).cost; },
+          [&](size_t c, int j, int k) {
+            return TransitionCost(
+                note_at(c - 1), note_at(c), state_at(c - 1, j), state_at(c, k), options, input.fps);
+          })
+          .states;
 
   // Frames of the decoded notes.
   std::vector<uint8_t> decoded_note(notes.size(), 0);

@@ -42,9 +42,7 @@
 
 namespace arco::refine {
 
-// Semitones from finger 1's stop to finger k's in the instrument's closed hand frame:
-// cello and double bass 0/1/2/3, violin and viola 0/2/4/5 (approximate).
-double FingerOffsetSemitones(InstrumentKind kind, int finger);
+// The hand position of a state uses FingerOffsetSemitones (registry/instruments.h).
 
 // lift_max_mm[k] for finger k = 1..4 (entry 0 unused). One FrameContact per frame (before
 // IK). Frames of a note whose contact fails the lift test come back kUncertain with

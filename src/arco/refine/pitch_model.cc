@@ -11,14 +11,6 @@ namespace {
 
 double Cents(double f0_hz) { return 1200.0 * std::log2(f0_hz / 440.0); }
 
-double Percentile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  const double pos = q * static_cast<double>(v.size() - 1);
-  const size_t lo = static_cast<size_t>(std::floor(pos));
-  const size_t hi = std::min(v.size() - 1, lo + 1);
-  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
-
 // Builds notes frame by frame (header comment of pitch_model.h).
 class Segmenter {
  public:
@@ -79,9 +71,10 @@ class Segmenter {
     note.first_frame = members_.front();
     note.last_frame = members_.back();
     note.f0_hz = 440.0 * std::exp2(Median(all_cents_) / 1200.0);
-    note.modulation_cents = members_.size() >= 2
-                                ? 0.5 * (Percentile(all_cents_, 0.9) - Percentile(all_cents_, 0.1))
-                                : 0.0;
+    note.modulation_cents =
+        members_.size() >= 2
+            ? 0.5 * (InterpolatedQuantile(all_cents_, 0.9) - InterpolatedQuantile(all_cents_, 0.1))
+            : 0.0;
     double conf = 0;
     for (int64_t f : members_) conf += pitch_[static_cast<size_t>(f)].confidence;
     note.mean_confidence = conf / static_cast<double>(members_.size());

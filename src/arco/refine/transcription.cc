@@ -6,6 +6,7 @@
 #include <map>
 
 #include "arco/refine/arco_decode.h"
+#include "arco/util/stats.h"
 
 namespace arco::refine {
 
@@ -63,8 +64,7 @@ std::vector<NoteFingering> Transcribe(const InstrumentModel& model,
         }
       }
       if (!from_nut.empty()) {
-        std::sort(from_nut.begin(), from_nut.end());
-        row.from_nut_mm = from_nut[from_nut.size() / 2];
+        row.from_nut_mm = UpperMedian(from_nut);  // one of the measured positions
       }
       const double semitones = CentsBetween(model.open_hz(row.string), note.f0_hz) / 100.0;
       row.position_semitones = semitones - FingerOffsetSemitones(model.kind(), row.finger);

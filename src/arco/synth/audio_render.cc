@@ -13,6 +13,7 @@
 #include "arco/audio/harmonic_fit.h"
 #include "arco/synth/random.h"
 #include "arco/util/file_io.h"
+#include "arco/util/stats.h"
 
 namespace arco::synth {
 namespace {
@@ -100,9 +101,7 @@ StatusOr<std::map<int, SampleContour>> MeasureContours(const std::map<int, doubl
       valid.push_back(cents);
     }
     if (valid.size() < 20) continue;  // not measurable: leave this key uncompensated
-    std::nth_element(
-        valid.begin(), valid.begin() + static_cast<long>(valid.size() / 2), valid.end());
-    c.median_cents = valid[valid.size() / 2];
+    c.median_cents = UpperMedianInPlace(valid.begin(), valid.end());
     // Holes (attack, unvoiced rows) take the nearest earlier value, else the median.
     double last = c.median_cents;
     for (double& v : c.cents) {

@@ -41,8 +41,8 @@ Eigen::Matrix3d FrameFromAxes(const Eigen::Vector3d& x_axis, const Eigen::Vector
 }
 
 // 68-point face template (iBUG order) in the head frame: x left, y up, z forward.
-std::array<Eigen::Vector3d, 68> FaceTemplate() {
-  std::array<Eigen::Vector3d, 68> f;
+std::array<Eigen::Vector3d, wholebody::kNumFace> FaceTemplate() {
+  std::array<Eigen::Vector3d, wholebody::kNumFace> f;
   for (int i = 0; i < 17; ++i) {  // jaw, from the subject's right ear to the left
     const double u = kPi * i / 16.0;
     f[i] = {-68 * std::cos(u), -20 - 62 * std::sin(u), 30 + 60 * std::sin(u)};
@@ -158,15 +158,16 @@ void BodyKeypoints(const Eigen::Matrix3d& torso,
                    const Eigen::Vector3d& left_wrist,
                    const Eigen::Vector3d& right_wrist,
                    bool violin_hold,
-                   std::array<Eigen::Vector3d, kNumBodyPoints>* out) {
+                   std::array<Eigen::Vector3d, wholebody::kNumPoints>* out) {
   auto& p = *out;
   // Head: turned left and tilted onto the chin rest for violin/viola.
   const Eigen::Matrix3d head =
       torso * (violin_hold ? Eigen::Matrix3d(RotY(25 * kDeg) * RotZ(-12 * kDeg) * RotX(10 * kDeg))
                            : Eigen::Matrix3d(RotY(8 * kDeg) * RotX(6 * kDeg)));
   const Eigen::Vector3d head_centre = torso * kHeadCentre;
-  static const std::array<Eigen::Vector3d, 68> face = FaceTemplate();
-  for (int i = 0; i < 68; ++i) p[23 + i] = head_centre + head * face[i];
+  static const std::array<Eigen::Vector3d, wholebody::kNumFace> face = FaceTemplate();
+  for (int i = 0; i < wholebody::kNumFace; ++i)
+    p[wholebody::kFaceFirst + i] = head_centre + head * face[i];
   p[0] = head_centre + head * Eigen::Vector3d(0, 0, 108);    // nose
   p[1] = head_centre + head * Eigen::Vector3d(32, 20, 84);   // left eye
   p[2] = head_centre + head * Eigen::Vector3d(-32, 20, 84);  // right eye

@@ -14,12 +14,11 @@
 #include <cstdint>
 
 #include "arco/instrument/instrument_model.h"
+#include "arco/registry/keypoint_layout.h"
 
 namespace arco::synth {
 
-constexpr int kNumBodyPoints = 133;
-constexpr int kLeftHandFirst = 91;
-constexpr int kRightHandFirst = 112;
+// Point indices: wholebody:: in registry/keypoint_layout.h.
 
 // A rigid transform: point_in_parent = rotation * point + translation.
 struct Rigid {
@@ -69,7 +68,7 @@ void BodyKeypoints(const Eigen::Matrix3d& torso_rotation,
                    const Eigen::Vector3d& left_wrist,
                    const Eigen::Vector3d& right_wrist,
                    bool violin_hold,
-                   std::array<Eigen::Vector3d, kNumBodyPoints>* points);
+                   std::array<Eigen::Vector3d, wholebody::kNumPoints>* points);
 
 // Elbow of a two-bone arm (law of cosines); the wrist is unreachable beyond
 // upper + fore: the elbow then lies on the shoulder-wrist line.

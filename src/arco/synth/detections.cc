@@ -91,7 +91,8 @@ NpyArray<float> EmulateDetections(const Rig& rig,
     const double b = std::sqrt(1 - a * a);
     for (int p = 0; p < num_points; ++p) {
       double scale = 1.5;  // body, feet, face
-      if (p >= layout.left_hand_first && p < layout.right_hand_first + 21) scale = 1.0;
+      if (p >= layout.left_hand_first && p < layout.right_hand_first + wholebody::kNumHandPoints)
+        scale = 1.0;
       if (p >= layout.instrument_first) scale = is_bow[static_cast<size_t>(p)] ? 1.0 : 0.3;
       Eigen::Vector3d state(rng.Normal(), rng.Normal(), rng.Normal());
       for (int fr = 0; fr < num_frames; ++fr) {
@@ -163,7 +164,7 @@ NpyArray<float> EmulateDetections(const Rig& rig,
       }
       // Left/right hand swap for this view and frame.
       if (rng.Bernoulli(o.outlier_rate)) {
-        for (int k = 0; k < 21; ++k) {
+        for (int k = 0; k < wholebody::kNumHandPoints; ++k) {
           float* a = slot(layout.left_hand_first + k);
           float* b = slot(layout.right_hand_first + k);
           for (int c = 0; c < 3; ++c) std::swap(a[c], b[c]);

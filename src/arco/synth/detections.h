@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "arco/camera/rig.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/util/npy.h"
 #include "arco/util/status.h"
 
@@ -67,8 +68,9 @@ struct DetectionFrame {
 
 struct DetectionLayout {
   int num_points = 0;
-  int left_hand_first = 91, right_hand_first = 112;
-  int instrument_first = 133;
+  int left_hand_first = wholebody::kLeftHandFirst;
+  int right_hand_first = wholebody::kRightHandFirst;
+  int instrument_first = wholebody::kNumPoints;
   std::vector<int> bow_points;    // e.g. frog, tip
   std::vector<int> torso_points;  // points on the torso surface (never torso-occluded)
 };

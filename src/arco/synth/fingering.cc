@@ -4,6 +4,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "arco/util/viterbi.h"
+
 namespace arco::synth {
 namespace {
 
@@ -70,36 +72,17 @@ Status FingeringOptions::Validate() const {
   return Status::Ok();
 }
 
-std::vector<FingerSpan> HandFrameFor(const std::string& name) {
-  if (name == "cello") {
-    return {{1, 0, false},
-            {2, 1, false},
-            {3, 2, false},
-            {4, 3, false},
-            {2, 2, true},
-            {3, 3, true},
-            {4, 4, true}};
-  }
-  if (name == "violin" || name == "viola") {
-    return {{1, 0, false},
-            {2, 1, false},
-            {2, 2, false},
-            {3, 3, false},
-            {3, 4, false},
-            {4, 5, false},
-            {4, 6, true}};
-  }
-  if (name == "double_bass" || name == "contrabass" || name == "bass") {
-    return {{1, 0, false}, {2, 1, false}, {4, 2, false}};
-  }
-  throw std::invalid_argument("HandFrameFor: unknown instrument '" + name + "'");
+const std::vector<FingerSpan>& HandFrameFor(const std::string& name) {
+  const StatusOr<InstrumentKind> kind = ParseInstrumentKind(name);
+  if (!kind.ok()) throw std::invalid_argument("HandFrameFor: " + kind.status().message());
+  return GetInstrumentInfo(*kind).hand_frame;
 }
 
 StatusOr<FingeringPlan> PlanFingering(const Score& score,
                                       const ScoreInstrument& instrument,
                                       const FingeringOptions& options) {
   ARCO_RETURN_IF_ERROR(options.Validate());
-  const std::vector<FingerSpan> frame = HandFrameFor(instrument.name);
+  const std::vector<FingerSpan>& frame = HandFrameFor(instrument.name);
   const size_t n = score.notes.size();
   const int num_strings = static_cast<int>(instrument.open_string_midi.size());
   // Candidate states per note.
@@ -139,38 +122,23 @@ StatusOr<FingeringPlan> PlanFingering(const Score& score,
   }
   FingeringPlan plan;
   if (n == 0) return plan;
-  // Viterbi: best[i][k] = cost of the cheapest plan for notes 0..i ending in state k.
-  std::vector<std::vector<double>> best(n);
-  std::vector<std::vector<int>> back(n);
-  best[0].resize(states[0].size());
-  back[0].assign(states[0].size(), -1);
-  for (size_t k = 0; k < states[0].size(); ++k) best[0][k] = states[0][k].note_cost;
-  for (size_t i = 1; i < n; ++i) {
-    best[i].assign(states[i].size(), std::numeric_limits<double>::infinity());
-    back[i].assign(states[i].size(), -1);
-    for (size_t k = 0; k < states[i].size(); ++k) {
-      for (size_t j = 0; j < states[i - 1].size(); ++j) {
-        const double c =
-            best[i - 1][j] +
-            TransitionCost(
-                states[i - 1][j], score.notes[i - 1], states[i][k], score.notes[i], options);
-        if (c < best[i][k]) {
-          best[i][k] = c;
-          back[i][k] = static_cast<int>(j);
-        }
-      }
-      best[i][k] += states[i][k].note_cost;
-    }
-  }
-  int k = 0;
-  for (size_t j = 1; j < best[n - 1].size(); ++j) {
-    if (best[n - 1][j] < best[n - 1][static_cast<size_t>(k)]) k = static_cast<int>(j);
-  }
-  plan.total_cost = best[n - 1][static_cast<size_t>(k)];
+  // Viterbi over the notes (util/viterbi.h: ties to the lower state index).
+  std::vector<int> num_states(n);
+  for (size_t i = 0; i < n; ++i) num_states[i] = static_cast<int>(states[i].size());
+  const ViterbiPath path = DecodeViterbi(
+      num_states,
+      [&](size_t i, int k) { return states[i][static_cast<size_t>(k)].note_cost; },
+      [&](size_t i, int j, int k) {
+        return TransitionCost(states[i - 1][static_cast<size_t>(j)],
+                              score.notes[i - 1],
+                              states[i][static_cast<size_t>(k)],
+                              score.notes[i],
+                              options);
+      });
+  plan.total_cost = path.total_cost;
   plan.notes.resize(n);
-  for (size_t i = n; i-- > 0;) {
-    plan.notes[i] = states[i][static_cast<size_t>(k)].f;
-    k = back[i][static_cast<size_t>(k)];
+  for (size_t i = 0; i < n; ++i) {
+    plan.notes[i] = states[i][static_cast<size_t>(path.states[i])].f;
   }
   for (size_t i = 0; i < n; ++i) {
     if (plan.notes[i].finger == 0) ++plan.num_open_strings;

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "arco/registry/instruments.h"
 #include "arco/synth/score.h"
 #include "arco/util/status.h"
 
@@ -45,16 +46,9 @@ struct FingeringOptions {
   Status Validate() const;
 };
 
-// One entry of a hand frame: finger `finger` stops offset_semitones above finger 1.
-struct FingerSpan {
-  int finger = 1;
-  int offset_semitones = 0;
-  bool extended = false;
-};
-
-// The hand frame for an instrument name ("violin", "viola", "cello",
-// "double_bass"/"contrabass"/"bass"); unknown names throw std::invalid_argument.
-std::vector<FingerSpan> HandFrameFor(const std::string& instrument_name);
+// The hand frame (registry/instruments.h, FingerSpan) of an instrument name
+// (ParseInstrumentKind); unknown names throw std::invalid_argument.
+const std::vector<FingerSpan>& HandFrameFor(const std::string& instrument_name);
 
 struct NoteFingering {
   int string_index = 0;        // 0 = lowest string (cello C, violin G)

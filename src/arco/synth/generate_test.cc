@@ -56,14 +56,14 @@ TEST_P(GenerateTruth, FingertipOnTheStringAtThePitchesContactPoint) {
   ASSERT_TRUE(model.ok());
   const int n_capture = static_cast<int>(c.points3d.shape[1]) - 13;
   ASSERT_EQ(static_cast<int>(c.keypoint_names.size()), n_capture);
-  EXPECT_EQ(c.keypoint_names[kNumBodyPoints + 1], "nut_l");
+  EXPECT_EQ(c.keypoint_names[wholebody::kNumPoints + 1], "nut_l");
   ASSERT_GT(c.pressed_frames, c.num_frames / 4);
   for (int f = 0; f < c.num_frames; ++f) {
     const ContactTruth& ct = c.contact[static_cast<size_t>(f)];
     if (ct.finger == 0) continue;
     // 1. The playing fingertip is at the contact point (< 0.1 mm).
-    const Eigen::Vector3d tip =
-        Point(c, f, kLeftHandFirst + hand::TipKeypoint(static_cast<hand::Finger>(ct.finger)));
+    const Eigen::Vector3d tip = Point(
+        c, f, wholebody::kLeftHandFirst + hand::TipKeypoint(static_cast<hand::Finger>(ct.finger)));
     EXPECT_LT((tip - ct.point_mm).norm(), 0.1) << "frame " << f;
     // 2. The contact point lies on the string (strings stored nut, bridge; lowest first)...
     const int k = model->num_strings() - ct.string;
@@ -91,7 +91,8 @@ TEST_P(GenerateTruth, HandsWithinJointLimitsAndConsistentWithTheirModel) {
     EXPECT_EQ(hand::CountLimitViolations(left, c.left_hand[static_cast<size_t>(f)]), 0) << f;
     EXPECT_EQ(hand::CountLimitViolations(right, c.right_hand[static_cast<size_t>(f)]), 0) << f;
     const auto pts = hand::ForwardKinematics(left, c.left_hand[static_cast<size_t>(f)]);
-    for (int k = 0; k < 21; ++k) EXPECT_LT((pts[k] - Point(c, f, kLeftHandFirst + k)).norm(), 1e-9);
+    for (int k = 0; k < 21; ++k)
+      EXPECT_LT((pts[k] - Point(c, f, wholebody::kLeftHandFirst + k)).norm(), 1e-9);
     EXPECT_LT((Point(c, f, 9) - pts[0]).norm(), 1e-9);  // body wrist = hand wrist
     // Idle fingertips hover above the string plane, never through it.
     const Eigen::Matrix4d& m = c.world_from_instrument[static_cast<size_t>(f)];
@@ -190,9 +191,9 @@ TEST(Generate, CleanDetectionsAreTheProjectionsExceptTheBiasedFinger) {
   int biased = 0;
   for (int f = 0; f < c->num_frames; ++f) {
     const ContactTruth& ct = c->contact[static_cast<size_t>(f)];
-    const int tip = ct.finger > 0
-                        ? kLeftHandFirst + hand::TipKeypoint(static_cast<hand::Finger>(ct.finger))
-                        : -1;
+    const int tip = ct.finger > 0 ? wholebody::kLeftHandFirst +
+                                        hand::TipKeypoint(static_cast<hand::Finger>(ct.finger))
+                                  : -1;
     for (int v = 0; v < static_cast<int>(c->rig_mm.cameras.size()); ++v) {
       for (int p = 0; p < static_cast<int>(c->keypoints2d.shape[2]); ++p) {
         const auto px = c->rig_mm.cameras[static_cast<size_t>(v)].Project(Point(*c, f, p));

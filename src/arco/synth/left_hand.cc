@@ -83,7 +83,7 @@ LeftHandAnimator::LeftHandAnimator(const hand::HandModel& model,
   }
   // Anchors per note and the glide into each note.
   int max_offset = 0;
-  for (const FingerSpan& s : HandFrameFor(instrument.name())) {
+  for (const FingerSpan& s : GetInstrumentInfo(instrument.kind()).hand_frame) {
     if (!s.extended) max_offset = std::max(max_offset, s.offset_semitones);
   }
   const int n = instrument.num_strings();
@@ -200,7 +200,7 @@ LeftHandFrame LeftHandAnimator::Next(double t) {
     hover.seed_levels = 0;
     hover.max_iterations = 25;
     const int position = hn.fingering.position_semitones;
-    for (const FingerSpan& span : HandFrameFor(instrument_.name())) {
+    for (const FingerSpan& span : GetInstrumentInfo(instrument_.kind()).hand_frame) {
       if (span.extended || (pressed && span.finger == hn.fingering.finger)) continue;
       const double x = PlaceX(position + span.offset_semitones);
       const Eigen::Vector3d target(x, StringY(hand_string, x), options_.hover_mm);

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <vector>
 
+#include "arco/util/stats.h"
+
 namespace arco::synth {
 
 // Measured on ../shared/data/spd/cello_1113_scale_camera.xml scaled by 695 mm /
@@ -45,8 +47,7 @@ double MedianCameraDistance(const Rig& rig, Eigen::Vector3d* focus_out) {
   std::vector<double> dist;
   for (const Camera& cam : rig.cameras) dist.push_back((cam.CenterInWorld() - focus).norm());
   if (dist.empty()) return 0;
-  std::nth_element(dist.begin(), dist.begin() + static_cast<long>(dist.size() / 2), dist.end());
-  return dist[dist.size() / 2];
+  return UpperMedianInPlace(dist.begin(), dist.end());
 }
 
 StatusOr<Stage> PlaceStage(const Rig& rig, const StageOptions& options) {

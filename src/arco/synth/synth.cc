@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "arco/hand/kinematics.h"
-#include "arco/mocap/keypoint_layout.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/synth/midi_reader.h"
 #include "arco/synth/synth_instrument.h"
 
@@ -87,17 +87,17 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
 
   // Layout: the SPD layout of the instrument, plus the 13 contact-stage extras in truth.
   const bool violin_like = kind == InstrumentKind::kViolin || kind == InstrumentKind::kViola;
-  cap.layout = violin_like ? "spd_violin" : "spd_cello";
+  cap.layout = GetInstrumentInfo(model.kind()).spd_layout;
   cap.truth_layout = cap.layout + "_contact";
   if (const KeypointLayout* layout = FindKeypointLayout(cap.layout))
     cap.keypoint_names = layout->names;
   ARCO_ASSIGN_OR_RETURN(const InstrumentTemplate tmpl, MakeInstrumentTemplate(model));
   const auto& inst_names = model.keypoint_names();
   cap.num_instrument_points = static_cast<int>(inst_names.size());
-  const int num_capture_points = kNumBodyPoints + cap.num_instrument_points;
+  const int num_capture_points = wholebody::kNumPoints + cap.num_instrument_points;
   const int num_truth_points = num_capture_points + kContactExtras;
-  const int frog = kNumBodyPoints + model.KeypointIndex("frog");
-  const int tip = kNumBodyPoints + model.KeypointIndex("tip");
+  const int frog = wholebody::kNumPoints + model.KeypointIndex("frog");
+  const int tip = wholebody::kNumPoints + model.KeypointIndex("tip");
 
   // Animators.
   const Rigid rest = InstrumentRestPose(kind, tmpl.scale);
@@ -145,7 +145,8 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     lw.wrist_in_world_mm = world_from_instrument * lh.pose.wrist_in_world_mm;
     cap.left_hand[static_cast<size_t>(fr)] = lw;
     const hand::HandPointsMm left_pts = hand::ForwardKinematics(left_model, lw);
-    for (int k = 0; k < 21; ++k) set(kLeftHandFirst + k, left_pts[k]);
+    for (int k = 0; k < wholebody::kNumHandPoints; ++k)
+      set(wholebody::kLeftHandFirst + k, left_pts[k]);
 
     // Bow and right hand.
     const BowFrame bf = bow.At(t);
@@ -155,19 +156,20 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     rw.wrist_in_world_mm = world_from_instrument * bf.right_hand.wrist_in_world_mm;
     cap.right_hand[static_cast<size_t>(fr)] = rw;
     const hand::HandPointsMm right_pts = hand::ForwardKinematics(right_model, rw);
-    for (int k = 0; k < 21; ++k) set(kRightHandFirst + k, right_pts[k]);
+    for (int k = 0; k < wholebody::kNumHandPoints; ++k)
+      set(wholebody::kRightHandFirst + k, right_pts[k]);
 
     // Instrument keypoints.
     for (int i = 0; i < cap.num_instrument_points; ++i) {
       const Eigen::Vector3d& p = tmpl.keypoints_mm[static_cast<size_t>(i)];
-      if (p.allFinite()) set(kNumBodyPoints + i, world_from_instrument * p);
+      if (p.allFinite()) set(wholebody::kNumPoints + i, world_from_instrument * p);
     }
     set(frog, world_from_instrument * bf.frog_mm);
     set(tip, world_from_instrument * bf.tip_mm);
 
     // Body from the wrists (performer frame).
     const Rigid performer_from_world = world_from_performer.Inverse();
-    std::array<Eigen::Vector3d, kNumBodyPoints> body;
+    std::array<Eigen::Vector3d, wholebody::kNumPoints> body;
     BodyKeypoints(torso,
                   performer_from_world * left_pts[0],
                   performer_from_world * right_pts[0],
@@ -200,7 +202,8 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
         set(num_capture_points + 9 + j,
             left_pts[hand::KeypointIndex(static_cast<hand::Finger>(lh.finger), j)]);
       }
-      df.bias_tip = kLeftHandFirst + hand::TipKeypoint(static_cast<hand::Finger>(lh.finger));
+      df.bias_tip =
+          wholebody::kLeftHandFirst + hand::TipKeypoint(static_cast<hand::Finger>(lh.finger));
       df.bias_dip = df.bias_tip - 1;
       df.bias_direction = world_from_instrument.rotation.col(2);
     }
@@ -226,7 +229,7 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
 
   DetectionLayout layout;
   layout.num_points = num_capture_points;
-  layout.instrument_first = kNumBodyPoints;
+  layout.instrument_first = wholebody::kNumPoints;
   layout.bow_points = {frog, tip};
   layout.torso_points = {5, 6, 11, 12};
   cap.keypoints2d = EmulateDetections(cap.rig_mm,

@@ -29,19 +29,7 @@ ScoreInstrument ScoreInstrumentFor(const InstrumentModel& model) {
   return s;
 }
 
-int GmProgramFor(InstrumentKind kind) {
-  switch (kind) {
-    case InstrumentKind::kViolin:
-      return 40;
-    case InstrumentKind::kViola:
-      return 41;
-    case InstrumentKind::kCello:
-      return 42;
-    case InstrumentKind::kDoubleBass:
-      return 43;
-  }
-  return 42;
-}
+int GmProgramFor(InstrumentKind kind) { return GetInstrumentInfo(kind).gm_program; }
 
 StatusOr<InstrumentTemplate> MakeInstrumentTemplate(const InstrumentModel& model) {
   InstrumentTemplate t;

@@ -1,4 +1,4 @@
-#include "arco/mocap/keypoint_layout.h"
+#include "arco/registry/keypoint_layout.h"
 
 #include <map>
 #include <string>
@@ -31,16 +31,17 @@ KeypointLayout Wholebody() {
              "right_wrist",   "left_hip",        "right_hip",    "left_knee",      "right_knee",
              "left_ankle",    "right_ankle",     "left_big_toe", "left_small_toe", "left_heel",
              "right_big_toe", "right_small_toe", "right_heel"};
-  for (int i = 0; i < 68; ++i) {
+  for (int i = 0; i < wholebody::kNumFace; ++i) {
     l.names.push_back((i < 10 ? "face_0" : "face_") + std::to_string(i));
   }
   for (const auto& n : HandNames("left_hand_")) l.names.push_back(n);
   for (const auto& n : HandNames("right_hand_")) l.names.push_back(n);
-  l.groups = {{"body", Range(0, 17)},
-              {"feet", Range(17, 23)},
-              {"face", Range(23, 91)},
-              {"left_hand", Range(91, 112)},
-              {"right_hand", Range(112, 133)}};
+  using namespace wholebody;
+  l.groups = {{"body", Range(kBodyFirst, kBodyFirst + kNumBody)},
+              {"feet", Range(kFeetFirst, kFeetFirst + kNumFeet)},
+              {"face", Range(kFaceFirst, kFaceFirst + kNumFace)},
+              {"left_hand", Range(kLeftHandFirst, kLeftHandFirst + kNumHandPoints)},
+              {"right_hand", Range(kRightHandFirst, kRightHandFirst + kNumHandPoints)}};
   return l;
 }
 
@@ -94,7 +95,7 @@ KeypointLayout Hand21() {
   KeypointLayout l;
   l.name = "hand_21";
   l.names = HandNames("");
-  l.groups = {{"hand", Range(0, 21)}};
+  l.groups = {{"hand", Range(0, wholebody::kNumHandPoints)}};
   return l;
 }
 
