@@ -14,7 +14,8 @@ TEST(FormatLabelViewsReport, RealLabelsScaledToTheCello) {
   pipeline::LabelViewsOptions o;
   o.calibration = kSpd + "cello_1113_scale_camera.xml";
   for (const char* s : {"21334181", "21334190", "21334211", "21334237"}) {
-    o.views.emplace_back(s, kSpd + "labels_frame128/cello_1113_scale_" + std::string(s) + "_128.json");
+    o.views.emplace_back(s,
+                         kSpd + "labels_frame128/cello_1113_scale_" + std::string(s) + "_128.json");
   }
   o.reference_string_length_mm = 695;
   auto r = pipeline::TriangulateLabelViews(o);

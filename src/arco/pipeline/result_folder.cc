@@ -49,16 +49,15 @@ Status WriteContactsCsv(const std::string& path,
       out << f << ',' << refine::ContactStateName(c.state) << ','
           << refine::ContactReasonName(c.reason) << ',' << (pressed ? c.string : 0) << ','
           << (pressed ? c.finger : 0) << ',' << c.note << ',' << Num(p.x()) << ',' << Num(p.y())
-          << ',' << Num(p.z()) << ',' << Num(pressed ? c.from_nut_mm : kNaN) << ','
-          << Num(c.f0_hz) << ',' << Num(c.confidence) << ',' << Num(c.tip_distance_vision_mm)
-          << ',' << Num(c.tip_distance_refined_mm) << ',' << open << '\n';
+          << ',' << Num(p.z()) << ',' << Num(pressed ? c.from_nut_mm : kNaN) << ',' << Num(c.f0_hz)
+          << ',' << Num(c.confidence) << ',' << Num(c.tip_distance_vision_mm) << ','
+          << Num(c.tip_distance_refined_mm) << ',' << open << '\n';
     }
     return Status::Ok();
   });
 }
 
-Status WriteFingeringCsv(const std::string& path,
-                         const std::vector<refine::NoteFingering>& rows) {
+Status WriteFingeringCsv(const std::string& path, const std::vector<refine::NoteFingering>& rows) {
   return AtomicWriteWith(path, [&](std::ostream& out) {
     out << kFingeringCsvHeader << '\n';
     for (const refine::NoteFingering& r : rows) {
@@ -272,11 +271,10 @@ Status ResultFolder::WriteInstrument(const InstrumentRecord& r) const {
 
 StatusOr<double> ResultFolder::ReadWorldUnitsPerMm() const {
   ARCO_ASSIGN_OR_RETURN(const Json manifest, ReadManifest());
-  const double s =
-      manifest.contains("stages") && manifest["stages"].contains(kInstrumentStage)
-          ? JsonNumberOrNaN(
-                manifest["stages"][kInstrumentStage].value("world_units_per_mm", Json()))
-          : kNaN;
+  const double s = manifest.contains("stages") && manifest["stages"].contains(kInstrumentStage)
+                       ? JsonNumberOrNaN(manifest["stages"][kInstrumentStage].value(
+                             "world_units_per_mm", Json()))
+                       : kNaN;
   if (!(s > 0)) {
     return Status::Error(ManifestPath() +
                          ": no instrument stage with world_units_per_mm (run `arco run` first)");
@@ -307,10 +305,11 @@ Status ResultFolder::WriteHand(const HandRecord& r) const {
   NpyArray<double> lengths;
   lengths.shape = {hand::kNumHandKeypoints};
   lengths.data.assign(r.bone_lengths_mm.begin(), r.bone_lengths_mm.end());
-  Json entry = {{"files", {{"hand_params", kHandParamsFile}, {"bone_lengths_mm", kBoneLengthsFile}}},
-                {"side", "left"},
-                {"units", "mm"},
-                {"summary", ToJson(r.summary)}};
+  Json entry = {
+      {"files", {{"hand_params", kHandParamsFile}, {"bone_lengths_mm", kBoneLengthsFile}}},
+      {"side", "left"},
+      {"units", "mm"},
+      {"summary", ToJson(r.summary)}};
   return WriteStageFolder(
       kHandStage,
       [&](const std::string& dir) -> Status {
@@ -452,8 +451,8 @@ StatusOr<std::vector<ContactRow>> ReadContactsCsv(const std::string& path) {
     const std::vector<std::string> cells = SplitCsv(line);
     const std::string where = path + ":" + std::to_string(line_number) + ": ";
     if (cells.size() < header.size()) {
-      return Status::Error(where + "expected " + std::to_string(header.size()) +
-                           " fields, found " + std::to_string(cells.size()));
+      return Status::Error(where + "expected " + std::to_string(header.size()) + " fields, found " +
+                           std::to_string(cells.size()));
     }
     auto cell = [&](const char* name) -> const std::string* {
       const auto it = col.find(name);

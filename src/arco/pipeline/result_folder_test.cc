@@ -74,7 +74,8 @@ TEST(ResultFolder, TriangulationWritesStageFolderAndKeepsOtherStages) {
   info.capture_dir = "cap";
   info.units = "m";
   info.summary = Summarize(raw);
-  ASSERT_TRUE(ResultFolder(result_dir).WriteTriangulation(m, *FindKeypointLayout("spd_cello"), raw, raw.points3d, info)
+  ASSERT_TRUE(ResultFolder(result_dir)
+                  .WriteTriangulation(m, *FindKeypointLayout("spd_cello"), raw, raw.points3d, info)
                   .ok());
   auto manifest = ResultFolder(result_dir).ReadManifest();
   ASSERT_TRUE(manifest.ok());
@@ -100,7 +101,8 @@ TEST(ResultFolder, TriangulationWritesStageFolderAndKeepsOtherStages) {
 }
 
 TEST(HandParams, RoundTrip) {
-  const refine::testing::Scene scene = refine::testing::MakeScene(InstrumentKind::kCello, {{2, 1, 2, 4}});
+  const refine::testing::Scene scene =
+      refine::testing::MakeScene(InstrumentKind::kCello, {{2, 1, 2, 4}});
   std::vector<std::optional<hand::HandPose>> hands = scene.input.vision_hand;
   hands[2].reset();
   const auto back = HandsFromParams(HandParams(hands), "x");

@@ -46,8 +46,8 @@ struct RunOptions {
 };
 
 struct StageTiming {
-  std::string name;     // triangulate, instrument, hands, pitch (when it ran), refine
-  double seconds = 0;   // wall time (informational, not in results)
+  std::string name;    // triangulate, instrument, hands, pitch (when it ran), refine
+  double seconds = 0;  // wall time (informational, not in results)
 };
 
 struct RunSummary {

@@ -21,9 +21,7 @@ Json ToJson(const HandStageSummary& s) {
 }
 
 Json ToJson(const PitchStageSummary& s) {
-  return {{"duration_s", s.duration_s},
-          {"voiced_fraction", s.voiced_fraction},
-          {"notes", s.notes}};
+  return {{"duration_s", s.duration_s}, {"voiced_fraction", s.voiced_fraction}, {"notes", s.notes}};
 }
 
 }  // namespace arco::pipeline

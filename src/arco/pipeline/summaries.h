@@ -51,7 +51,7 @@ struct HandStageSummary {
 Json ToJson(const HandStageSummary& summary);
 
 struct PitchStageSummary {
-  bool ran = false;  // false: the capture has no audio (a warning says so)
+  bool ran = false;   // false: the capture has no audio (a warning says so)
   std::string audio;  // the file tracked
   double duration_s = 0;
   double voiced_fraction = 0;
