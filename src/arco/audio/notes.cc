@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <stdexcept>
 
 #include "arco/registry/instruments.h"
@@ -282,11 +283,38 @@ Status WriteNotesCsv(const std::string& path, const NoteAnalysis& analysis) {
   std::stable_sort(
       rows.begin(), rows.end(), [](const Row& x, const Row& y) { return x.onset < y.onset; });
   return AtomicWriteWith(path, [&](std::ostream& out) {
-    out << "kind,onset_s,offset_s,median_f0_hz,midi_note,note_name,cents_from_et,"
-           "vibrato_rate_hz,vibrato_extent_cents,start_f0_hz,end_f0_hz\n";
+    out << kNotesCsvHeader << '\n';
     for (const Row& r : rows) out << r.text;
     return Status::Ok();
   });
+}
+
+StatusOr<std::vector<Note>> ReadNotesCsv(const std::string& path) {
+  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
+  // The columns read back: kind, onset_s, offset_s, median_f0_hz.
+  const std::string required(kNotesCsvHeader,
+                             std::string(kNotesCsvHeader).find(",midi_note"));
+  std::istringstream in(text);
+  std::string line;
+  if (!std::getline(in, line) || line.rfind(required, 0) != 0) {
+    return Status::Error(path + ": not a notes.csv (bad header)");
+  }
+  std::vector<Note> notes;
+  int line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.empty() || line.rfind("note,", 0) != 0) continue;
+    Note n;
+    if (std::sscanf(line.c_str(), "note,%lf,%lf,%lf", &n.onset_s, &n.offset_s, &n.median_f0_hz) !=
+            3 ||
+        !(std::isfinite(n.onset_s) && std::isfinite(n.offset_s) && n.offset_s >= n.onset_s &&
+          n.median_f0_hz > 0 && std::isfinite(n.median_f0_hz)) ||
+        (!notes.empty() && n.onset_s < notes.back().onset_s)) {
+      return Status::Error(path + ": line " + std::to_string(line_number) + ": malformed note row");
+    }
+    notes.push_back(n);
+  }
+  return notes;
 }
 
 }  // namespace arco::audio

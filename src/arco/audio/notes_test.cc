@@ -6,6 +6,9 @@
 #include <cmath>
 #include <functional>
 
+#include "arco/util/file_io.h"
+#include "arco/util/test_dir.h"
+
 namespace arco::audio {
 namespace {
 
@@ -121,6 +124,48 @@ TEST(NotesToMidi, BendsFollowThePitchInsideNotes) {
     EXPECT_NEAR(b.semitones * 100, 30 * std::sin(2 * M_PI * 5 * b.time_s), 1.0);
   }
   EXPECT_NEAR(max_bend, 0.30, 0.01);
+}
+
+TEST(ReadNotesCsv, ReadsBackTheNotesOfWriteNotesCsv) {
+  arco::testing::TempDir dir;
+  NoteAnalysis a;
+  Note n1;
+  n1.onset_s = 0.5;
+  n1.offset_s = 0.9;
+  n1.median_f0_hz = 220.0;
+  n1.midi_note = 57;
+  Note n2 = n1;
+  n2.onset_s = 1.0;
+  n2.offset_s = 1.5;
+  n2.median_f0_hz = 246.9;
+  a.notes = {n1, n2};
+  a.glides.push_back({0.9, 1.0, 220.0, 246.9});
+  const std::string path = dir / "notes.csv";
+  ASSERT_TRUE(WriteNotesCsv(path, a).ok());
+  const auto back = ReadNotesCsv(path);
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  ASSERT_EQ(back->size(), 2u);  // glides are not read back
+  EXPECT_DOUBLE_EQ((*back)[1].onset_s, 1.0);
+  EXPECT_DOUBLE_EQ((*back)[1].offset_s, 1.5);
+  EXPECT_DOUBLE_EQ((*back)[1].median_f0_hz, 246.9);
+}
+
+TEST(ReadNotesCsv, MalformedFilesNameTheFileAndLine) {
+  arco::testing::TempDir dir;
+  const std::string path = dir / "notes.csv";
+  EXPECT_FALSE(ReadNotesCsv(path).ok());  // missing
+  ASSERT_TRUE(AtomicWriteFile(path, "frame,time_s\n").ok());
+  EXPECT_FALSE(ReadNotesCsv(path).ok());
+  const std::string header = std::string(kNotesCsvHeader) + "\n";
+  for (const char* row : {"note,0.5,x,220\n", "note,0.5,0.4,220\n", "note,0.5,0.6,0\n"}) {
+    ASSERT_TRUE(AtomicWriteFile(path, header + row).ok());
+    const auto r = ReadNotesCsv(path);
+    ASSERT_FALSE(r.ok()) << row;
+    EXPECT_NE(r.status().message().find("notes.csv: line 2"), std::string::npos)
+        << r.status().message();
+  }
+  ASSERT_TRUE(AtomicWriteFile(path, header + "note,1.0,1.2,220\nnote,0.5,0.6,220\n").ok());
+  EXPECT_FALSE(ReadNotesCsv(path).ok());  // onsets out of order
 }
 
 }  // namespace

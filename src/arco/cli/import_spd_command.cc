@@ -3,13 +3,13 @@
 #include <memory>
 
 #include "arco/cli/command.h"
-#include "arco/cli/import_spd.h"
+#include "arco/pipeline/import_spd.h"
 
 namespace arco::cli {
 namespace {
 
 std::function<int()> Setup(CLI::App& app) {
-  auto o = std::make_shared<ImportSpdOptions>();
+  auto o = std::make_shared<pipeline::ImportSpdOptions>();
   CLI::App* sub = app.add_subcommand(
       "import-spd",
       "Turn SPD per-frame 2D keypoint folders (HUMAN_DIR/<serial>/<n>.json, bare NaN, "
@@ -40,7 +40,7 @@ std::function<int()> Setup(CLI::App& app) {
   sub->add_option("-o,--output", o->output_dir, "Capture folder to create (must not exist)")
       ->required();
   return [o]() {
-    auto r = ImportSpdCapture(*o);
+    auto r = pipeline::ImportSpdCapture(*o);
     if (!r.ok()) return PrintError(r.status().message());
     std::printf(
         "imported %lld frames x %lld views x %lld points (%lld files read, %lld missing -> NaN, "

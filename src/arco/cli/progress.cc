@@ -7,15 +7,28 @@
 namespace arco::cli {
 
 ProgressBar::ProgressBar(std::string label, int64_t total)
-    : label_(std::move(label)),
-      total_(total),
-      enabled_(::isatty(STDERR_FILENO) != 0),
-      start_(std::chrono::steady_clock::now()),
-      last_draw_(start_) {}
+    : label_(std::move(label)), enabled_(::isatty(STDERR_FILENO) != 0) {
+  if (total >= 0) SetTotal(total);
+}
 
 ProgressBar::~ProgressBar() { Finish(); }
 
-void ProgressBar::Add(int64_t done) {
+void ProgressBar::StartStage(int index, int count, const std::string& name) {
+  Finish();
+  label_ = name;
+  std::fprintf(stderr, "[%d/%d] %s\n", index, count, name.c_str());
+}
+
+void ProgressBar::SetTotal(int64_t total) {
+  Finish();
+  total_ = total;
+  done_ = 0;
+  last_draw_ = std::chrono::steady_clock::now();
+  active_ = true;
+}
+
+void ProgressBar::Advance(int64_t done) {
+  if (!active_) return;
   const int64_t now_done = done_.fetch_add(done) + done;
   if (!enabled_) return;
   const auto now = std::chrono::steady_clock::now();
@@ -37,8 +50,7 @@ void ProgressBar::Draw(int64_t done) {
 }
 
 void ProgressBar::Finish() {
-  if (finished_) return;
-  finished_ = true;
+  if (!active_.exchange(false)) return;
   if (!enabled_) return;
   std::lock_guard<std::mutex> lock(mutex_);
   Draw(done_.load());

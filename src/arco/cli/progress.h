@@ -1,5 +1,6 @@
-// A terminal progress bar on stderr, only drawn when stderr is a terminal
-// (so logs and CI output stay clean); thread-safe Update().
+// The terminal's progress (arco::Progress, util/progress.h): "[i/n] stage" lines and a
+// progress bar on stderr. The bar is only drawn when stderr is a terminal (so logs and CI
+// output stay clean); Advance() is thread-safe.
 #pragma once
 
 #include <atomic>
@@ -8,24 +9,34 @@
 #include <mutex>
 #include <string>
 
+#include "arco/util/progress.h"
+
 namespace arco::cli {
 
-class ProgressBar {
+class ProgressBar : public Progress {
  public:
-  ProgressBar(std::string label, int64_t total);
-  ~ProgressBar();
-  void Add(int64_t done = 1);
+  // With total >= 0 a bar labelled `label` starts at once; otherwise at SetTotal().
+  explicit ProgressBar(std::string label = "", int64_t total = -1);
+  ~ProgressBar() override;
+
+  // Ends the current bar and prints "[index/count] name"; later bars are labelled name.
+  void StartStage(int index, int count, const std::string& name) override;
+  // Ends the current bar and starts a new one of `total` units.
+  void SetTotal(int64_t total) override;
+  void Advance(int64_t done) override;
+  void Add(int64_t done = 1) { Advance(done); }
+  // Ends the current bar (its last state and a newline).
   void Finish();
 
  private:
   void Draw(int64_t done);
   std::string label_;
-  int64_t total_;
+  int64_t total_ = 0;
   std::atomic<int64_t> done_{0};
-  bool enabled_;
-  bool finished_ = false;
+  std::atomic<bool> active_{false};
+  const bool enabled_;
   std::mutex mutex_;
-  std::chrono::steady_clock::time_point start_, last_draw_;
+  std::chrono::steady_clock::time_point last_draw_;
 };
 
 }  // namespace arco::cli

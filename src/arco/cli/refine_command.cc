@@ -1,10 +1,12 @@
 // `arco refine RESULT --mode paper|arco|vision`: re-runs only the refinement on a result
-// folder written by `arco run` (run.h), e.g. after changing refinement options.
+// folder written by `arco run` (pipeline/refine_stage.h), e.g. after changing refinement
+// options.
 #include <cstdio>
 #include <memory>
 
 #include "arco/cli/command.h"
-#include "arco/cli/run.h"
+#include "arco/cli/report.h"
+#include "arco/pipeline/refine_stage.h"
 
 namespace arco::cli {
 namespace {
@@ -33,7 +35,7 @@ struct RefineArgs {
 };
 
 int RunRefine(const RefineArgs& a) {
-  RefineDirOptions o;
+  pipeline::RefineStageOptions o;
   o.result_dir = a.result;
   auto mode = refine::ParseRefineMode(a.mode);
   if (!mode.ok()) return PrintError(mode.status().message());
@@ -57,9 +59,9 @@ int RunRefine(const RefineArgs& a) {
   if (a.neighbour_shift_frames >= 0) o.refine.ik.neighbour_shift_frames = a.neighbour_shift_frames;
   if (a.straddle_s >= 0) o.refine.decode.boundaries.straddle_s = a.straddle_s;
   if (a.onset_tolerance_s >= 0) o.refine.decode.boundaries.onset_tolerance_s = a.onset_tolerance_s;
-  const Status valid = o.refine.Validate();
+  const Status valid = o.Validate();
   if (!valid.ok()) return PrintError(valid.message());
-  auto summary = RefineResultDir(o);
+  auto summary = pipeline::RunRefineStage(o);
   if (!summary.ok()) return PrintError(summary.status().message());
   std::printf("%s\nwrote %s/%s/\n",
               FormatRefineSummary(*summary).c_str(),

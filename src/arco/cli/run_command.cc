@@ -1,11 +1,12 @@
 // `arco run CAPTURE -o RESULT`: every stage from 2D keypoints and audio to the refined hand
-// (run.h), with progress per stage and a final summary.
+// (pipeline/run_capture.h), with progress per stage and a final summary.
 #include <cstdio>
 #include <memory>
 
 #include "arco/cli/command.h"
 #include "arco/cli/progress.h"
-#include "arco/cli/run.h"
+#include "arco/cli/report.h"
+#include "arco/pipeline/run_capture.h"
 
 namespace arco::cli {
 namespace {
@@ -17,33 +18,22 @@ struct RunArgs {
 };
 
 int RunRun(const RunArgs& a) {
-  RunOptions o;
+  pipeline::RunOptions o;
   o.capture_dir = a.capture;
   o.result_dir = a.output;
   o.num_threads = a.threads;
   o.refine.pitch.min_confidence = a.min_confidence;
-  std::unique_ptr<ProgressBar> bar;
-  std::string stage_name;
-  RunProgress progress;
-  progress.on_stage = [&](int index, int count, const std::string& name) {
-    if (bar) bar->Finish();
-    bar.reset();
-    stage_name = name;
-    std::fprintf(stderr, "[%d/%d] %s\n", index, count, name.c_str());
-  };
-  progress.on_total = [&](int64_t total) {
-    bar = std::make_unique<ProgressBar>(stage_name, total);
-  };
-  progress.on_advance = [&](int64_t done) {
-    if (bar) bar->Add(done);
-  };
-  auto summary = RunCapture(o, progress);
-  if (bar) bar->Finish();
+  ProgressBar progress;
+  auto summary = pipeline::RunCapture(o, progress);
+  progress.Finish();
   if (!summary.ok()) return PrintError(summary.status().message());
   double total_s = 0;
-  for (const StageReport& s : summary->stages) {
-    std::printf("%-12s %7.2f s  %s\n", s.name.c_str(), s.seconds, s.summary.c_str());
-    total_s += s.seconds;
+  for (const pipeline::StageTiming& t : summary->timings) {
+    std::printf("%-12s %7.2f s  %s\n",
+                t.name.c_str(),
+                t.seconds,
+                FormatStageLine(*summary, t).c_str());
+    total_s += t.seconds;
   }
   for (const auto& m : summary->methods) std::printf("%s\n", FormatRefineSummary(m).c_str());
   for (const std::string& w : summary->warnings) std::printf("warning: %s\n", w.c_str());

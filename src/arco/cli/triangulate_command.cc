@@ -5,7 +5,9 @@
 
 #include "arco/cli/command.h"
 #include "arco/cli/progress.h"
-#include "arco/cli/triangulate.h"
+#include "arco/cli/report.h"
+#include "arco/pipeline/label_views.h"
+#include "arco/pipeline/triangulate_stage.h"
 #include "arco/instrument/instrument_model.h"
 
 namespace arco::cli {
@@ -31,7 +33,7 @@ StatusOr<std::pair<std::string, std::string>> SplitAssignment(const std::string&
 }
 
 int RunViews(const Args& a) {
-  LabelViewsOptions o;
+  pipeline::LabelViewsOptions o;
   o.calibration = a.calibration;
   o.triangulation = a.t;
   o.ignore_distortion = a.ignore_distortion;
@@ -46,7 +48,7 @@ int RunViews(const Args& a) {
     if (!model.ok()) return PrintError("--scale-to: " + model.status().message());
     o.reference_string_length_mm = model->string_length_mm();
   }
-  auto result = TriangulateLabelViews(o);
+  auto result = pipeline::TriangulateLabelViews(o);
   if (!result.ok()) return PrintError(result.status().message());
   const Status written = WriteJsonFile(a.output, *result);
   if (!written.ok()) return PrintError(written.message());
@@ -55,8 +57,8 @@ int RunViews(const Args& a) {
   return 0;
 }
 
-int RunCapture(const Args& a) {
-  CaptureOptions o;
+int RunCaptureFolder(const Args& a) {
+  pipeline::TriangulateStageOptions o;
   o.capture_dir = a.capture_dir;
   o.result_dir = a.output;
   o.triangulation.point = a.t;
@@ -69,15 +71,10 @@ int RunCapture(const Args& a) {
     spec->max_gap_frames = a.max_gap_frames;
     o.filters.emplace_back(kv->first, *spec);
   }
-  std::unique_ptr<ProgressBar> bar;
+  ProgressBar bar("triangulate");
   const auto start = std::chrono::steady_clock::now();
-  auto summary = TriangulateCapture(
-      o,
-      [&](int64_t n) {
-        if (bar) bar->Add(n);
-      },
-      [&](int64_t frames) { bar = std::make_unique<ProgressBar>("triangulate", frames); });
-  if (bar) bar->Finish();
+  auto summary = pipeline::RunTriangulateStage(o, bar);
+  bar.Finish();
   if (!summary.ok()) return PrintError(summary.status().message());
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -168,7 +165,7 @@ std::function<int()> Setup(CLI::App& app) {
       return PrintError("give a CAPTURE_DIR, or --calibration CAL with --view CAMERA=LABELS");
     }
     if (!a->scale_instrument.empty()) return PrintError("--scale-to applies to labelled views");
-    return RunCapture(*a);
+    return RunCaptureFolder(*a);
   };
 }
 

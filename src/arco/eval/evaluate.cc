@@ -10,8 +10,8 @@
 
 #include "arco/audio/pitch_tracker.h"
 #include "arco/hand/kinematics.h"
-#include "arco/mocap/capture.h"
 #include "arco/mocap/keypoint_layout.h"
+#include "arco/pipeline/result_folder.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
 
@@ -20,22 +20,6 @@ namespace {
 
 // Stages in the order the ablation table lists them; others follow by name.
 const std::vector<std::string> kMethodOrder = {"triangulation", "vision", "paper", "arco"};
-
-std::vector<std::string> SplitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cell;
-  std::istringstream in(line);
-  while (std::getline(in, cell, ',')) out.push_back(cell);
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
-
-double ParseNumber(const std::string& s) {
-  if (s.empty() || s == "nan" || s == "NaN") return NAN;
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  return end && *end == '\0' ? v : NAN;
-}
 
 // Points of `array` (F, P, 3) re-indexed into `names` by keypoint name.
 StatusOr<PointSequence> ToSequence(const NpyArray<double>& array,
@@ -94,63 +78,31 @@ HandJointLimitsDeg DefaultLeftHandLimits() {
 }
 
 StatusOr<ContactTrack> ReadContactCsv(const std::string& path, int num_frames) {
-  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
-  std::istringstream in(text);
-  std::string line;
-  if (!std::getline(in, line)) return Status::Error(path + ": empty contact file");
-  const std::vector<std::string> header = SplitCsv(line);
-  std::map<std::string, size_t> col;
-  for (size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
-  for (const char* need :
-       {"frame", "string", "finger", "contact_x_mm", "contact_y_mm", "contact_z_mm"}) {
-    if (!col.count(need)) return Status::Error(path + ": no column '" + need + "'");
-  }
+  ARCO_ASSIGN_OR_RETURN(const std::vector<pipeline::ContactRow> rows,
+                        pipeline::ReadContactsCsv(path));
   ContactTrack t;
   t.string.assign(static_cast<size_t>(num_frames), 0);
   t.finger.assign(static_cast<size_t>(num_frames), 0);
   t.point_mm.assign(static_cast<size_t>(num_frames), Eigen::Vector3d::Constant(NAN));
-  int row = 1;
-  while (std::getline(in, line)) {
-    ++row;
-    if (line.empty()) continue;
-    const std::vector<std::string> cells = SplitCsv(line);
-    if (cells.size() < header.size())
-      return Status::Error(path + ": row " + std::to_string(row) + " is short");
-    const double frame = ParseNumber(cells[col["frame"]]);
-    const double string = ParseNumber(cells[col["string"]]);
-    const double finger = ParseNumber(cells[col["finger"]]);
-    if (std::isnan(frame) || std::isnan(string) || std::isnan(finger) || frame < 0 || string < 0 ||
-        string > 8 || finger < 0 || finger > 4) {
-      return Status::Error(path + ": row " + std::to_string(row) +
-                           " has a bad frame, string or finger");
-    }
-    if (frame >= num_frames) continue;
-    const auto f = static_cast<size_t>(frame);
-    t.string[f] = static_cast<int>(string);
-    t.finger[f] = static_cast<int>(finger);
-    t.point_mm[f] = Eigen::Vector3d(ParseNumber(cells[col["contact_x_mm"]]),
-                                    ParseNumber(cells[col["contact_y_mm"]]),
-                                    ParseNumber(cells[col["contact_z_mm"]]));
-    if (t.string[f] > 0 && (t.finger[f] == 0 || !t.point_mm[f].allFinite())) {
-      return Status::Error(path + ": row " + std::to_string(row) +
-                           " presses a string without a finger or point");
-    }
+  for (const pipeline::ContactRow& row : rows) {
+    if (row.frame >= num_frames) continue;
+    const auto f = static_cast<size_t>(row.frame);
+    t.string[f] = row.string;
+    t.finger[f] = row.finger;
+    t.point_mm[f] = row.point_mm;
   }
   return t;
 }
 
 StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
   EvalReport report;
-  ARCO_ASSIGN_OR_RETURN(const Json result, ReadResultManifest(r.result_dir));
-  if (!result.contains("stages") || !result["stages"].is_object()) {
-    return Status::Error(JoinPath(r.result_dir, "result.json") +
-                         ": no stages (run arco triangulate first)");
-  }
-  std::vector<std::string> result_names;
-  if (result.contains("keypoint_names"))
-    result_names = result["keypoint_names"].get<std::vector<std::string>>();
-  report.units = result.value("units", std::string("unknown"));
-  report.fps = result.value("fps", 30.0);
+  const pipeline::ResultFolder result(r.result_dir);
+  ARCO_ASSIGN_OR_RETURN(const std::vector<pipeline::PointStage> point_stages,
+                        result.PointStages());
+  ARCO_ASSIGN_OR_RETURN(const pipeline::ResultHeader header, result.ReadHeader());
+  const std::vector<std::string>& result_names = header.keypoint_names;
+  report.units = header.units;
+  report.fps = header.fps;
   if (report.units != "mm")
     report.warnings.push_back("result units are '" + report.units + "', not mm");
 
@@ -202,12 +154,10 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
                            std::to_string(r.truth_frames.size()) + " frames)");
     }
     if (result_names.empty()) {
-      return Status::Error(JoinPath(r.result_dir, "result.json") + ": no keypoint_names");
+      return Status::Error(result.ManifestPath() + ": no keypoint_names");
     }
-    const int64_t first =
-        result.contains("frames") ? result["frames"].value("first", int64_t{1}) : 1;
-    const int64_t count =
-        result.contains("frames") ? result["frames"].value("count", int64_t{0}) : 0;
+    const int64_t first = header.frame_first;
+    const int64_t count = header.frame_count;
     truth_names = result_names;
     truth = PointSequence(static_cast<int>(count), static_cast<int>(truth_names.size()));
     std::map<std::string, int> index;
@@ -257,23 +207,22 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
   for (int f = 0; f < truth_contact.num_frames(); ++f)
     report.contact_frames += truth_contact.pressed(f);
 
-  // Methods.
-  std::vector<std::string> stages;
+  // Methods: the stages with 3D points, in the ablation table's order, then by name.
+  std::vector<const pipeline::PointStage*> stages;
   for (const std::string& m : kMethodOrder) {
-    if (result["stages"].contains(m)) stages.push_back(m);
+    for (const pipeline::PointStage& p : point_stages) {
+      if (p.name == m) stages.push_back(&p);
+    }
   }
-  for (auto it = result["stages"].begin(); it != result["stages"].end(); ++it) {
-    if (std::find(stages.begin(), stages.end(), it.key()) == stages.end())
-      stages.push_back(it.key());
+  for (const pipeline::PointStage& p : point_stages) {
+    if (std::find(kMethodOrder.begin(), kMethodOrder.end(), p.name) == kMethodOrder.end())
+      stages.push_back(&p);
   }
-  for (const std::string& stage : stages) {
-    const Json& sj = result["stages"][stage];
-    if (!sj.contains("files") || !sj["files"].contains("points3d")) continue;
-    const std::string dir = JoinPath(r.result_dir, sj.value("dir", stage));
-    const std::string path = JoinPath(dir, sj["files"]["points3d"].get<std::string>());
+  for (const pipeline::PointStage* stage : stages) {
+    const std::string& path = stage->points3d_path;
     ARCO_ASSIGN_OR_RETURN(const NpyArray<double> rp, ReadNpy<double>(path));
     std::vector<std::string> names = result_names;
-    if (sj.contains("keypoint_names")) names = sj["keypoint_names"].get<std::vector<std::string>>();
+    if (!stage->keypoint_names.empty()) names = stage->keypoint_names;
     if (names.empty() && rp.shape.size() == 3 &&
         rp.shape[1] <= static_cast<int64_t>(truth_names.size())) {
       names.assign(truth_names.begin(), truth_names.begin() + rp.shape[1]);  // same layout prefix
@@ -284,13 +233,11 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
                            " frames but the truth has " + std::to_string(truth.num_frames));
     }
     std::optional<ContactTrack> contact;
-    if (sj["files"].contains("contact")) {
-      ARCO_ASSIGN_OR_RETURN(contact,
-                            ReadContactCsv(JoinPath(dir, sj["files"]["contact"].get<std::string>()),
-                                           truth.num_frames));
+    if (!stage->contacts_path.empty()) {
+      ARCO_ASSIGN_OR_RETURN(contact, ReadContactCsv(stage->contacts_path, truth.num_frames));
     }
-    report.methods.push_back(
-        EvaluateMethod(stage, truth, truth_contact, rs, contact ? &*contact : nullptr, options));
+    report.methods.push_back(EvaluateMethod(
+        stage->name, truth, truth_contact, rs, contact ? &*contact : nullptr, options));
   }
   if (report.methods.empty())
     return Status::Error(r.result_dir + ": no stage with 3D points to evaluate");
@@ -298,8 +245,7 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
 
   // Pitch.
   std::string pitch_path = r.pitch_csv;
-  if (pitch_path.empty() && FileExists(JoinPath(r.result_dir, "pitch.csv")))
-    pitch_path = JoinPath(r.result_dir, "pitch.csv");
+  if (pitch_path.empty() && FileExists(result.PitchPath())) pitch_path = result.PitchPath();
   if (!pitch_path.empty() && !truth_f0.empty()) {
     ARCO_ASSIGN_OR_RETURN(const std::vector<audio::PitchFrame> est,
                           audio::ReadPitchCsv(pitch_path));

@@ -140,54 +140,5 @@ TEST(CaptureKeypoints, ShapeIsCheckedAndDroppedFramesBecomeNaN) {
   EXPECT_NE(r.status().message().find("(4, 2, 142, 3)"), std::string::npos);
 }
 
-TEST(TriangulationResult, WritesStageFolderAndKeepsOtherStages) {
-  TempDir dir;
-  const std::string result_dir = dir / "result";
-  ASSERT_TRUE(MakeDirectories(result_dir).ok());
-  ASSERT_TRUE(
-      WriteJsonFile(result_dir + "/result.json",
-                    Json{{"format", "arco-result"}, {"stages", {{"arco", {{"dir", "arco"}}}}}})
-          .ok());
-  const CaptureManifest m = SampleManifest();
-  SequenceTriangulation raw;
-  raw.points3d.shape = {4, 142, 3};
-  raw.points3d.data.assign(4 * 142 * 3, 1.0);
-  raw.rms_reprojection_px.shape = {4, 142};
-  raw.rms_reprojection_px.data.assign(4 * 142, 2.0f);
-  raw.num_inliers.shape = raw.num_views.shape = {4, 142};
-  raw.num_inliers.data.assign(4 * 142, 2);
-  raw.num_views.data.assign(4 * 142, 2);
-  raw.inlier_mask.shape = {4, 142, 2};
-  raw.inlier_mask.data.assign(4 * 142 * 2, 1);
-  TriangulationStageInfo info;
-  info.capture_dir = "cap";
-  info.units = "m";
-  info.summary = Summarize(raw);
-  ASSERT_TRUE(WriteTriangulationResult(
-                  result_dir, m, *FindKeypointLayout("spd_cello"), raw, raw.points3d, info)
-                  .ok());
-  auto manifest = ReadResultManifest(result_dir);
-  ASSERT_TRUE(manifest.ok());
-  EXPECT_TRUE((*manifest)["stages"].contains("arco"));
-  EXPECT_EQ((*manifest)["stages"]["triangulation"]["summary"]["triangulated"], 568);
-  EXPECT_EQ((*manifest)["keypoint_names"].size(), 142u);
-  auto points = ReadResultPoints3d(result_dir, "triangulation");
-  ASSERT_TRUE(points.ok());
-  EXPECT_EQ(points->shape, raw.points3d.shape);
-  for (const char* f : {"points3d_raw.npy",
-                        "reprojection_rms_px.npy",
-                        "inlier_count.npy",
-                        "view_count.npy",
-                        "inlier_mask.npy"}) {
-    EXPECT_TRUE(FileExists(result_dir + "/triangulation/" + f)) << f;
-  }
-  int entries = 0;
-  for (const auto& e : std::filesystem::directory_iterator(result_dir)) {
-    (void)e;
-    ++entries;
-  }
-  EXPECT_EQ(entries, 2);  // result.json and triangulation/, no temporary folder left
-}
-
 }  // namespace
 }  // namespace arco

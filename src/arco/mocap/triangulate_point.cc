@@ -277,4 +277,16 @@ std::optional<TriangulatedPoint> TriangulateRobust(const Rig& rig,
   return Triangulator(rig, options).Triangulate(views);
 }
 
+Json ToJson(const TriangulationOptions& o) {
+  return {{"min_score", o.min_score},
+          {"max_reprojection_px", o.max_reprojection_px},
+          {"max_ransac_trials", o.max_ransac_trials},
+          {"ransac_confidence", o.ransac_confidence},
+          {"seed", o.seed},
+          {"weight_by_score", o.weight_by_score},
+          {"refine", o.refine},
+          {"robust_loss_scale_px", o.robust_loss_scale_px},
+          {"max_refine_iterations", o.max_refine_iterations}};
+}
+
 }  // namespace arco

@@ -21,6 +21,7 @@
 
 #include "arco/camera/rig.h"
 #include "arco/geometry/triangulation.h"
+#include "arco/util/json_io.h"
 #include "arco/util/status.h"
 
 namespace arco {
@@ -37,6 +38,9 @@ struct TriangulationOptions {
   int max_refine_iterations = 20;
   Status Validate() const;  // readable message on a bad value or combination
 };
+
+// Every field by its name (recorded with results).
+Json ToJson(const TriangulationOptions& options);
 
 // One 2D detection of the keypoint in one camera of the rig.
 struct PointObservation {

@@ -19,7 +19,7 @@ StatusOr<SequenceTriangulation> TriangulateSequence(const Rig& rig,
                                                     const std::vector<int>& view_to_camera,
                                                     const NpyArray<double>& keypoints2d,
                                                     const SequenceTriangulationOptions& options,
-                                                    const std::function<void(int64_t)>& progress,
+                                                    Progress* progress,
                                                     const std::string& source) {
   ARCO_RETURN_IF_ERROR(options.Validate());
   const auto& shape = keypoints2d.shape;
@@ -92,7 +92,7 @@ StatusOr<SequenceTriangulation> TriangulateSequence(const Rig& rig,
             out.inlier_mask.data[fp * num_views + camera_to_view[c]] = 1;
           }
         }
-        if (progress) progress(1);
+        if (progress) progress->Advance(1);
       },
       /*chunk=*/1);
   return out;
@@ -118,6 +118,14 @@ SequenceTriangulationSummary Summarize(const SequenceTriangulation& result) {
     s.mean_inliers = static_cast<double>(inliers) / static_cast<double>(rms.size());
   }
   return s;
+}
+
+Json ToJson(const SequenceTriangulationSummary& s) {
+  return {{"frames", s.frames},
+          {"points", s.points},
+          {"triangulated", s.triangulated},
+          {"median_rms_reprojection_px", JsonFromDouble(s.median_rms_reprojection_px)},
+          {"mean_inliers", s.mean_inliers}};
 }
 
 }  // namespace arco

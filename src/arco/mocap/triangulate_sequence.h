@@ -8,12 +8,13 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <vector>
 
 #include "arco/camera/rig.h"
 #include "arco/mocap/triangulate_point.h"
+#include "arco/util/json_io.h"
 #include "arco/util/npy.h"
+#include "arco/util/progress.h"
 #include "arco/util/status.h"
 
 namespace arco {
@@ -41,17 +42,20 @@ struct SequenceTriangulationSummary {
 };
 
 // `keypoints2d` is (F, V, P, 3); `view_to_camera[v]` is the rig camera of view v.
-// `progress`, when set, is called with the number of frames just finished (from
-// worker threads; it must be thread-safe). Errors: shape mismatches and view indices
+// `progress`, when set, is advanced by the number of frames just finished (from worker
+// threads). Errors: shape mismatches and view indices
 // outside the rig are returned as a Status naming `source`.
 StatusOr<SequenceTriangulation> TriangulateSequence(
     const Rig& rig,
     const std::vector<int>& view_to_camera,
     const NpyArray<double>& keypoints2d,
     const SequenceTriangulationOptions& options,
-    const std::function<void(int64_t frames_done)>& progress = {},
+    Progress* progress = nullptr,
     const std::string& source = "keypoints2d");
 
 SequenceTriangulationSummary Summarize(const SequenceTriangulation& result);
+
+// {frames, points, triangulated, median_rms_reprojection_px (null when NaN), mean_inliers}.
+Json ToJson(const SequenceTriangulationSummary& summary);
 
 }  // namespace arco

@@ -37,11 +37,13 @@ TEST(TriangulateSequence, RecoversTruthWithOutliersAndOcclusions) {
   const Scene s = MakeScene(20, 6, 40, 0.05, 0.2);
   SequenceTriangulationOptions options;
   options.num_threads = 2;
-  std::atomic<int64_t> frames_done{0};
-  auto r = TriangulateSequence(
-      s.rig, s.view_to_camera, s.detections, options, [&](int64_t n) { frames_done += n; });
+  struct CountFrames : Progress {
+    std::atomic<int64_t> frames_done{0};
+    void Advance(int64_t n) override { frames_done += n; }
+  } progress;
+  auto r = TriangulateSequence(s.rig, s.view_to_camera, s.detections, options, &progress);
   ASSERT_TRUE(r.ok()) << r.status().message();
-  EXPECT_EQ(frames_done.load(), 6);
+  EXPECT_EQ(progress.frames_done.load(), 6);
   ASSERT_EQ(r->points3d.shape, (std::vector<int64_t>{6, 40, 3}));
   double max_err = 0;
   for (int64_t f = 0; f < 6; ++f) {

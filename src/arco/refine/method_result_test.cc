@@ -2,16 +2,11 @@
 
 #include <gtest/gtest.h>
 
-#include <filesystem>
-#include <fstream>
 
 #include "arco/hand/kinematics.h"
-#include "arco/mocap/capture.h"
 #include "arco/mocap/keypoint_layout.h"
 #include "arco/refine/refine.h"
 #include "arco/refine/test_scene.h"
-#include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::refine {
 namespace {
@@ -68,100 +63,6 @@ TEST(BuildSpdPoints, SpdLayoutWithStringsContactAndPlayingFinger) {
     EXPECT_TRUE(std::isnan(v.at(5, extra + 8, 0)));
     EXPECT_EQ(v.at(5, extra, 0), strings[3].nut.x());
   }
-}
-
-TEST(HandParams, RoundTrip) {
-  const testing::Scene scene = testing::MakeScene(InstrumentKind::kCello, {{2, 1, 2, 4}});
-  std::vector<std::optional<hand::HandPose>> hands = scene.input.vision_hand;
-  hands[2].reset();
-  const auto back = HandsFromParams(HandParams(hands), "x");
-  ASSERT_TRUE(back.ok());
-  ASSERT_EQ(back->size(), 4u);
-  EXPECT_FALSE((*back)[2].has_value());
-  const auto p0 = hand::ForwardKinematics(scene.input.hand_model, *hands[0]);
-  const auto q0 = hand::ForwardKinematics(scene.input.hand_model, *(*back)[0]);
-  for (int k = 0; k < 21; ++k) EXPECT_LT((p0[k] - q0[k]).norm(), 1e-9);
-  NpyArray<double> bad;
-  bad.shape = {3, 25};
-  bad.data.assign(75, 0.0);
-  EXPECT_FALSE(HandsFromParams(bad, "bad.npy").ok());
-}
-
-TEST(WriteMethodResult, WritesTheFolderAndTheManifestAndReadsBack) {
-  arco::testing::TempDir dir;
-  const testing::Scene scene =
-      testing::MakeScene(InstrumentKind::kCello, {{0, 0, 0, 2}, {2, 2, 3, 8}});
-  RefineOptions o;
-  const RefineResult r = Refine(scene.input, o);
-  MethodOutput out;
-  out.method = "arco";
-  out.layout = SpdContactLayoutName(*scene.model);
-  out.points3d = BuildSpdPoints(SourcesFor(scene), r.hand, &r.contacts);
-  out.hands = r.hand;
-  out.contacts = r.contacts;
-  out.fingering = r.fingering;
-  out.summary = {{"pressed", r.summary.pressed}};
-  ASSERT_TRUE(WriteMethodResult(dir.path(), out).ok());
-  const auto manifest = ReadResultManifest(dir.path());
-  ASSERT_TRUE(manifest.ok()) << manifest.status().message();
-  EXPECT_EQ((*manifest)["stages"]["arco"]["layout"], "spd_cello_contact");
-  EXPECT_EQ((*manifest)["stages"]["arco"]["summary"]["pressed"], 8);
-  const auto points = ReadResultPoints3d(dir.path(), "arco");
-  ASSERT_TRUE(points.ok());
-  EXPECT_EQ(points->shape, out.points3d.shape);
-  const auto rows = ReadContactsCsv(dir / "arco/contacts.csv");
-  ASSERT_TRUE(rows.ok()) << rows.status().message();
-  ASSERT_EQ(rows->size(), 10u);
-  EXPECT_EQ((*rows)[0].state, "rest");
-  EXPECT_EQ((*rows)[4].state, "pressed");
-  EXPECT_EQ((*rows)[4].string, 2);
-  EXPECT_EQ((*rows)[4].finger, 2);
-  EXPECT_EQ((*rows)[4].point_mm, r.contacts[4].point_in_world_mm);  // exact round trip
-  EXPECT_TRUE(FileExists(dir / "arco/fingering.csv"));
-  // A second method keeps the first in the manifest; vision has no contacts.
-  out.method = "vision";
-  out.contacts.clear();
-  ASSERT_TRUE(WriteMethodResult(dir.path(), out).ok());
-  const auto m2 = ReadResultManifest(dir.path());
-  EXPECT_TRUE((*m2)["stages"].contains("arco"));
-  EXPECT_FALSE(FileExists(dir / "vision/contacts.csv"));
-}
-
-TEST(WriteMethodResult, FailsWholeWithoutPartialOutput) {
-  arco::testing::TempDir dir;
-  ASSERT_TRUE(AtomicWriteFile(dir / "file", "x").ok());
-  MethodOutput out;
-  out.method = "arco";
-  EXPECT_FALSE(WriteMethodResult(dir / "file", out).ok());  // the result folder is a file
-  ASSERT_TRUE(AtomicWriteFile(dir / "result.json", "{\"format\": \"other\"}").ok());
-  const Status s = WriteMethodResult(dir.path(), out);
-  EXPECT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("result.json"), std::string::npos) << s.message();
-  EXPECT_FALSE(FileExists(dir / "arco"));
-}
-
-TEST(ReadContactsCsv, MalformedFilesNameTheFileAndLine) {
-  arco::testing::TempDir dir;
-  EXPECT_FALSE(ReadContactsCsv(dir / "missing.csv").ok());
-  ASSERT_TRUE(AtomicWriteFile(dir / "a.csv", "frame,state\n").ok());
-  EXPECT_FALSE(ReadContactsCsv(dir / "a.csv").ok());
-  const std::string header = std::string(kContactsCsvHeader) + "\n";
-  ASSERT_TRUE(AtomicWriteFile(dir / "b.csv", header + "0,pressed,,1,2,0,1,2\n").ok());
-  const auto b = ReadContactsCsv(dir / "b.csv");
-  ASSERT_FALSE(b.ok());
-  EXPECT_NE(b.status().message().find("b.csv:2"), std::string::npos) << b.status().message();
-  ASSERT_TRUE(AtomicWriteFile(dir / "c.csv", header + "0,pressed,,1,2,0,x,2,3,4,5,6,7,8,0\n").ok());
-  EXPECT_FALSE(ReadContactsCsv(dir / "c.csv").ok());
-  ASSERT_TRUE(AtomicWriteFile(dir / "d.csv", header + "0,flying,,1,2,0,1,2,3,4,5,6,7,8,0\n").ok());
-  EXPECT_FALSE(ReadContactsCsv(dir / "d.csv").ok());
-  ASSERT_TRUE(AtomicWriteFile(dir / "e.csv", header + "0,pressed,,9,2,0,1,2,3,4,5,6,7,8,0\n").ok());
-  EXPECT_FALSE(ReadContactsCsv(dir / "e.csv").ok());
-  ASSERT_TRUE(AtomicWriteFile(dir / "f.csv",
-                              header + "0,rest,unvoiced,0,0,-1,nan,nan,nan,nan,0,0.1,nan,nan,0\n")
-                  .ok());
-  const auto f = ReadContactsCsv(dir / "f.csv");
-  ASSERT_TRUE(f.ok()) << f.status().message();
-  EXPECT_TRUE(std::isnan((*f)[0].point_mm.x()));
 }
 
 }  // namespace

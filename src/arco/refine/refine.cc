@@ -248,4 +248,33 @@ RefineResult Refine(const RefineInput& input, const RefineOptions& options) {
   return result;
 }
 
+Json ToJson(const RefineOptions& o) {
+  return {{"mode", RefineModeName(o.mode)},
+          {"min_confidence", o.pitch.min_confidence},
+          {"binding_cents", o.paper.binding_cents},
+          {"ik_joints",
+           hand::FingerIkJointsName(o.mode == RefineMode::kPaper ? hand::FingerIkJoints::kPipDip
+                                                                 : o.ik.joints)},
+          {"max_residual_mm", o.ik.max_residual_mm},
+          {"audio_onsets", o.mode == RefineMode::kArco && o.decode.audio_onsets}};
+}
+
+Json ToJson(const RefineSummary& s) {
+  return {{"frames", s.frames},
+          {"frames_with_hand", s.frames_with_hand},
+          {"pressed", s.pressed},
+          {"open_string", s.open_string},
+          {"rest", s.rest},
+          {"uncertain", s.uncertain},
+          {"notes", s.notes},
+          {"usable_notes", s.usable_notes},
+          {"corrected_frames", s.corrected_frames},
+          {"rejected_out_of_reach", s.rejected_out_of_reach},
+          {"before_onset", s.before_onset},
+          {"note_boundary", s.note_boundary},
+          {"mean_tip_distance_vision_mm", JsonFromDouble(s.mean_tip_distance_vision_mm)},
+          {"mean_tip_distance_refined_mm", JsonFromDouble(s.mean_tip_distance_refined_mm)},
+          {"joint_limit_violations", s.joint_limit_violations}};
+}
+
 }  // namespace arco::refine

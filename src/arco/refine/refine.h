@@ -16,6 +16,7 @@
 // the IK, which runs in parallel; results do not depend on the thread count.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -26,12 +27,14 @@
 #include "arco/refine/contact_annotation.h"
 #include "arco/refine/note_boundaries.h"
 #include "arco/refine/pitch_model.h"
+#include "arco/util/json_io.h"
 #include "arco/util/status.h"
 
 namespace arco::refine {
 
 struct RefineInput {
-  const InstrumentModel* instrument = nullptr;
+  // Owned (shared, immutable): an input stays valid however long it is kept or copied.
+  std::shared_ptr<const InstrumentModel> instrument;
   hand::HandModel hand_model = hand::HandModel::Default(hand::HandSide::kLeft);
   // Per frame (all three the same length): the strings in the world, index = string - 1
   // (empty: no instrument pose this frame); the fitted left hand; the pitch.
@@ -171,5 +174,14 @@ struct RefineResult {
 
 // Throws std::invalid_argument for invalid input or options (Validate() messages).
 RefineResult Refine(const RefineInput& input, const RefineOptions& options);
+
+// The options as the refinement applies them, recorded with a method's result: mode,
+// min_confidence, binding_cents, ik_joints (the paper always solves PIP and DIP),
+// max_residual_mm, audio_onsets (arco only).
+Json ToJson(const RefineOptions& options);
+
+// The counts and distances of a refinement recorded with a method's result (mean tip
+// distances null when NaN).
+Json ToJson(const RefineSummary& summary);
 
 }  // namespace arco::refine

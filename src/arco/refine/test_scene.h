@@ -43,7 +43,7 @@ struct SceneOptions {
 };
 
 struct Scene {
-  std::shared_ptr<const InstrumentModel> model;  // input.instrument points here (survives copies)
+  std::shared_ptr<const InstrumentModel> model;  // shared with input.instrument
   RefineInput input;
   std::vector<hand::HandPose> truth_hand;
   std::vector<int> truth_string, truth_finger;  // 0 = none
@@ -129,7 +129,7 @@ inline Scene MakeScene(InstrumentKind kind,
   Scene scene;
   scene.model = std::make_shared<const InstrumentModel>(InstrumentModel::Create(io).value());
   const InstrumentModel& model = *scene.model;
-  scene.input.instrument = scene.model.get();
+  scene.input.instrument = scene.model;
   const hand::HandModel hand_model = hand::HandModel::Default(hand::HandSide::kLeft);
   const std::vector<StringSegment> strings = StringsInInstrument(model);
   std::mt19937 rng(static_cast<uint32_t>(options.seed));

@@ -1,6 +1,6 @@
-// `arco run` / `arco refine` end to end on a short synthetic capture (arco synth, the real
+// RunCapture (`arco run`) and RunRefineStage (`arco refine`) end to end on a short synthetic capture (arco synth, the real
 // SPD rig), scored with arco eval's library.
-#include "arco/cli/run.h"
+#include "arco/pipeline/run_capture.h"
 
 #include <gtest/gtest.h>
 
@@ -10,12 +10,12 @@
 #include "arco/io/calibration_file.h"
 #include "arco/mocap/capture.h"
 #include "arco/util/test_dir.h"
-#include "arco/refine/method_result.h"
+#include "arco/pipeline/result_folder.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"
 #include "arco/util/file_io.h"
 
-namespace arco::cli {
+namespace arco::pipeline {
 namespace {
 
 namespace fs = std::filesystem;
@@ -60,12 +60,13 @@ TEST(RunCapture, EveryStageAndThreeMethodsThatEvalScores) {
   o.capture_dir = SyntheticCapture();
   o.result_dir = result;
   o.num_threads = 2;
-  std::vector<std::string> stages;
-  RunProgress progress;
-  progress.on_stage = [&](int, int, const std::string& name) { stages.push_back(name); };
+  struct Stages : Progress {
+    std::vector<std::string> names;
+    void StartStage(int, int, const std::string& name) override { names.push_back(name); }
+  } progress;
   auto summary = RunCapture(o, progress);
   ASSERT_TRUE(summary.ok()) << summary.status().message();
-  EXPECT_EQ(stages,
+  EXPECT_EQ(progress.names,
             (std::vector<std::string>{"triangulate", "instrument", "hands", "pitch", "refine"}));
   ASSERT_EQ(summary->methods.size(), 3u);
   for (const char* f : {"triangulation/points3d.npy",
@@ -79,7 +80,7 @@ TEST(RunCapture, EveryStageAndThreeMethodsThatEvalScores) {
                         "arco/fingering.csv"}) {
     EXPECT_TRUE(FileExists(JoinPath(result, f))) << f;
   }
-  auto points = ReadResultPoints3d(result, "arco");
+  auto points = ResultFolder(result).ReadPoints3d("arco");
   ASSERT_TRUE(points.ok());
   EXPECT_EQ(points->shape[1], 155);
 
@@ -112,11 +113,11 @@ TEST(RunCapture, EveryStageAndThreeMethodsThatEvalScores) {
   // `arco refine` reproduces the run's paper folder bit for bit.
   auto before = ReadFileToString(JoinPath(result, "paper/contacts.csv"));
   auto before_points = ReadFileToString(JoinPath(result, "paper/points3d.npy"));
-  RefineDirOptions r;
+  RefineStageOptions r;
   r.result_dir = result;
   r.refine.mode = refine::RefineMode::kPaper;
   r.refine.num_threads = 1;
-  ASSERT_TRUE(RefineResultDir(r).ok());
+  ASSERT_TRUE(RunRefineStage(r).ok());
   EXPECT_EQ(*before, *ReadFileToString(JoinPath(result, "paper/contacts.csv")));
   EXPECT_EQ(*before_points, *ReadFileToString(JoinPath(result, "paper/points3d.npy")));
   // ... and its arco folder (which reads notes.csv for the note boundaries).
@@ -124,13 +125,13 @@ TEST(RunCapture, EveryStageAndThreeMethodsThatEvalScores) {
   ASSERT_TRUE(arco_before.ok());
   EXPECT_NE(arco_before->find("note_boundary"), std::string::npos);
   r.refine.mode = refine::RefineMode::kArco;
-  ASSERT_TRUE(RefineResultDir(r).ok());
+  ASSERT_TRUE(RunRefineStage(r).ok());
   EXPECT_EQ(*arco_before, *ReadFileToString(JoinPath(result, "arco/contacts.csv")));
   // A malformed notes.csv is one clear error naming the file; the folder stays as it was.
   ASSERT_TRUE(AtomicWriteFile(JoinPath(result, "notes.csv"),
                               "kind,onset_s,offset_s,median_f0_hz\nnote,0.5,x,220\n")
                   .ok());
-  auto bad = RefineResultDir(r);
+  auto bad = RunRefineStage(r);
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find("notes.csv: line 2"), std::string::npos)
       << bad.status().message();
@@ -147,9 +148,9 @@ TEST(RunCapture, BadInputIsOneClearError) {
   EXPECT_NE(missing.status().message().find("missing"), std::string::npos);
   EXPECT_FALSE(FileExists(out / "result"));
 
-  RefineDirOptions r;
+  RefineStageOptions r;
   r.result_dir = out.path();
-  auto empty = RefineResultDir(r);
+  auto empty = RunRefineStage(r);
   ASSERT_FALSE(empty.ok());
   EXPECT_NE(empty.status().message().find("arco run"), std::string::npos)
       << empty.status().message();
@@ -168,10 +169,10 @@ TEST(RunCapture, BadInputIsOneClearError) {
   ASSERT_FALSE(silent->warnings.empty());
   r.result_dir = o.result_dir;
   r.refine.mode = refine::RefineMode::kArco;
-  auto no_pitch = RefineResultDir(r);
+  auto no_pitch = RunRefineStage(r);
   ASSERT_FALSE(no_pitch.ok());
   EXPECT_NE(no_pitch.status().message().find("pitch"), std::string::npos);
 }
 
 }  // namespace
-}  // namespace arco::cli
+}  // namespace arco::pipeline

@@ -1,25 +1,20 @@
-// The work behind `arco triangulate` (triangulate_command.cc parses argv into these
-// options; tests call these functions directly).
-//
-// Two modes:
-//  - labelled views: one labelme file per camera -> one JSON file of 3D points;
-//  - a capture folder (docs/formats.md) -> a result folder with whole sequences.
+// Labelled views triangulated: one labelme file per camera -> 3D points as JSON
+// (`arco triangulate --calibration CAL --view CAMERA=LABELS ...`; the truth of
+// `arco eval` on real recordings). A capture folder's sequences are stage 1 of the
+// pipeline (pipeline/triangulate_stage.h).
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "arco/mocap/capture.h"
 #include "arco/mocap/labelme.h"
-#include "arco/mocap/temporal_filter.h"
 #include "arco/mocap/triangulate_point.h"
 #include "arco/util/json_io.h"
 #include "arco/util/status.h"
 
-namespace arco::cli {
+namespace arco::pipeline {
 
 struct LabelViewsOptions {
   std::string calibration;  // any calibration format LoadCalibration reads
@@ -43,28 +38,4 @@ struct LabelViewsOptions {
 // label triangulated at all.
 StatusOr<Json> TriangulateLabelViews(const LabelViewsOptions& options);
 
-// Human-readable report of TriangulateLabelViews' JSON (for the terminal and the demo).
-std::string FormatLabelViewsReport(const Json& result);
-
-struct CaptureOptions {
-  std::string capture_dir;
-  std::string result_dir;
-  SequenceTriangulationOptions triangulation;
-  // (group, filter) applied in order; later entries win for points in several groups.
-  std::vector<std::pair<std::string, TemporalFilterOptions>> filters;
-};
-
-struct CaptureRunSummary {
-  SequenceTriangulationSummary triangulation;
-  std::string units;
-  int64_t views = 0;
-  int64_t keypoints = 0;
-};
-
-// Reads CAPTURE_DIR, triangulates every frame, filters, writes RESULT_DIR (see
-// mocap/capture.h). `progress(frames_done)` is called from worker threads.
-StatusOr<CaptureRunSummary> TriangulateCapture(const CaptureOptions& options,
-                                               const std::function<void(int64_t)>& progress = {},
-                                               const std::function<void(int64_t)>& on_start = {});
-
-}  // namespace arco::cli
+}  // namespace arco::pipeline

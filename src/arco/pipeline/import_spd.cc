@@ -1,4 +1,4 @@
-#include "arco/cli/import_spd.h"
+#include "arco/pipeline/import_spd.h"
 
 #include <unistd.h>
 
@@ -8,13 +8,13 @@
 #include "arco/mocap/capture.h"
 #include "arco/util/file_io.h"
 
-namespace arco::cli {
+namespace arco::pipeline {
 namespace {
 namespace fs = std::filesystem;
 }  // namespace
 
 StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
-  if (o.output_dir.empty()) return Status::Error("no output folder given");
+  if (o.output_dir.empty()) return Status::Error("output_dir is empty");
   std::error_code ec;
   if (fs::exists(o.output_dir, ec) &&
       (!fs::is_directory(o.output_dir, ec) || !fs::is_empty(o.output_dir, ec))) {
@@ -35,7 +35,7 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
   }
   if (spd.frame_first <= 0 || spd.frame_last <= 0) {
     return Status::Error(
-        "give the frame range (--first/--last) or a summary with StartFrame and "
+        "give the frame range (frame_first, frame_last) or a summary with StartFrame and "
         "EndFrame");
   }
   // Views: the serials given, else every calibrated camera with a keypoint folder.
@@ -120,4 +120,4 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
   return out;
 }
 
-}  // namespace arco::cli
+}  // namespace arco::pipeline

@@ -1,5 +1,5 @@
-// `arco import-spd`: turns SPD per-frame 2D keypoint folders (mocap/spd_import.h) into
-// an arco capture folder (docs/formats.md) that `arco triangulate CAPTURE_DIR` reads.
+// SPD per-frame 2D keypoint folders (mocap/spd_import.h) -> an arco capture folder
+// (docs/formats.md) that the pipeline reads (`arco import-spd`).
 #pragma once
 
 #include <cstdint>
@@ -9,7 +9,7 @@
 #include "arco/mocap/spd_import.h"
 #include "arco/util/status.h"
 
-namespace arco::cli {
+namespace arco::pipeline {
 
 struct ImportSpdOptions {
   std::string calibration;           // copied into the capture; gives camera names and serials
@@ -35,4 +35,4 @@ struct ImportSpdSummary {
 // a temporary folder and renamed into place, so nothing is left on error.
 StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& options);
 
-}  // namespace arco::cli
+}  // namespace arco::pipeline

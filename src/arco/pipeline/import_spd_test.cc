@@ -1,17 +1,19 @@
-#include "arco/cli/import_spd.h"
+#include "arco/pipeline/import_spd.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 
-#include "arco/cli/triangulate.h"
+#include "arco/pipeline/label_views.h"
+#include "arco/pipeline/result_folder.h"
+#include "arco/pipeline/triangulate_stage.h"
 #include "arco/io/calibration_file.h"
 #include "arco/mocap/synthetic_views.h"
 #include "arco/util/test_dir.h"
 #include "arco/util/file_io.h"
 
-namespace arco::cli {
+namespace arco::pipeline {
 namespace {
 
 using arco::testing::TempDir;
@@ -72,13 +74,13 @@ TEST(ImportSpdCapture, SpdFoldersToCaptureToTriangulation) {
   EXPECT_EQ(manifest->cameras[2].dropped_frames, (std::vector<int64_t>{11}));
   EXPECT_EQ(manifest->VideoFrameNumber(2, 12), 11);
 
-  CaptureOptions t;
+  TriangulateStageOptions t;
   t.capture_dir = o.output_dir;
   t.result_dir = dir / "result";
-  auto run = TriangulateCapture(t);
+  auto run = RunTriangulateStage(t);
   ASSERT_TRUE(run.ok()) << run.status().message();
   EXPECT_EQ(run->triangulation.triangulated, 3 * 142);
-  auto points = ReadResultPoints3d(t.result_dir, "triangulation");
+  auto points = ResultFolder(t.result_dir).ReadPoints3d(kTriangulationStage);
   ASSERT_TRUE(points.ok());
   double worst = 0;
   for (size_t i = 0; i < points->data.size(); ++i) {
@@ -105,4 +107,4 @@ TEST(ImportSpdCapture, SpdFoldersToCaptureToTriangulation) {
 }
 
 }  // namespace
-}  // namespace arco::cli
+}  // namespace arco::pipeline

@@ -1,0 +1,41 @@
+#include "arco/pipeline/capture_context.h"
+
+#include "arco/hand/hand_model.h"
+#include "arco/util/file_io.h"
+
+namespace arco::pipeline {
+namespace {
+
+constexpr int kLeftHandFirst = 91;  // TODO(registry)
+
+}  // namespace
+
+StatusOr<CaptureContext> OpenCapture(const std::string& capture_dir) {
+  CaptureContext c;
+  c.capture_dir = capture_dir;
+  ARCO_ASSIGN_OR_RETURN(c.manifest, ReadCaptureManifest(capture_dir));
+  const std::string where = JoinPath(capture_dir, kCaptureManifestName);
+  ARCO_ASSIGN_OR_RETURN(c.layout, c.manifest.Layout());
+  if (c.manifest.instrument == "none" || c.manifest.instrument.empty()) {
+    return Status::Error(where + ": the capture names no instrument; arco run needs one");
+  }
+  ARCO_ASSIGN_OR_RETURN(InstrumentKind kind, ParseInstrumentKind(c.manifest.instrument));
+  InstrumentOptions io;
+  io.kind = kind;
+  io.tuning.a4_hz = c.manifest.tuning_a4_hz;
+  StatusOr<InstrumentModel> model = InstrumentModel::Create(io);
+  if (!model.ok()) return model.status().WithContext(where);
+  c.instrument = std::make_shared<const InstrumentModel>(std::move(model).value());
+  for (const std::string& name : c.instrument->keypoint_names()) {
+    if (c.layout.Find(name) < 0) {
+      return Status::Error(where + ": layout " + c.layout.name + " has no instrument point " +
+                           name);
+    }
+  }
+  if (c.layout.size() < kLeftHandFirst + hand::kNumHandKeypoints) {
+    return Status::Error(where + ": layout " + c.layout.name + " has no whole-body hands");
+  }
+  return c;
+}
+
+}  // namespace arco::pipeline

@@ -1,0 +1,138 @@
+#include "arco/pipeline/hand_stage.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include "arco/io/calibration_file.h"
+#include "arco/pipeline/result_folder.h"
+#include "arco/util/parallel.h"
+
+namespace arco::pipeline {
+namespace {
+
+constexpr int kLeftHandFirst = 91;  // TODO(registry)
+
+Eigen::Vector3d PointAt(const NpyArray<double>& a, int64_t f, int64_t p) {
+  return Eigen::Vector3d(a.at(f, p, 0), a.at(f, p, 1), a.at(f, p, 2));
+}
+
+}  // namespace
+
+Status HandStageOptions::Validate() const {
+  if (result_dir.empty()) return Status::Error("result_dir is empty");
+  if (chunk_frames < 1) return Status::Error("chunk_frames must be >= 1");
+  if (num_threads < 0) return Status::Error("num_threads must be >= 0");
+  ARCO_RETURN_IF_ERROR(bones.Validate().WithContext("bones"));
+  return fit.Validate().WithContext("fit");
+}
+
+StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
+                                        const CaptureContext& capture,
+                                        Progress& progress) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  const ResultFolder result(options.result_dir);
+  ARCO_ASSIGN_OR_RETURN(const double s, result.ReadWorldUnitsPerMm());
+  ARCO_ASSIGN_OR_RETURN(NpyArray<double> points, result.ReadPoints3d(kTriangulationStage));
+  const CaptureManifest& m = capture.manifest;
+  const std::string calibration_path = ResolveCapturePath(capture.capture_dir, m.calibration);
+  ARCO_ASSIGN_OR_RETURN(Calibration calibration, LoadCalibration(calibration_path));
+  // The views' cameras with the world scaled to mm (projection is unchanged: t / s).
+  std::vector<Camera> cameras;
+  for (const CaptureCamera& cam : m.cameras) {
+    int c = calibration.rig.FindCamera(cam.name);
+    if (c < 0 && !cam.serial.empty()) c = calibration.rig.FindCamera(cam.serial);
+    if (c < 0) return Status::Error(calibration_path + ": no camera \"" + cam.name + "\"");
+    Camera camera = calibration.rig.cameras[static_cast<size_t>(c)];
+    camera.cam_from_world_translation /= s;
+    cameras.push_back(camera);
+  }
+  ARCO_ASSIGN_OR_RETURN(NpyArray<double> k2d, ReadCaptureKeypoints2d(capture.capture_dir, m));
+  const int64_t frames = points.shape[0];
+  const int64_t views = static_cast<int64_t>(cameras.size());
+  std::vector<hand::HandPointsMm> left(static_cast<size_t>(frames));
+  for (int64_t f = 0; f < frames; ++f) {
+    for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
+      left[static_cast<size_t>(f)][k] = PointAt(points, f, kLeftHandFirst + k) / s;
+    }
+  }
+  HandStageSummary summary;
+  const hand::HandModel prior = hand::HandModel::Default(hand::HandSide::kLeft);
+  hand::HandModel model = prior;
+  StatusOr<hand::BoneLengthEstimate> bones = hand::EstimateBoneLengths(left, prior, options.bones);
+  if (bones.ok()) {
+    StatusOr<hand::HandModel> sized = prior.WithBoneLengths(bones->lengths_mm);
+    if (sized.ok()) model = *sized;
+  } else {
+    summary.warnings.push_back("hand: default bone lengths (" + bones.status().message() + ")");
+  }
+  const int chunk = options.chunk_frames;
+  const int64_t num_chunks = (frames + chunk - 1) / chunk;
+  HandRecord record;
+  std::vector<std::optional<hand::HandPose>>& fitted = record.hands;
+  fitted.resize(static_cast<size_t>(frames));
+  std::vector<double> residual_px(static_cast<size_t>(frames), kNaN);
+  std::vector<double> median_residual_px(static_cast<size_t>(frames), kNaN);
+  progress.SetTotal(frames);
+  ParallelFor(
+      num_chunks,
+      options.num_threads,
+      [&](int64_t ci, int) {
+        std::optional<hand::HandPose> previous;
+        const int64_t end = std::min(frames, (ci + 1) * chunk);
+        for (int64_t f = ci * chunk; f < end; ++f) {
+          std::vector<hand::HandKeypoints2d> obs(static_cast<size_t>(views));
+          for (int64_t v = 0; v < views; ++v) {
+            for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
+              const int64_t p = kLeftHandFirst + k;
+              obs[static_cast<size_t>(v)].pixels[k] =
+                  Eigen::Vector2d(k2d.at(f, v, p, 0), k2d.at(f, v, p, 1));
+              const double score = k2d.at(f, v, p, 2);
+              obs[static_cast<size_t>(v)].scores[k] = std::isfinite(score) ? score : 0.0;
+            }
+          }
+          hand::HandFitInit init;
+          init.points_in_world_mm = left[static_cast<size_t>(f)];
+          init.previous_pose = previous;
+          const hand::HandFitResult r =
+              hand::FitHandMultiView(model, cameras, obs, init, options.fit);
+          if (r.ok) {
+            fitted[static_cast<size_t>(f)] = r.pose;
+            residual_px[static_cast<size_t>(f)] = r.rms_residual_px;
+            median_residual_px[static_cast<size_t>(f)] = r.median_residual_px;
+            previous = r.pose;
+          }
+        }
+        progress.Advance(end - ci * chunk);
+      },
+      1);
+  int ok = 0;
+  // Per frame: the RMS (dominated by the few outlier detections a robust fit
+  // ignores) and the median residual; the summary gives the median over frames of both
+  // (the upper middle element when even).
+  std::vector<double> res, res_median;
+  for (int64_t f = 0; f < frames; ++f) {
+    if (!fitted[static_cast<size_t>(f)]) continue;
+    ++ok;
+    res.push_back(residual_px[static_cast<size_t>(f)]);
+    res_median.push_back(median_residual_px[static_cast<size_t>(f)]);
+  }
+  std::sort(res.begin(), res.end());
+  std::sort(res_median.begin(), res_median.end());
+  summary.frames = frames;
+  summary.frames_fitted = ok;
+  summary.median_rms_residual_px = res.empty() ? kNaN : res[res.size() / 2];
+  summary.median_residual_px = res_median.empty() ? kNaN : res_median[res_median.size() / 2];
+  summary.bone_lengths_from_data = bones.ok();
+  for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
+    record.bone_lengths_mm[static_cast<size_t>(k)] = k == 0 ? 0.0 : model.bone_length_mm(k);
+  }
+  record.summary = summary;
+  ARCO_RETURN_IF_ERROR(result.WriteHand(record));
+  return summary;
+}
+
+}  // namespace arco::pipeline

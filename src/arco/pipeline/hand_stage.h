@@ -1,0 +1,35 @@
+// Stage 3: the left hand. Per-performer bone lengths from the triangulated hand
+// (hand/bone_lengths.h), then the multi-view hand model fit (hand/fit.h) of every frame;
+// writes RESULT_DIR/hand/ hand_params.npy (F, 26) and bone_lengths_mm.npy
+// (pipeline/result_folder.h).
+#pragma once
+
+#include <string>
+
+#include "arco/hand/bone_lengths.h"
+#include "arco/hand/fit.h"
+#include "arco/pipeline/capture_context.h"
+#include "arco/pipeline/summaries.h"
+#include "arco/util/progress.h"
+#include "arco/util/status.h"
+
+namespace arco::pipeline {
+
+struct HandStageOptions {
+  std::string result_dir;  // holds the triangulation and the instrument (the metric scale)
+  hand::BoneLengthOptions bones;
+  hand::HandFitOptions fit;
+  // The fit carries a temporal prior from frame to frame; the clip is cut into chunks of
+  // this many frames that are fitted in parallel (each starts from its own 3D keypoints),
+  // so results do not depend on the thread count.
+  int chunk_frames = 30;
+  int num_threads = 0;  // 0 = all cores
+  Status Validate() const;
+};
+
+// Progress: the total is the frame count, advanced per finished chunk.
+StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
+                                        const CaptureContext& capture,
+                                        Progress& progress = NoProgress());
+
+}  // namespace arco::pipeline

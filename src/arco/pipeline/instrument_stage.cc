@@ -1,0 +1,112 @@
+#include "arco/pipeline/instrument_stage.h"
+
+#include <limits>
+#include <vector>
+
+#include "arco/pipeline/result_folder.h"
+
+namespace arco::pipeline {
+namespace {
+
+constexpr int kLeftShoulder = 5, kRightShoulder = 6;  // TODO(registry)
+
+Eigen::Vector3d PointAt(const NpyArray<double>& a, int64_t f, int64_t p) {
+  return Eigen::Vector3d(a.at(f, p, 0), a.at(f, p, 1), a.at(f, p, 2));
+}
+
+}  // namespace
+
+Status InstrumentStageOptions::Validate() const {
+  if (result_dir.empty()) return Status::Error("result_dir is empty");
+  if (num_threads < 0) return Status::Error("num_threads must be >= 0");
+  ARCO_RETURN_IF_ERROR(fit.Validate().WithContext("fit"));
+  return smoothing.Validate().WithContext("smoothing");
+}
+
+StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions& options,
+                                                    const CaptureContext& capture,
+                                                    Progress& /*progress*/) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  const ResultFolder result(options.result_dir);
+  ARCO_ASSIGN_OR_RETURN(Json manifest, result.ReadManifest());
+  ARCO_ASSIGN_OR_RETURN(NpyArray<double> points, result.ReadPoints3d(kTriangulationStage));
+  const InstrumentModel& model = *capture.instrument;
+  const int64_t frames = points.shape[0];
+  const int num_k = static_cast<int>(model.keypoint_names().size());
+  std::vector<int> columns;
+  for (const std::string& name : model.keypoint_names())
+    columns.push_back(capture.layout.Find(name));
+  std::vector<Eigen::Matrix3Xd> keypoints(static_cast<size_t>(frames));
+  std::vector<FrontHint> hints(static_cast<size_t>(frames));
+  for (int64_t f = 0; f < frames; ++f) {
+    Eigen::Matrix3Xd& m = keypoints[static_cast<size_t>(f)];
+    m.resize(3, num_k);
+    for (int k = 0; k < num_k; ++k) m.col(k) = PointAt(points, f, columns[static_cast<size_t>(k)]);
+    // The performer sits behind the instrument: the shoulders' midpoint says where the
+    // back is (strings.h FrontHint).
+    hints[static_cast<size_t>(f)].kind = FrontHint::Kind::kPerformerPoint;
+    hints[static_cast<size_t>(f)].value =
+        0.5 * (PointAt(points, f, kLeftShoulder) + PointAt(points, f, kRightShoulder));
+  }
+  InstrumentFitOptions fit_options = options.fit;
+  const std::string units = manifest.value("units", "unknown");
+  if (units == "mm") fit_options.scale = InstrumentFitOptions::Scale::kWorldIsMillimetres;
+  fit_options.num_threads = options.num_threads;
+  StatusOr<InstrumentFit> fit = FitInstrument(model, keypoints, hints, fit_options);
+  if (!fit.ok()) return fit.status().WithContext("instrument fit");
+  const std::vector<InstrumentFramePose> poses = SmoothFramePoses(fit->frames, options.smoothing);
+  InstrumentStageSummary summary;
+  for (const std::string& w : fit->summary.warnings) summary.warnings.push_back("instrument: " + w);
+  if (fit->instrument.order.ambiguous) {
+    summary.warnings.push_back("instrument: string order ambiguous: " +
+                               fit->instrument.order.warning);
+  }
+  const double s = fit->instrument.world_units_per_mm;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  // Strings (F, 4, 2, 3) and the placed template keypoints (F, K, 3), world scaled to mm.
+  InstrumentRecord record;
+  NpyArray<double>& strings = record.strings_mm;
+  NpyArray<double>& placed = record.keypoints_mm;
+  strings.shape = {frames, model.num_strings(), 2, 3};
+  strings.data.assign(static_cast<size_t>(frames * model.num_strings() * 6), kNaN);
+  placed.shape = {frames, num_k, 3};
+  placed.data.assign(static_cast<size_t>(frames * num_k * 3), kNaN);
+  int with_pose = 0;
+  for (int64_t f = 0; f < frames; ++f) {
+    const InstrumentFramePose& p = poses[static_cast<size_t>(f)];
+    if (!p.has_pose()) continue;
+    ++with_pose;
+    const std::vector<StringSegment> seg = StringsAt(fit->instrument, p.pose);
+    for (int i = 0; i < model.num_strings(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        strings.at(f, i, 0, c) = seg[static_cast<size_t>(i)].nut[c] / s;
+        strings.at(f, i, 1, c) = seg[static_cast<size_t>(i)].bridge[c] / s;
+      }
+    }
+    for (int k = 0; k < num_k; ++k) {
+      const Eigen::Vector3d& t = fit->instrument.keypoints_in_instrument[static_cast<size_t>(k)];
+      if (!t.allFinite()) continue;
+      const Eigen::Vector3d w = p.pose.ToWorld(t) / s;
+      for (int c = 0; c < 3; ++c) placed.at(f, k, c) = w[c];
+    }
+  }
+  const InstrumentFitSummary& fs = fit->summary;
+  summary.instrument = model.name();
+  summary.frames = frames;
+  summary.frames_with_pose = with_pose;
+  summary.frames_high_residual = fs.frames_high_residual;
+  summary.median_rms_residual_mm = fs.median_rms_residual_mm;
+  summary.front_agreement = fs.front_agreement;
+  summary.string_order_ambiguous = fit->instrument.order.ambiguous;
+  summary.labels_agree = fit->instrument.order.labels_agree;
+  summary.world_units_per_mm = s;
+  record.instrument = model.name();
+  record.a4_hz = capture.manifest.tuning_a4_hz;
+  record.world_units_per_mm = s;
+  record.keypoint_names = model.keypoint_names();
+  record.summary = summary;
+  ARCO_RETURN_IF_ERROR(result.WriteInstrument(record));
+  return summary;
+}
+
+}  // namespace arco::pipeline

@@ -1,0 +1,37 @@
+// Stage 2: the instrument. A rigid template fitted over the whole clip to the triangulated
+// instrument keypoints (instrument/template_fit.h), per-frame poses smoothed and short gaps
+// filled (instrument/pose_smoothing.h), the world's metric scale; writes
+// RESULT_DIR/instrument/ strings.npy (F, 4, 2, 3) and the placed template keypoints.npy,
+// both in mm (pipeline/result_folder.h).
+#pragma once
+
+#include <string>
+
+#include "arco/instrument/pose_smoothing.h"
+#include "arco/instrument/template_fit.h"
+#include "arco/pipeline/capture_context.h"
+#include "arco/pipeline/summaries.h"
+#include "arco/util/progress.h"
+#include "arco/util/status.h"
+
+namespace arco::pipeline {
+
+struct InstrumentStageOptions {
+  std::string result_dir;  // holds the triangulation
+  InstrumentFitOptions fit;
+  // Gaussian pose smoothing; frames without a pose within 15 frames of posed frames on both
+  // sides get one.
+  PoseSmoothingOptions smoothing = [] {
+    PoseSmoothingOptions o;
+    o.max_fill_gap_frames = 15;
+    return o;
+  }();
+  int num_threads = 0;  // 0 = all cores; results do not depend on it
+  Status Validate() const;
+};
+
+StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions& options,
+                                                    const CaptureContext& capture,
+                                                    Progress& progress = NoProgress());
+
+}  // namespace arco::pipeline

@@ -1,0 +1,77 @@
+#include "arco/pipeline/pitch_stage.h"
+
+#include <algorithm>
+#include <vector>
+
+#include "arco/audio/notes.h"
+#include "arco/audio/pitch_tracker.h"
+#include "arco/pipeline/result_folder.h"
+
+namespace arco::pipeline {
+
+Status PitchStageOptions::Validate() const {
+  if (result_dir.empty()) return Status::Error("result_dir is empty");
+  return Status::Ok();
+}
+
+StatusOr<PitchStageSummary> RunPitchStage(const PitchStageOptions& options,
+                                          const CaptureContext& capture,
+                                          Progress& progress) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  const CaptureManifest& m = capture.manifest;
+  PitchStageSummary summary;
+  if (m.audio.empty()) {
+    summary.warnings.push_back(
+        "pitch: the capture has no audio; only the vision method is written");
+    return summary;
+  }
+  // TODO(registry): the audio layer's range name of an instrument.
+  std::string range_name = capture.instrument->name();
+  if (capture.instrument->kind() == InstrumentKind::kDoubleBass) range_name = "bass";
+  ARCO_ASSIGN_OR_RETURN(audio::InstrumentRange range, audio::InstrumentRangeByName(range_name));
+  audio::PitchTrackerOptions po;
+  po.range = range;
+  po.fps = m.fps;
+  po.start_s = m.audio_offset_s;
+  po.max_frames = m.frame_count;
+  po.a4_hz = m.tuning_a4_hz;
+  ARCO_RETURN_IF_ERROR(po.Validate());
+  const std::string audio_path = ResolveCapturePath(capture.capture_dir, m.audio);
+  audio::PitchSummary tracked;
+  constexpr int64_t kSteps = 1000;
+  progress.SetTotal(kSteps);
+  int64_t shown = 0;
+  ARCO_ASSIGN_OR_RETURN(audio::PitchTrack track,
+                        audio::TrackPitchFile(audio_path, po, &tracked, [&](double fraction) {
+                          const int64_t now = static_cast<int64_t>(fraction * kSteps);
+                          if (now > shown) progress.Advance(now - shown);
+                          shown = std::max(shown, now);
+                        }));
+  // One row per video frame of the capture (audio shorter than the video: unvoiced).
+  PitchRecord record;
+  std::vector<audio::PitchFrame>& frames = record.frames;
+  frames = track.frames;
+  frames.resize(static_cast<size_t>(std::max<int64_t>(0, m.frame_count)));
+  for (size_t i = track.frames.size(); i < frames.size(); ++i) {
+    frames[i].frame = static_cast<int64_t>(i);
+    frames[i].time_s = m.audio_offset_s + static_cast<double>(i) / m.fps;
+  }
+  if (track.frames.size() < frames.size()) {
+    summary.warnings.push_back("pitch: the audio ends before the video; later frames are unvoiced");
+  }
+  for (const std::string& w : tracked.warnings) summary.warnings.push_back("pitch: " + w);
+  audio::NoteOptions note_options;
+  note_options.a4_hz = m.tuning_a4_hz;
+  record.notes = audio::SegmentNotes(track.fine, track.fine_fps, note_options);
+  summary.ran = true;
+  summary.audio = audio_path;
+  summary.duration_s = tracked.duration_s;
+  summary.voiced_fraction = tracked.voiced_fraction;
+  summary.notes = static_cast<int64_t>(record.notes.notes.size());
+  record.a4_hz = m.tuning_a4_hz;
+  record.summary = summary;
+  ARCO_RETURN_IF_ERROR(ResultFolder(options.result_dir).WritePitch(record));
+  return summary;
+}
+
+}  // namespace arco::pipeline

@@ -1,0 +1,164 @@
+#include "arco/pipeline/refine_stage.h"
+
+#include <cmath>
+#include <vector>
+
+#include "arco/pipeline/result_folder.h"
+#include "arco/util/file_io.h"
+
+namespace arco::pipeline {
+namespace {
+
+constexpr int kNumWholeBody = 133;  // TODO(registry)
+
+Status Expect(bool ok, const std::string& path, const std::string& what) {
+  return ok ? Status::Ok() : Status::Error(path + ": " + what);
+}
+
+}  // namespace
+
+Status RefineStageOptions::Validate() const {
+  if (result_dir.empty()) return Status::Error("result_dir is empty");
+  return refine.Validate();
+}
+
+StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
+  const ResultFolder result(result_dir);
+  ARCO_ASSIGN_OR_RETURN(const bool has_hand, result.HasStage(kHandStage));
+  if (!has_hand) {
+    return Status::Error(result.ManifestPath() + ": no hand stage (run `arco run` first)");
+  }
+  ARCO_ASSIGN_OR_RETURN(const double s, result.ReadWorldUnitsPerMm());
+  ARCO_ASSIGN_OR_RETURN(const ResultHeader header, result.ReadHeader());
+  ARCO_ASSIGN_OR_RETURN(InstrumentRecord instrument, result.ReadInstrument());
+  ARCO_ASSIGN_OR_RETURN(InstrumentKind kind, ParseInstrumentKind(instrument.instrument));
+  InstrumentOptions io;
+  io.kind = kind;
+  io.tuning.a4_hz = instrument.a4_hz;
+  StatusOr<InstrumentModel> model = InstrumentModel::Create(io);
+  if (!model.ok()) return model.status().WithContext(result.ManifestPath());
+  RefineInputs out;
+  out.instrument = std::make_shared<const InstrumentModel>(std::move(model).value());
+  const InstrumentModel& m = *out.instrument;
+
+  // Triangulated points (world units) -> mm; the instrument keypoints from the template.
+  ARCO_ASSIGN_OR_RETURN(NpyArray<double> base, result.ReadPoints3d(kTriangulationStage));
+  const NpyArray<double>& strings = instrument.strings_mm;
+  const NpyArray<double>& placed = instrument.keypoints_mm;
+  const std::string strings_path = result.InstrumentStringsPath();
+  const std::string placed_path = result.InstrumentKeypointsPath();
+  const std::string hands_path = result.HandParamsPath();
+  ARCO_ASSIGN_OR_RETURN(HandRecord hand, result.ReadHand());
+  const int64_t frames = base.shape.empty() ? 0 : base.shape[0];
+  const int64_t num_k = static_cast<int64_t>(m.keypoint_names().size());
+  const int64_t num_base = kNumWholeBody + num_k;
+  ARCO_RETURN_IF_ERROR(
+      Expect(base.shape.size() == 3 && base.shape[1] == num_base && base.shape[2] == 3,
+             result.Points3dPath(kTriangulationStage),
+             "expected (frames, " + std::to_string(num_base) + ", 3)"));
+  ARCO_RETURN_IF_ERROR(Expect(strings.shape == std::vector<int64_t>{frames, m.num_strings(), 2, 3},
+                              strings_path,
+                              "expected (frames, strings, 2, 3)"));
+  ARCO_RETURN_IF_ERROR(Expect(placed.shape == std::vector<int64_t>{frames, num_k, 3},
+                              placed_path,
+                              "expected (frames, instrument keypoints, 3)"));
+  ARCO_RETURN_IF_ERROR(Expect(static_cast<int64_t>(hand.hands.size()) == frames,
+                              hands_path,
+                              "frame count differs from the triangulation's"));
+  out.input.vision_hand = std::move(hand.hands);
+  StatusOr<hand::HandModel> hand_model =
+      hand::HandModel::Default(hand::HandSide::kLeft).WithBoneLengths(hand.bone_lengths_mm);
+  if (!hand_model.ok()) {
+    return hand_model.status().WithContext(result.BoneLengthsPath());
+  }
+
+  NpyArray<double> base_mm = base;
+  for (double& v : base_mm.data) v /= s;
+  for (int64_t f = 0; f < frames; ++f) {
+    for (int64_t k = 0; k < num_k; ++k) {
+      if (!std::isfinite(placed.at(f, k, 0))) continue;  // bow points, frames without a pose
+      for (int c = 0; c < 3; ++c) base_mm.at(f, kNumWholeBody + k, c) = placed.at(f, k, c);
+    }
+  }
+  std::vector<std::vector<StringSegment>> seg(static_cast<size_t>(frames));
+  for (int64_t f = 0; f < frames; ++f) {
+    std::vector<StringSegment> frame_strings;
+    bool finite = true;
+    for (int i = 0; i < m.num_strings(); ++i) {
+      StringSegment sgm;
+      sgm.string = i + 1;
+      sgm.nut =
+          Eigen::Vector3d(strings.at(f, i, 0, 0), strings.at(f, i, 0, 1), strings.at(f, i, 0, 2));
+      sgm.bridge =
+          Eigen::Vector3d(strings.at(f, i, 1, 0), strings.at(f, i, 1, 1), strings.at(f, i, 1, 2));
+      finite = finite && sgm.nut.allFinite() && sgm.bridge.allFinite();
+      frame_strings.push_back(sgm);
+    }
+    if (finite) seg[static_cast<size_t>(f)] = std::move(frame_strings);
+  }
+
+  const double fps = header.fps;
+  out.input.instrument = out.instrument;
+  out.input.hand_model = *hand_model;
+  out.input.strings_in_world_mm = seg;
+  out.input.fps = fps > 0 ? fps : 30.0;
+  out.input.a4_hz = io.tuning.a4_hz;
+  out.input.pitch.assign(static_cast<size_t>(frames), refine::FramePitch{});
+  ARCO_ASSIGN_OR_RETURN(out.has_pitch, result.HasStage(kPitchStage));
+  if (out.has_pitch) {
+    ARCO_ASSIGN_OR_RETURN(std::vector<audio::PitchFrame> pitch, result.ReadPitch());
+    ARCO_RETURN_IF_ERROR(Expect(
+        static_cast<int64_t>(pitch.size()) == frames,
+        result.PitchPath(),
+        "has " + std::to_string(pitch.size()) + " rows for " + std::to_string(frames) + " frames"));
+    for (int64_t f = 0; f < frames; ++f) {
+      const audio::PitchFrame& p = pitch[static_cast<size_t>(f)];
+      out.input.pitch[static_cast<size_t>(f)] = {p.voiced ? p.f0_hz : 0.0, p.confidence};
+    }
+    if (!pitch.empty()) out.input.start_s = pitch.front().time_s;
+    // notes.csv: the onsets for arco's note boundaries (result folders of older versions
+    // have none: frames are then assigned by their own pitch).
+    ARCO_ASSIGN_OR_RETURN(const std::vector<audio::Note> notes, result.ReadNotes());
+    for (const audio::Note& n : notes) {
+      out.input.audio_notes.push_back({n.onset_s, n.offset_s, n.median_f0_hz});
+    }
+  }
+  out.spd.instrument = out.instrument;
+  out.spd.hand_model = *hand_model;
+  out.spd.base_points_mm = std::move(base_mm);
+  out.spd.strings_in_world_mm = std::move(seg);
+  return out;
+}
+
+StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
+                                               const RefineInputs& inputs,
+                                               const refine::RefineOptions& options) {
+  const ResultFolder result(result_dir);
+  if (options.mode != refine::RefineMode::kVision && !inputs.has_pitch) {
+    return Status::Error(result.ManifestPath() +
+                         ": no pitch stage (the capture has no audio); only vision can be written");
+  }
+  const refine::RefineResult r = refine::Refine(inputs.input, options);
+  MethodRecord out;
+  out.method = refine::RefineModeName(options.mode);
+  out.layout = refine::SpdContactLayoutName(*inputs.instrument);
+  out.points3d = refine::BuildSpdPoints(
+      inputs.spd, r.hand, options.mode == refine::RefineMode::kVision ? nullptr : &r.contacts);
+  out.hands = r.hand;
+  out.contacts = r.contacts;
+  out.fingering = r.fingering;
+  // Recorded as applied: without the audio's notes there are no onsets to use.
+  out.options = options;
+  if (inputs.input.audio_notes.empty()) out.options.decode.audio_onsets = false;
+  out.summary = r.summary;
+  ARCO_RETURN_IF_ERROR(result.WriteMethod(out));
+  return r.summary;
+}
+
+StatusOr<refine::RefineSummary> RunRefineStage(const RefineStageOptions& options) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  ARCO_ASSIGN_OR_RETURN(RefineInputs inputs, LoadRefineInputs(options.result_dir));
+  return RefineAndWrite(options.result_dir, inputs, options.refine);
+}
+
+}  // namespace arco::pipeline

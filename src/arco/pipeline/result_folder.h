@@ -1,0 +1,215 @@
+// The result folder of `arco run` (docs/formats.md, "Result folder"): its one reader and
+// one writer per output. Every file name, CSV header and result.json entry of the folder
+// is spelled here (or in result_folder.cc) and nowhere else; the stages, `arco refine` and
+// `arco eval` read and write through ResultFolder.
+//
+//   RESULT_DIR/result.json      the manifest: the capture's header (name, instrument, fps,
+//                               frames, units, layout, keypoint_names, cameras) and
+//                               "stages"."<stage>" = {dir, files, options, summary, ...}
+//   triangulation/              points3d.npy (F, P, 3) filtered, points3d_raw.npy,
+//                               reprojection_rms_px.npy (F, P), inlier_count.npy,
+//                               view_count.npy, inlier_mask.npy (F, P, V); world units
+//   instrument/                 strings.npy (F, S, 2, 3) nut and bridge of each string,
+//                               keypoints.npy (F, K, 3) the placed template; mm
+//   hand/                       hand_params.npy (F, 26), bone_lengths_mm.npy (21)
+//   pitch.csv, notes.csv        the audio layer's formats (audio/pitch_tracker.h,
+//                               audio/notes.h), in the folder itself
+//   vision/ paper/ arco/        points3d.npy (refine/method_result.h), hand_params.npy,
+//                               contacts.csv (kContactsCsvHeader) and fingering.csv
+//                               (kFingeringCsvHeader) for paper and arco
+//
+// hand_params.npy rows: the left wrist rotation as an angle-axis (3, rad), the wrist
+// position (3, mm), the 20 joint angles (rad, hand/hand_model.h); a NaN row is no hand.
+// Stage folders are written whole or not at all (a temporary folder, then a rename), and
+// each writer records its entry in result.json keeping the other stages'.
+#pragma once
+
+#include <functional>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "arco/audio/notes.h"
+#include "arco/audio/pitch_tracker.h"
+#include "arco/hand/hand_model.h"
+#include "arco/mocap/capture.h"
+#include "arco/mocap/keypoint_layout.h"
+#include "arco/mocap/triangulate_sequence.h"
+#include "arco/pipeline/summaries.h"
+#include "arco/refine/contact_annotation.h"
+#include "arco/refine/refine.h"
+#include "arco/util/json_io.h"
+#include "arco/util/npy.h"
+#include "arco/util/status.h"
+
+namespace arco::pipeline {
+
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+inline constexpr char kResultManifestName[] = "result.json";
+// Stage names: the keys of result.json "stages" and the folders they write.
+inline constexpr char kTriangulationStage[] = "triangulation";
+inline constexpr char kInstrumentStage[] = "instrument";
+inline constexpr char kHandStage[] = "hand";
+inline constexpr char kPitchStage[] = "pitch";  // writes pitch.csv and notes.csv, no folder
+
+// contacts.csv: one row per frame; frame = row of the arrays, from 0. string, finger and
+// contact_*_mm describe a pressed contact only (0 / NaN otherwise); open_string names the
+// sounding open string on open-string frames.
+inline constexpr char kContactsCsvHeader[] =
+    "frame,state,reason,string,finger,note,contact_x_mm,contact_y_mm,contact_z_mm,from_nut_mm,"
+    "f0_hz,confidence,tip_distance_vision_mm,tip_distance_refined_mm,open_string";
+// fingering.csv: one row per note.
+inline constexpr char kFingeringCsvHeader[] =
+    "note,first_frame,last_frame,onset_s,duration_s,f0_hz,midi_note,note_name,cents_off,state,"
+    "string,finger,position_semitones,from_nut_mm,pressed_frames,open_frames,uncertain_frames";
+
+// What the triangulation stage writes besides its arrays.
+struct TriangulationRecord {
+  std::string capture_dir;
+  std::string units;  // of the rig
+  Json options;       // triangulation and filter options as run
+  SequenceTriangulationSummary summary;
+};
+
+// instrument/ and its entry.
+struct InstrumentRecord {
+  std::string instrument;  // model name (instrument/instrument_model.h)
+  double a4_hz = 440.0;
+  double world_units_per_mm = 0;
+  std::vector<std::string> keypoint_names;  // the template's, the columns of keypoints_mm
+  NpyArray<double> strings_mm;              // (F, S, 2, 3), NaN without a pose
+  NpyArray<double> keypoints_mm;            // (F, K, 3), NaN without a pose
+  InstrumentStageSummary summary;           // written, not read back
+};
+
+// hand/ and its entry: the fitted left hand.
+struct HandRecord {
+  std::vector<std::optional<hand::HandPose>> hands;  // per frame
+  hand::BoneLengthsMm bone_lengths_mm{};             // index = keypoint, [0] unused (0)
+  HandStageSummary summary;                          // written, not read back
+};
+
+// pitch.csv, notes.csv and the pitch entry.
+struct PitchRecord {
+  std::vector<audio::PitchFrame> frames;  // one per video frame
+  audio::NoteAnalysis notes;
+  double a4_hz = 440.0;
+  PitchStageSummary summary;  // summary.audio: the file tracked
+};
+
+// One method folder (vision, paper, arco) and its entry.
+struct MethodRecord {
+  std::string method;  // "vision", "paper", "arco"
+  std::string layout;  // refine::SpdContactLayoutName
+  NpyArray<double> points3d;
+  std::vector<std::optional<hand::HandPose>> hands;
+  std::vector<refine::FrameContact> contacts;    // empty: no contacts.csv (vision)
+  std::vector<refine::NoteFingering> fingering;  // written with contacts
+  refine::RefineOptions options;                 // as applied (refine::ToJson)
+  refine::RefineSummary summary;
+};
+
+// A stage with 3D points, as `arco eval` finds them.
+struct PointStage {
+  std::string name;
+  std::string points3d_path;
+  std::vector<std::string> keypoint_names;  // empty: the result's
+  std::string contacts_path;                // empty: none
+};
+
+// The capture header of result.json (with the defaults of a manifest that lacks them).
+struct ResultHeader {
+  std::string units = "unknown";
+  double fps = 30.0;  // 30 when absent
+  int64_t frame_first = 1;
+  int64_t frame_count = 0;
+  std::vector<std::string> keypoint_names;
+};
+
+class ResultFolder {
+ public:
+  explicit ResultFolder(std::string dir) : dir_(std::move(dir)) {}
+  const std::string& dir() const { return dir_; }
+  std::string ManifestPath() const;
+  // RESULT_DIR/<stage>/<file>.
+  std::string StagePath(const std::string& stage, const std::string& file) const;
+  // The files' paths, for messages about their contents.
+  std::string Points3dPath(const std::string& stage) const;
+  std::string InstrumentStringsPath() const;
+  std::string InstrumentKeypointsPath() const;
+  std::string HandParamsPath() const;
+  std::string BoneLengthsPath() const;
+
+  // result.json: an empty object when absent; an error when it is not an arco result.
+  StatusOr<Json> ReadManifest() const;
+  StatusOr<ResultHeader> ReadHeader() const;
+  StatusOr<bool> HasStage(const std::string& stage) const;
+  // The stages whose entry lists a points3d file, in result.json's order.
+  StatusOr<std::vector<PointStage>> PointStages() const;
+
+  // triangulation/ and the capture header of result.json.
+  Status WriteTriangulation(const CaptureManifest& manifest,
+                            const KeypointLayout& layout,
+                            const SequenceTriangulation& raw,
+                            const NpyArray<double>& points3d_filtered,
+                            const TriangulationRecord& record) const;
+  // <stage>/points3d.npy of any stage (triangulation, vision, paper, arco).
+  StatusOr<NpyArray<double>> ReadPoints3d(const std::string& stage) const;
+
+  Status WriteInstrument(const InstrumentRecord& record) const;
+  // The scale recorded by the instrument stage; an error naming result.json without one.
+  StatusOr<double> ReadWorldUnitsPerMm() const;
+  // Entry (instrument, a4_hz, world_units_per_mm) and both arrays, shapes unchecked.
+  StatusOr<InstrumentRecord> ReadInstrument() const;
+
+  Status WriteHand(const HandRecord& record) const;
+  // Errors: a hand_params.npy not (F, 26), a bone_lengths_mm.npy not (21).
+  StatusOr<HandRecord> ReadHand() const;
+
+  Status WritePitch(const PitchRecord& record) const;
+  StatusOr<std::vector<audio::PitchFrame>> ReadPitch() const;
+  std::string PitchPath() const;
+  // The notes of notes.csv (empty when the file is absent: results of older versions).
+  StatusOr<std::vector<audio::Note>> ReadNotes() const;
+
+  Status WriteMethod(const MethodRecord& record) const;
+  std::string ContactsPath(const std::string& method) const;
+
+ private:
+  // Sets result.json "stages"."<stage>" = entry (other stages kept; the manifest is
+  // created when absent).
+  Status RecordStage(const std::string& stage, const Json& entry) const;
+  // Writes RESULT_DIR/<stage>/ whole or not at all, then records `entry` plus "dir".
+  Status WriteStageFolder(const std::string& stage,
+                          const std::function<Status(const std::string& dir)>& write,
+                          Json entry) const;
+
+  std::string dir_;
+};
+
+// hand_params.npy rows (F, 26) of per-frame hands (see the header comment) and back; rows
+// with any NaN are no hand. The inverse errors on a wrong shape, naming `source`.
+NpyArray<double> HandParams(const std::vector<std::optional<hand::HandPose>>& hands);
+StatusOr<std::vector<std::optional<hand::HandPose>>> HandsFromParams(const NpyArray<double>& params,
+                                                                     const std::string& source);
+
+// One row of a contact CSV: a method's contacts.csv or a synthetic truth's contact.csv
+// (synth/capture_writer.h). Columns are found by header name: frame, string, finger and
+// contact_{x,y,z}_mm are required; the others of kContactsCsvHeader are read when present.
+struct ContactRow {
+  int64_t frame = 0;
+  std::string state;  // pressed, open (open_string in truth files), rest, uncertain; or ""
+  std::string reason;
+  int string = 0, finger = 0, note = -1, open_string = 0;
+  Eigen::Vector3d point_mm = Eigen::Vector3d::Constant(kNaN);
+  double from_nut_mm = kNaN, f0_hz = 0, confidence = 0;
+  double tip_distance_vision_mm = kNaN, tip_distance_refined_mm = kNaN;
+};
+// The one contact CSV reader. Errors name the file and line: a missing column, a short
+// row, an unparsable number (an empty cell is NaN where a number may be missing), an
+// unknown state, a string (0-8) or finger (0-4) out of range, a negative frame, a pressed
+// string without a finger or a finite point.
+StatusOr<std::vector<ContactRow>> ReadContactsCsv(const std::string& path);
+
+}  // namespace arco::pipeline

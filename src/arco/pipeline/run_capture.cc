@@ -1,0 +1,118 @@
+#include "arco/pipeline/run_capture.h"
+
+#include <chrono>
+
+#include "arco/pipeline/capture_context.h"
+
+namespace arco::pipeline {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void Append(std::vector<std::string>* to, const std::vector<std::string>& from) {
+  to->insert(to->end(), from.begin(), from.end());
+}
+
+}  // namespace
+
+TriangulateStageOptions RunOptions::ForTriangulate() const {
+  TriangulateStageOptions o = triangulate;
+  o.capture_dir = capture_dir;
+  o.result_dir = result_dir;
+  o.triangulation.num_threads = num_threads;
+  return o;
+}
+
+InstrumentStageOptions RunOptions::ForInstrument() const {
+  InstrumentStageOptions o = instrument;
+  o.result_dir = result_dir;
+  o.num_threads = num_threads;
+  return o;
+}
+
+HandStageOptions RunOptions::ForHands() const {
+  HandStageOptions o = hands;
+  o.result_dir = result_dir;
+  o.num_threads = num_threads;
+  return o;
+}
+
+PitchStageOptions RunOptions::ForPitch() const {
+  PitchStageOptions o = pitch;
+  o.result_dir = result_dir;
+  return o;
+}
+
+RefineStageOptions RunOptions::ForRefine(refine::RefineMode mode) const {
+  RefineStageOptions o;
+  o.result_dir = result_dir;
+  o.refine = refine;
+  o.refine.mode = mode;
+  o.refine.num_threads = num_threads;
+  return o;
+}
+
+Status RunOptions::Validate() const {
+  if (num_threads < 0) return Status::Error("num_threads must be >= 0");
+  ARCO_RETURN_IF_ERROR(ForTriangulate().Validate().WithContext("triangulate"));
+  ARCO_RETURN_IF_ERROR(ForInstrument().Validate().WithContext("instrument"));
+  ARCO_RETURN_IF_ERROR(ForHands().Validate().WithContext("hands"));
+  ARCO_RETURN_IF_ERROR(ForPitch().Validate().WithContext("pitch"));
+  return ForRefine(refine.mode).Validate().WithContext("refine");
+}
+
+StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  ARCO_ASSIGN_OR_RETURN(const CaptureContext capture, OpenCapture(options.capture_dir));
+  RunSummary summary;
+  auto stage = [&](int index, const char* name) {
+    progress.StartStage(index, kRunStages, name);
+    return Clock::now();
+  };
+
+  auto start = stage(1, "triangulate");
+  ARCO_ASSIGN_OR_RETURN(summary.triangulate,
+                        RunTriangulateStage(options.ForTriangulate(), progress));
+  summary.timings.push_back({"triangulate", SecondsSince(start)});
+
+  start = stage(2, "instrument");
+  ARCO_ASSIGN_OR_RETURN(summary.instrument,
+                        RunInstrumentStage(options.ForInstrument(), capture, progress));
+  summary.timings.push_back({"instrument", SecondsSince(start)});
+  Append(&summary.warnings, summary.instrument.warnings);
+
+  start = stage(3, "hands");
+  ARCO_ASSIGN_OR_RETURN(summary.hands, RunHandStage(options.ForHands(), capture, progress));
+  summary.timings.push_back({"hands", SecondsSince(start)});
+  Append(&summary.warnings, summary.hands.warnings);
+
+  start = stage(4, "pitch");
+  ARCO_ASSIGN_OR_RETURN(summary.pitch, RunPitchStage(options.ForPitch(), capture, progress));
+  if (summary.pitch.ran) summary.timings.push_back({"pitch", SecondsSince(start)});
+  Append(&summary.warnings, summary.pitch.warnings);
+
+  // Refinement: vision, then paper and arco when there is pitch.
+  start = stage(5, "refine");
+  ARCO_ASSIGN_OR_RETURN(const RefineInputs inputs, LoadRefineInputs(options.result_dir));
+  std::vector<refine::RefineMode> modes = {refine::RefineMode::kVision};
+  if (inputs.has_pitch) {
+    modes.push_back(refine::RefineMode::kPaper);
+    modes.push_back(refine::RefineMode::kArco);
+  }
+  progress.SetTotal(static_cast<int64_t>(modes.size()));
+  for (refine::RefineMode mode : modes) {
+    const RefineStageOptions ro = options.ForRefine(mode);
+    ARCO_ASSIGN_OR_RETURN(refine::RefineSummary s,
+                          RefineAndWrite(options.result_dir, inputs, ro.refine));
+    summary.methods.push_back(s);
+    progress.Advance(1);
+  }
+  summary.timings.push_back({"refine", SecondsSince(start)});
+  return summary;
+}
+
+}  // namespace arco::pipeline

@@ -1,0 +1,68 @@
+// `arco run CAPTURE -o RESULT` as a library call: every stage, in order, each reading what
+// the earlier ones wrote into the result folder (pipeline/result_folder.h):
+//   1. triangulate  triangulation/   pipeline/triangulate_stage.h
+//   2. instrument   instrument/      pipeline/instrument_stage.h
+//   3. hands        hand/            pipeline/hand_stage.h
+//   4. pitch        pitch.csv, notes.csv  pipeline/pitch_stage.h (skipped without audio)
+//   5. refine       vision/ paper/ arco/  pipeline/refine_stage.h (paper and arco need
+//                                    the pitch)
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "arco/pipeline/hand_stage.h"
+#include "arco/pipeline/instrument_stage.h"
+#include "arco/pipeline/pitch_stage.h"
+#include "arco/pipeline/refine_stage.h"
+#include "arco/pipeline/summaries.h"
+#include "arco/pipeline/triangulate_stage.h"
+#include "arco/util/progress.h"
+#include "arco/util/status.h"
+
+namespace arco::pipeline {
+
+struct RunOptions {
+  std::string capture_dir;
+  std::string result_dir;
+  // The stages' own options; their capture_dir / result_dir / num_threads are set from the
+  // fields above and below when the run starts.
+  TriangulateStageOptions triangulate;
+  InstrumentStageOptions instrument;
+  HandStageOptions hands;
+  PitchStageOptions pitch;
+  refine::RefineOptions refine;  // mode ignored: vision, paper and arco are all written
+  int num_threads = 0;           // 0 = all cores; results do not depend on it
+
+  // Every nested option (as the stages will receive them).
+  Status Validate() const;
+  // The stages' options with the run's folders and thread count filled in.
+  TriangulateStageOptions ForTriangulate() const;
+  InstrumentStageOptions ForInstrument() const;
+  HandStageOptions ForHands() const;
+  PitchStageOptions ForPitch() const;
+  RefineStageOptions ForRefine(refine::RefineMode mode) const;
+};
+
+struct StageTiming {
+  std::string name;    // triangulate, instrument, hands, pitch (when it ran), refine
+  double seconds = 0;  // wall time (informational, not in results)
+};
+
+struct RunSummary {
+  TriangulateStageSummary triangulate;
+  InstrumentStageSummary instrument;
+  HandStageSummary hands;
+  PitchStageSummary pitch;
+  std::vector<refine::RefineSummary> methods;  // vision, then paper and arco with audio
+  std::vector<StageTiming> timings;            // in the order the stages ran
+  std::vector<std::string> warnings;           // of all stages, in order
+};
+
+inline constexpr int kRunStages = 5;
+
+// Progress: StartStage(i, 5, name) for each stage, then that stage's SetTotal / Advance.
+StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress = NoProgress());
+
+}  // namespace arco::pipeline

@@ -1,0 +1,27 @@
+#include "arco/pipeline/summaries.h"
+
+namespace arco::pipeline {
+
+Json ToJson(const InstrumentStageSummary& s) {
+  return {{"frames", s.frames},
+          {"frames_with_pose", s.frames_with_pose},
+          {"frames_high_residual", s.frames_high_residual},
+          {"median_rms_residual_mm", JsonFromDouble(s.median_rms_residual_mm)},
+          {"front_agreement", JsonFromDouble(s.front_agreement)},
+          {"string_order_ambiguous", s.string_order_ambiguous},
+          {"labels_agree", s.labels_agree}};
+}
+
+Json ToJson(const HandStageSummary& s) {
+  return {{"frames", s.frames},
+          {"frames_fitted", s.frames_fitted},
+          {"median_rms_residual_px", JsonFromDouble(s.median_rms_residual_px)},
+          {"median_residual_px", JsonFromDouble(s.median_residual_px)},
+          {"bone_lengths_from_data", s.bone_lengths_from_data}};
+}
+
+Json ToJson(const PitchStageSummary& s) {
+  return {{"duration_s", s.duration_s}, {"voiced_fraction", s.voiced_fraction}, {"notes", s.notes}};
+}
+
+}  // namespace arco::pipeline

@@ -1,0 +1,64 @@
+// What each stage of the pipeline reports (pipeline/run_capture.h). Each summary writes
+// itself to JSON (ToJson, next to the struct); the result folder records that JSON in
+// result.json (pipeline/result_folder.h), so the entries are assembled in one place.
+// Warnings are full sentences prefixed with the stage ("instrument: ...") for the terminal.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "arco/mocap/triangulate_sequence.h"
+#include "arco/util/json_io.h"
+
+namespace arco::pipeline {
+
+struct TriangulateStageSummary {
+  SequenceTriangulationSummary triangulation;
+  std::string units;  // of the rig
+  int64_t views = 0;
+  int64_t keypoints = 0;
+};
+
+struct InstrumentStageSummary {
+  std::string instrument;  // model name
+  int64_t frames = 0;
+  int frames_with_pose = 0;  // after smoothing and gap filling
+  int frames_high_residual = 0;
+  double median_rms_residual_mm = 0;
+  double front_agreement = 0;
+  bool string_order_ambiguous = false;
+  bool labels_agree = false;
+  double world_units_per_mm = 0;  // the metric scale of the world
+  std::vector<std::string> warnings;
+};
+// {frames, frames_with_pose, frames_high_residual, median_rms_residual_mm,
+// front_agreement, string_order_ambiguous, labels_agree}.
+Json ToJson(const InstrumentStageSummary& summary);
+
+struct HandStageSummary {
+  int64_t frames = 0;
+  int frames_fitted = 0;
+  // Medians over the fitted frames of the per-frame RMS reprojection residual (dominated
+  // by the few outlier detections a robust fit ignores) and of the per-frame median.
+  double median_rms_residual_px = 0;
+  double median_residual_px = 0;
+  bool bone_lengths_from_data = false;  // false: the default hand's lengths
+  std::vector<std::string> warnings;
+};
+// {frames, frames_fitted, median_rms_residual_px, median_residual_px,
+// bone_lengths_from_data}.
+Json ToJson(const HandStageSummary& summary);
+
+struct PitchStageSummary {
+  bool ran = false;   // false: the capture has no audio (a warning says so)
+  std::string audio;  // the file tracked
+  double duration_s = 0;
+  double voiced_fraction = 0;
+  int64_t notes = 0;
+  std::vector<std::string> warnings;
+};
+// {duration_s, voiced_fraction, notes}.
+Json ToJson(const PitchStageSummary& summary);
+
+}  // namespace arco::pipeline

@@ -1,0 +1,101 @@
+#include "arco/pipeline/triangulate_stage.h"
+
+#include "arco/io/calibration_file.h"
+#include "arco/mocap/capture.h"
+#include "arco/pipeline/result_folder.h"
+#include "arco/util/file_io.h"
+
+namespace arco::pipeline {
+
+Status TriangulateStageOptions::Validate() const {
+  if (capture_dir.empty()) return Status::Error("capture_dir is empty");
+  if (result_dir.empty()) return Status::Error("result_dir is empty");
+  return triangulation.Validate();
+}
+
+Json ToJson(const TriangulateStageOptions& o) {
+  Json filters = Json::array();
+  for (const auto& [group, filter] : o.filters) {
+    filters.push_back({{"group", group},
+                       {"filter", FilterSpecToString(filter)},
+                       {"max_gap_frames", filter.max_gap_frames}});
+  }
+  Json j = ToJson(o.triangulation.point);
+  j["filters"] = filters;
+  return j;
+}
+
+StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOptions& o,
+                                                      Progress& progress) {
+  ARCO_RETURN_IF_ERROR(o.Validate());
+  ARCO_ASSIGN_OR_RETURN(CaptureManifest manifest, ReadCaptureManifest(o.capture_dir));
+  const std::string manifest_path = JoinPath(o.capture_dir, kCaptureManifestName);
+  ARCO_ASSIGN_OR_RETURN(KeypointLayout layout, [&]() -> StatusOr<KeypointLayout> {
+    if (manifest.keypoints2d.empty()) {
+      return Status::Error(manifest_path + ": no \"keypoints2d\" entry to triangulate");
+    }
+    auto l = manifest.Layout();
+    if (!l.ok()) return l.status().WithContext(manifest_path);
+    return l;
+  }());
+  // Filters refer to groups of the layout; check them before any work.
+  std::vector<const std::vector<int>*> filter_groups;
+  for (const auto& [group, filter] : o.filters) {
+    const std::vector<int>* indices = layout.Group(group);
+    if (!indices) {
+      std::string known;
+      for (const auto& g : layout.groups) known += (known.empty() ? "" : ", ") + g.name;
+      return Status::Error("filter group \"" + group + "\" is not in layout " + layout.name +
+                           " (groups: " + known + ")");
+    }
+    const Status valid = filter.Validate(manifest.fps);
+    if (!valid.ok()) {
+      return Status::Error("filter " + group + "=" + FilterSpecToString(filter) + " at " +
+                           std::to_string(manifest.fps) + " fps (" + manifest_path +
+                           "): " + valid.message());
+    }
+    filter_groups.push_back(indices);
+  }
+  const std::string calibration_path = ResolveCapturePath(o.capture_dir, manifest.calibration);
+  ARCO_ASSIGN_OR_RETURN(Calibration calibration, LoadCalibration(calibration_path));
+  std::vector<int> view_to_camera;
+  for (const auto& cam : manifest.cameras) {
+    int c = calibration.rig.FindCamera(cam.name);
+    if (c < 0 && !cam.serial.empty()) c = calibration.rig.FindCamera(cam.serial);
+    if (c < 0) {
+      return Status::Error(manifest_path + ": camera \"" + cam.name + "\" is not in " +
+                           calibration_path);
+    }
+    view_to_camera.push_back(c);
+  }
+  ARCO_ASSIGN_OR_RETURN(NpyArray<double> keypoints,
+                        ReadCaptureKeypoints2d(o.capture_dir, manifest));
+  progress.SetTotal(manifest.frame_count);
+  ARCO_ASSIGN_OR_RETURN(
+      SequenceTriangulation raw,
+      TriangulateSequence(calibration.rig,
+                          view_to_camera,
+                          keypoints,
+                          o.triangulation,
+                          &progress,
+                          ResolveCapturePath(o.capture_dir, manifest.keypoints2d)));
+  NpyArray<double> filtered = raw.points3d;
+  for (size_t i = 0; i < filter_groups.size(); ++i) {
+    FilterPoints(o.filters[i].second, manifest.fps, *filter_groups[i], &filtered);
+  }
+  TriangulationRecord record;
+  record.capture_dir = o.capture_dir;
+  record.units = calibration.rig.units;
+  record.summary = Summarize(raw);
+  record.options = ToJson(o);
+  ARCO_RETURN_IF_ERROR(
+      ResultFolder(o.result_dir).WriteTriangulation(manifest, layout, raw, filtered, record));
+  TriangulateStageSummary summary;
+  summary.triangulation = record.summary;
+  summary.units = record.units;
+  summary.views = static_cast<int64_t>(view_to_camera.size());
+  summary.keypoints = layout.size();
+  return summary;
+}
+
+}  // namespace arco::pipeline
