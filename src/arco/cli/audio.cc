@@ -11,7 +11,6 @@ namespace arco::cli {
 namespace {
 
 std::string InstrumentFromManifest(const std::string& name) {
-  if (name == "double_bass") return "bass";
   if (name == "none" || name.empty()) return "any";
   return name;
 }

@@ -18,9 +18,10 @@ std::function<int()> SetupPitch(CLI::App& app) {
                   o->capture_dir,
                   "Capture folder: audio file, offset, fps, frame count, instrument and A4 "
                   "from its capture.json (options given here win)");
-  cmd->add_option("--instrument",
-                  o->instrument,
-                  "violin | viola | cello | bass | any: the pitch range (default cello)");
+  cmd->add_option(
+      "--instrument",
+      o->instrument,
+      "violin | viola | cello | double_bass (alias bass) | any: the pitch range (default cello)");
   cmd->add_option("--fps", o->fps, "Video frame rate: one row per frame (Hz; default 30)");
   auto* start =
       cmd->add_option("--start-s",

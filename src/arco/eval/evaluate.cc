@@ -10,7 +10,7 @@
 
 #include "arco/audio/pitch_tracker.h"
 #include "arco/hand/kinematics.h"
-#include "arco/mocap/keypoint_layout.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "arco/camera/calibration_io.h"
-#include "arco/mocap/keypoint_layout.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"

@@ -8,6 +8,7 @@
 #include <limits>
 #include <set>
 
+#include "arco/registry/instruments.h"
 #include "arco/util/atomic_dir.h"
 #include "arco/util/file_io.h"
 
@@ -16,8 +17,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The registry's canonical instrument names, and "none".
 const std::set<std::string>& Instruments() {
-  static const std::set<std::string> k = {"cello", "violin", "viola", "double_bass", "none"};
+  static const std::set<std::string> k = [] {
+    std::set<std::string> names = {"none"};
+    for (const InstrumentInfo& info : AllInstruments()) names.insert(info.name);
+    return names;
+  }();
   return k;
 }
 

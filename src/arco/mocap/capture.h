@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "arco/mocap/keypoint_layout.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/mocap/triangulate_sequence.h"
 #include "arco/util/json_io.h"
 #include "arco/util/npy.h"

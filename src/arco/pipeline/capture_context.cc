@@ -1,12 +1,13 @@
 #include "arco/pipeline/capture_context.h"
 
 #include "arco/hand/hand_model.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
 
 namespace arco::pipeline {
 namespace {
 
-constexpr int kLeftHandFirst = 91;  // TODO(registry)
+constexpr int kLeftHandFirst = wholebody::kLeftHandFirst;
 
 }  // namespace
 

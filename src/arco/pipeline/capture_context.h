@@ -7,7 +7,7 @@
 
 #include "arco/instrument/instrument_model.h"
 #include "arco/mocap/capture.h"
-#include "arco/mocap/keypoint_layout.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/util/status.h"
 
 namespace arco::pipeline {

@@ -8,12 +8,14 @@
 
 #include "arco/io/calibration_file.h"
 #include "arco/pipeline/result_folder.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/util/parallel.h"
+#include "arco/util/stats.h"
 
 namespace arco::pipeline {
 namespace {
 
-constexpr int kLeftHandFirst = 91;  // TODO(registry)
+constexpr int kLeftHandFirst = wholebody::kLeftHandFirst;
 
 Eigen::Vector3d PointAt(const NpyArray<double>& a, int64_t f, int64_t p) {
   return Eigen::Vector3d(a.at(f, p, 0), a.at(f, p, 1), a.at(f, p, 2));
@@ -120,12 +122,10 @@ StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
     res.push_back(residual_px[static_cast<size_t>(f)]);
     res_median.push_back(median_residual_px[static_cast<size_t>(f)]);
   }
-  std::sort(res.begin(), res.end());
-  std::sort(res_median.begin(), res_median.end());
   summary.frames = frames;
   summary.frames_fitted = ok;
-  summary.median_rms_residual_px = res.empty() ? kNaN : res[res.size() / 2];
-  summary.median_residual_px = res_median.empty() ? kNaN : res_median[res_median.size() / 2];
+  summary.median_rms_residual_px = res.empty() ? kNaN : UpperMedian(res);
+  summary.median_residual_px = res_median.empty() ? kNaN : UpperMedian(res_median);
   summary.bone_lengths_from_data = bones.ok();
   for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
     record.bone_lengths_mm[static_cast<size_t>(k)] = k == 0 ? 0.0 : model.bone_length_mm(k);

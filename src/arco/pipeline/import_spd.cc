@@ -6,6 +6,7 @@
 
 #include "arco/io/calibration_file.h"
 #include "arco/mocap/capture.h"
+#include "arco/registry/instruments.h"
 #include "arco/util/file_io.h"
 
 namespace arco::pipeline {
@@ -72,7 +73,8 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
   m.frame_count = spd.frame_last - spd.frame_first + 1;
   m.calibration = "calibration" + fs::path(o.calibration).extension().string();
   m.keypoints2d = "keypoints2d.npy";
-  m.layout = o.instrument == "violin" ? "spd_violin" : "spd_cello";
+  ARCO_ASSIGN_OR_RETURN(InstrumentKind kind, ParseInstrumentKind(o.instrument));
+  m.layout = GetInstrumentInfo(kind).spd_layout;
   if (!o.audio.empty()) {
     m.audio = "audio" + fs::path(o.audio).extension().string();
     m.audio_offset_s = o.audio_offset_s;

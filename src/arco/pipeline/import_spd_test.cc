@@ -5,13 +5,13 @@
 #include <cmath>
 #include <filesystem>
 
+#include "arco/io/calibration_file.h"
+#include "arco/mocap/synthetic_views.h"
 #include "arco/pipeline/label_views.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/triangulate_stage.h"
-#include "arco/io/calibration_file.h"
-#include "arco/mocap/synthetic_views.h"
-#include "arco/util/test_dir.h"
 #include "arco/util/file_io.h"
+#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {

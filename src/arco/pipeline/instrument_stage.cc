@@ -4,11 +4,13 @@
 #include <vector>
 
 #include "arco/pipeline/result_folder.h"
+#include "arco/registry/keypoint_layout.h"
 
 namespace arco::pipeline {
 namespace {
 
-constexpr int kLeftShoulder = 5, kRightShoulder = 6;  // TODO(registry)
+constexpr int kLeftShoulder = wholebody::kLeftShoulder;
+constexpr int kRightShoulder = wholebody::kRightShoulder;
 
 Eigen::Vector3d PointAt(const NpyArray<double>& a, int64_t f, int64_t p) {
   return Eigen::Vector3d(a.at(f, p, 0), a.at(f, p, 1), a.at(f, p, 2));

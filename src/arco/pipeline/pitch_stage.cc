@@ -25,10 +25,8 @@ StatusOr<PitchStageSummary> RunPitchStage(const PitchStageOptions& options,
         "pitch: the capture has no audio; only the vision method is written");
     return summary;
   }
-  // TODO(registry): the audio layer's range name of an instrument.
-  std::string range_name = capture.instrument->name();
-  if (capture.instrument->kind() == InstrumentKind::kDoubleBass) range_name = "bass";
-  ARCO_ASSIGN_OR_RETURN(audio::InstrumentRange range, audio::InstrumentRangeByName(range_name));
+  ARCO_ASSIGN_OR_RETURN(audio::InstrumentRange range,
+                        audio::InstrumentRangeByName(capture.instrument->name()));
   audio::PitchTrackerOptions po;
   po.range = range;
   po.fps = m.fps;

@@ -4,12 +4,13 @@
 #include <vector>
 
 #include "arco/pipeline/result_folder.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
 
 namespace arco::pipeline {
 namespace {
 
-constexpr int kNumWholeBody = 133;  // TODO(registry)
+constexpr int kNumWholeBody = wholebody::kNumPoints;
 
 Status Expect(bool ok, const std::string& path, const std::string& what) {
   return ok ? Status::Ok() : Status::Error(path + ": " + what);

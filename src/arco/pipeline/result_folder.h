@@ -34,7 +34,7 @@
 #include "arco/audio/pitch_tracker.h"
 #include "arco/hand/hand_model.h"
 #include "arco/mocap/capture.h"
-#include "arco/mocap/keypoint_layout.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/mocap/triangulate_sequence.h"
 #include "arco/pipeline/summaries.h"
 #include "arco/refine/contact_annotation.h"

@@ -8,10 +8,10 @@
 #include <filesystem>
 
 #include "arco/hand/kinematics.h"
-#include "arco/mocap/keypoint_layout.h"
 #include "arco/refine/method_result.h"
 #include "arco/refine/refine.h"
 #include "arco/refine/test_scene.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
 #include "arco/util/test_dir.h"
 
@@ -43,7 +43,8 @@ refine::SpdSources SourcesFor(const refine::testing::Scene& scene) {
   s.instrument = scene.input.instrument;
   s.hand_model = scene.input.hand_model;
   const int64_t frames = static_cast<int64_t>(scene.input.pitch.size());
-  const int64_t points = 133 + static_cast<int64_t>(scene.model->keypoint_names().size());
+  const int64_t points =
+      wholebody::kNumPoints + static_cast<int64_t>(scene.model->keypoint_names().size());
   s.base_points_mm.shape = {frames, points, 3};
   s.base_points_mm.data.assign(static_cast<size_t>(frames * points * 3), 0.0);
   for (size_t i = 0; i < s.base_points_mm.data.size(); ++i) s.base_points_mm.data[i] = 0.25 * i;

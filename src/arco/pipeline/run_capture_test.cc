@@ -1,5 +1,5 @@
-// RunCapture (`arco run`) and RunRefineStage (`arco refine`) end to end on a short synthetic capture (arco synth, the real
-// SPD rig), scored with arco eval's library.
+// RunCapture (`arco run`) and RunRefineStage (`arco refine`) end to end on a short synthetic
+// capture (arco synth, the real SPD rig), scored with arco eval's library.
 #include "arco/pipeline/run_capture.h"
 
 #include <gtest/gtest.h>
@@ -9,11 +9,11 @@
 #include "arco/eval/evaluate.h"
 #include "arco/io/calibration_file.h"
 #include "arco/mocap/capture.h"
-#include "arco/util/test_dir.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"
 #include "arco/util/file_io.h"
+#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {

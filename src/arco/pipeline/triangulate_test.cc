@@ -1,7 +1,3 @@
-#include "arco/pipeline/label_views.h"
-#include "arco/pipeline/result_folder.h"
-#include "arco/pipeline/triangulate_stage.h"
-
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -10,8 +6,11 @@
 
 #include "arco/io/calibration_file.h"
 #include "arco/mocap/synthetic_views.h"
-#include "arco/util/test_dir.h"
+#include "arco/pipeline/label_views.h"
+#include "arco/pipeline/result_folder.h"
+#include "arco/pipeline/triangulate_stage.h"
 #include "arco/util/file_io.h"
+#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {

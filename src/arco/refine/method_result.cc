@@ -3,12 +3,13 @@
 #include <stdexcept>
 
 #include "arco/hand/kinematics.h"
+#include "arco/registry/keypoint_layout.h"
 
 namespace arco::refine {
 namespace {
 
 constexpr int kLeftHandFirst = 91;
-constexpr int kNumWholeBody = 133;
+constexpr int kNumWholeBody = wholebody::kNumPoints;
 
 void SetPoint(NpyArray<double>* a, int64_t f, int64_t p, const Eigen::Vector3d& v) {
   for (int c = 0; c < 3; ++c) a->at(f, p, c) = v[c];

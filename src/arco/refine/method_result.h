@@ -1,7 +1,7 @@
 // The SPD-compatible points of a refined method (docs/formats.md, "Method folders"):
 // RESULT_DIR/<method>/points3d.npy is (F, 155, 3) cello / (F, 153, 3) violin, float64,
 // millimetres, NaN = missing, in the layout spd_cello_contact / spd_violin_contact
-// (mocap/keypoint_layout.h; DOMAIN.md section 3). The folder itself is written by the
+// (registry/keypoint_layout.h; DOMAIN.md section 3). The folder itself is written by the
 // result folder's owner (pipeline/result_folder.h).
 #pragma once
 

@@ -4,7 +4,7 @@
 
 
 #include "arco/hand/kinematics.h"
-#include "arco/mocap/keypoint_layout.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/refine/refine.h"
 #include "arco/refine/test_scene.h"
 

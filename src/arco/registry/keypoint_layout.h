@@ -29,6 +29,8 @@ namespace arco {
 namespace wholebody {
 constexpr int kBodyFirst = 0;  // nose .. right_ankle
 constexpr int kNumBody = 17;
+constexpr int kLeftShoulder = 5;  // where the performer's back is (instrument stage)
+constexpr int kRightShoulder = 6;
 constexpr int kFeetFirst = 17;  // left_big_toe .. right_heel
 constexpr int kNumFeet = 6;
 constexpr int kFaceFirst = 23;  // face_00 .. face_67

@@ -86,6 +86,8 @@ TEST(KeypointLayoutRegistry, WholeBodyConstantsMatchTheLayouts) {
     EXPECT_EQ(count("left_hand"), wholebody::kNumHandPoints);
     EXPECT_EQ(count("right_hand"), wholebody::kNumHandPoints);
     EXPECT_EQ(l.Find("left_hand_wrist"), wholebody::kLeftHandFirst);
+    EXPECT_EQ(l.Find("left_shoulder"), wholebody::kLeftShoulder);
+    EXPECT_EQ(l.Find("right_shoulder"), wholebody::kRightShoulder);
     EXPECT_EQ(l.Find("right_hand_wrist"), wholebody::kRightHandFirst);
     EXPECT_EQ(l.Find("right_hand_little_tip"), wholebody::kNumPoints - 1);
     if (l.size() > wholebody::kNumPoints) {
