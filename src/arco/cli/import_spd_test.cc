@@ -5,11 +5,11 @@
 #include <cmath>
 #include <filesystem>
 
+#include "arco/calibration/calibration_file.h"
 #include "arco/cli/triangulate.h"
-#include "arco/io/calibration_file.h"
 #include "arco/mocap/synthetic_views.h"
-#include "arco/util/test_dir.h"
 #include "arco/util/file_io.h"
+#include "arco/util/test_dir.h"
 
 namespace arco::cli {
 namespace {

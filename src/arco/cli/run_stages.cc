@@ -8,8 +8,8 @@
 
 #include "arco/audio/notes.h"
 #include "arco/audio/pitch_tracker.h"
+#include "arco/calibration/calibration_file.h"
 #include "arco/hand/kinematics.h"
-#include "arco/io/calibration_file.h"
 #include "arco/util/file_io.h"
 #include "arco/util/parallel.h"
 

@@ -6,14 +6,14 @@
 
 #include <filesystem>
 
+#include "arco/calibration/calibration_file.h"
 #include "arco/eval/evaluate.h"
-#include "arco/io/calibration_file.h"
 #include "arco/mocap/capture.h"
-#include "arco/util/test_dir.h"
 #include "arco/refine/method_result.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"
 #include "arco/util/file_io.h"
+#include "arco/util/test_dir.h"
 
 namespace arco::cli {
 namespace {

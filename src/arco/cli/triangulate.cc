@@ -6,7 +6,7 @@
 #include <set>
 #include <sstream>
 
-#include "arco/io/calibration_file.h"
+#include "arco/calibration/calibration_file.h"
 #include "arco/mocap/triangulate_sequence.h"
 #include "arco/util/file_io.h"
 
