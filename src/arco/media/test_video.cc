@@ -108,7 +108,9 @@ Status WriteIndexVideo(const std::string& path, const IndexVideo& v) {
   if (v.rotation_deg != 0) {
     uint8_t* matrix = av_stream_new_side_data(e.stream, AV_PKT_DATA_DISPLAYMATRIX, 9 * sizeof(int32_t));
     if (matrix == nullptr) return fail("cannot add a display matrix");
-    av_display_rotation_set(reinterpret_cast<int32_t*>(matrix), -v.rotation_deg);
+    // av_display_rotation_set takes the clockwise angle (av_display_rotation_get
+    // returns the counter-clockwise one).
+    av_display_rotation_set(reinterpret_cast<int32_t*>(matrix), v.rotation_deg);
   }
   if (avio_open(&e.format->pb, path.c_str(), AVIO_FLAG_WRITE) < 0) return fail("cannot write");
   if (avformat_write_header(e.format, nullptr) < 0) return fail("cannot write the header");

@@ -122,16 +122,7 @@ class VideoFile : public FrameSource {
     return Status::Ok();
   }
 
-  StatusOr<bool> Read(Image* image) override {
-    if (!have_frame_) {
-      ARCO_ASSIGN_OR_RETURN(const bool got, Decode());
-      if (!got) return false;
-    }
-    have_frame_ = false;
-    ARCO_RETURN_IF_ERROR(Convert(image));
-    ++next_frame_;
-    return true;
-  }
+  StatusOr<bool> Read(Image* image) override { return Advance(image); }
 
   Status Seek(int64_t index) override {
     ARCO_RETURN_IF_ERROR(CheckIndex(index));
@@ -168,6 +159,8 @@ class VideoFile : public FrameSource {
     }
     if (packet_ == nullptr) packet_.reset(av_packet_alloc());
     if (frame_ == nullptr) frame_.reset(av_frame_alloc());
+    if (shown_ == nullptr) shown_.reset(av_frame_alloc());
+    av_frame_unref(shown_.get());
     draining_ = false;
     have_frame_ = false;
     return Status::Ok();
@@ -188,46 +181,75 @@ class VideoFile : public FrameSource {
         avcodec_send_packet(codec_.get(), nullptr);
       } else {
         // A damaged packet is rejected here and the decoder resynchronises on the
-        // next one, as players do.
-        if (packet_->stream_index == stream_index_) avcodec_send_packet(codec_.get(), packet_.get());
+        // next one, as players do. An empty packet (AVI's dropped frame) is skipped:
+        // sent, it would read as the end of the stream; the timeline repeats the
+        // previous picture instead (Advance).
+        if (packet_->stream_index == stream_index_ && packet_->size > 0) {
+          avcodec_send_packet(codec_.get(), packet_.get());
+        }
         av_packet_unref(packet_.get());
       }
     }
   }
 
-  // Decodes and drops frames until the next Read returns frame `index`.
-  Status DecodeForwardTo(int64_t index) {
-    while (next_frame_ < index) {
+  // One step along the frame timeline: the picture shown at frame next_frame_ goes
+  // to *image (when given). Frame n shows the last decoded frame whose timestamp
+  // rounds to at most n on the grid first_pts + n / fps, as a constant-frame-rate
+  // player does: a gap in the timestamps (a dropped frame, a variable-rate AVI)
+  // repeats the previous picture, a second frame in one tick is dropped. Frames
+  // without timestamps are taken in decoding order. False after the last frame.
+  StatusOr<bool> Advance(Image* image) {
+    while (true) {
       if (!have_frame_) {
         ARCO_ASSIGN_OR_RETURN(const bool got, Decode());
-        if (!got) {
-          return Status::Error(path_ + ": frame " + std::to_string(index) +
-                               " not found (the video ends after " +
-                               std::to_string(next_frame_) + " frames)");
-        }
+        if (!got) return false;
+        have_frame_ = true;
       }
-      have_frame_ = false;
-      av_frame_unref(frame_.get());
+      const bool have_shown = shown_->buf[0] != nullptr;
+      const int64_t at = IndexOfPts(frame_->best_effort_timestamp);
+      if (have_shown && at >= 0 && at < next_frame_) {  // a second frame in one tick
+        av_frame_unref(frame_.get());
+        have_frame_ = false;
+        continue;
+      }
+      if (!have_shown || at < 0 || at <= next_frame_) {  // frame_ is frame next_frame_
+        av_frame_unref(shown_.get());
+        av_frame_move_ref(shown_.get(), frame_.get());
+        have_frame_ = false;
+      }
+      if (image != nullptr) ARCO_RETURN_IF_ERROR(Convert(*shown_, image));
       ++next_frame_;
+      return true;
+    }
+  }
+
+  // Steps along the timeline until the next Read returns frame `index`.
+  Status DecodeForwardTo(int64_t index) {
+    while (next_frame_ < index) {
+      ARCO_ASSIGN_OR_RETURN(const bool more, Advance(nullptr));
+      if (!more) {
+        return Status::Error(path_ + ": frame " + std::to_string(index) +
+                             " not found (the video ends after " +
+                             std::to_string(next_frame_) + " frames)");
+      }
     }
     return Status::Ok();
   }
 
-  // Frame index of a timestamp on the grid first_pts + k / fps; -1 when there is
-  // no timestamp or it lies off the grid by more than a quarter frame.
+  // Nearest frame index of a timestamp on the grid first_pts + n / fps; -1 when
+  // there is no timestamp or no frame rate.
   int64_t IndexOfPts(int64_t pts) const {
     if (pts == AV_NOPTS_VALUE || first_pts_ == AV_NOPTS_VALUE || frame_rate_.num <= 0 ||
         frame_rate_.den <= 0) {
       return -1;
     }
-    const double frames =
-        static_cast<double>(pts - first_pts_) * av_q2d(time_base_) * av_q2d(frame_rate_);
-    const double nearest = std::round(frames);
-    return std::abs(frames - nearest) <= 0.25 ? static_cast<int64_t>(nearest) : -1;
+    return av_rescale_q_rnd(pts - first_pts_, time_base_, av_inv_q(frame_rate_),
+                            static_cast<AVRounding>(AV_ROUND_NEAR_INF | AV_ROUND_PASS_MINMAX));
   }
 
   // Seeks the container to the key frame before frame `index`, decodes forward and
-  // checks timestamps. False when that cannot find the frame (the caller counts
+  // checks timestamps (the frame shown at `index` is the last one whose timestamp
+  // rounds to at most `index`). False when that cannot find the frame (the caller counts
   // from the start instead).
   StatusOr<bool> SeekByTimestamp(int64_t index) {
     if (first_pts_ == AV_NOPTS_VALUE || frame_rate_.num <= 0 || frame_rate_.den <= 0) return false;
@@ -242,32 +264,39 @@ class VideoFile : public FrameSource {
       avcodec_flush_buffers(codec_.get());
       draining_ = false;
       have_frame_ = false;
+      av_frame_unref(shown_.get());
       while (true) {
         ARCO_ASSIGN_OR_RETURN(const bool got, Decode());
         if (!got) return false;
         const int64_t at = IndexOfPts(frame_->best_effort_timestamp);
         if (at < 0) return false;
-        if (at == index) {
+        if (at < index) {  // shown at `index` unless a later frame is
+          av_frame_unref(shown_.get());
+          av_frame_move_ref(shown_.get(), frame_.get());
+          continue;
+        }
+        if (at == index || shown_->buf[0] != nullptr) {
+          // Advance shows frame_ at `index`, or repeats shown_ until frame_'s tick.
           have_frame_ = true;
           next_frame_ = index;
           return true;
         }
         av_frame_unref(frame_.get());
-        if (at > index) break;  // landed after the target: aim earlier
+        break;  // landed after the target: aim earlier
       }
       if (seek_ts <= first_pts_) return false;
     }
     return false;
   }
 
-  // frame_ -> *image in the requested format and size.
-  Status Convert(Image* image) {
+  // `frame` -> *image in the requested format and size.
+  Status Convert(const AVFrame& frame, Image* image) {
     const VideoProperties& p = properties_;
     const bool rgb = options_.format == PixelFormat::kRgb8;
     sws_.reset(sws_getCachedContext(sws_.release(),
-                                    frame_->width,
-                                    frame_->height,
-                                    static_cast<AVPixelFormat>(frame_->format),
+                                    frame.width,
+                                    frame.height,
+                                    static_cast<AVPixelFormat>(frame.format),
                                     p.width,
                                     p.height,
                                     rgb ? AV_PIX_FMT_RGB24 : AV_PIX_FMT_GRAY8,
@@ -275,18 +304,15 @@ class VideoFile : public FrameSource {
                                     nullptr,
                                     nullptr,
                                     nullptr));
-    if (sws_ == nullptr) {
-      av_frame_unref(frame_.get());
-      return Status::Error(path_ + ": unsupported pixel format");
-    }
+    if (sws_ == nullptr) return Status::Error(path_ + ": unsupported pixel format");
     if (image->width != p.width || image->height != p.height || image->format != options_.format ||
-        image->pixels.size() != static_cast<size_t>(p.width) * p.height * ChannelCount(options_.format)) {
+        image->pixels.size() !=
+            static_cast<size_t>(p.width) * p.height * ChannelCount(options_.format)) {
       *image = MakeImage(p.width, p.height, options_.format);
     }
     uint8_t* planes[1] = {image->pixels.data()};
     int strides[1] = {static_cast<int>(image->row_bytes())};
-    sws_scale(sws_.get(), frame_->data, frame_->linesize, 0, frame_->height, planes, strides);
-    av_frame_unref(frame_.get());
+    sws_scale(sws_.get(), frame.data, frame.linesize, 0, frame.height, planes, strides);
     return Status::Ok();
   }
 
@@ -295,14 +321,15 @@ class VideoFile : public FrameSource {
   FormatPtr format_;
   std::unique_ptr<AVCodecContext, CodecFreer> codec_;
   std::unique_ptr<AVPacket, PacketFreer> packet_;
-  std::unique_ptr<AVFrame, FrameFreer> frame_;
+  std::unique_ptr<AVFrame, FrameFreer> frame_;  // decoded, not yet shown (have_frame_)
+  std::unique_ptr<AVFrame, FrameFreer> shown_;  // the picture of frame next_frame_ - 1
   std::unique_ptr<SwsContext, SwsFreer> sws_;
   int stream_index_ = -1;
   AVRational time_base_{1, 1};
   AVRational frame_rate_{0, 1};
   int64_t first_pts_ = AV_NOPTS_VALUE;
   bool draining_ = false;
-  bool have_frame_ = false;  // frame_ holds frame next_frame_, decoded but not returned
+  bool have_frame_ = false;
 };
 
 }  // namespace

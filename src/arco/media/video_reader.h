@@ -7,12 +7,20 @@
 //   media::Image frame;
 //   ARCO_ASSIGN_OR_RETURN(bool more, reader.Read(&frame));
 //
-// Frame indices count frames in presentation order from 0. Seeking is frame
-// accurate for constant-frame-rate videos: Seek(n) seeks the container to the key
-// frame at or before frame n's timestamp (first pts + n / fps), decodes forward and
-// checks each decoded frame's pts until it maps to n. When timestamps are missing or
-// do not fit that grid (variable frame rate), Seek decodes from the start and counts,
-// which is exact but slow. Short forward seeks just decode forward.
+// Frame n is the picture shown at time n / fps after the first frame, as a
+// constant-frame-rate player shows it: for an ordinary video that is simply the n-th
+// decoded frame; a gap in the timestamps (a dropped frame, a variable-rate AVI such as
+// opencv-doc's tree.avi, 68 pictures on a 444-frame timeline) repeats the previous
+// picture, and a second picture within one frame period is dropped. Frames without
+// timestamps are taken in decoding order. This keeps frame n at video time n / fps,
+// the contract of pitch.csv and sync.
+//
+// Seek(n) seeks the container to the key frame before frame n's timestamp, decodes
+// forward and checks each decoded frame's pts until the one shown at n; if the
+// demuxer lands after n it aims earlier, and without timestamps it decodes from the
+// start. Short forward seeks just decode forward. Either way Seek(n) + Read gives
+// exactly what sequential reading gives at n (tests: random seeks on generated
+// ffv1/mpeg4/h264 videos with B-frames and on opencv-doc's AVIs).
 //
 // Frames are returned as stored in the file (coded orientation, coded size unless
 // options.max_width scales them down); properties().rotation_deg says how a player
@@ -48,6 +56,8 @@ struct VideoProperties {
   std::string codec;  // decoder name: "h264", "ffv1", "png", ...
   Rational fps;       // nominal frame rate; 0/1 when unknown
   double fps_hz = 0;  // fps as a double
+  // Frames on the timeline (for a variable-rate Matroska file, counted packets: the
+  // pictures, which may be fewer).
   int64_t frame_count = 0;
   FrameCountSource frame_count_source = FrameCountSource::kContainer;
   int width = 0, height = 0;  // of the frames Read returns (after max_width scaling)
