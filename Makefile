@@ -1,12 +1,14 @@
 # arco top-level targets. `make test` and `make demo` run the idempotent
 # scripts/setup first, so they work on a fresh Debian 12 machine.
+# `make demo` builds only the `arco` executable and the libraries it links; the unit
+# tests are built by `make build`/`make test`, the benchmarks by `make bench`.
 JOBS ?= $(shell nproc)
 BUILD ?= build
 ASAN_BUILD ?= build-asan
 FUZZ_BUILD ?= build-fuzz
 CMAKE_GEN := -G Ninja
 
-.PHONY: setup build test test-unit test-asan test-fuzz fuzz-long demo bench format clean
+.PHONY: setup build build-arco build-bench test test-unit test-asan test-fuzz fuzz-long demo bench format clean
 
 setup:
 	@bash scripts/setup
@@ -14,8 +16,16 @@ setup:
 $(BUILD)/build.ninja:
 	cmake -S . -B $(BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release
 
+# Everything: libraries, `arco`, unit tests, benchmarks.
 build: setup $(BUILD)/build.ninja
 	cmake --build $(BUILD) -j $(JOBS)
+
+# Only what the demo and the README's commands need.
+build-arco: setup $(BUILD)/build.ninja
+	cmake --build $(BUILD) -j $(JOBS) --target arco
+
+build-bench: setup $(BUILD)/build.ninja
+	cmake --build $(BUILD) -j $(JOBS) --target arco benchmarks
 
 test-unit: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
@@ -36,10 +46,10 @@ fuzz-long: setup
 
 test: test-unit test-asan test-fuzz
 
-demo: build
+demo: build-arco
 	bash scripts/demo $(BUILD)
 
-bench: build
+bench: build-bench
 	bash bench/run_all.sh $(BUILD)
 
 format:

@@ -38,18 +38,18 @@ StatusOr<InstrumentRange> InstrumentRangeByName(const std::string& name) {
 
 Status PitchTrackerOptions::Validate() const {
   if (!(fps > 0 && fps <= 1000)) {
-    return Status::Error("--fps must be in (0, 1000], got " + std::to_string(fps));
+    return Status::Error("fps must be in (0, 1000], got " + std::to_string(fps));
   }
   if (!std::isfinite(start_s) || start_s < -3600 || start_s > 1e6) {
     return Status::Error(
-        "--start-s must be in [-3600, 1e6] s (video may start at most an hour "
+        "start_s must be in [-3600, 1e6] s (video may start at most an hour "
         "before the audio)");
   }
   if (hops_per_frame < 0 || hops_per_frame > 100) {
     return Status::Error("hops per frame must be in [0, 100]");
   }
   if (max_frames < -1) return Status::Error("max_frames must be >= -1");
-  if (!(a4_hz >= 300 && a4_hz <= 600)) return Status::Error("--a4 must be in [300, 600] Hz");
+  if (!(a4_hz >= 300 && a4_hz <= 600)) return Status::Error("a4_hz must be in [300, 600] Hz");
   if (!(range.min_f0_hz >= 20 && range.max_f0_hz > range.min_f0_hz &&
         range.max_f0_hz <= range.analysis_rate_hz / 4.0)) {
     return Status::Error("pitch range must satisfy 20 <= min < max <= analysis rate / 4");
@@ -152,7 +152,7 @@ StatusOr<PitchTrack> TrackPitch(std::unique_ptr<AudioReader> reader,
     if (stream.source_samples() == 0) {
       summary->warnings.push_back("empty: the file holds no audio samples");
     } else if (track.frames.empty()) {
-      summary->warnings.push_back("empty: no video frame falls inside the audio (check --start-s)");
+      summary->warnings.push_back("empty: no video frame falls inside the audio (check start_s)");
     } else if (voiced == 0) {
       summary->warnings.push_back("no voiced frames: the audio is silent or unpitched");
     }

@@ -1,17 +1,12 @@
 #include "arco/audio/sync.h"
 
-extern "C" {
-#include <libavcodec/avcodec.h>
-#include <libavformat/avformat.h>
-#include <libswscale/swscale.h>
-}
-
 #include <algorithm>
 #include <cstdlib>
-#include <memory>
+#include <utility>
 
 #include "arco/audio/audio_reader.h"
 #include "arco/audio/sample_stream.h"
+#include "arco/media/video_reader.h"
 
 namespace arco::audio {
 namespace {
@@ -54,8 +49,8 @@ void PeakAndRunnerUp(const std::vector<double>& v,
 }  // namespace
 
 Status SyncOptions::Validate() const {
-  if (!(video_fps >= 0 && video_fps <= 1000)) return Status::Error("--fps must be in [0, 1000]");
-  if (!(search_s > 0 && search_s <= 3600)) return Status::Error("--search-s must be in (0, 3600]");
+  if (!(video_fps >= 0 && video_fps <= 1000)) return Status::Error("video_fps must be in [0, 1000]");
+  if (!(search_s > 0 && search_s <= 3600)) return Status::Error("search_s must be in (0, 3600]");
   if (!(max_seconds > 0)) return Status::Error("max_seconds must be positive");
   return Status::Ok();
 }
@@ -113,98 +108,30 @@ StatusOr<SyncEvent> FindAudioOnset(const std::string& path, const SyncOptions& o
 }
 
 StatusOr<MotionEnergy> ComputeMotionEnergy(const std::string& path, double max_seconds) {
-  av_log_set_level(AV_LOG_QUIET);
-  AVFormatContext* format = nullptr;
-  if (avformat_open_input(&format, path.c_str(), nullptr, nullptr) < 0) {
-    return Status::Error(path + ": cannot open video");
-  }
-  std::unique_ptr<AVFormatContext, void (*)(AVFormatContext*)> format_guard(
-      format, [](AVFormatContext* f) { avformat_close_input(&f); });
-  if (avformat_find_stream_info(format, nullptr) < 0) {
-    return Status::Error(path + ": cannot read stream info");
-  }
-  const AVCodec* decoder = nullptr;
-  const int index = av_find_best_stream(format, AVMEDIA_TYPE_VIDEO, -1, -1, &decoder, 0);
-  if (index < 0 || decoder == nullptr) {
-    return Status::Error(path + (index == AVERROR_STREAM_NOT_FOUND ? ": no video stream"
-                                                                   : ": unsupported video codec"));
-  }
-  AVStream* stream = format->streams[index];
-  AVCodecContext* codec = avcodec_alloc_context3(decoder);
-  std::unique_ptr<AVCodecContext, void (*)(AVCodecContext*)> codec_guard(
-      codec, [](AVCodecContext* c) { avcodec_free_context(&c); });
-  avcodec_parameters_to_context(codec, stream->codecpar);
-  codec->thread_count = 1;
-  if (avcodec_open2(codec, decoder, nullptr) < 0)
-    return Status::Error(path + ": cannot open decoder");
+  media::VideoReaderOptions options;
+  options.format = media::PixelFormat::kGray8;
+  options.max_width = kGrayWidth;
+  ARCO_ASSIGN_OR_RETURN(media::VideoReader reader, media::VideoReader::Open(path, options));
   MotionEnergy out;
-  const AVRational rate = av_guess_frame_rate(format, stream, nullptr);
-  out.fps = rate.num > 0 && rate.den > 0 ? av_q2d(rate) : 0.0;
-  AVPacket* packet = av_packet_alloc();
-  AVFrame* frame = av_frame_alloc();
-  std::unique_ptr<AVPacket, void (*)(AVPacket*)> packet_guard(
-      packet, [](AVPacket* p) { av_packet_free(&p); });
-  std::unique_ptr<AVFrame, void (*)(AVFrame*)> frame_guard(frame,
-                                                           [](AVFrame* f) { av_frame_free(&f); });
-  SwsContext* sws = nullptr;
-  std::vector<uint8_t> gray, previous;
-  int width = 0, height = 0;
+  out.fps = reader.properties().fps_hz;
   const int64_t max_frames =
       out.fps > 0 ? static_cast<int64_t>(max_seconds * out.fps) + 1 : static_cast<int64_t>(1e6);
-  bool draining = false;
-  Status status;
+  media::Image gray, previous;
   while (static_cast<int64_t>(out.energy.size()) < max_frames) {
-    int rc = avcodec_receive_frame(codec, frame);
-    if (rc == AVERROR(EAGAIN) && !draining) {
-      if (av_read_frame(format, packet) < 0) {
-        draining = true;
-        avcodec_send_packet(codec, nullptr);
-      } else {
-        if (packet->stream_index == index) avcodec_send_packet(codec, packet);
-        av_packet_unref(packet);
-      }
-      continue;
-    }
-    if (rc < 0) break;  // end of stream (or an undecodable tail)
-    if (sws == nullptr) {
-      if (frame->width <= 0 || frame->height <= 0) {
-        status = Status::Error(path + ": invalid frame size");
-        break;
-      }
-      width = std::min(kGrayWidth, frame->width);
-      height =
-          std::max(2, static_cast<int>(std::lround(double(frame->height) * width / frame->width)));
-      sws = sws_getContext(frame->width,
-                           frame->height,
-                           static_cast<AVPixelFormat>(frame->format),
-                           width,
-                           height,
-                           AV_PIX_FMT_GRAY8,
-                           SWS_AREA,
-                           nullptr,
-                           nullptr,
-                           nullptr);
-      if (sws == nullptr) {
-        status = Status::Error(path + ": unsupported pixel format");
-        break;
-      }
-      gray.resize(static_cast<size_t>(width) * height);
-    }
-    uint8_t* planes[1] = {gray.data()};
-    int strides[1] = {width};
-    sws_scale(sws, frame->data, frame->linesize, 0, frame->height, planes, strides);
-    av_frame_unref(frame);
+    // A frame that cannot be decoded ends the signal (an undecodable tail): the
+    // event is searched in the frames before it.
+    const StatusOr<bool> more = reader.Read(&gray);
+    if (!more.ok() || !*more) break;
     double e = 0;
     if (!previous.empty()) {
-      for (size_t i = 0; i < gray.size(); ++i) e += std::abs(int(gray[i]) - int(previous[i]));
-      e /= static_cast<double>(gray.size());
+      for (size_t i = 0; i < gray.pixels.size(); ++i) {
+        e += std::abs(int(gray.pixels[i]) - int(previous.pixels[i]));
+      }
+      e /= static_cast<double>(gray.pixels.size());
     }
     out.energy.push_back(e);
-    previous.swap(gray);
-    gray.resize(previous.size());
+    std::swap(previous, gray);
   }
-  sws_freeContext(sws);
-  if (!status.ok()) return status;
   if (out.energy.empty()) return Status::Error(path + ": no decodable video frames");
   return out;
 }
@@ -215,7 +142,7 @@ StatusOr<SyncEvent> FindVideoEvent(const std::string& path,
   ARCO_RETURN_IF_ERROR(options.Validate());
   ARCO_ASSIGN_OR_RETURN(const MotionEnergy motion, ComputeMotionEnergy(path, options.max_seconds));
   const double fps = options.video_fps > 0 ? options.video_fps : motion.fps;
-  if (!(fps > 0)) return Status::Error(path + ": unknown frame rate; pass --fps");
+  if (!(fps > 0)) return Status::Error(path + ": unknown frame rate; set video_fps");
   if (fps_out != nullptr) *fps_out = fps;
   const auto& e = motion.energy;
   const int64_t n = static_cast<int64_t>(e.size());
@@ -277,10 +204,10 @@ StatusOr<SyncResult> SyncAudioToVideo(const std::string& audio_path,
     result.warnings.push_back("the audio onset is weak (< 10 dB above the preceding 50 ms)");
   }
   if (result.audio.runner_up > result.audio.strength - 3.0) {
-    result.warnings.push_back("another audio onset is nearly as strong: pass --audio-near-s");
+    result.warnings.push_back("another audio onset is nearly as strong: set audio_near_s");
   }
   if (result.video.runner_up > 0.7 * result.video.strength) {
-    result.warnings.push_back("other motion is nearly as strong: pass --video-near-s");
+    result.warnings.push_back("other motion is nearly as strong: set video_near_s");
   }
   return result;
 }

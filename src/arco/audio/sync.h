@@ -9,7 +9,7 @@
 // (emphasises broadband clicks) minus the log of the mean energy of the previous
 // 50 ms; the winning frame is refined to the first sample whose |difference|
 // exceeds a quarter of the burst's peak.
-// Video motion energy: frames decoded with FFmpeg, scaled to 160 px wide
+// Video motion energy: frames read with media::VideoReader, scaled to 160 px wide
 // grayscale; E[j] = mean |g_j - g_{j-1}|. Frame j's timestamp j / fps is taken
 // as the middle of its exposure (so pitch row j, centred at offset + j / fps,
 // matches what frame j shows). For a step change (a light switching on) at time

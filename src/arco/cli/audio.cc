@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "arco/cli/flag_names.h"
 #include "arco/mocap/capture.h"
 #include "arco/util/file_io.h"
 
@@ -105,7 +106,7 @@ std::string FormatPitchReport(const PitchRunOptions& o, const PitchRunResult& r)
   out += "\n";
   out +=
       Format("notes: %d (%d with vibrato), glides: %d\n", r.notes, r.notes_with_vibrato, r.glides);
-  for (const auto& w : s.warnings) out += "warning: " + w + "\n";
+  for (const auto& w : s.warnings) out += "warning: " + WithFlagNames(w, kPitchFlags) + "\n";
   out += Format("wrote %s; %.3f s CPU (%.0fx real time)\n",
                 o.output.c_str(),
                 s.cpu_seconds,
@@ -153,7 +154,7 @@ std::string FormatSyncReport(const SyncRunOptions& o, const audio::SyncResult& r
       Format("offset_s %.4f  (audio time = video time + offset; use arco pitch --offset-s %.4f)\n",
              r.offset_s,
              r.offset_s);
-  for (const auto& w : r.warnings) out += "warning: " + w + "\n";
+  for (const auto& w : r.warnings) out += "warning: " + WithFlagNames(w, kSyncFlags) + "\n";
   if (!o.capture_dir.empty()) {
     out += "wrote audio.offset_s to " + JoinPath(o.capture_dir, kCaptureManifestName) + "\n";
   }

@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <memory>
 
+#include "arco/calibration/calibration_file.h"
 #include "arco/cli/command.h"
-#include "arco/io/calibration_file.h"
 
 namespace arco::cli {
 namespace {

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "arco/cli/command.h"
+#include "arco/cli/flag_names.h"
 #include "arco/eval/evaluate.h"
 #include "arco/eval/plot.h"
 #include "arco/util/file_io.h"
@@ -25,7 +26,7 @@ int Run(Args& a) {
     a.r.labels = a.truths;
   }
   auto report = eval::Evaluate(a.r);
-  if (!report.ok()) return PrintError(report.status().message());
+  if (!report.ok()) return PrintError(WithFlagNames(report.status().message(), kEvalFlags));
   if (!a.output.empty()) {
     const Status st = WriteJsonFile(a.output, report->ToJson(a.r.metrics));
     if (!st.ok()) return PrintError(st.message());

@@ -4,6 +4,7 @@
 
 #include "arco/cli/audio.h"
 #include "arco/cli/command.h"
+#include "arco/cli/flag_names.h"
 #include "arco/cli/progress.h"
 
 namespace arco::cli {
@@ -56,7 +57,7 @@ std::function<int()> SetupPitch(CLI::App& app) {
       if (now > shown) bar.Add(now - shown), shown = now;
     });
     bar.Finish();
-    if (!result.ok()) return PrintError(result.status().message());
+    if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kPitchFlags));
     std::fputs(FormatPitchReport(*o, *result).c_str(), stdout);
     return 0;
   };

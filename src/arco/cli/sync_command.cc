@@ -4,6 +4,7 @@
 
 #include "arco/cli/audio.h"
 #include "arco/cli/command.h"
+#include "arco/cli/flag_names.h"
 
 namespace arco::cli {
 namespace {
@@ -38,7 +39,7 @@ std::function<int()> SetupSync(CLI::App& app) {
   return [o, event] {
     o->sync.video_event = *event == "flash" ? audio::VideoEvent::kFlash : audio::VideoEvent::kClap;
     auto result = RunSync(*o);
-    if (!result.ok()) return PrintError(result.status().message());
+    if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kSyncFlags));
     std::fputs(FormatSyncReport(*o, *result).c_str(), stdout);
     return 0;
   };

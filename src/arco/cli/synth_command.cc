@@ -7,8 +7,9 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "arco/calibration/calibration_file.h"
 #include "arco/cli/command.h"
-#include "arco/io/calibration_file.h"
+#include "arco/cli/flag_names.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"
 
@@ -86,7 +87,7 @@ int Run(Args& a) {
                a.output.c_str());
   synth::WriteSummary ws;
   const Status written = synth::WriteCapture(*capture, a.output, a.w, &ws);
-  if (!written.ok()) return PrintError(written.message());
+  if (!written.ok()) return PrintError(WithFlagNames(written.message(), kSynthFlags));
   const double total_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const auto& c = *capture;

@@ -116,7 +116,7 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
   const bool folder = r.labels.empty();
   if (folder && !std::filesystem::is_directory(r.truth)) {
     return Status::Error(r.truth +
-                         ": not a truth folder (give labelled frames as JSON with --truth-frame)");
+                         ": not a truth folder (give labelled frames as labels JSON with truth_frames)");
   }
   if (folder) {
     report.truth_kind = "synthetic";
@@ -149,7 +149,7 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
     // Labelled views triangulated by `arco triangulate --view`: one JSON per frame.
     report.truth_kind = "labels";
     if (r.truth_frames.size() != r.labels.size()) {
-      return Status::Error("give one --truth-frame per labels JSON (" +
+      return Status::Error("give one truth_frames entry per labels JSON (" +
                            std::to_string(r.labels.size()) + " files, " +
                            std::to_string(r.truth_frames.size()) + " frames)");
     }
@@ -169,7 +169,7 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
         return Status::Error(path + ": no \"points\" array");
       const int64_t row = r.truth_frames[k] - first;
       if (row < 0 || row >= count) {
-        return Status::Error(path + ": --truth-frame " + std::to_string(r.truth_frames[k]) +
+        return Status::Error(path + ": truth_frames entry " + std::to_string(r.truth_frames[k]) +
                              " is outside the result's frames " + std::to_string(first) + ".." +
                              std::to_string(first + count - 1));
       }

@@ -6,7 +6,7 @@
 #include <optional>
 #include <vector>
 
-#include "arco/io/calibration_file.h"
+#include "arco/calibration/calibration_file.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/parallel.h"

@@ -4,7 +4,7 @@
 
 #include <filesystem>
 
-#include "arco/io/calibration_file.h"
+#include "arco/calibration/calibration_file.h"
 #include "arco/mocap/capture.h"
 #include "arco/registry/instruments.h"
 #include "arco/util/file_io.h"

@@ -4,7 +4,7 @@
 #include <map>
 #include <set>
 
-#include "arco/io/calibration_file.h"
+#include "arco/calibration/calibration_file.h"
 #include "arco/util/file_io.h"
 
 namespace arco::pipeline {

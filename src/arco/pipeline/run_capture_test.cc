@@ -6,8 +6,8 @@
 
 #include <filesystem>
 
+#include "arco/calibration/calibration_file.h"
 #include "arco/eval/evaluate.h"
-#include "arco/io/calibration_file.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/synth/capture_writer.h"

@@ -1,6 +1,6 @@
 #include "arco/pipeline/triangulate_stage.h"
 
-#include "arco/io/calibration_file.h"
+#include "arco/calibration/calibration_file.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/util/file_io.h"

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "arco/io/calibration_file.h"
+#include "arco/calibration/calibration_file.h"
 #include "arco/mocap/synthetic_views.h"
 #include "arco/pipeline/label_views.h"
 #include "arco/pipeline/result_folder.h"

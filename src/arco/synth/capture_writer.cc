@@ -215,7 +215,7 @@ Status WriteCapture(const SyntheticCapture& c,
       return Status::Error(out_dir + ": exists and is not a folder");
     if (!fs::is_empty(target, ec) && !w.overwrite) {
       return Status::Error(out_dir +
-                           ": folder exists and is not empty (use --overwrite to replace it)");
+                           ": folder exists and is not empty (set overwrite to replace it)");
     }
   }
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");

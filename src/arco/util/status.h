@@ -1,6 +1,8 @@
 // Expected-failure reporting (error kind 3 in docs/architecture.md): a Status
 // carries one readable line; StatusOr<T> carries a value or that line.
 // Bugs use ARCO_CHECK (check.h); caller mistakes throw std::invalid_argument.
+// Both are [[nodiscard]]: an ignored error is a compiler warning. Where ignoring one is
+// deliberate, say why and cast to void.
 #pragma once
 
 #include <optional>
@@ -11,7 +13,7 @@
 
 namespace arco {
 
-class Status {
+class [[nodiscard]] Status {
  public:
   Status() = default;  // OK
   static Status Ok() { return Status(); }
@@ -33,7 +35,7 @@ class Status {
 };
 
 template <typename T>
-class StatusOr {
+class [[nodiscard]] StatusOr {
  public:
   StatusOr(T value) : value_(std::move(value)) {}  // NOLINT: implicit by design
   StatusOr(Status status) : status_(std::move(status)) {  // NOLINT

@@ -1,6 +1,6 @@
 // LoadCalibration/SaveCalibration: format detection, read -> write -> read round
 // trips for every writer (on the real SPD calibration), malformed files.
-#include "arco/io/calibration_file.h"
+#include "arco/calibration/calibration_file.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -23,7 +23,7 @@ class TempDir : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("arco_io_test_" + std::to_string(::getpid()) + "_" +
+           ("arco_calibration_test_" + std::to_string(::getpid()) + "_" +
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);

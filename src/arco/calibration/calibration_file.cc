@@ -1,4 +1,4 @@
-#include "arco/io/calibration_file.h"
+#include "arco/calibration/calibration_file.h"
 
 #include <algorithm>
 #include <filesystem>

@@ -2,7 +2,7 @@
 // calibration_file.h. Values are arco's (OpenCV's) convention, so no conversion.
 #include <opencv2/core.hpp>
 
-#include "arco/io/calibration_file.h"
+#include "arco/calibration/calibration_file.h"
 
 namespace arco {
 namespace {

@@ -1,0 +1,52 @@
+// Library messages name the options-struct fields they check ("start_s must be
+// ..."), so they read right from any caller (CLI, Python, a workflow). Where the CLI
+// prints one, it names the flag that sets the field instead ("--start-s must be ...").
+#pragma once
+
+#include <cctype>
+#include <string>
+#include <string_view>
+
+namespace arco::cli {
+
+struct FieldFlag {
+  std::string_view field, flag;
+};
+
+// Pitch (PitchTrackerOptions, as set by `arco pitch`).
+inline constexpr FieldFlag kPitchFlags[] = {
+    {"fps", "--fps"}, {"start_s", "--start-s"}, {"a4_hz", "--a4"}};
+// Sync (SyncOptions, as set by `arco sync`).
+inline constexpr FieldFlag kSyncFlags[] = {{"video_fps", "--fps"},
+                                           {"search_s", "--search-s"},
+                                           {"audio_near_s", "--audio-near-s"},
+                                           {"video_near_s", "--video-near-s"},
+                                           {"max_seconds", "--max-s"}};
+// Evaluation (EvaluateRequest, as set by `arco eval`).
+inline constexpr FieldFlag kEvalFlags[] = {{"truth_frames", "--truth-frame"}};
+// Synthesis (CaptureWriteOptions, as set by `arco synth`).
+inline constexpr FieldFlag kSynthFlags[] = {{"overwrite", "--overwrite"}};
+
+// `text` with every whole-word field name of `names` replaced by its flag.
+template <size_t N>
+std::string WithFlagNames(std::string text, const FieldFlag (&names)[N]) {
+  auto word_char = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  for (const FieldFlag& name : names) {
+    for (size_t at = text.find(name.field); at != std::string::npos;
+         at = text.find(name.field, at)) {
+      const size_t end = at + name.field.size();
+      const bool whole = (at == 0 || !word_char(text[at - 1])) &&
+                         (end == text.size() || !word_char(text[end])) &&
+                         (at == 0 || text[at - 1] != '-');
+      if (!whole) {
+        at = end;
+        continue;
+      }
+      text.replace(at, name.field.size(), name.flag);
+      at += name.flag.size();
+    }
+  }
+  return text;
+}
+
+}  // namespace arco::cli
