@@ -8,10 +8,13 @@ ASAN_BUILD ?= build-asan
 FUZZ_BUILD ?= build-fuzz
 CMAKE_GEN := -G Ninja
 
-.PHONY: setup build build-arco build-bench test test-unit test-asan test-fuzz fuzz-long demo bench format clean
+.PHONY: setup setup-demo build build-arco build-bench test test-unit test-asan test-fuzz fuzz-long demo bench format clean
 
 setup:
 	@bash scripts/setup
+
+setup-demo:
+	@bash scripts/setup demo
 
 $(BUILD)/build.ninja:
 	cmake -S . -B $(BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release
@@ -21,7 +24,7 @@ build: setup $(BUILD)/build.ninja
 	cmake --build $(BUILD) -j $(JOBS)
 
 # Only what the demo and the README's commands need.
-build-arco: setup $(BUILD)/build.ninja
+build-arco: setup-demo $(BUILD)/build.ninja
 	cmake --build $(BUILD) -j $(JOBS) --target arco
 
 build-bench: setup $(BUILD)/build.ninja
