@@ -5,6 +5,7 @@
 #include <exception>
 #include <functional>
 #include <iostream>
+#include <string>
 
 #include "arco/cli/command.h"
 
@@ -30,7 +31,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "arco 0.1.0");
   auto registry = CommandRegistry();
-  std::stable_sort(registry.begin(), registry.end(),
+  std::stable_sort(registry.begin(),
+                   registry.end(),
                    [](const CommandEntry& a, const CommandEntry& b) { return a.order < b.order; });
   std::vector<std::pair<CLI::App*, std::function<int()>>> runners;
   for (auto& entry : registry) {
@@ -38,6 +40,19 @@ int main(int argc, char** argv) {
     auto run = entry.setup(app);
     auto subs = app.get_subcommands({});
     if (subs.size() > before) runners.emplace_back(subs.back(), run);
+  }
+  // CLI11 reports an unknown first word as "A subcommand is required"; name it instead.
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string known;
+    bool found = false;
+    for (const auto& [sub, run] : runners) {
+      found = found || sub->get_name() == argv[1];
+      known += (known.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!found) {
+      return PrintError("unknown command '" + std::string(argv[1]) + "' (commands: " + known +
+                        "; see `arco --help`)");
+    }
   }
   try {
     app.parse(argc, argv);

@@ -7,6 +7,7 @@
 #include "arco/cli/progress.h"
 #include "arco/cli/report.h"
 #include "arco/pipeline/run_capture.h"
+#include "arco/refine/contact_annotation.h"
 
 namespace arco::cli {
 namespace {
@@ -29,19 +30,21 @@ int RunRun(const RunArgs& a) {
   if (!summary.ok()) return PrintError(summary.status().message());
   double total_s = 0;
   for (const pipeline::StageTiming& t : summary->timings) {
-    std::printf("%-12s %7.2f s  %s\n",
-                t.name.c_str(),
-                t.seconds,
-                FormatStageLine(*summary, t).c_str());
+    std::printf(
+        "%-12s %7.2f s  %s\n", t.name.c_str(), t.seconds, FormatStageLine(*summary, t).c_str());
     total_s += t.seconds;
   }
   for (const auto& m : summary->methods) std::printf("%s\n", FormatRefineSummary(m).c_str());
   for (const std::string& w : summary->warnings) std::printf("warning: %s\n", w.c_str());
-  std::printf(
-      "total %.2f s -> %s (vision/, paper/, arco/: points3d.npy, contacts.csv, "
-      "fingering.csv)\n",
-      total_s,
-      a.output.c_str());
+  // Name only the method folders this run wrote (no audio: vision/ alone).
+  std::string folders;
+  for (const auto& m : summary->methods) {
+    folders += std::string(folders.empty() ? "" : ", ") + refine::RefineModeName(m.mode) + "/";
+  }
+  std::printf("total %.2f s -> %s (%s: points3d.npy, contacts.csv, fingering.csv)\n",
+              total_s,
+              a.output.c_str(),
+              folders.c_str());
   return 0;
 }
 
