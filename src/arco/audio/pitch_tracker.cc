@@ -60,7 +60,7 @@ Status PitchTrackerOptions::Validate() const {
 StatusOr<PitchTrack> TrackPitch(std::unique_ptr<AudioReader> reader,
                                 const PitchTrackerOptions& options,
                                 PitchSummary* summary,
-                                const ProgressFn& progress) {
+                                Progress& progress) {
   const std::clock_t cpu_start = std::clock();
   ARCO_RETURN_IF_ERROR(options.Validate());
   PitchTrack track;
@@ -103,6 +103,8 @@ StatusOr<PitchTrack> TrackPitch(std::unique_ptr<AudioReader> reader,
   FrameCandidates candidates;
   const int64_t max_fine = options.max_frames >= 0 ? options.max_frames * hops : -1;
   ARCO_ASSIGN_OR_RETURN(const bool has_audio, stream.Has(0));
+  progress.SetTotal(kPitchProgressSteps);
+  int64_t steps_done = 0;
   const double expected_s =
       info.frames > 0 ? static_cast<double>(info.frames) / info.sample_rate_hz : -1.0;
   for (int64_t j = 0; has_audio && (max_fine < 0 || j < max_fine); ++j) {
@@ -116,7 +118,11 @@ StatusOr<PitchTrack> TrackPitch(std::unique_ptr<AudioReader> reader,
     ARCO_RETURN_IF_ERROR(stream.Read(centre - window / 2, window, buffer.data()));
     analyzer.Analyze(buffer.data(), &candidates);
     hmm.Push(candidates);
-    if (progress && expected_s > 0 && j % 256 == 0) progress(std::min(1.0, time_s / expected_s));
+    if (expected_s > 0 && j % 256 == 0) {
+      const auto steps = static_cast<int64_t>(std::min(1.0, time_s / expected_s) *
+                                              static_cast<double>(kPitchProgressSteps));
+      if (steps > steps_done) progress.Advance(steps - steps_done), steps_done = steps;
+    }
   }
   hmm.Finish();
   for (size_t j = 0; j < track.fine.size(); j += hops) {
@@ -164,7 +170,7 @@ StatusOr<PitchTrack> TrackPitch(std::unique_ptr<AudioReader> reader,
 StatusOr<PitchTrack> TrackPitchFile(const std::string& path,
                                     const PitchTrackerOptions& options,
                                     PitchSummary* summary,
-                                    const ProgressFn& progress) {
+                                    Progress& progress) {
   ARCO_RETURN_IF_ERROR(options.Validate());
   ARCO_ASSIGN_OR_RETURN(auto reader, OpenAudio(path));
   auto track = TrackPitch(std::move(reader), options, summary, progress);

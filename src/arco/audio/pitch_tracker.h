@@ -8,13 +8,13 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <string>
 #include <vector>
 
 #include "arco/audio/audio_reader.h"
 #include "arco/audio/pitch_hmm.h"
 #include "arco/audio/yin.h"
+#include "arco/util/progress.h"
 #include "arco/util/status.h"
 
 namespace arco::audio {
@@ -74,19 +74,20 @@ struct PitchSummary {
   std::vector<std::string> warnings;    // e.g. truncated file, silent audio
 };
 
-// Progress callback: fraction of the expected duration done (may be unknown: -1).
-using ProgressFn = std::function<void(double fraction)>;
+// Progress (util/progress.h) of TrackPitch: SetTotal(kPitchProgressSteps), then Advance as
+// the audio is read, in thousandths of its expected duration (none when it is unknown).
+inline constexpr int64_t kPitchProgressSteps = 1000;
 
 // Tracks pitch from an open reader. Errors: decode failures mid-stream.
 StatusOr<PitchTrack> TrackPitch(std::unique_ptr<AudioReader> reader,
                                 const PitchTrackerOptions& options,
                                 PitchSummary* summary,
-                                const ProgressFn& progress = nullptr);
+                                Progress& progress = NoProgress());
 // Opens `path` (OpenAudio) and tracks it.
 StatusOr<PitchTrack> TrackPitchFile(const std::string& path,
                                     const PitchTrackerOptions& options,
                                     PitchSummary* summary,
-                                    const ProgressFn& progress = nullptr);
+                                    Progress& progress = NoProgress());
 
 // pitch.csv: header `frame,time_s,f0_hz,confidence,voiced`, written atomically.
 Status WritePitchCsv(const std::string& path, const std::vector<PitchFrame>& frames);

@@ -42,6 +42,28 @@ std::string WriteTone(const std::string& name,
   return path;
 }
 
+// Progress goes through arco::Progress: one total of kPitchProgressSteps, advanced in
+// steps that never pass it.
+TEST(TrackPitch, ReportsProgressThroughTheOneInterface) {
+  struct Recorder : Progress {
+    int64_t total = -1, done = 0;
+    int totals = 0;
+    void SetTotal(int64_t t) override { total = t, ++totals; }
+    void Advance(int64_t d) override {
+      EXPECT_GT(d, 0);
+      done += d;
+    }
+  } recorder;
+  const std::string path = WriteTone(
+      "progress.wav", [](double) { return 220.0; }, 6.0);
+  PitchSummary summary;
+  ASSERT_TRUE(TrackPitchFile(path, Options("cello"), &summary, recorder).ok());
+  EXPECT_EQ(recorder.totals, 1);
+  EXPECT_EQ(recorder.total, kPitchProgressSteps);
+  EXPECT_GT(recorder.done, kPitchProgressSteps / 2);
+  EXPECT_LE(recorder.done, kPitchProgressSteps);
+}
+
 TEST(TrackPitch, RowsAreExactlyAtStartPlusIOverFps) {
   testing::ToneOptions tone;
   tone.harmonics = 6;

@@ -28,7 +28,7 @@ std::string Format(const char* format, ...) {
 
 }  // namespace
 
-StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, const audio::ProgressFn& progress) {
+StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, Progress& progress) {
   PitchRunResult result;
   std::string instrument = o.instrument;
   double fps = o.fps, start_s = o.start_s, a4_hz = o.a4_hz;

@@ -40,7 +40,7 @@ struct PitchRunResult {
 // Tracks, writes pitch.csv (and the optional outputs). Errors are one line that
 // names the file.
 StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& options,
-                                  const audio::ProgressFn& progress = nullptr);
+                                  Progress& progress = NoProgress());
 std::string FormatPitchReport(const PitchRunOptions& options, const PitchRunResult& result);
 
 struct SyncRunOptions {

@@ -50,12 +50,8 @@ std::function<int()> SetupPitch(CLI::App& app) {
                   o->midi_output,
                   "Write the notes as a standard MIDI file with pitch bends (+-2 semitones)");
   return [o] {
-    ProgressBar bar("pitch", 1000);
-    int64_t shown = 0;
-    auto result = RunPitch(*o, [&](double fraction) {
-      const int64_t now = static_cast<int64_t>(fraction * 1000);
-      if (now > shown) bar.Add(now - shown), shown = now;
-    });
+    ProgressBar bar("pitch");  // the bar starts at TrackPitch's SetTotal
+    auto result = RunPitch(*o, bar);
     bar.Finish();
     if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kPitchFlags));
     std::fputs(FormatPitchReport(*o, *result).c_str(), stdout);

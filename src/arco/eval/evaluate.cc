@@ -10,8 +10,10 @@
 
 #include "arco/audio/pitch_tracker.h"
 #include "arco/hand/kinematics.h"
-#include "arco/registry/keypoint_layout.h"
 #include "arco/pipeline/result_folder.h"
+#include "arco/refine/contacts_csv.h"
+#include "arco/registry/keypoint_layout.h"
+#include "arco/synth/truth_folder.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
 
@@ -77,14 +79,12 @@ HandJointLimitsDeg DefaultLeftHandLimits() {
   return out;
 }
 
-StatusOr<ContactTrack> ReadContactCsv(const std::string& path, int num_frames) {
-  ARCO_ASSIGN_OR_RETURN(const std::vector<pipeline::ContactRow> rows,
-                        pipeline::ReadContactsCsv(path));
+ContactTrack ContactTrackFromRows(const std::vector<refine::ContactRow>& rows, int num_frames) {
   ContactTrack t;
   t.string.assign(static_cast<size_t>(num_frames), 0);
   t.finger.assign(static_cast<size_t>(num_frames), 0);
   t.point_mm.assign(static_cast<size_t>(num_frames), Eigen::Vector3d::Constant(NAN));
-  for (const pipeline::ContactRow& row : rows) {
+  for (const refine::ContactRow& row : rows) {
     if (row.frame >= num_frames) continue;
     const auto f = static_cast<size_t>(row.frame);
     t.string[f] = row.string;
@@ -94,11 +94,15 @@ StatusOr<ContactTrack> ReadContactCsv(const std::string& path, int num_frames) {
   return t;
 }
 
+StatusOr<ContactTrack> ReadContactCsv(const std::string& path, int num_frames) {
+  ARCO_ASSIGN_OR_RETURN(const std::vector<refine::ContactRow> rows, refine::ReadContactsCsv(path));
+  return ContactTrackFromRows(rows, num_frames);
+}
+
 StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
   EvalReport report;
   const pipeline::ResultFolder result(r.result_dir);
-  ARCO_ASSIGN_OR_RETURN(const std::vector<pipeline::PointStage> point_stages,
-                        result.PointStages());
+  ARCO_ASSIGN_OR_RETURN(const std::vector<pipeline::PointStage> point_stages, result.PointStages());
   ARCO_ASSIGN_OR_RETURN(const pipeline::ResultHeader header, result.ReadHeader());
   const std::vector<std::string>& result_names = header.keypoint_names;
   report.units = header.units;
@@ -115,35 +119,31 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
   EvalOptions options = r.metrics;
   const bool folder = r.labels.empty();
   if (folder && !std::filesystem::is_directory(r.truth)) {
-    return Status::Error(r.truth +
-                         ": not a truth folder (give labelled frames as labels JSON with truth_frames)");
+    return Status::Error(
+        r.truth + ": not a truth folder (give labelled frames as labels JSON with truth_frames)");
   }
   if (folder) {
     report.truth_kind = "synthetic";
-    ARCO_ASSIGN_OR_RETURN(const Json tj, ReadJsonFile(JoinPath(r.truth, "truth.json")));
-    const std::string layout_name = tj.value("truth_layout", std::string());
+    ARCO_ASSIGN_OR_RETURN(const synth::TruthFolder tf, synth::ReadTruthFolder(r.truth));
+    const std::string& layout_name = tf.manifest.truth_layout;
     const KeypointLayout* layout = FindKeypointLayout(layout_name);
     if (!layout)
-      return Status::Error(JoinPath(r.truth, "truth.json") + ": unknown truth layout '" +
+      return Status::Error(synth::TruthManifestPath(r.truth) + ": unknown truth layout '" +
                            layout_name + "'");
     truth_names = layout->names;
-    const std::string path = JoinPath(r.truth, "points3d.npy");
-    ARCO_ASSIGN_OR_RETURN(const NpyArray<double> tp, ReadNpy<double>(path));
-    ARCO_ASSIGN_OR_RETURN(truth, ToSequence(tp, truth_names, truth_names, path));
-    ARCO_ASSIGN_OR_RETURN(truth_contact,
-                          ReadContactCsv(JoinPath(r.truth, "contact.csv"), truth.num_frames));
-    const KeypointLayout* capture_layout = FindKeypointLayout(tj.value("layout", std::string()));
+    ARCO_ASSIGN_OR_RETURN(
+        truth,
+        ToSequence(tf.points3d, truth_names, truth_names, synth::TruthPoints3dPath(r.truth)));
+    truth_contact = ContactTrackFromRows(tf.contacts, truth.num_frames);
+    const KeypointLayout* capture_layout = FindKeypointLayout(tf.manifest.layout);
     options.num_instrument_points = capture_layout ? capture_layout->size() - kNumWholeBody : 0;
     options.instrument_first = kNumWholeBody;
     for (size_t i = 0; i < truth_names.size(); ++i) {
       if (truth_names[i] == "string4_top") options.string_points_first = static_cast<int>(i);
     }
-    auto pitch = audio::ReadPitchCsv(JoinPath(r.truth, "pitch.csv"));
-    if (pitch.ok()) {
-      for (const auto& f : *pitch) {
-        truth_f0.push_back(f.voiced ? f.f0_hz : 0.0);
-        truth_scored.push_back(f.confidence > 0);  // confidence 0: not scored
-      }
+    for (const audio::PitchFrame& f : tf.pitch) {
+      truth_f0.push_back(f.voiced ? f.f0_hz : 0.0);
+      truth_scored.push_back(f.confidence > 0);  // confidence 0: not scored
     }
   } else {
     // Labelled views triangulated by `arco triangulate --view`: one JSON per frame.

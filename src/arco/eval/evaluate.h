@@ -7,8 +7,8 @@
 // (files.contact, CSV with the columns frame, string, finger, contact_x_mm,
 // contact_y_mm, contact_z_mm as truth/contact.csv): then string and finger
 // identification are scored.
-// Truth: a synthetic truth folder (arco synth's truth/: points3d.npy, contact.csv,
-// pitch.csv), or points JSONs of `arco triangulate --view ...` (manually labelled
+// Truth: a synthetic truth folder (arco synth's truth/, read by synth/truth_folder.h:
+// points3d.npy, contact.csv, pitch.csv are scored), or points JSONs of `arco triangulate --view ...` (manually labelled
 // views triangulated: the paper's real-data protocol), one per labelled frame.
 // Pitch: RESULT_DIR/pitch.csv (or --pitch FILE) against truth/pitch.csv.
 #pragma once
@@ -50,7 +50,8 @@ struct EvalReport {
 
 StatusOr<EvalReport> Evaluate(const EvalRequest& request);
 
-// Reads a contact CSV (columns by header name; extra columns ignored).
+// Reads a contact CSV (refine/contacts_csv.h: columns by header name; extra columns
+// ignored) as a track of num_frames frames; rows past the last frame are ignored.
 StatusOr<ContactTrack> ReadContactCsv(const std::string& path, int num_frames);
 
 // Joint limits of arco's default left hand as geometric PIP/DIP bounds, with the

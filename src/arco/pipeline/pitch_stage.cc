@@ -36,15 +36,8 @@ StatusOr<PitchStageSummary> RunPitchStage(const PitchStageOptions& options,
   ARCO_RETURN_IF_ERROR(po.Validate());
   const std::string audio_path = ResolveCapturePath(capture.capture_dir, m.audio);
   audio::PitchSummary tracked;
-  constexpr int64_t kSteps = 1000;
-  progress.SetTotal(kSteps);
-  int64_t shown = 0;
   ARCO_ASSIGN_OR_RETURN(audio::PitchTrack track,
-                        audio::TrackPitchFile(audio_path, po, &tracked, [&](double fraction) {
-                          const int64_t now = static_cast<int64_t>(fraction * kSteps);
-                          if (now > shown) progress.Advance(now - shown);
-                          shown = std::max(shown, now);
-                        }));
+                        audio::TrackPitchFile(audio_path, po, &tracked, progress));
   // One row per video frame of the capture (audio shorter than the video: unvoiced).
   PitchRecord record;
   std::vector<audio::PitchFrame>& frames = record.frames;

@@ -6,7 +6,10 @@
 #include <map>
 #include <sstream>
 
+#include "arco/hand/hand_params.h"
+#include "arco/refine/contacts_csv.h"
 #include "arco/util/atomic_dir.h"
+#include "arco/util/csv.h"
 #include "arco/util/file_io.h"
 
 namespace arco::pipeline {
@@ -27,77 +30,21 @@ constexpr char kPitchCsvFile[] = "pitch.csv";
 constexpr char kNotesCsvFile[] = "notes.csv";
 constexpr char kContactsCsvFile[] = "contacts.csv";
 constexpr char kFingeringCsvFile[] = "fingering.csv";
-constexpr int kHandParamsColumns = 6 + hand::kNumJointDofs;  // angle-axis, wrist, joints
-
-// Numbers in CSV: shortest round-trip form; NaN as "nan".
-std::string Num(double v) {
-  if (!std::isfinite(v)) return "nan";
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
-}
-
-Status WriteContactsCsv(const std::string& path,
-                        const std::vector<refine::FrameContact>& contacts) {
-  return AtomicWriteWith(path, [&](std::ostream& out) {
-    out << kContactsCsvHeader << '\n';
-    for (size_t f = 0; f < contacts.size(); ++f) {
-      const refine::FrameContact& c = contacts[f];
-      const bool pressed = c.pressed();
-      const Eigen::Vector3d p = pressed ? c.point_in_world_mm : Eigen::Vector3d::Constant(kNaN);
-      const int open = c.state == refine::ContactState::kOpenString ? c.string : 0;
-      out << f << ',' << refine::ContactStateName(c.state) << ','
-          << refine::ContactReasonName(c.reason) << ',' << (pressed ? c.string : 0) << ','
-          << (pressed ? c.finger : 0) << ',' << c.note << ',' << Num(p.x()) << ',' << Num(p.y())
-          << ',' << Num(p.z()) << ',' << Num(pressed ? c.from_nut_mm : kNaN) << ',' << Num(c.f0_hz)
-          << ',' << Num(c.confidence) << ',' << Num(c.tip_distance_vision_mm) << ','
-          << Num(c.tip_distance_refined_mm) << ',' << open << '\n';
-    }
-    return Status::Ok();
-  });
-}
 
 Status WriteFingeringCsv(const std::string& path, const std::vector<refine::NoteFingering>& rows) {
   return AtomicWriteWith(path, [&](std::ostream& out) {
     out << kFingeringCsvHeader << '\n';
     for (const refine::NoteFingering& r : rows) {
-      out << r.note << ',' << r.first_frame << ',' << r.last_frame << ',' << Num(r.onset_s) << ','
-          << Num(r.duration_s) << ',' << Num(r.f0_hz) << ',' << r.midi_note << ','
-          << refine::MidiNoteName(r.midi_note) << ',' << Num(r.cents_off) << ',' << r.state << ','
-          << r.string << ',' << r.finger << ',' << Num(r.position_semitones) << ','
-          << Num(r.from_nut_mm) << ',' << r.pressed_frames << ',' << r.open_frames << ','
-          << r.uncertain_frames << '\n';
+      out << r.note << ',' << r.first_frame << ',' << r.last_frame << ','
+          << FormatCsvDouble(r.onset_s) << ',' << FormatCsvDouble(r.duration_s) << ','
+          << FormatCsvDouble(r.f0_hz) << ',' << r.midi_note << ','
+          << refine::MidiNoteName(r.midi_note) << ',' << FormatCsvDouble(r.cents_off) << ','
+          << r.state << ',' << r.string << ',' << r.finger << ','
+          << FormatCsvDouble(r.position_semitones) << ',' << FormatCsvDouble(r.from_nut_mm) << ','
+          << r.pressed_frames << ',' << r.open_frames << ',' << r.uncertain_frames << '\n';
     }
     return Status::Ok();
   });
-}
-
-std::vector<std::string> SplitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cell;
-  std::istringstream in(line);
-  while (std::getline(in, cell, ',')) out.push_back(cell);
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
-
-// An empty cell is a missing number (NaN); "nan" / "-nan" too.
-bool ParseDouble(const std::string& s, double* out) {
-  if (s.empty()) {
-    *out = kNaN;
-    return true;
-  }
-  char* end = nullptr;
-  *out = std::strtod(s.c_str(), &end);
-  return end == s.c_str() + s.size();
-}
-
-bool ParseInt(const std::string& s, int64_t* out) {
-  char* end = nullptr;
-  const long long v = std::strtoll(s.c_str(), &end, 10);
-  if (s.empty() || end != s.c_str() + s.size()) return false;
-  *out = v;
-  return true;
 }
 
 Status Expect(bool ok, const std::string& path, const std::string& what) {
@@ -313,7 +260,7 @@ Status ResultFolder::WriteHand(const HandRecord& r) const {
   return WriteStageFolder(
       kHandStage,
       [&](const std::string& dir) -> Status {
-        ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, kHandParamsFile), HandParams(r.hands)));
+        ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, kHandParamsFile), hand::HandParams(r.hands)));
         return WriteNpy(JoinPath(dir, kBoneLengthsFile), lengths);
       },
       entry);
@@ -328,7 +275,7 @@ StatusOr<HandRecord> ResultFolder::ReadHand() const {
                               bones_path,
                               "expected 21 bone lengths"));
   HandRecord r;
-  ARCO_ASSIGN_OR_RETURN(r.hands, HandsFromParams(params, hands_path));
+  ARCO_ASSIGN_OR_RETURN(r.hands, hand::HandsFromParams(params, hands_path));
   for (int k = 0; k < hand::kNumHandKeypoints; ++k)
     r.bone_lengths_mm[static_cast<size_t>(k)] = bones.data[static_cast<size_t>(k)];
   return r;
@@ -370,9 +317,9 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
   const KeypointLayout* layout = FindKeypointLayout(r.layout);
   auto write = [&](const std::string& dir) -> Status {
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, kPoints3dFile), r.points3d));
-    ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, kHandParamsFile), HandParams(r.hands)));
+    ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, kHandParamsFile), hand::HandParams(r.hands)));
     if (!r.contacts.empty()) {
-      ARCO_RETURN_IF_ERROR(WriteContactsCsv(JoinPath(dir, kContactsCsvFile), r.contacts));
+      ARCO_RETURN_IF_ERROR(refine::WriteContactsCsv(JoinPath(dir, kContactsCsvFile), r.contacts));
       ARCO_RETURN_IF_ERROR(WriteFingeringCsv(JoinPath(dir, kFingeringCsvFile), r.fingering));
     }
     return Status::Ok();
@@ -385,126 +332,6 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
                            {"units", "mm"},
                            {"options", refine::ToJson(r.options)},
                            {"summary", refine::ToJson(r.summary)}});
-}
-
-// ---- encodings
-
-NpyArray<double> HandParams(const std::vector<std::optional<hand::HandPose>>& hands) {
-  NpyArray<double> out;
-  const int64_t n = static_cast<int64_t>(hands.size());
-  out.shape = {n, kHandParamsColumns};
-  out.data.assign(static_cast<size_t>(n * kHandParamsColumns), kNaN);
-  for (int64_t f = 0; f < n; ++f) {
-    const auto& h = hands[static_cast<size_t>(f)];
-    if (!h) continue;
-    const Eigen::Vector3d aa = h->WristAngleAxis();
-    for (int c = 0; c < 3; ++c) {
-      out.at(f, c) = aa[c];
-      out.at(f, 3 + c) = h->wrist_in_world_mm[c];
-    }
-    for (int d = 0; d < hand::kNumJointDofs; ++d)
-      out.at(f, 6 + d) = h->angles_rad[static_cast<size_t>(d)];
-  }
-  return out;
-}
-
-StatusOr<std::vector<std::optional<hand::HandPose>>> HandsFromParams(const NpyArray<double>& params,
-                                                                     const std::string& source) {
-  if (params.shape.size() != 2 || params.shape[1] != kHandParamsColumns) {
-    return Status::Error(source + ": hand parameters must have shape (frames, 26)");
-  }
-  std::vector<std::optional<hand::HandPose>> out(static_cast<size_t>(params.shape[0]));
-  for (int64_t f = 0; f < params.shape[0]; ++f) {
-    bool finite = true;
-    for (int i = 0; i < kHandParamsColumns; ++i) finite = finite && std::isfinite(params.at(f, i));
-    if (!finite) continue;
-    hand::HandPose pose;
-    pose.SetWristAngleAxis(Eigen::Vector3d(params.at(f, 0), params.at(f, 1), params.at(f, 2)));
-    pose.wrist_in_world_mm = Eigen::Vector3d(params.at(f, 3), params.at(f, 4), params.at(f, 5));
-    for (int d = 0; d < hand::kNumJointDofs; ++d)
-      pose.angles_rad[static_cast<size_t>(d)] = params.at(f, 6 + d);
-    out[static_cast<size_t>(f)] = pose;
-  }
-  return out;
-}
-
-StatusOr<std::vector<ContactRow>> ReadContactsCsv(const std::string& path) {
-  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
-  std::istringstream in(text);
-  std::string line;
-  if (!std::getline(in, line)) return Status::Error(path + ": empty contact file");
-  const std::vector<std::string> header = SplitCsv(line);
-  std::map<std::string, size_t> col;
-  for (size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
-  for (const char* need :
-       {"frame", "string", "finger", "contact_x_mm", "contact_y_mm", "contact_z_mm"}) {
-    if (!col.count(need)) {
-      return Status::Error(path + ": no column '" + need + "' (expected a header like '" +
-                           std::string(kContactsCsvHeader) + "')");
-    }
-  }
-  std::vector<ContactRow> rows;
-  int line_number = 1;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (line.empty()) continue;
-    const std::vector<std::string> cells = SplitCsv(line);
-    const std::string where = path + ":" + std::to_string(line_number) + ": ";
-    if (cells.size() < header.size()) {
-      return Status::Error(where + "expected " + std::to_string(header.size()) + " fields, found " +
-                           std::to_string(cells.size()));
-    }
-    auto cell = [&](const char* name) -> const std::string* {
-      const auto it = col.find(name);
-      return it == col.end() ? nullptr : &cells[it->second];
-    };
-    bool ok = true;
-    auto integer = [&](const char* name, int64_t fallback) {
-      const std::string* c = cell(name);
-      int64_t v = fallback;
-      if (c && !ParseInt(*c, &v)) ok = false;
-      return v;
-    };
-    auto number = [&](const char* name, double fallback) {
-      const std::string* c = cell(name);
-      double v = fallback;
-      if (c && !ParseDouble(*c, &v)) ok = false;
-      return v;
-    };
-    ContactRow r;
-    r.frame = integer("frame", 0);
-    const int64_t string = integer("string", 0);
-    const int64_t finger = integer("finger", 0);
-    const int64_t note = integer("note", -1);
-    const int64_t open_string = integer("open_string", 0);
-    r.point_mm = Eigen::Vector3d(
-        number("contact_x_mm", kNaN), number("contact_y_mm", kNaN), number("contact_z_mm", kNaN));
-    r.from_nut_mm = number("from_nut_mm", kNaN);
-    r.f0_hz = number("f0_hz", 0);
-    r.confidence = number("confidence", 0);
-    r.tip_distance_vision_mm = number("tip_distance_vision_mm", kNaN);
-    r.tip_distance_refined_mm = number("tip_distance_refined_mm", kNaN);
-    if (!ok) return Status::Error(where + "a field is not a number");
-    if (const std::string* s = cell("state")) r.state = *s;
-    if (const std::string* s = cell("reason")) r.reason = *s;
-    if (cell("state") && r.state != "pressed" && r.state != "open" && r.state != "open_string" &&
-        r.state != "rest" && r.state != "uncertain") {
-      return Status::Error(where + "unknown state '" + r.state + "'");
-    }
-    if (r.frame < 0 || string < 0 || string > 8 || finger < 0 || finger > 4 || open_string < 0 ||
-        open_string > 8) {
-      return Status::Error(where + "frame, string or finger out of range");
-    }
-    r.string = static_cast<int>(string);
-    r.finger = static_cast<int>(finger);
-    r.note = static_cast<int>(note);
-    r.open_string = static_cast<int>(open_string);
-    if (r.string > 0 && (r.finger == 0 || !r.point_mm.allFinite())) {
-      return Status::Error(where + "presses a string without a finger or point");
-    }
-    rows.push_back(std::move(r));
-  }
-  return rows;
 }
 
 }  // namespace arco::pipeline

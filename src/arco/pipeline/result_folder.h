@@ -15,7 +15,7 @@
 //   pitch.csv, notes.csv        the audio layer's formats (audio/pitch_tracker.h,
 //                               audio/notes.h), in the folder itself
 //   vision/ paper/ arco/        points3d.npy (refine/method_result.h), hand_params.npy,
-//                               contacts.csv (kContactsCsvHeader) and fingering.csv
+//                               contacts.csv (refine/contacts_csv.h) and fingering.csv
 //                               (kFingeringCsvHeader) for paper and arco
 //
 // hand_params.npy rows: the left wrist rotation as an angle-axis (3, rad), the wrist
@@ -34,11 +34,11 @@
 #include "arco/audio/pitch_tracker.h"
 #include "arco/hand/hand_model.h"
 #include "arco/mocap/capture.h"
-#include "arco/registry/keypoint_layout.h"
 #include "arco/mocap/triangulate_sequence.h"
 #include "arco/pipeline/summaries.h"
 #include "arco/refine/contact_annotation.h"
 #include "arco/refine/refine.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/util/json_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/status.h"
@@ -53,12 +53,6 @@ inline constexpr char kInstrumentStage[] = "instrument";
 inline constexpr char kHandStage[] = "hand";
 inline constexpr char kPitchStage[] = "pitch";  // writes pitch.csv and notes.csv, no folder
 
-// contacts.csv: one row per frame; frame = row of the arrays, from 0. string, finger and
-// contact_*_mm describe a pressed contact only (0 / NaN otherwise); open_string names the
-// sounding open string on open-string frames.
-inline constexpr char kContactsCsvHeader[] =
-    "frame,state,reason,string,finger,note,contact_x_mm,contact_y_mm,contact_z_mm,from_nut_mm,"
-    "f0_hz,confidence,tip_distance_vision_mm,tip_distance_refined_mm,open_string";
 // fingering.csv: one row per note.
 inline constexpr char kFingeringCsvHeader[] =
     "note,first_frame,last_frame,onset_s,duration_s,f0_hz,midi_note,note_name,cents_off,state,"
@@ -187,29 +181,5 @@ class ResultFolder {
 
   std::string dir_;
 };
-
-// hand_params.npy rows (F, 26) of per-frame hands (see the header comment) and back; rows
-// with any NaN are no hand. The inverse errors on a wrong shape, naming `source`.
-NpyArray<double> HandParams(const std::vector<std::optional<hand::HandPose>>& hands);
-StatusOr<std::vector<std::optional<hand::HandPose>>> HandsFromParams(const NpyArray<double>& params,
-                                                                     const std::string& source);
-
-// One row of a contact CSV: a method's contacts.csv or a synthetic truth's contact.csv
-// (synth/capture_writer.h). Columns are found by header name: frame, string, finger and
-// contact_{x,y,z}_mm are required; the others of kContactsCsvHeader are read when present.
-struct ContactRow {
-  int64_t frame = 0;
-  std::string state;  // pressed, open (open_string in truth files), rest, uncertain; or ""
-  std::string reason;
-  int string = 0, finger = 0, note = -1, open_string = 0;
-  Eigen::Vector3d point_mm = Eigen::Vector3d::Constant(kNaN);
-  double from_nut_mm = kNaN, f0_hz = 0, confidence = 0;
-  double tip_distance_vision_mm = kNaN, tip_distance_refined_mm = kNaN;
-};
-// The one contact CSV reader. Errors name the file and line: a missing column, a short
-// row, an unparsable number (an empty cell is NaN where a number may be missing), an
-// unknown state, a string (0-8) or finger (0-4) out of range, a negative frame, a pressed
-// string without a finger or a finite point.
-StatusOr<std::vector<ContactRow>> ReadContactsCsv(const std::string& path);
 
 }  // namespace arco::pipeline

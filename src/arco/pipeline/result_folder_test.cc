@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "arco/hand/kinematics.h"
+#include "arco/refine/contacts_csv.h"
 #include "arco/refine/method_result.h"
 #include "arco/refine/refine.h"
 #include "arco/refine/test_scene.h"
@@ -101,24 +102,6 @@ TEST(ResultFolder, TriangulationWritesStageFolderAndKeepsOtherStages) {
   EXPECT_EQ(entries, 2);  // result.json and triangulation/, no temporary folder left
 }
 
-TEST(HandParams, RoundTrip) {
-  const refine::testing::Scene scene =
-      refine::testing::MakeScene(InstrumentKind::kCello, {{2, 1, 2, 4}});
-  std::vector<std::optional<hand::HandPose>> hands = scene.input.vision_hand;
-  hands[2].reset();
-  const auto back = HandsFromParams(HandParams(hands), "x");
-  ASSERT_TRUE(back.ok());
-  ASSERT_EQ(back->size(), 4u);
-  EXPECT_FALSE((*back)[2].has_value());
-  const auto p0 = hand::ForwardKinematics(scene.input.hand_model, *hands[0]);
-  const auto q0 = hand::ForwardKinematics(scene.input.hand_model, *(*back)[0]);
-  for (int k = 0; k < 21; ++k) EXPECT_LT((p0[k] - q0[k]).norm(), 1e-9);
-  NpyArray<double> bad;
-  bad.shape = {3, 25};
-  bad.data.assign(75, 0.0);
-  EXPECT_FALSE(HandsFromParams(bad, "bad.npy").ok());
-}
-
 TEST(ResultFolder, WriteMethodWritesTheFolderAndTheManifestAndReadsBack) {
   arco::testing::TempDir dir;
   const refine::testing::Scene scene =
@@ -141,7 +124,7 @@ TEST(ResultFolder, WriteMethodWritesTheFolderAndTheManifestAndReadsBack) {
   const auto points = ResultFolder(dir.path()).ReadPoints3d("arco");
   ASSERT_TRUE(points.ok());
   EXPECT_EQ(points->shape, out.points3d.shape);
-  const auto rows = ReadContactsCsv(dir / "arco/contacts.csv");
+  const auto rows = refine::ReadContactsCsv(dir / "arco/contacts.csv");
   ASSERT_TRUE(rows.ok()) << rows.status().message();
   ASSERT_EQ(rows->size(), 10u);
   EXPECT_EQ((*rows)[0].state, "rest");
@@ -170,58 +153,6 @@ TEST(ResultFolder, WriteMethodFailsWholeWithoutPartialOutput) {
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("result.json"), std::string::npos) << s.message();
   EXPECT_FALSE(FileExists(dir / "arco"));
-}
-
-TEST(ReadContactsCsv, MalformedFilesNameTheFileAndLine) {
-  arco::testing::TempDir dir;
-  EXPECT_FALSE(ReadContactsCsv(dir / "missing.csv").ok());
-  ASSERT_TRUE(AtomicWriteFile(dir / "a.csv", "frame,state\n").ok());
-  EXPECT_FALSE(ReadContactsCsv(dir / "a.csv").ok());
-  const std::string header = std::string(kContactsCsvHeader) + "\n";
-  ASSERT_TRUE(AtomicWriteFile(dir / "b.csv", header + "0,pressed,,1,2,0,1,2\n").ok());
-  const auto b = ReadContactsCsv(dir / "b.csv");
-  ASSERT_FALSE(b.ok());
-  EXPECT_NE(b.status().message().find("b.csv:2"), std::string::npos) << b.status().message();
-  ASSERT_TRUE(AtomicWriteFile(dir / "c.csv", header + "0,pressed,,1,2,0,x,2,3,4,5,6,7,8,0\n").ok());
-  EXPECT_FALSE(ReadContactsCsv(dir / "c.csv").ok());
-  ASSERT_TRUE(AtomicWriteFile(dir / "d.csv", header + "0,flying,,1,2,0,1,2,3,4,5,6,7,8,0\n").ok());
-  EXPECT_FALSE(ReadContactsCsv(dir / "d.csv").ok());
-  ASSERT_TRUE(AtomicWriteFile(dir / "e.csv", header + "0,pressed,,9,2,0,1,2,3,4,5,6,7,8,0\n").ok());
-  EXPECT_FALSE(ReadContactsCsv(dir / "e.csv").ok());
-  ASSERT_TRUE(AtomicWriteFile(dir / "f.csv",
-                              header + "0,rest,unvoiced,0,0,-1,nan,nan,nan,nan,0,0.1,nan,nan,0\n")
-                  .ok());
-  const auto f = ReadContactsCsv(dir / "f.csv");
-  ASSERT_TRUE(f.ok()) << f.status().message();
-  EXPECT_TRUE(std::isnan((*f)[0].point_mm.x()));
-}
-
-TEST(ReadContactsCsv, ReadsTruthContactFilesByColumnName) {
-  arco::testing::TempDir dir;
-  // synth's truth/contact.csv: other columns, other order, "open_string" for open strings.
-  ASSERT_TRUE(AtomicWriteFile(dir / "contact.csv",
-                              "frame,time_s,state,string,finger,note,f0_hz,contact_x_mm,"
-                              "contact_y_mm,contact_z_mm\n"
-                              "0,0.000000,rest,0,0,-1,0.0000,nan,nan,nan\n"
-                              "1,0.033333,pressed,2,3,0,220.0000,1.5000,-2.0000,3.2500\n"
-                              "2,0.066667,open_string,0,0,1,220.0000,-nan,-nan,-nan\n")
-                  .ok());
-  const auto rows = ReadContactsCsv(dir / "contact.csv");
-  ASSERT_TRUE(rows.ok()) << rows.status().message();
-  ASSERT_EQ(rows->size(), 3u);
-  EXPECT_EQ((*rows)[1].string, 2);
-  EXPECT_EQ((*rows)[1].finger, 3);
-  EXPECT_EQ((*rows)[1].point_mm, Eigen::Vector3d(1.5, -2.0, 3.25));
-  EXPECT_EQ((*rows)[2].state, "open_string");
-  EXPECT_TRUE(std::isnan((*rows)[2].point_mm.x()));
-  // A pressed string needs a finger and a point.
-  ASSERT_TRUE(AtomicWriteFile(dir / "bad.csv",
-                              "frame,string,finger,contact_x_mm,contact_y_mm,contact_z_mm\n"
-                              "0,1,0,1,2,3\n")
-                  .ok());
-  const auto bad = ReadContactsCsv(dir / "bad.csv");
-  ASSERT_FALSE(bad.ok());
-  EXPECT_NE(bad.status().message().find("bad.csv:2"), std::string::npos);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "arco/camera/calibration_io.h"
 #include "arco/mocap/capture.h"
 #include "arco/synth/synth_instrument.h"
+#include "arco/synth/truth_folder.h"
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
 
@@ -18,123 +19,91 @@ namespace {
 
 namespace fs = std::filesystem;
 
-NpyArray<double> HandPoses(const std::vector<hand::HandPose>& poses) {
-  NpyArray<double> a;
-  a.shape = {static_cast<int64_t>(poses.size()), 26};
-  a.data.reserve(poses.size() * 26);
-  for (const hand::HandPose& p : poses) {
-    const Eigen::Vector3d aa = p.WristAngleAxis();
-    for (int i = 0; i < 3; ++i) a.data.push_back(aa[i]);
-    for (int i = 0; i < 3; ++i) a.data.push_back(p.wrist_in_world_mm[i]);
-    for (double v : p.angles_rad) a.data.push_back(v);
-  }
-  return a;
-}
-
-std::string ContactCsv(const SyntheticCapture& c) {
-  std::ostringstream out;
-  out << "frame,time_s,state,string,finger,note,f0_hz,contact_x_mm,contact_y_mm,contact_z_mm\n";
-  char line[256];
-  for (int f = 0; f < c.num_frames; ++f) {
-    const ContactTruth& t = c.contact[static_cast<size_t>(f)];
-    const char* state = t.finger > 0 ? "pressed" : (t.open_string ? "open_string" : "rest");
-    std::snprintf(line,
-                  sizeof(line),
-                  "%d,%.6f,%s,%d,%d,%d,%.4f,%.4f,%.4f,%.4f\n",
-                  f,
-                  f / c.options.fps,
-                  state,
-                  t.string,
-                  t.finger,
-                  t.note_index,
-                  t.f0_hz,
-                  t.point_mm.x(),
-                  t.point_mm.y(),
-                  t.point_mm.z());
-    out << line;
-  }
-  return out.str();
-}
-
-std::string NotesCsv(const SyntheticCapture& c) {
-  std::ostringstream out;
-  out << "note,onset_s,offset_s,midi_note,name,velocity,string,finger,position_semitones,"
-         "intonation_cents,vibrato_rate_hz,vibrato_extent_cents\n";
-  char line[256];
-  const int n = static_cast<int>(c.performance.notes.size());
-  const int num_strings = 4;  // every supported instrument; string 1 = highest
-  for (int i = 0; i < n; ++i) {
-    const PerformedNote& p = c.performance.notes[static_cast<size_t>(i)];
-    std::snprintf(line,
-                  sizeof(line),
-                  "%d,%.6f,%.6f,%d,%s,%d,%d,%d,%d,%.3f,%.3f,%.3f\n",
-                  i,
-                  p.note.onset_s,
-                  p.note.offset_s,
-                  p.note.midi_note,
-                  MidiNoteName(p.note.midi_note).c_str(),
-                  p.note.velocity,
-                  num_strings - p.fingering.string_index,
-                  p.fingering.finger,
-                  p.fingering.position_semitones,
-                  p.intonation_cents,
-                  p.vibrato_rate_hz,
-                  p.vibrato_extent_cents);
-    out << line;
-  }
-  return out.str();
-}
-
-Json TruthJson(const SyntheticCapture& c, const WriteOptions& w, const WriteSummary& s) {
-  Json j;
-  j["format"] = "arco-synth-truth";
-  j["version"] = 1;
+// The truth folder's contents (synth/truth_folder.h) of a generated capture.
+TruthFolder MakeTruthFolder(const SyntheticCapture& c,
+                            const WriteOptions& w,
+                            const WriteSummary& s) {
+  TruthFolder t;
+  TruthManifest& m = t.manifest;
   const SynthOptions& o = c.options;
-  j["instrument"] = o.instrument;
-  j["piece"] = o.midi_path.empty() ? o.piece : o.midi_path;
-  j["seed"] = o.seed;
-  j["fps"] = o.fps;
-  j["frames"] = c.num_frames;
-  j["notes"] = c.performance.notes.size();
-  j["pressed_frames"] = c.pressed_frames;
-  j["max_residual_shift_mm"] = c.max_residual_shift_mm;
-  j["layout"] = c.layout;
-  j["truth_layout"] = c.truth_layout;
-  j["units"] = "mm";
-  j["calibration_source"] = w.calibration_source;
-  j["stage"] = {{"mm_per_unit", c.stage.mm_per_unit},
-                {"median_camera_distance_mm", c.stage.median_camera_distance_mm},
-                {"performer_origin_in_world_mm",
-                 {c.stage.performer_origin_in_world_mm.x(),
-                  c.stage.performer_origin_in_world_mm.y(),
-                  c.stage.performer_origin_in_world_mm.z()}}};
-  j["hand_model"] = "arco default (hand/hand_model.h), left and right";
-  j["detection"] = {{"noise_px", o.detection.noise_px},
-                    {"outlier_rate", o.detection.outlier_rate},
-                    {"occlusion_rate", o.detection.occlusion_rate},
-                    {"finger_bias_mm", o.detection.finger_bias_mm}};
-  j["fingering"] = {{"shifts", c.fingering.num_shifts},
-                    {"open_strings", c.fingering.num_open_strings},
-                    {"string_crossings", c.fingering.num_string_crossings},
-                    {"total_cost", c.fingering.total_cost}};
-  Json offsets = Json::object();
-  for (const auto& [key, cents] : s.audio.key_offset_cents) offsets[std::to_string(key)] = cents;
-  j["sample_median_offset_cents"] = offsets;
-  j["files"] = {{"points3d", "points3d.npy"},
-                {"left_hand_pose", "left_hand_pose.npy"},
-                {"right_hand_pose", "right_hand_pose.npy"},
-                {"instrument_pose", "instrument_pose.npy"},
-                {"contact", "contact.csv"},
-                {"pitch", "pitch.csv"},
-                {"notes", "notes.csv"}};
-  return j;
+  m.instrument = o.instrument;
+  m.piece = o.midi_path.empty() ? o.piece : o.midi_path;
+  m.seed = o.seed;
+  m.fps = o.fps;
+  m.frames = c.num_frames;
+  m.notes = static_cast<int64_t>(c.performance.notes.size());
+  m.pressed_frames = c.pressed_frames;
+  m.max_residual_shift_mm = c.max_residual_shift_mm;
+  m.layout = c.layout;
+  m.truth_layout = c.truth_layout;
+  m.units = "mm";
+  m.calibration_source = w.calibration_source;
+  m.mm_per_unit = c.stage.mm_per_unit;
+  m.median_camera_distance_mm = c.stage.median_camera_distance_mm;
+  m.performer_origin_in_world_mm = c.stage.performer_origin_in_world_mm;
+  m.hand_model = "arco default (hand/hand_model.h), left and right";
+  m.noise_px = o.detection.noise_px;
+  m.outlier_rate = o.detection.outlier_rate;
+  m.occlusion_rate = o.detection.occlusion_rate;
+  m.finger_bias_mm = o.detection.finger_bias_mm;
+  m.fingering_shifts = c.fingering.num_shifts;
+  m.fingering_open_strings = c.fingering.num_open_strings;
+  m.fingering_string_crossings = c.fingering.num_string_crossings;
+  m.fingering_total_cost = c.fingering.total_cost;
+  m.sample_median_offset_cents = s.audio.key_offset_cents;
+
+  t.points3d = c.points3d;
+  t.left_hand.assign(c.left_hand.begin(), c.left_hand.end());
+  t.right_hand.assign(c.right_hand.begin(), c.right_hand.end());
+  t.world_from_instrument = c.world_from_instrument;
+  for (int f = 0; f < c.num_frames; ++f) {
+    const ContactTruth& truth = c.contact[static_cast<size_t>(f)];
+    refine::ContactRow r;
+    r.frame = f;
+    r.state = truth.finger > 0 ? "pressed" : (truth.open_string ? "open_string" : "rest");
+    r.string = truth.string;
+    r.finger = truth.finger;
+    r.note = truth.note_index;
+    r.f0_hz = truth.f0_hz;
+    r.point_mm = truth.point_mm;
+    t.contacts.push_back(r);
+  }
+  const int num_strings = 4;  // every supported instrument; string 1 = highest
+  for (const PerformedNote& p : c.performance.notes) {
+    TruthNote n;
+    n.onset_s = p.note.onset_s;
+    n.offset_s = p.note.offset_s;
+    n.midi_note = p.note.midi_note;
+    n.velocity = p.note.velocity;
+    n.string = num_strings - p.fingering.string_index;
+    n.finger = p.fingering.finger;
+    n.position_semitones = p.fingering.position_semitones;
+    n.intonation_cents = p.intonation_cents;
+    n.vibrato_rate_hz = p.vibrato_rate_hz;
+    n.vibrato_extent_cents = p.vibrato_extent_cents;
+    t.notes.push_back(n);
+  }
+  // Confidence marks what a pitch evaluation should score: 0 for the first
+  // 60 ms of a note (the sample speaks) and for release tails (0.7 s after a
+  // note's end, the rendered sample still rings), 1 elsewhere.
+  for (int f = 0; f < c.num_frames; ++f) {
+    const double time_s = f / c.options.fps;
+    const double f0 = c.performance.F0HzAt(time_s);
+    bool scored = true;
+    for (const PerformedNote& n : c.performance.notes) {
+      if (time_s >= n.note.onset_s && time_s < n.note.onset_s + 0.06) scored = false;
+      if (f0 <= 0 && time_s >= n.note.offset_s && time_s < n.note.offset_s + 0.7) scored = false;
+    }
+    t.pitch.push_back({f, time_s, f0, scored ? 1.0 : 0.0, f0 > 0});
+  }
+  return t;
 }
 
 Status WriteAll(const SyntheticCapture& c,
                 const std::string& dir,
                 const WriteOptions& w,
                 WriteSummary* s) {
-  const std::string truth = JoinPath(dir, "truth");
+  const std::string truth = JoinPath(dir, kTruthFolderName);
   ARCO_RETURN_IF_ERROR(MakeDirectories(truth));
   // Calibration in mm.
   ARCO_ASSIGN_OR_RETURN(const std::string calibration, WriteArcoJson(c.rig_mm));
@@ -168,36 +137,7 @@ Status WriteAll(const SyntheticCapture& c,
   for (const Camera& cam : c.rig_mm.cameras) m.cameras.push_back({cam.name, cam.serial, "", {}});
   ARCO_RETURN_IF_ERROR(WriteCaptureManifest(dir, m));
   // Truth.
-  ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(truth, "points3d.npy"), c.points3d));
-  ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(truth, "left_hand_pose.npy"), HandPoses(c.left_hand)));
-  ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(truth, "right_hand_pose.npy"), HandPoses(c.right_hand)));
-  NpyArray<double> poses;
-  poses.shape = {c.num_frames, 4, 4};
-  for (const Eigen::Matrix4d& p : c.world_from_instrument) {
-    for (int r = 0; r < 4; ++r) {
-      for (int k = 0; k < 4; ++k) poses.data.push_back(p(r, k));
-    }
-  }
-  ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(truth, "instrument_pose.npy"), poses));
-  ARCO_RETURN_IF_ERROR(AtomicWriteFile(JoinPath(truth, "contact.csv"), ContactCsv(c)));
-  ARCO_RETURN_IF_ERROR(AtomicWriteFile(JoinPath(truth, "notes.csv"), NotesCsv(c)));
-  // Confidence marks what a pitch evaluation should score: 0 for the first
-  // 60 ms of a note (the sample speaks) and for release tails (0.7 s after a
-  // note's end, the rendered sample still rings), 1 elsewhere.
-  std::vector<audio::PitchFrame> pitch;
-  for (int f = 0; f < c.num_frames; ++f) {
-    const double t = f / c.options.fps;
-    const double f0 = c.performance.F0HzAt(t);
-    bool scored = true;
-    for (const PerformedNote& n : c.performance.notes) {
-      if (t >= n.note.onset_s && t < n.note.onset_s + 0.06) scored = false;
-      if (f0 <= 0 && t >= n.note.offset_s && t < n.note.offset_s + 0.7) scored = false;
-    }
-    pitch.push_back({f, t, f0, scored ? 1.0 : 0.0, f0 > 0});
-  }
-  ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(JoinPath(truth, "pitch.csv"), pitch));
-  ARCO_RETURN_IF_ERROR(WriteJsonFile(JoinPath(truth, "truth.json"), TruthJson(c, w, *s)));
-  return Status::Ok();
+  return WriteTruthFolder(truth, MakeTruthFolder(c, w, *s));
 }
 
 }  // namespace
