@@ -141,7 +141,18 @@ StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
       options.result_dir, options.Replace(), [&](const std::string& tmp_dir) -> Status {
         RunOptions staged = options;
         staged.result_dir = tmp_dir;
-        ARCO_ASSIGN_OR_RETURN(summary, RunStages(staged, capture, progress));
+        StatusOr<RunSummary> ran = RunStages(staged, capture, progress);
+        if (!ran.ok()) {
+          // Messages name the result folder the user gave, not its temporary.
+          std::string message = ran.status().message();
+          const std::string given = NormalizeOutputPath(options.result_dir);
+          for (size_t at = message.find(tmp_dir); at != std::string::npos;
+               at = message.find(tmp_dir, at + given.size())) {
+            message.replace(at, tmp_dir.size(), given);
+          }
+          return Status::Error(message);
+        }
+        summary = std::move(ran).value();
         return Status::Ok();
       }));
   return summary;
