@@ -66,7 +66,8 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
   ARCO_ASSIGN_OR_RETURN(NpyArray<double> keypoints, ImportSpdKeypoints(spd, &out.files));
 
   CaptureManifest m;
-  m.name = o.name.empty() ? fs::path(NormalizeOutputPath(o.output_dir)).filename().string() : o.name;
+  m.name =
+      o.name.empty() ? fs::path(NormalizeOutputPath(o.output_dir)).filename().string() : o.name;
   m.instrument = o.instrument;
   m.fps = o.fps;
   m.frame_first = spd.frame_first;

@@ -6,8 +6,8 @@
 #include <map>
 #include <sstream>
 
-#include "arco/util/output_set.h"
 #include "arco/util/file_io.h"
+#include "arco/util/output_set.h"
 
 namespace arco::pipeline {
 namespace {

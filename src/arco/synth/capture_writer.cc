@@ -1,6 +1,5 @@
 #include "arco/synth/capture_writer.h"
 
-
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -220,9 +219,8 @@ Status WriteCapture(const SyntheticCapture& c,
                     WriteSummary* summary) {
   WriteSummary local;
   WriteSummary* s = summary ? summary : &local;
-  ARCO_RETURN_IF_ERROR(AtomicWriteDirectory(out_dir, CaptureReplace(w), [&](const std::string& tmp) {
-    return WriteAll(c, tmp, w, s);
-  }));
+  ARCO_RETURN_IF_ERROR(AtomicWriteDirectory(
+      out_dir, CaptureReplace(w), [&](const std::string& tmp) { return WriteAll(c, tmp, w, s); }));
   std::error_code ec;
   const fs::path target(NormalizeOutputPath(out_dir));
   for (const auto& e : fs::recursive_directory_iterator(target, ec)) {

@@ -1,6 +1,5 @@
 #include "arco/util/file_io.h"
 
-
 #include <cerrno>
 #include <cstring>
 #include <filesystem>

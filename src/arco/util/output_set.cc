@@ -31,8 +31,7 @@ Status CheckParent(const std::string& path, const fs::path& parent, bool create)
   }
   fs::create_directories(parent, ec);
   if (ec) {
-    return Status::Error(path + ": cannot create folder " + parent.string() + ": " +
-                         ec.message());
+    return Status::Error(path + ": cannot create folder " + parent.string() + ": " + ec.message());
   }
   return Status::Ok();
 }
@@ -145,8 +144,7 @@ StatusOr<std::string> OutputSet::AddFile(const std::string& given) {
   return o.tmp;
 }
 
-StatusOr<std::string> OutputSet::AddFolder(const std::string& given,
-                                           const FolderReplace& replace) {
+StatusOr<std::string> OutputSet::AddFolder(const std::string& given, const FolderReplace& replace) {
   ARCO_RETURN_IF_ERROR(CheckOutputFolder(given, replace));
   const std::string path = NormalizeOutputPath(given);
   for (const Output& o : outputs_) {
@@ -184,8 +182,8 @@ Status OutputSet::Commit() {
       if (ec) {
         const std::string why = ec.message();
         roll_back(i);
-        return Status::Error(o.path + ": cannot move the old " +
-                             (o.folder ? "folder" : "file") + " aside: " + why);
+        return Status::Error(o.path + ": cannot move the old " + (o.folder ? "folder" : "file") +
+                             " aside: " + why);
       }
       had_old[i] = true;
     }

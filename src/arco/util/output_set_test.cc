@@ -1,7 +1,6 @@
 #include "arco/util/output_set.h"
 
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <filesystem>
@@ -65,7 +64,8 @@ TEST(AtomicWriteDirectory, ExistingFolderNeedsOverwrite) {
   const Status s =
       AtomicWriteDirectory(tmp / "cap", FolderReplace{false, "capture.json", "capture"}, WriteNew);
   ASSERT_FALSE(s.ok());
-  EXPECT_EQ(s.message(), tmp / "cap" + ": capture exists and is not empty (--overwrite replaces it)");
+  EXPECT_EQ(s.message(),
+            tmp / "cap" + ": capture exists and is not empty (--overwrite replaces it)");
   EXPECT_EQ(Read(tmp / "cap/capture.json"), "old");
   EXPECT_EQ(Entries(tmp.path()), std::set<std::string>{"cap"});
 }
@@ -115,8 +115,7 @@ TEST(AtomicWriteDirectory, FailureToMoveInRestoresTheOldFolder) {
         return Status::Ok();
       });
   ASSERT_FALSE(s.ok());
-  EXPECT_EQ(s.message(),
-            tmp / "cap" + ": cannot move into place: No such file or directory");
+  EXPECT_EQ(s.message(), tmp / "cap" + ": cannot move into place: No such file or directory");
   EXPECT_EQ(Read(tmp / "cap/capture.json"), "old");
   EXPECT_EQ(Entries(tmp.path()), std::set<std::string>{"cap"});
 }
@@ -126,7 +125,8 @@ TEST(AtomicWriteDirectory, ParentUnderAFileIsAClearError) {
   ASSERT_TRUE(AtomicWriteFile(tmp / "file", "x").ok());
   const Status s = AtomicWriteDirectory(tmp / "file/sub/cap", FolderReplace{}, WriteNew);
   ASSERT_FALSE(s.ok());
-  EXPECT_EQ(s.message(), tmp / "file/sub/cap: cannot create folder: " + tmp / "file is not a folder");
+  EXPECT_EQ(s.message(),
+            tmp / "file/sub/cap: cannot create folder: " + tmp / "file is not a folder");
   const Status f = AtomicWriteDirectory(tmp / "file", FolderReplace{}, WriteNew);
   EXPECT_EQ(f.message(), tmp / "file: exists and is not a folder");
 }
