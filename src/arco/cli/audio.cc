@@ -3,10 +3,12 @@
 #include <cstdarg>
 #include <cstdio>
 #include <filesystem>
+#include <utility>
 
 #include "arco/cli/flag_names.h"
 #include "arco/mocap/capture.h"
 #include "arco/util/file_io.h"
+#include "arco/util/output_set.h"
 
 namespace arco::cli {
 namespace {
@@ -62,6 +64,16 @@ StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, Progress& progress) 
   t.max_frames = frames;
   t.hops_per_frame = o.hops_per_frame;
   ARCO_RETURN_IF_ERROR(t.Validate());
+  // Every output declared and checked before the work, written together at the end.
+  OutputSet outputs;
+  ARCO_ASSIGN_OR_RETURN(const std::string pitch_tmp, outputs.AddFile(o.output));
+  std::string fine_tmp, notes_tmp, midi_tmp;
+  for (auto [path, tmp] : {std::pair{&o.fine_output, &fine_tmp},
+                           std::pair{&o.notes_output, &notes_tmp},
+                           std::pair{&o.midi_output, &midi_tmp}}) {
+    if (path->empty()) continue;
+    ARCO_ASSIGN_OR_RETURN(*tmp, outputs.AddFile(*path));
+  }
   ARCO_ASSIGN_OR_RETURN(const audio::PitchTrack track,
                         audio::TrackPitchFile(result.input, t, &result.summary, progress));
   result.fine_fps = track.fine_fps;
@@ -71,15 +83,16 @@ StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, Progress& progress) 
   result.notes = static_cast<int>(notes.notes.size());
   result.glides = static_cast<int>(notes.glides.size());
   for (const auto& n : notes.notes) result.notes_with_vibrato += n.vibrato_rate_hz > 0;
-  ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(o.output, track.frames));
-  if (!o.fine_output.empty()) ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(o.fine_output, track.fine));
-  if (!o.notes_output.empty()) ARCO_RETURN_IF_ERROR(audio::WriteNotesCsv(o.notes_output, notes));
-  if (!o.midi_output.empty()) {
+  ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(pitch_tmp, track.frames));
+  if (!fine_tmp.empty()) ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(fine_tmp, track.fine));
+  if (!notes_tmp.empty()) ARCO_RETURN_IF_ERROR(audio::WriteNotesCsv(notes_tmp, notes));
+  if (!midi_tmp.empty()) {
     ARCO_RETURN_IF_ERROR(audio::WriteMidiFile(
-        o.midi_output,
+        midi_tmp,
         audio::NotesToMidi(
             notes, track.fine, note_options, audio::GmProgramForInstrument(t.range.name))));
   }
+  ARCO_RETURN_IF_ERROR(outputs.Commit());
   return result;
 }
 

@@ -6,6 +6,7 @@
 
 #include "arco/calibration/calibration_file.h"
 #include "arco/cli/command.h"
+#include "arco/util/output_set.h"
 
 namespace arco::cli {
 namespace {
@@ -89,6 +90,8 @@ int RunCalibrationConvert(const CalibrationConvertOptions& o) {
     if (!parsed.ok()) return PrintError(parsed.status().message());
     format = *parsed;
   }
+  const Status writable = CheckOutputFile(o.output);  // before the work
+  if (!writable.ok()) return PrintError(writable.message());
   auto calibration = LoadCalibration(o.input);
   if (!calibration.ok()) return PrintError(calibration.status().message());
   PrintWarnings(*calibration);

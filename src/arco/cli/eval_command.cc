@@ -1,6 +1,7 @@
 // `arco eval`: scores every method in a result folder against truth and prints
 // the ablation table (docs/evaluation.md).
 #include <cstdio>
+#include <utility>
 
 #include "arco/cli/command.h"
 #include "arco/cli/flag_names.h"
@@ -8,6 +9,7 @@
 #include "arco/eval/plot.h"
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
+#include "arco/util/output_set.h"
 
 namespace arco::cli {
 namespace {
@@ -25,12 +27,24 @@ int Run(Args& a) {
   } else {
     a.r.labels = a.truths;
   }
+  // Both outputs declared and checked before the work, written together at the end.
+  OutputSet outputs;
+  std::string json_tmp, plot_tmp;
+  for (auto [path, tmp] : {std::pair{&a.output, &json_tmp}, std::pair{&a.plot, &plot_tmp}}) {
+    if (path->empty()) continue;
+    auto declared = outputs.AddFile(*path);
+    if (!declared.ok()) return PrintError(declared.status().message());
+    *tmp = *declared;
+  }
   auto report = eval::Evaluate(a.r);
   if (!report.ok()) return PrintError(WithFlagNames(report.status().message(), kEvalFlags));
-  if (!a.output.empty()) {
-    const Status st = WriteJsonFile(a.output, report->ToJson(a.r.metrics));
-    if (!st.ok()) return PrintError(st.message());
+  Status written = Status::Ok();
+  if (!json_tmp.empty()) written = WriteJsonFile(json_tmp, report->ToJson(a.r.metrics));
+  if (written.ok() && !plot_tmp.empty()) {
+    written = AtomicWriteFile(plot_tmp, eval::EvalPlotSvg(*report, report->fps));
   }
+  if (written.ok()) written = outputs.Commit();
+  if (!written.ok()) return PrintError(written.message());
   std::printf("arco eval: %s truth, %d frames (%d with a pressed note), units %s\n\n",
               report->truth_kind.c_str(),
               report->truth_frames,
@@ -40,11 +54,7 @@ int Run(Args& a) {
   for (const auto& w : report->warnings)
     std::fprintf(stderr, "arco eval: warning: %s\n", w.c_str());
   if (!a.output.empty()) std::printf("\nwrote %s\n", a.output.c_str());
-  if (!a.plot.empty()) {
-    const Status st = AtomicWriteFile(a.plot, eval::EvalPlotSvg(*report, report->fps));
-    if (!st.ok()) return PrintError(st.message());
-    std::printf("wrote %s\n", a.plot.c_str());
-  }
+  if (!a.plot.empty()) std::printf("wrote %s\n", a.plot.c_str());
   return 0;
 }
 

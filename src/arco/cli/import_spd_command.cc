@@ -37,8 +37,11 @@ std::function<int()> Setup(CLI::App& app) {
          "--audio-offset-s", o->audio_offset_s, "Audio time (s) at the start of the first frame")
       ->capture_default_str();
   sub->add_option("--name", o->name, "Session name (default: the output folder's name)");
-  sub->add_option("-o,--output", o->output_dir, "Capture folder to create (must not exist)")
+  sub->add_option("-o,--output",
+                  o->output_dir,
+                  "Capture folder to create (must not exist, unless --overwrite)")
       ->required();
+  sub->add_flag("--overwrite", o->overwrite, "Replace an existing capture folder");
   return [o]() {
     auto r = pipeline::ImportSpdCapture(*o);
     if (!r.ok()) return PrintError(r.status().message());

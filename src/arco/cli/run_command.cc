@@ -16,6 +16,7 @@ struct RunArgs {
   std::string capture, output;
   int threads = 0;
   double min_confidence = 0.5;
+  bool overwrite = false;
 };
 
 int RunRun(const RunArgs& a) {
@@ -23,6 +24,7 @@ int RunRun(const RunArgs& a) {
   o.capture_dir = a.capture;
   o.result_dir = a.output;
   o.num_threads = a.threads;
+  o.overwrite = a.overwrite;
   o.refine.pitch.min_confidence = a.min_confidence;
   ProgressBar progress;
   auto summary = pipeline::RunCapture(o, progress);
@@ -55,6 +57,7 @@ std::function<int()> SetupRun(CLI::App& app) {
   sub->add_option("capture", a->capture, "Capture folder (capture.json, docs/formats.md)")
       ->required();
   sub->add_option("-o,--output", a->output, "Result folder to write")->required();
+  sub->add_flag("--overwrite", a->overwrite, "Replace an existing result folder");
   sub->add_option(
          "--threads", a->threads, "Worker threads (0 = all cores; results do not depend on it)")
       ->default_val(0);

@@ -68,6 +68,9 @@ int Run(Args& a) {
   a.w.audio = !a.no_audio;
   a.w.audio_render.tune_soundfont = !a.no_sample_tuning;
   a.w.calibration_source = a.calibration;
+  // The output is checked before the work (docs/architecture.md, "Outputs").
+  const Status writable = synth::CheckCaptureOutput(a.output, a.w);
+  if (!writable.ok()) return PrintError(writable.message());
   const auto start = std::chrono::steady_clock::now();
   auto calibration = LoadCalibration(a.calibration);
   if (!calibration.ok()) return PrintError(calibration.status().message());

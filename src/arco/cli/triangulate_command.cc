@@ -9,6 +9,7 @@
 #include "arco/pipeline/label_views.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/instrument/instrument_model.h"
+#include "arco/util/output_set.h"
 
 namespace arco::cli {
 namespace {
@@ -48,6 +49,8 @@ int RunViews(const Args& a) {
     if (!model.ok()) return PrintError("--scale-to: " + model.status().message());
     o.reference_string_length_mm = model->string_length_mm();
   }
+  const Status writable = CheckOutputFile(a.output);  // before the work
+  if (!writable.ok()) return PrintError(writable.message());
   auto result = pipeline::TriangulateLabelViews(o);
   if (!result.ok()) return PrintError(result.status().message());
   const Status written = WriteJsonFile(a.output, *result);

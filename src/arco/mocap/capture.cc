@@ -1,7 +1,5 @@
 #include "arco/mocap/capture.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -9,7 +7,6 @@
 #include <set>
 
 #include "arco/registry/instruments.h"
-#include "arco/util/atomic_dir.h"
 #include "arco/util/file_io.h"
 
 namespace arco {
@@ -266,74 +263,6 @@ StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir
     }
   }
   return k;
-}
-
-StatusOr<Json> ReadResultManifest(const std::string& result_dir) {
-  const std::string path = JoinPath(result_dir, kResultManifestName);
-  if (!FileExists(path)) return Json::object();
-  ARCO_ASSIGN_OR_RETURN(Json j, ReadJsonFile(path));
-  if (!j.is_object() || j.value("format", "") != "arco-result") {
-    return Status::Error(path + ": not an arco result manifest (\"format\": \"arco-result\")");
-  }
-  return j;
-}
-
-StatusOr<NpyArray<double>> ReadResultPoints3d(const std::string& result_dir,
-                                              const std::string& stage) {
-  return ReadNpy<double>(JoinPath(JoinPath(result_dir, stage), "points3d.npy"));
-}
-
-Status WriteTriangulationResult(const std::string& result_dir,
-                                const CaptureManifest& manifest,
-                                const KeypointLayout& layout,
-                                const SequenceTriangulation& raw,
-                                const NpyArray<double>& points3d_filtered,
-                                const TriangulationStageInfo& info) {
-  ARCO_ASSIGN_OR_RETURN(Json result, ReadResultManifest(result_dir));
-  ARCO_RETURN_IF_ERROR(MakeDirectories(result_dir));
-  auto write_all = [&](const std::string& tmp_dir) -> Status {
-    ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, "points3d.npy"), points3d_filtered));
-    ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, "points3d_raw.npy"), raw.points3d));
-    ARCO_RETURN_IF_ERROR(
-        WriteNpy(JoinPath(tmp_dir, "reprojection_rms_px.npy"), raw.rms_reprojection_px));
-    ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, "inlier_count.npy"), raw.num_inliers));
-    ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, "view_count.npy"), raw.num_views));
-    ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, "inlier_mask.npy"), raw.inlier_mask));
-    return Status::Ok();
-  };
-  ARCO_RETURN_IF_ERROR(AtomicWriteDirectory(JoinPath(result_dir, "triangulation"), write_all));
-
-  result["format"] = "arco-result";
-  result["version"] = 1;
-  result["capture"] = info.capture_dir;
-  result["name"] = manifest.name;
-  result["instrument"] = manifest.instrument;
-  result["fps"] = manifest.fps;
-  result["frames"] = {{"first", manifest.frame_first}, {"count", manifest.frame_count}};
-  result["units"] = info.units;
-  result["layout"] = layout.name;
-  result["keypoint_names"] = layout.names;
-  Json cams = Json::array();
-  for (const auto& c : manifest.cameras) cams.push_back(c.name);
-  result["cameras"] = cams;
-  const auto& s = info.summary;
-  result["stages"]["triangulation"] = {
-      {"dir", "triangulation"},
-      {"files",
-       {{"points3d", "points3d.npy"},
-        {"points3d_raw", "points3d_raw.npy"},
-        {"reprojection_rms_px", "reprojection_rms_px.npy"},
-        {"inlier_count", "inlier_count.npy"},
-        {"view_count", "view_count.npy"},
-        {"inlier_mask", "inlier_mask.npy"}}},
-      {"options", info.options},
-      {"summary",
-       {{"frames", s.frames},
-        {"points", s.points},
-        {"triangulated", s.triangulated},
-        {"median_rms_reprojection_px", JsonFromDouble(s.median_rms_reprojection_px)},
-        {"mean_inliers", s.mean_inliers}}}};
-  return WriteJsonFile(JoinPath(result_dir, kResultManifestName), result);
 }
 
 }  // namespace arco

@@ -75,24 +75,4 @@ std::string ResolveCapturePath(const std::string& dir, const std::string& entry)
 StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,
                                                   const CaptureManifest& manifest);
 
-// Result folder: writes RESULT_DIR/triangulation/ (built in a temporary folder and
-// renamed into place) and records the stage in result.json, keeping other stages.
-struct TriangulationStageInfo {
-  std::string capture_dir;
-  std::string units;  // of the rig
-  Json options;       // triangulation and filter options as run
-  SequenceTriangulationSummary summary;
-};
-Status WriteTriangulationResult(const std::string& result_dir,
-                                const CaptureManifest& manifest,
-                                const KeypointLayout& layout,
-                                const SequenceTriangulation& raw,
-                                const NpyArray<double>& points3d_filtered,
-                                const TriangulationStageInfo& info);
-
-// Reads RESULT_DIR/result.json (empty object when absent) and a stage's points3d.npy.
-StatusOr<Json> ReadResultManifest(const std::string& result_dir);
-StatusOr<NpyArray<double>> ReadResultPoints3d(const std::string& result_dir,
-                                              const std::string& stage);
-
 }  // namespace arco

@@ -1,12 +1,11 @@
 #include "arco/pipeline/import_spd.h"
 
-#include <unistd.h>
-
 #include <filesystem>
 
 #include "arco/calibration/calibration_file.h"
 #include "arco/mocap/capture.h"
 #include "arco/registry/instruments.h"
+#include "arco/util/atomic_dir.h"
 #include "arco/util/file_io.h"
 
 namespace arco::pipeline {
@@ -16,11 +15,12 @@ namespace fs = std::filesystem;
 
 StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
   if (o.output_dir.empty()) return Status::Error("output_dir is empty");
+  FolderReplace replace;
+  replace.overwrite = o.overwrite;
+  replace.marker = kCaptureManifestName;  // only an arco capture is replaced
+  replace.kind = "capture";
+  ARCO_RETURN_IF_ERROR(CheckOutputFolder(o.output_dir, replace));  // before the work
   std::error_code ec;
-  if (fs::exists(o.output_dir, ec) &&
-      (!fs::is_directory(o.output_dir, ec) || !fs::is_empty(o.output_dir, ec))) {
-    return Status::Error(o.output_dir + ": exists and is not an empty folder");
-  }
   ARCO_ASSIGN_OR_RETURN(Calibration calibration, LoadCalibration(o.calibration));
   SpdImportOptions spd;
   spd.instrument = o.instrument;
@@ -66,7 +66,8 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
   ARCO_ASSIGN_OR_RETURN(NpyArray<double> keypoints, ImportSpdKeypoints(spd, &out.files));
 
   CaptureManifest m;
-  m.name = o.name.empty() ? fs::path(o.output_dir).filename().string() : o.name;
+  m.name =
+      o.name.empty() ? fs::path(NormalizeOutputPath(o.output_dir)).filename().string() : o.name;
   m.instrument = o.instrument;
   m.fps = o.fps;
   m.frame_first = spd.frame_first;
@@ -90,11 +91,8 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
   ARCO_RETURN_IF_ERROR(ParseCaptureManifest(CaptureManifestToJson(m).dump(), "capture.json")
                            .status());  // the manifest we write must read back
 
-  // Build in a temporary sibling folder, then rename into place.
-  const std::string tmp = o.output_dir + ".tmp-" + std::to_string(::getpid());
-  fs::remove_all(tmp, ec);
-  auto write_all = [&]() -> Status {
-    ARCO_RETURN_IF_ERROR(MakeDirectories(tmp));
+  // Built in a hidden temporary sibling, moved into place once complete.
+  auto write_all = [&](const std::string& tmp) -> Status {
     NpyArray<float> k32;
     k32.shape = keypoints.shape;
     k32.data.assign(keypoints.data.begin(), keypoints.data.end());
@@ -105,17 +103,9 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
       fs::copy_file(o.audio, JoinPath(tmp, m.audio), ec);
       if (ec) return Status::Error(o.audio + ": cannot copy (" + ec.message() + ")");
     }
-    ARCO_RETURN_IF_ERROR(WriteCaptureManifest(tmp, m));
-    if (fs::exists(o.output_dir, ec)) fs::remove(o.output_dir, ec);  // empty folder
-    fs::rename(tmp, o.output_dir, ec);
-    if (ec) return Status::Error(o.output_dir + ": cannot create (" + ec.message() + ")");
-    return Status::Ok();
+    return WriteCaptureManifest(tmp, m);
   };
-  const Status status = write_all();
-  if (!status.ok()) {
-    fs::remove_all(tmp, ec);
-    return status;
-  }
+  ARCO_RETURN_IF_ERROR(AtomicWriteDirectory(o.output_dir, replace, write_all));
   out.frames = keypoints.shape[0];
   out.views = keypoints.shape[1];
   out.points = keypoints.shape[2];

@@ -23,7 +23,8 @@ struct ImportSpdOptions {
   std::string audio;  // optional, copied
   double audio_offset_s = 0;
   std::string name;        // session name (default: the output folder's name)
-  std::string output_dir;  // must not exist, or be empty
+  std::string output_dir;  // must not exist or be empty, unless `overwrite`
+  bool overwrite = false;  // replace an existing capture (a folder with capture.json)
 };
 
 struct ImportSpdSummary {

@@ -92,7 +92,8 @@ TEST(ImportSpdCapture, SpdFoldersToCaptureToTriangulation) {
   // The output folder must not be reused; bad inputs leave nothing behind.
   auto again = ImportSpdCapture(o);
   ASSERT_FALSE(again.ok());
-  EXPECT_NE(again.status().message().find("not an empty folder"), std::string::npos);
+  EXPECT_NE(again.status().message().find("capture exists and is not empty (--overwrite"),
+            std::string::npos);
   o.output_dir = dir / "capture2";
   o.serials = {"12345"};
   auto bad = ImportSpdCapture(o);

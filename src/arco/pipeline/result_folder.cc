@@ -8,9 +8,9 @@
 
 #include "arco/hand/hand_params.h"
 #include "arco/refine/contacts_csv.h"
-#include "arco/util/atomic_dir.h"
 #include "arco/util/csv.h"
 #include "arco/util/file_io.h"
+#include "arco/util/output_set.h"
 
 namespace arco::pipeline {
 namespace {
@@ -128,22 +128,47 @@ StatusOr<std::vector<PointStage>> ResultFolder::PointStages() const {
   return out;
 }
 
-Status ResultFolder::RecordStage(const std::string& stage, const Json& entry) const {
-  ARCO_ASSIGN_OR_RETURN(Json manifest, ReadManifest());
+namespace {
+
+// `manifest` with "stages"."<stage>" = entry (the other stages kept).
+Json WithStage(Json manifest, const std::string& stage, const Json& entry) {
   manifest["format"] = "arco-result";
   if (!manifest.contains("version")) manifest["version"] = 1;
   manifest["stages"][stage] = entry;
-  return WriteJsonFile(ManifestPath(), manifest);
+  return manifest;
+}
+
+// A stage folder is the result's own output: an existing one is always replaced.
+FolderReplace OwnStageFolder() {
+  FolderReplace r;
+  r.overwrite = true;
+  return r;
+}
+
+}  // namespace
+
+Status ResultFolder::CheckWritable() const {
+  FolderReplace r;
+  r.overwrite = true;  // stage folders of a result are replaced; other folders left alone
+  r.marker = kResultManifestName;
+  r.kind = "result folder";
+  return CheckOutputFolder(dir_, r);
 }
 
 Status ResultFolder::WriteStageFolder(const std::string& stage,
                                       const std::function<Status(const std::string& dir)>& write,
                                       Json entry) const {
-  ARCO_RETURN_IF_ERROR(ReadManifest().status());  // not some other JSON
+  ARCO_ASSIGN_OR_RETURN(const Json manifest, ReadManifest());  // not some other JSON
   ARCO_RETURN_IF_ERROR(MakeDirectories(dir_));
-  ARCO_RETURN_IF_ERROR(AtomicWriteDirectory(JoinPath(dir_, stage), write));
+  // The folder and result.json change together or not at all.
+  OutputSet outputs;
+  ARCO_ASSIGN_OR_RETURN(const std::string tmp_dir,
+                        outputs.AddFolder(JoinPath(dir_, stage), OwnStageFolder()));
+  ARCO_ASSIGN_OR_RETURN(const std::string tmp_manifest, outputs.AddFile(ManifestPath()));
+  ARCO_RETURN_IF_ERROR(write(tmp_dir));
   entry["dir"] = stage;
-  return RecordStage(stage, entry);
+  ARCO_RETURN_IF_ERROR(WriteJsonFile(tmp_manifest, WithStage(manifest, stage, entry)));
+  return outputs.Commit();
 }
 
 // ---- triangulation/
@@ -155,6 +180,11 @@ Status ResultFolder::WriteTriangulation(const CaptureManifest& manifest,
                                         const TriangulationRecord& record) const {
   ARCO_ASSIGN_OR_RETURN(Json result, ReadManifest());
   ARCO_RETURN_IF_ERROR(MakeDirectories(dir_));
+  // triangulation/ and result.json change together or not at all.
+  OutputSet outputs;
+  ARCO_ASSIGN_OR_RETURN(const std::string stage_tmp,
+                        outputs.AddFolder(JoinPath(dir_, kTriangulationStage), OwnStageFolder()));
+  ARCO_ASSIGN_OR_RETURN(const std::string manifest_tmp, outputs.AddFile(ManifestPath()));
   auto write_all = [&](const std::string& tmp_dir) -> Status {
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, kPoints3dFile), points3d_filtered));
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, kPoints3dRawFile), raw.points3d));
@@ -165,7 +195,7 @@ Status ResultFolder::WriteTriangulation(const CaptureManifest& manifest,
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, kInlierMaskFile), raw.inlier_mask));
     return Status::Ok();
   };
-  ARCO_RETURN_IF_ERROR(AtomicWriteDirectory(JoinPath(dir_, kTriangulationStage), write_all));
+  ARCO_RETURN_IF_ERROR(write_all(stage_tmp));
 
   result["format"] = "arco-result";
   result["version"] = 1;
@@ -190,7 +220,8 @@ Status ResultFolder::WriteTriangulation(const CaptureManifest& manifest,
                                              {"inlier_mask", kInlierMaskFile}}},
                                            {"options", record.options},
                                            {"summary", ToJson(record.summary)}};
-  return WriteJsonFile(ManifestPath(), result);
+  ARCO_RETURN_IF_ERROR(WriteJsonFile(manifest_tmp, result));
+  return outputs.Commit();
 }
 
 StatusOr<NpyArray<double>> ResultFolder::ReadPoints3d(const std::string& stage) const {
@@ -284,14 +315,23 @@ StatusOr<HandRecord> ResultFolder::ReadHand() const {
 // ---- pitch.csv, notes.csv
 
 Status ResultFolder::WritePitch(const PitchRecord& r) const {
-  ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(JoinPath(dir_, kPitchCsvFile), r.frames));
-  ARCO_RETURN_IF_ERROR(audio::WriteNotesCsv(JoinPath(dir_, kNotesCsvFile), r.notes));
-  return RecordStage(kPitchStage,
-                     {{"dir", "."},
+  ARCO_ASSIGN_OR_RETURN(const Json manifest, ReadManifest());
+  ARCO_RETURN_IF_ERROR(MakeDirectories(dir_));
+  // pitch.csv, notes.csv and result.json change together or not at all.
+  OutputSet outputs;
+  ARCO_ASSIGN_OR_RETURN(const std::string pitch_tmp, outputs.AddFile(PitchPath()));
+  ARCO_ASSIGN_OR_RETURN(const std::string notes_tmp,
+                        outputs.AddFile(JoinPath(dir_, kNotesCsvFile)));
+  ARCO_ASSIGN_OR_RETURN(const std::string manifest_tmp, outputs.AddFile(ManifestPath()));
+  ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(pitch_tmp, r.frames));
+  ARCO_RETURN_IF_ERROR(audio::WriteNotesCsv(notes_tmp, r.notes));
+  const Json entry = {{"dir", "."},
                       {"files", {{"pitch", kPitchCsvFile}, {"notes", kNotesCsvFile}}},
                       {"a4_hz", r.a4_hz},
                       {"audio", r.summary.audio},
-                      {"summary", ToJson(r.summary)}});
+                      {"summary", ToJson(r.summary)}};
+  ARCO_RETURN_IF_ERROR(WriteJsonFile(manifest_tmp, WithStage(manifest, kPitchStage, entry)));
+  return outputs.Commit();
 }
 
 std::string ResultFolder::PitchPath() const { return JoinPath(dir_, kPitchCsvFile); }

@@ -20,8 +20,8 @@
 //
 // hand_params.npy rows: the left wrist rotation as an angle-axis (3, rad), the wrist
 // position (3, mm), the 20 joint angles (rad, hand/hand_model.h); a NaN row is no hand.
-// Stage folders are written whole or not at all (a temporary folder, then a rename), and
-// each writer records its entry in result.json keeping the other stages'.
+// Each writer writes its files and its entry in result.json (keeping the other stages')
+// as one transaction (util/output_set.h): all of them or none.
 #pragma once
 
 #include <functional>
@@ -135,6 +135,11 @@ class ResultFolder {
   std::string HandParamsPath() const;
   std::string BoneLengthsPath() const;
 
+  // Before the work: the folder can be created, or is empty, or is an arco result folder
+  // (holds result.json), never some other folder whose stage-named subfolders would be
+  // replaced.
+  Status CheckWritable() const;
+
   // result.json: an empty object when absent; an error when it is not an arco result.
   StatusOr<Json> ReadManifest() const;
   StatusOr<ResultHeader> ReadHeader() const;
@@ -171,10 +176,9 @@ class ResultFolder {
   std::string ContactsPath(const std::string& method) const;
 
  private:
-  // Sets result.json "stages"."<stage>" = entry (other stages kept; the manifest is
-  // created when absent).
-  Status RecordStage(const std::string& stage, const Json& entry) const;
-  // Writes RESULT_DIR/<stage>/ whole or not at all, then records `entry` plus "dir".
+  // Writes RESULT_DIR/<stage>/ and result.json "stages"."<stage>" = `entry` plus "dir"
+  // (other stages kept; the manifest is created when absent) as one OutputSet: both or
+  // neither.
   Status WriteStageFolder(const std::string& stage,
                           const std::function<Status(const std::string& dir)>& write,
                           Json entry) const;

@@ -3,6 +3,8 @@
 #include <chrono>
 
 #include "arco/pipeline/capture_context.h"
+#include "arco/pipeline/result_folder.h"
+#include "arco/util/atomic_dir.h"
 
 namespace arco::pipeline {
 namespace {
@@ -65,9 +67,20 @@ Status RunOptions::Validate() const {
   return ForRefine(refine.mode).Validate().WithContext("refine");
 }
 
-StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
-  ARCO_RETURN_IF_ERROR(options.Validate());
-  ARCO_ASSIGN_OR_RETURN(const CaptureContext capture, OpenCapture(options.capture_dir));
+FolderReplace RunOptions::Replace() const {
+  FolderReplace r;
+  r.overwrite = overwrite;
+  r.marker = kResultManifestName;  // only an arco result folder is replaced
+  r.kind = "result folder";
+  return r;
+}
+
+namespace {
+
+// Every stage, in order, into options.result_dir.
+StatusOr<RunSummary> RunStages(const RunOptions& options,
+                               const CaptureContext& capture,
+                               Progress& progress) {
   RunSummary summary;
   auto stage = [&](int index, const char* name) {
     progress.StartStage(index, kRunStages, name);
@@ -112,6 +125,36 @@ StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
     progress.Advance(1);
   }
   summary.timings.push_back({"refine", SecondsSince(start)});
+  return summary;
+}
+
+}  // namespace
+
+StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options.result_dir, options.Replace()));
+  ARCO_ASSIGN_OR_RETURN(const CaptureContext capture, OpenCapture(options.capture_dir));
+  // The stages fill a hidden temporary result folder, moved into place once all are done:
+  // a failed run leaves no result folder and an old one as it was.
+  RunSummary summary;
+  ARCO_RETURN_IF_ERROR(AtomicWriteDirectory(
+      options.result_dir, options.Replace(), [&](const std::string& tmp_dir) -> Status {
+        RunOptions staged = options;
+        staged.result_dir = tmp_dir;
+        StatusOr<RunSummary> ran = RunStages(staged, capture, progress);
+        if (!ran.ok()) {
+          // Messages name the result folder the user gave, not its temporary.
+          std::string message = ran.status().message();
+          const std::string given = NormalizeOutputPath(options.result_dir);
+          for (size_t at = message.find(tmp_dir); at != std::string::npos;
+               at = message.find(tmp_dir, at + given.size())) {
+            message.replace(at, tmp_dir.size(), given);
+          }
+          return Status::Error(message);
+        }
+        summary = std::move(ran).value();
+        return Status::Ok();
+      }));
   return summary;
 }
 

@@ -18,6 +18,7 @@
 #include "arco/pipeline/refine_stage.h"
 #include "arco/pipeline/summaries.h"
 #include "arco/pipeline/triangulate_stage.h"
+#include "arco/util/output_set.h"
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
 
@@ -34,6 +35,9 @@ struct RunOptions {
   PitchStageOptions pitch;
   refine::RefineOptions refine;  // mode ignored: vision, paper and arco are all written
   int num_threads = 0;           // 0 = all cores; results do not depend on it
+  // Replace an existing non-empty result_dir (only one holding result.json). The whole
+  // result folder is written under a hidden temporary name and moved in at the end.
+  bool overwrite = false;
 
   // Every nested option (as the stages will receive them).
   Status Validate() const;
@@ -43,6 +47,8 @@ struct RunOptions {
   HandStageOptions ForHands() const;
   PitchStageOptions ForPitch() const;
   RefineStageOptions ForRefine(refine::RefineMode mode) const;
+  // When result_dir may be replaced (util/output_set.h).
+  FolderReplace Replace() const;
 };
 
 struct StageTiming {

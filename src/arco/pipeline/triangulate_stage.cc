@@ -28,6 +28,7 @@ Json ToJson(const TriangulateStageOptions& o) {
 StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOptions& o,
                                                       Progress& progress) {
   ARCO_RETURN_IF_ERROR(o.Validate());
+  ARCO_RETURN_IF_ERROR(ResultFolder(o.result_dir).CheckWritable());  // before the work
   ARCO_ASSIGN_OR_RETURN(CaptureManifest manifest, ReadCaptureManifest(o.capture_dir));
   const std::string manifest_path = JoinPath(o.capture_dir, kCaptureManifestName);
   ARCO_ASSIGN_OR_RETURN(KeypointLayout layout, [&]() -> StatusOr<KeypointLayout> {

@@ -144,7 +144,7 @@ Status AddRoomNoise(const std::string& wav, double dbfs, uint64_t seed) {
   SF_INFO out_info = info;
   out_info.format = SF_FORMAT_WAV | SF_FORMAT_PCM_16;
   SNDFILE* out = sf_open(tmp.c_str(), SFM_WRITE, &out_info);
-  if (!out) return Status::Error(tmp + ": cannot write");
+  if (!out) return Status::Error(tmp + ": cannot write: " + sf_strerror(nullptr));
   const sf_count_t put = sf_writef_float(out, samples.data(), info.frames);
   sf_close(out);
   std::error_code ec;

@@ -1,7 +1,5 @@
 #include "arco/synth/capture_writer.h"
 
-#include <unistd.h>
-
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -11,6 +9,7 @@
 #include "arco/mocap/capture.h"
 #include "arco/synth/synth_instrument.h"
 #include "arco/synth/truth_folder.h"
+#include "arco/util/atomic_dir.h"
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
 
@@ -142,38 +141,28 @@ Status WriteAll(const SyntheticCapture& c,
 
 }  // namespace
 
+static FolderReplace CaptureReplace(const WriteOptions& w) {
+  FolderReplace r;
+  r.overwrite = w.overwrite;
+  r.marker = kCaptureManifestName;  // only an arco capture is replaced
+  r.kind = "capture";
+  return r;
+}
+
+Status CheckCaptureOutput(const std::string& out_dir, const WriteOptions& w) {
+  return CheckOutputFolder(out_dir, CaptureReplace(w));
+}
+
 Status WriteCapture(const SyntheticCapture& c,
                     const std::string& out_dir,
                     const WriteOptions& w,
                     WriteSummary* summary) {
   WriteSummary local;
   WriteSummary* s = summary ? summary : &local;
+  ARCO_RETURN_IF_ERROR(AtomicWriteDirectory(
+      out_dir, CaptureReplace(w), [&](const std::string& tmp) { return WriteAll(c, tmp, w, s); }));
   std::error_code ec;
-  const fs::path target(out_dir);
-  if (fs::exists(target, ec)) {
-    if (!fs::is_directory(target, ec))
-      return Status::Error(out_dir + ": exists and is not a folder");
-    if (!fs::is_empty(target, ec) && !w.overwrite) {
-      return Status::Error(out_dir +
-                           ": folder exists and is not empty (set overwrite to replace it)");
-    }
-  }
-  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  if (!fs::exists(parent, ec)) ARCO_RETURN_IF_ERROR(MakeDirectories(parent.string()));
-  const std::string tmp =
-      (parent / (target.filename().string() + ".tmp-" + std::to_string(::getpid()))).string();
-  fs::remove_all(tmp, ec);
-  const Status st = WriteAll(c, tmp, w, s);
-  if (!st.ok()) {
-    fs::remove_all(tmp, ec);
-    return st;
-  }
-  if (fs::exists(target, ec)) fs::remove_all(target, ec);
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove_all(tmp, ec);
-    return Status::Error(out_dir + ": cannot move the capture into place: " + ec.message());
-  }
+  const fs::path target(NormalizeOutputPath(out_dir));
   for (const auto& e : fs::recursive_directory_iterator(target, ec)) {
     if (e.is_regular_file(ec)) s->bytes += static_cast<int64_t>(e.file_size(ec));
   }

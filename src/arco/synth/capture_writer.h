@@ -18,8 +18,9 @@
 //   OUT/truth/notes.csv     one row per note: timing, pitch, fingering, expression
 //
 // Rows are video frames: row i is at time_s = i / fps on the audio's clock
-// (manifest frame numbers start at 1, audio offset 0). The folder is built
-// under a temporary name and renamed into place, so a failure leaves nothing.
+// (manifest frame numbers start at 1, audio offset 0). The folder is built under a hidden
+// temporary name and moved into place (util/atomic_dir.h), so a failure leaves nothing and
+// an old capture is replaced only once the new one is complete.
 #pragma once
 
 #include <string>
@@ -42,9 +43,14 @@ struct WriteSummary {
   int64_t bytes = 0;
 };
 
+// An existing non-empty OUT is replaced only with options.overwrite and only when it holds
+// a capture.json (an arco capture); "OUT/" and "OUT" are the same folder.
 Status WriteCapture(const SyntheticCapture& capture,
                     const std::string& out_dir,
                     const WriteOptions& options,
                     WriteSummary* summary = nullptr);
+
+// WriteCapture's checks of OUT, for the command to make before synthesising.
+Status CheckCaptureOutput(const std::string& out_dir, const WriteOptions& options);
 
 }  // namespace arco::synth

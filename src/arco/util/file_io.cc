@@ -1,12 +1,12 @@
 #include "arco/util/file_io.h"
 
-#include <unistd.h>
-
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "arco/util/output_set.h"
 
 namespace arco {
 
@@ -26,31 +26,19 @@ StatusOr<std::string> ReadFileToString(const std::string& path) {
 
 Status AtomicWriteWith(const std::string& path,
                        const std::function<Status(std::ostream&)>& writer) {
-  const fs::path target(path);
-  std::error_code ec;
-  if (target.has_parent_path() && !fs::exists(target.parent_path(), ec)) {
-    return Status::Error(path + ": output folder " + target.parent_path().string() +
-                         " does not exist");
-  }
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  Status status;
+  OutputSet outputs;
+  ARCO_ASSIGN_OR_RETURN(const std::string tmp, outputs.AddFile(path));
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return Status::Error(path + ": cannot write: " + std::strerror(errno));
-    status = writer(out);
+    if (!out) {
+      const int err = errno;
+      return Status::Error(path + ": cannot write: " + std::strerror(err));
+    }
+    ARCO_RETURN_IF_ERROR(writer(out));
     out.flush();
-    if (status.ok() && !out.good()) status = Status::Error(path + ": write failed (disk full?)");
+    if (!out.good()) return Status::Error(path + ": write failed (disk full?)");
   }
-  if (!status.ok()) {
-    fs::remove(tmp, ec);
-    return status;
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    return Status::Error(path + ": cannot rename temporary file into place: " + ec.message());
-  }
-  return Status::Ok();
+  return outputs.Commit();
 }
 
 Status AtomicWriteFile(const std::string& path, const std::string& contents) {

@@ -1,5 +1,6 @@
-// File helpers. Outputs are written whole or not at all: AtomicWriteFile writes
-// to "<path>.tmp-<pid>" and renames into place only after a successful flush.
+// File helpers. Outputs are written whole or not at all: AtomicWriteFile writes a hidden
+// temporary sibling and moves it into place only after a successful flush (one-file
+// OutputSet, util/output_set.h: a folder or a missing parent folder is an error).
 #pragma once
 
 #include <functional>

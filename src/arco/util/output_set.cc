@@ -1,0 +1,203 @@
+#include "arco/util/output_set.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <system_error>
+
+namespace arco {
+namespace fs = std::filesystem;
+namespace {
+
+// The parent folder of a normalized path ("." for a bare name).
+fs::path ParentOf(const std::string& path) {
+  const fs::path p(path);
+  return p.has_parent_path() ? p.parent_path() : fs::path(".");
+}
+
+// Checks that `parent` is a folder, creating it (and its parents) when `create`.
+Status CheckParent(const std::string& path, const fs::path& parent, bool create) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(parent, ec);
+  if (fs::is_directory(st)) return Status::Ok();
+  if (fs::exists(st)) {
+    return Status::Error(path + ": " + parent.string() + " is not a folder");
+  }
+  if (!create) {
+    return Status::Error(path + ": output folder " + parent.string() + " does not exist");
+  }
+  fs::create_directories(parent, ec);
+  if (ec) {
+    return Status::Error(path + ": cannot create folder " + parent.string() + ": " + ec.message());
+  }
+  return Status::Ok();
+}
+
+bool IsEmptyFolder(const std::string& path) {
+  std::error_code ec;
+  return fs::is_empty(path, ec) && !ec;
+}
+
+}  // namespace
+
+std::string NormalizeOutputPath(const std::string& path) {
+  if (path.empty()) return path;
+  std::string p = fs::path(path).lexically_normal().string();
+  while (p.size() > 1 && p.back() == '/') p.pop_back();
+  return p;
+}
+
+std::string HiddenSibling(const std::string& path, const std::string& what) {
+  const fs::path p(NormalizeOutputPath(path));
+  // The extension stays last, for writers that choose the format from it.
+  const std::string name =
+      "." + what + "-" + std::to_string(::getpid()) + "." + p.filename().string();
+  return p.has_parent_path() ? (p.parent_path() / name).string() : name;
+}
+
+OutputSet::~OutputSet() {
+  if (done_) return;
+  std::error_code ec;
+  for (const Output& o : outputs_) fs::remove_all(o.tmp, ec);
+}
+
+std::vector<std::string> OutputSet::paths() const {
+  std::vector<std::string> out;
+  for (const Output& o : outputs_) out.push_back(o.path);
+  return out;
+}
+
+Status CheckOutputFile(const std::string& given) {
+  if (given.empty()) return Status::Error("an output file path is empty");
+  if (given.back() == '/') {
+    return Status::Error(given + ": names a folder; expected a file path");
+  }
+  const std::string path = NormalizeOutputPath(given);
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    return Status::Error(path + ": is a folder; expected a file path");
+  }
+  ARCO_RETURN_IF_ERROR(CheckParent(path, ParentOf(path), /*create=*/false));
+  if (::access(ParentOf(path).c_str(), W_OK) != 0) {
+    const int err = errno;
+    return Status::Error(path + ": cannot write: " + std::strerror(err));
+  }
+  return Status::Ok();
+}
+
+Status CheckOutputFolder(const std::string& given, const FolderReplace& replace) {
+  if (given.empty()) return Status::Error("an output folder path is empty");
+  const std::string path = NormalizeOutputPath(given);
+  std::error_code ec;
+  const fs::file_status st = fs::symlink_status(path, ec);
+  if (fs::exists(st)) {
+    if (!fs::is_directory(st)) return Status::Error(path + ": exists and is not a folder");
+    if (!IsEmptyFolder(path)) {
+      if (!replace.overwrite) {
+        return Status::Error(path + ": " + replace.kind + " exists and is not empty (" +
+                             replace.option + " replaces it)");
+      }
+      if (!replace.marker.empty() && !fs::exists(fs::path(path) / replace.marker, ec)) {
+        return Status::Error(path + ": no " + replace.marker + ": not an arco " + replace.kind +
+                             ", so left alone (choose another folder)");
+      }
+    }
+  }
+  // The nearest existing ancestor must be a folder we can write into.
+  fs::path ancestor = ParentOf(path);
+  while (!fs::exists(fs::symlink_status(ancestor, ec)) && ancestor.has_parent_path() &&
+         ancestor.parent_path() != ancestor) {
+    ancestor = ancestor.parent_path();
+  }
+  if (!fs::exists(ancestor, ec)) ancestor = ".";
+  if (!fs::is_directory(ancestor, ec)) {
+    return Status::Error(path + ": cannot create folder: " + ancestor.string() +
+                         " is not a folder");
+  }
+  if (::access(ancestor.c_str(), W_OK) != 0) {
+    const int err = errno;
+    return Status::Error(path + ": cannot create folder in " + ancestor.string() + ": " +
+                         std::strerror(err));
+  }
+  return Status::Ok();
+}
+
+StatusOr<std::string> OutputSet::AddFile(const std::string& given) {
+  ARCO_RETURN_IF_ERROR(CheckOutputFile(given));
+  const std::string path = NormalizeOutputPath(given);
+  for (const Output& o : outputs_) {
+    if (o.path == path) return Status::Error(path + ": given for two outputs");
+  }
+  Output o{path, HiddenSibling(path, "tmp"), HiddenSibling(path, "old"), false};
+  std::error_code ec;
+  fs::remove_all(o.tmp, ec);
+  const int fd = ::open(o.tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    const int err = errno;
+    return Status::Error(path + ": cannot write: " + std::strerror(err));
+  }
+  ::close(fd);
+  outputs_.push_back(o);
+  return o.tmp;
+}
+
+StatusOr<std::string> OutputSet::AddFolder(const std::string& given, const FolderReplace& replace) {
+  ARCO_RETURN_IF_ERROR(CheckOutputFolder(given, replace));
+  const std::string path = NormalizeOutputPath(given);
+  for (const Output& o : outputs_) {
+    if (o.path == path) return Status::Error(path + ": given for two outputs");
+  }
+  ARCO_RETURN_IF_ERROR(CheckParent(path, ParentOf(path), /*create=*/true));
+  Output o{path, HiddenSibling(path, "tmp"), HiddenSibling(path, "old"), true};
+  std::error_code ec;
+  fs::remove_all(o.tmp, ec);
+  fs::create_directory(o.tmp, ec);
+  if (ec) return Status::Error(path + ": cannot create a folder beside it: " + ec.message());
+  outputs_.push_back(o);
+  return o.tmp;
+}
+
+Status OutputSet::Commit() {
+  if (done_) return Status::Error("output set committed twice");
+  done_ = true;
+  std::error_code ec;
+  std::vector<bool> had_old(outputs_.size(), false);
+  // Undoes outputs [0, n): the new one out, the old one back.
+  auto roll_back = [&](size_t n) {
+    std::error_code ignored;
+    for (size_t k = n; k-- > 0;) {
+      fs::remove_all(outputs_[k].path, ignored);
+      if (had_old[k]) fs::rename(outputs_[k].old, outputs_[k].path, ignored);
+    }
+    for (const Output& o : outputs_) fs::remove_all(o.tmp, ignored);
+  };
+  for (size_t i = 0; i < outputs_.size(); ++i) {
+    const Output& o = outputs_[i];
+    if (fs::exists(fs::symlink_status(o.path, ec))) {
+      fs::remove_all(o.old, ec);
+      fs::rename(o.path, o.old, ec);
+      if (ec) {
+        const std::string why = ec.message();
+        roll_back(i);
+        return Status::Error(o.path + ": cannot move the old " + (o.folder ? "folder" : "file") +
+                             " aside: " + why);
+      }
+      had_old[i] = true;
+    }
+    fs::rename(o.tmp, o.path, ec);
+    if (ec) {
+      const std::string why = ec.message();
+      roll_back(i + 1);
+      return Status::Error(o.path + ": cannot move into place: " + why);
+    }
+  }
+  for (size_t i = 0; i < outputs_.size(); ++i) {
+    if (had_old[i]) fs::remove_all(outputs_[i].old, ec);
+  }
+  return Status::Ok();
+}
+
+}  // namespace arco
