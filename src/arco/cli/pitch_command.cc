@@ -2,7 +2,7 @@
 #include <cstdio>
 #include <memory>
 
-#include "arco/cli/audio.h"
+#include "arco/cli/audio_report.h"
 #include "arco/cli/command.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/progress.h"
@@ -11,7 +11,7 @@ namespace arco::cli {
 namespace {
 
 std::function<int()> SetupPitch(CLI::App& app) {
-  auto o = std::make_shared<PitchRunOptions>();
+  auto o = std::make_shared<pipeline::PitchRunOptions>();
   auto* cmd = app.add_subcommand(
       "pitch", "Pitch (f0) at video-frame times: pitch.csv with one row per frame");
   cmd->add_option("input", o->input, "Audio file (WAV/FLAC/OGG/...) or a video with audio");
@@ -51,7 +51,7 @@ std::function<int()> SetupPitch(CLI::App& app) {
                   "Write the notes as a standard MIDI file with pitch bends (+-2 semitones)");
   return [o] {
     ProgressBar bar("pitch");  // the bar starts at TrackPitch's SetTotal
-    auto result = RunPitch(*o, bar);
+    auto result = pipeline::RunPitch(*o, bar);
     bar.Finish();
     if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kPitchFlags));
     std::fputs(FormatPitchReport(*o, *result).c_str(), stdout);

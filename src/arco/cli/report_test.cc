@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "arco/cli/audio_report.h"
 #include "arco/pipeline/label_views.h"
 
 namespace arco::cli {
@@ -41,6 +42,22 @@ TEST(FormatStageLine, OneLinePerStage) {
   vision.mode = refine::RefineMode::kVision;
   s.methods = {vision, arco};
   EXPECT_EQ(FormatStageLine(s, {"refine", 0}), "wrote vision, arco");
+}
+
+TEST(FormatPitchReport, NotesAndWarningsWithTheCommandsFlags) {
+  pipeline::PitchRunOptions o;
+  o.output = "p.csv";
+  pipeline::PitchRunResult r;
+  r.input = "take.wav";
+  r.fine_fps = 120;
+  r.notes = 2;
+  r.notes_with_vibrato = 1;
+  r.summary.warnings = {"no voiced frames: check start_s"};
+  const std::string report = FormatPitchReport(o, r);
+  EXPECT_NE(report.find("notes: 2 (1 with vibrato)"), std::string::npos) << report;
+  // The library names its field; the terminal names the flag the user can give.
+  EXPECT_NE(report.find("warning: no voiced frames: check --start-s"), std::string::npos) << report;
+  EXPECT_NE(report.find("wrote p.csv"), std::string::npos) << report;
 }
 
 }  // namespace

@@ -2,7 +2,7 @@
 #include <cstdio>
 #include <memory>
 
-#include "arco/cli/audio.h"
+#include "arco/cli/audio_report.h"
 #include "arco/cli/command.h"
 #include "arco/cli/flag_names.h"
 
@@ -10,7 +10,7 @@ namespace arco::cli {
 namespace {
 
 std::function<int()> SetupSync(CLI::App& app) {
-  auto o = std::make_shared<SyncRunOptions>();
+  auto o = std::make_shared<pipeline::SyncRunOptions>();
   auto* cmd = app.add_subcommand(
       "sync", "Find a clap/flash in audio and video; print offset_s (audio = video + offset)");
   cmd->add_option("audio", o->audio, "Audio recording (or a video whose audio track to use)")
@@ -38,7 +38,7 @@ std::function<int()> SetupSync(CLI::App& app) {
                   "Capture folder: store the offset as audio.offset_s in its capture.json");
   return [o, event] {
     o->sync.video_event = *event == "flash" ? audio::VideoEvent::kFlash : audio::VideoEvent::kClap;
-    auto result = RunSync(*o);
+    auto result = pipeline::RunSync(*o);
     if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kSyncFlags));
     std::fputs(FormatSyncReport(*o, *result).c_str(), stdout);
     return 0;

@@ -1,5 +1,6 @@
-// The work behind `arco pitch` and `arco sync` (pitch_command.cc and
-// sync_command.cc parse argv into these options; tests call these directly).
+// The work behind `arco pitch` and `arco sync` (cli/pitch_command.cc and
+// cli/sync_command.cc parse argv into these options and print cli/report.h's text; tests
+// and bindings call these directly).
 #pragma once
 
 #include <cmath>
@@ -12,13 +13,13 @@
 #include "arco/audio/sync.h"
 #include "arco/util/status.h"
 
-namespace arco::cli {
+namespace arco::pipeline {
 
 struct PitchRunOptions {
   std::string input;        // audio file or video with an audio track
   std::string capture_dir;  // optional: audio, offset, fps, frames, instrument, A4 from
                             // CAPTURE_DIR/capture.json (explicit options below win)
-  std::string instrument;   // violin | viola | cello | bass | any (default cello)
+  std::string instrument;   // violin | viola | cello | double_bass | any (default cello)
   double fps = NAN;         // default 30 (or the manifest's)
   double start_s = NAN;     // audio time of video frame 0 (default 0 or the manifest's)
   int64_t frames = -1;      // -1: to the end of the audio (or the manifest's count)
@@ -41,7 +42,6 @@ struct PitchRunResult {
 // names the file.
 StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& options,
                                   Progress& progress = NoProgress());
-std::string FormatPitchReport(const PitchRunOptions& options, const PitchRunResult& result);
 
 struct SyncRunOptions {
   std::string audio;
@@ -53,6 +53,5 @@ struct SyncRunOptions {
 // Finds the event in both files; with capture_dir, writes audio.file (when empty)
 // and audio.offset_s into CAPTURE_DIR/capture.json.
 StatusOr<audio::SyncResult> RunSync(const SyncRunOptions& options);
-std::string FormatSyncReport(const SyncRunOptions& options, const audio::SyncResult& result);
 
-}  // namespace arco::cli
+}  // namespace arco::pipeline

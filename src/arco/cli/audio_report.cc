@@ -1,0 +1,83 @@
+// The terminal text of `arco pitch` and `arco sync` (the work is pipeline/pitch_sync.h).
+#include "arco/cli/audio_report.h"
+
+#include <cstdarg>
+#include <cstdio>
+
+#include "arco/cli/flag_names.h"
+#include "arco/mocap/capture.h"
+#include "arco/util/file_io.h"
+
+namespace arco::cli {
+namespace {
+
+std::string Format(const char* format, ...) __attribute__((format(printf, 1, 2)));
+std::string Format(const char* format, ...) {
+  char buffer[512];
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(buffer, sizeof(buffer), format, args);
+  va_end(args);
+  return buffer;
+}
+
+}  // namespace
+
+std::string FormatPitchReport(const pipeline::PitchRunOptions& o,
+                              const pipeline::PitchRunResult& r) {
+  const auto& s = r.summary;
+  std::string out;
+  out += Format("%s: %s, %d Hz, %d ch, %.2f s (analysed at %d Hz, %s %.0f-%.0f Hz)\n",
+                r.input.c_str(),
+                s.source_format.c_str(),
+                s.source_rate_hz,
+                s.source_channels,
+                s.duration_s,
+                s.analysis_rate_hz,
+                r.tracker.range.name.c_str(),
+                r.tracker.range.min_f0_hz,
+                r.tracker.range.max_f0_hz);
+  out += Format("frames: %lld at %.3f fps from %.4f s (fine hop %.2f ms)\n",
+                static_cast<long long>(s.frames),
+                r.tracker.fps,
+                r.tracker.start_s,
+                1000.0 / r.fine_fps);
+  out += Format("voiced: %.1f%%", 100.0 * s.voiced_fraction);
+  if (s.max_f0_hz > 0) out += Format(", range %.2f-%.2f Hz", s.min_f0_hz, s.max_f0_hz);
+  out += "\n";
+  out +=
+      Format("notes: %d (%d with vibrato), glides: %d\n", r.notes, r.notes_with_vibrato, r.glides);
+  for (const auto& w : s.warnings) out += "warning: " + WithFlagNames(w, kPitchFlags) + "\n";
+  out += Format("wrote %s; %.3f s CPU (%.0fx real time)\n",
+                o.output.c_str(),
+                s.cpu_seconds,
+                s.cpu_seconds > 0 ? s.duration_s / s.cpu_seconds : 0.0);
+  return out;
+}
+
+std::string FormatSyncReport(const pipeline::SyncRunOptions& o, const audio::SyncResult& r) {
+  std::string out;
+  out += Format("audio %s: onset at %.4f s (%.1f dB; next strongest %.1f dB)\n",
+                o.audio.c_str(),
+                r.audio.time_s,
+                r.audio.strength,
+                r.audio.runner_up);
+  out += Format("video %s: event at %.4f s = frame %.2f of %.3f fps (motion %.1f; next %.1f)\n",
+                o.video.c_str(),
+                r.video.time_s,
+                r.video.time_s * r.video_fps,
+                r.video_fps,
+                r.video.strength,
+                r.video.runner_up);
+  out +=
+      Format("offset_s %.4f  (audio time = video time + offset; use arco pitch --offset-s %.4f)\n",
+             r.offset_s,
+             r.offset_s);
+  for (const auto& w : r.warnings) out += "warning: " + WithFlagNames(w, kSyncFlags) + "\n";
+  if (!o.capture_dir.empty()) {
+    out += "wrote audio.offset_s to " + JoinPath(o.capture_dir, kCaptureManifestName) + "\n";
+  }
+  return out;
+}
+
+}  // namespace arco::cli

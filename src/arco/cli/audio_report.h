@@ -1,0 +1,16 @@
+// The terminal text of `arco pitch` and `arco sync`: what was read, tracked and written,
+// and the library's warnings with its field names mapped to the command's flags.
+#pragma once
+
+#include <string>
+
+#include "arco/pipeline/pitch_sync.h"
+
+namespace arco::cli {
+
+std::string FormatPitchReport(const pipeline::PitchRunOptions& options,
+                              const pipeline::PitchRunResult& result);
+std::string FormatSyncReport(const pipeline::SyncRunOptions& options,
+                             const audio::SyncResult& result);
+
+}  // namespace arco::cli
