@@ -5,31 +5,15 @@
 #include <cmath>
 #include <filesystem>
 
-#include "arco/util/test_dir.h"
+#include "arco/mocap/sample_manifest.h"
 #include "arco/util/file_io.h"
+#include "arco/util/test_dir.h"
 
 namespace arco {
 namespace {
 
+using arco::testing::SampleManifest;
 using testing::TempDir;
-
-CaptureManifest SampleManifest() {
-  CaptureManifest m;
-  m.name = "cello_1113_scale";
-  m.instrument = "cello";
-  m.fps = 30;
-  m.frame_first = 128;
-  m.frame_count = 4;
-  m.tuning_a4_hz = 442;
-  m.calibration = "calibration.xml";
-  m.audio = "audio.wav";
-  m.audio_offset_s = 1.25;
-  m.keypoints2d = "keypoints2d.npy";
-  m.layout = "spd_cello";
-  m.cameras = {{"cam0", "21334181", "videos/21334181.avi", {129, 300}},
-               {"cam1", "21334237", "", {}}};
-  return m;
-}
 
 TEST(KeypointLayout, BuiltInLayoutsHaveSpdSizesAndNames) {
   auto size = [](const char* n) { return FindKeypointLayout(n)->size(); };

@@ -17,10 +17,6 @@ namespace {
 
 constexpr int kLeftHandFirst = wholebody::kLeftHandFirst;
 
-Eigen::Vector3d PointAt(const NpyArray<double>& a, int64_t f, int64_t p) {
-  return Eigen::Vector3d(a.at(f, p, 0), a.at(f, p, 1), a.at(f, p, 2));
-}
-
 }  // namespace
 
 Status HandStageOptions::Validate() const {

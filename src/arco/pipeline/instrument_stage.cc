@@ -12,10 +12,6 @@ namespace {
 constexpr int kLeftShoulder = wholebody::kLeftShoulder;
 constexpr int kRightShoulder = wholebody::kRightShoulder;
 
-Eigen::Vector3d PointAt(const NpyArray<double>& a, int64_t f, int64_t p) {
-  return Eigen::Vector3d(a.at(f, p, 0), a.at(f, p, 1), a.at(f, p, 2));
-}
-
 }  // namespace
 
 Status InstrumentStageOptions::Validate() const {

@@ -24,6 +24,7 @@
 // as one transaction (util/output_set.h): all of them or none.
 #pragma once
 
+#include <Eigen/Core>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -185,5 +186,11 @@ class ResultFolder {
 
   std::string dir_;
 };
+
+// Point `point` of frame `frame` of a (F, P, 3) points array (NaN where missing).
+inline Eigen::Vector3d PointAt(const NpyArray<double>& points, int64_t frame, int64_t point) {
+  return Eigen::Vector3d(
+      points.at(frame, point, 0), points.at(frame, point, 1), points.at(frame, point, 2));
+}
 
 }  // namespace arco::pipeline

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "arco/hand/kinematics.h"
+#include "arco/mocap/sample_manifest.h"
 #include "arco/refine/contacts_csv.h"
 #include "arco/refine/method_result.h"
 #include "arco/refine/refine.h"
@@ -19,25 +20,8 @@
 namespace arco::pipeline {
 namespace {
 
+using arco::testing::SampleManifest;
 using arco::testing::TempDir;
-
-CaptureManifest SampleManifest() {
-  CaptureManifest m;
-  m.name = "cello_1113_scale";
-  m.instrument = "cello";
-  m.fps = 30;
-  m.frame_first = 128;
-  m.frame_count = 4;
-  m.tuning_a4_hz = 442;
-  m.calibration = "calibration.xml";
-  m.audio = "audio.wav";
-  m.audio_offset_s = 1.25;
-  m.keypoints2d = "keypoints2d.npy";
-  m.layout = "spd_cello";
-  m.cameras = {{"cam0", "21334181", "videos/21334181.avi", {129, 300}},
-               {"cam1", "21334237", "", {}}};
-  return m;
-}
 
 refine::SpdSources SourcesFor(const refine::testing::Scene& scene) {
   refine::SpdSources s;
