@@ -76,6 +76,7 @@ def main():
         print("SKIPPED: " + message + " (CI is unset)")
         return 77
 
+    env = dict(os.environ, ARCO_MODELS_DIR=args.models)  # the runner reads this folder
     failures = 0
     worst = 0.0
     with tempfile.TemporaryDirectory() as tmp:
@@ -85,7 +86,7 @@ def main():
                 crop = os.path.join(tmp, "input.npy")
                 subprocess.run([args.runner, "crop", image, str(cx), str(cy), str(side),
                                 str(angle), str(size), value_range, crop], check=True)
-                subprocess.run([args.runner, name, crop, tmp, "2"], check=True)
+                subprocess.run([args.runner, name, crop, tmp, "2"], check=True, env=env)
                 expected = list(reference.run(np.load(crop)).values())
                 parts = []
                 for out_name, want in zip(outputs, expected):

@@ -16,11 +16,11 @@
 namespace arco::detect {
 
 enum class ModelId {
-  kPoseDetection,      // person detector (SSD, 2254 anchors)
-  kPoseLandmarkLite,   // 33 body + 6 auxiliary landmarks, three sizes
+  kPoseDetection,     // person detector (SSD, 2254 anchors)
+  kPoseLandmarkLite,  // 33 body + 6 auxiliary landmarks, three sizes
   kPoseLandmarkFull,
   kPoseLandmarkHeavy,
-  kHandLandmarkLite,   // 21 hand landmarks, two sizes
+  kHandLandmarkLite,  // 21 hand landmarks, two sizes
   kHandLandmarkFull,
   kHandRecrop,         // refines a pose-derived hand crop (MediaPipe Holistic)
   kPalmDetectionFull,  // palm detector (SSD, 2016 anchors)

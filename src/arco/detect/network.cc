@@ -1,10 +1,9 @@
 #include "arco/detect/network.h"
 
-#include <opencv2/core.hpp>
-#include <opencv2/dnn.hpp>
-
 #include <cstring>
 #include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/dnn.hpp>
 #include <stdexcept>
 #include <system_error>
 
@@ -25,18 +24,21 @@ Status NetworkOptions::Validate() const {
   return Status::Ok();
 }
 
-StatusOr<Network> Network::Load(ModelId id, const std::string& models_dir,
+StatusOr<Network> Network::Load(ModelId id,
+                                const std::string& models_dir,
                                 const NetworkOptions& options) {
   return LoadFile(id, ModelPath(id, models_dir), options);
 }
 
-StatusOr<Network> Network::LoadFile(ModelId id, const std::string& path,
+StatusOr<Network> Network::LoadFile(ModelId id,
+                                    const std::string& path,
                                     const NetworkOptions& options) {
   ARCO_RETURN_IF_ERROR(options.Validate());
   const ModelInfo& info = GetModelInfo(id);
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
-    return Status::Error(path + ": model file not found; run scripts/setup to fetch and "
+    return Status::Error(path +
+                         ": model file not found; run scripts/setup to fetch and "
                          "convert the models (docs/detect.md)");
   }
   auto impl = std::make_unique<Impl>();
@@ -56,8 +58,8 @@ StatusOr<Network> Network::LoadFile(ModelId id, const std::string& path,
     bool found = false;
     for (const cv::String& name : graph_outputs) found = found || name == output.onnx_name;
     if (!found) {
-      return Status::Error(path + ": the model has no output '" + output.onnx_name +
-                           "' (" + info.name + "'s " + output.name +
+      return Status::Error(path + ": the model has no output '" + output.onnx_name + "' (" +
+                           info.name + "'s " + output.name +
                            "); run scripts/setup to convert it again");
     }
     impl->onnx_names.push_back(output.onnx_name);
@@ -67,7 +69,9 @@ StatusOr<Network> Network::LoadFile(ModelId id, const std::string& path,
   return Network(info, path, options, std::move(impl));
 }
 
-Network::Network(const ModelInfo& info, std::string path, NetworkOptions options,
+Network::Network(const ModelInfo& info,
+                 std::string path,
+                 NetworkOptions options,
                  std::unique_ptr<Impl> impl)
     : info_(&info), path_(std::move(path)), options_(options), impl_(std::move(impl)) {
   for (const ModelOutput& output : info.outputs) {
@@ -88,9 +92,9 @@ Status Network::Run(const float* input, size_t input_size, TensorLayout layout) 
   const int height = info_->input_height, width = info_->input_width;
   const size_t plane = static_cast<size_t>(height) * width;
   if (input == nullptr || input_size != 3 * plane) {
-    throw std::invalid_argument(std::string(info_->name) + " takes 3 x " +
-                                std::to_string(height) + " x " + std::to_string(width) +
-                                " floats, got " + std::to_string(input_size));
+    throw std::invalid_argument(std::string(info_->name) + " takes 3 x " + std::to_string(height) +
+                                " x " + std::to_string(width) + " floats, got " +
+                                std::to_string(input_size));
   }
   float* blob = impl_->blob.ptr<float>();
   if (layout == TensorLayout::kNchw) {
@@ -112,8 +116,7 @@ Status Network::Run(const float* input, size_t input_size, TensorLayout layout) 
   for (size_t k = 0; k < outputs_.size(); ++k) {
     const cv::Mat& result = impl_->results[k];
     Tensor& tensor = outputs_[k];
-    if (result.type() != CV_32F || !result.isContinuous() ||
-        result.total() != tensor.data.size()) {
+    if (result.type() != CV_32F || !result.isContinuous() || result.total() != tensor.data.size()) {
       return Status::Error(path_ + ": output '" + info_->outputs[k].onnx_name + "' has " +
                            std::to_string(result.total()) + " values, expected " +
                            std::to_string(tensor.data.size()));

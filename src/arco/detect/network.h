@@ -39,10 +39,12 @@ class Network {
  public:
   // Loads models_dir/NAME.onnx. A missing file is one line naming it and pointing to
   // scripts/setup; an unreadable or wrong graph names the file and OpenCV's reason.
-  static StatusOr<Network> Load(ModelId id, const std::string& models_dir = DefaultModelsDir(),
+  static StatusOr<Network> Load(ModelId id,
+                                const std::string& models_dir = DefaultModelsDir(),
                                 const NetworkOptions& options = {});
   // Loads `path` as the network `id` describes (its outputs are checked on load).
-  static StatusOr<Network> LoadFile(ModelId id, const std::string& path,
+  static StatusOr<Network> LoadFile(ModelId id,
+                                    const std::string& path,
                                     const NetworkOptions& options = {});
 
   Network(Network&&) noexcept;
@@ -64,7 +66,9 @@ class Network {
 
  private:
   struct Impl;
-  Network(const ModelInfo& info, std::string path, NetworkOptions options,
+  Network(const ModelInfo& info,
+          std::string path,
+          NetworkOptions options,
           std::unique_ptr<Impl> impl);
 
   const ModelInfo* info_;

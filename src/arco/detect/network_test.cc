@@ -1,15 +1,15 @@
 #include "arco/detect/network.h"
 
 #include <gtest/gtest.h>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <set>
 #include <string>
 #include <vector>
@@ -34,10 +34,10 @@ bool ModelsPresentOrSkip(std::string* why) {
   return true;
 }
 
-#define ARCO_REQUIRE_MODELS()                                   \
-  do {                                                          \
-    std::string why;                                            \
-    if (!ModelsPresentOrSkip(&why)) GTEST_SKIP() << why;        \
+#define ARCO_REQUIRE_MODELS()                            \
+  do {                                                   \
+    std::string why;                                     \
+    if (!ModelsPresentOrSkip(&why)) GTEST_SKIP() << why; \
   } while (0)
 
 TEST(NetworkLoad, MissingFileNamesItAndScriptsSetup) {
@@ -116,11 +116,20 @@ std::vector<float> CutCrop(const cv::Mat& rgb, const Crop& crop, ValueRange rang
   const double s = crop.side_px / crop.size;
   // Crop pixel (u, v) -> image point, for WARP_INVERSE_MAP.
   const cv::Point2d origin = crop.ToImage(0.5 / crop.size, 0.5 / crop.size);
-  cv::Mat to_image = (cv::Mat_<double>(2, 3) << s * crop.right.x, -s * crop.up.x, origin.x,
-                      s * crop.right.y, -s * crop.up.y, origin.y);
+  cv::Mat to_image = (cv::Mat_<double>(2, 3) << s * crop.right.x,
+                      -s * crop.up.x,
+                      origin.x,
+                      s * crop.right.y,
+                      -s * crop.up.y,
+                      origin.y);
   cv::Mat out;
-  cv::warpAffine(rgb, out, to_image, cv::Size(crop.size, crop.size),
-                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+  cv::warpAffine(rgb,
+                 out,
+                 to_image,
+                 cv::Size(crop.size, crop.size),
+                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
+                 cv::BORDER_CONSTANT,
+                 cv::Scalar::all(0));
   std::vector<float> data(static_cast<size_t>(crop.size) * crop.size * 3);
   for (int y = 0; y < crop.size; ++y) {
     const cv::Vec3f* row = out.ptr<cv::Vec3f>(y);
@@ -197,9 +206,11 @@ TEST(NetworkRealImage, CellistPoseAndLeftHand) {
     return whole.ToImage(raw[4 + 2 * k] / 224.0 + anchors[best].x,
                          raw[5 + 2 * k] / 224.0 + anchors[best].y);
   };
-  const cv::Point2d box_centre = whole.ToImage(raw[0] / 224.0 + anchors[best].x,
-                                               raw[1] / 224.0 + anchors[best].y);
-  std::printf("pose_detection: score %.3f, box centre (%.0f, %.0f) px\n", score, box_centre.x,
+  const cv::Point2d box_centre =
+      whole.ToImage(raw[0] / 224.0 + anchors[best].x, raw[1] / 224.0 + anchors[best].y);
+  std::printf("pose_detection: score %.3f, box centre (%.0f, %.0f) px\n",
+              score,
+              box_centre.x,
               box_centre.y);
   EXPECT_GT(score, 0.5);
   // The detector's box is the player's face and upper body: in the middle of the frame
@@ -228,26 +239,83 @@ TEST(NetworkRealImage, CellistPoseAndLeftHand) {
   };
 
   // 3. The left hand (MediaPipe's 15 left wrist, 17 left pinky, 19 left index): the
-  // middle finger estimated as (2 index + pinky) / 3, the crop centred between it and
-  // the wrist's far side, turned wrist -> middle finger.
+  // middle finger's base estimated as (2 index + pinky) / 3 (the pose's hand points sit
+  // near the knuckles), the crop centred on it with a side of 4 wrist-to-middle
+  // lengths, turned so that wrist -> middle finger points up.
   const cv::Point2d wrist = body_point(15), pinky = body_point(17), index = body_point(19);
   const cv::Point2d middle = (2.0 * index + pinky) / 3.0;
   const cv::Point2d wrist_to_middle = middle - wrist;
   const double length = std::hypot(wrist_to_middle.x, wrist_to_middle.y);
-  std::printf("left wrist (%.0f, %.0f), middle finger (%.0f, %.0f) px\n", wrist.x, wrist.y,
-              middle.x, middle.y);
+  std::printf("left wrist (%.0f, %.0f), middle finger (%.0f, %.0f) px\n",
+              wrist.x,
+              wrist.y,
+              middle.x,
+              middle.y);
   // On the fingerboard: right of the neck line, between the scroll and the bridge.
   EXPECT_GT(wrist.x, 1150);
   EXPECT_GT(middle.y, 535);
   EXPECT_LT(middle.y, 1610);
   const Crop hand = MakeCrop(middle, wrist_to_middle, 4.0 * length, 224);
-  StatusOr<Network> hand_net = Network::Load(ModelId::kHandLandmarkFull, DefaultModelsDir(), options);
+  StatusOr<Network> hand_net =
+      Network::Load(ModelId::kHandLandmarkFull, DefaultModelsDir(), options);
   ASSERT_TRUE(hand_net.ok()) << hand_net.status().message();
   const std::vector<float> hand_input = CutCrop(image, hand, hand_net->info().range);
   ASSERT_TRUE(hand_net->Run(hand_input.data(), hand_input.size()).ok());
   const double hand_presence = hand_net->output("presence").data[0];
   std::printf("hand_landmark_full: presence %.3f\n", hand_presence);
   EXPECT_GT(hand_presence, 0.9);
+
+  // The four fingertips (hand points 8, 12, 16, 20) press the strings: on the
+  // fingerboard, near the line from the nut's centre to the neck's lower end (labelled
+  // in example.json), and between them along it; 40 px is about the fingerboard's
+  // width here (37 px at the nut, 62 px at the neck's end).
+  const cv::Point2d nut = 0.5 * (cv::Point2d(1205.3, 734.8) + cv::Point2d(1242.0, 731.3));
+  const cv::Point2d neck_bottom = 0.5 * (cv::Point2d(1140.2, 1102.3) + cv::Point2d(1201.8, 1104.6));
+  const cv::Point2d along =
+      (neck_bottom - nut) / std::hypot(neck_bottom.x - nut.x, neck_bottom.y - nut.y);
+  const double neck_length = std::hypot(neck_bottom.x - nut.x, neck_bottom.y - nut.y);
+  const std::vector<float>& hand_points = hand_net->output("landmarks").data;
+  for (int tip : {8, 12, 16, 20}) {
+    const cv::Point2d p =
+        hand.ToImage(hand_points[3 * tip] / 224.0, hand_points[3 * tip + 1] / 224.0);
+    const cv::Point2d d = p - nut;
+    const double t = d.x * along.x + d.y * along.y;
+    const double off_line = std::abs(d.x * along.y - d.y * along.x);
+    std::printf(
+        "fingertip %d: (%.0f, %.0f) px, %.2f of the way nut -> neck end, %.0f px off the line\n",
+        tip,
+        p.x,
+        p.y,
+        t / neck_length,
+        off_line);
+    EXPECT_GT(t, 0.0) << tip;
+    EXPECT_LT(t, neck_length) << tip;
+    EXPECT_LT(off_line, 40.0) << tip;
+  }
+
+  // hand_recrop on the same pose-derived crop (256 px): its two points (the refined
+  // crop's centre and a point on its edge, crop pixels) must stay on this hand.
+  StatusOr<Network> recrop = Network::Load(ModelId::kHandRecrop, DefaultModelsDir(), options);
+  ASSERT_TRUE(recrop.ok()) << recrop.status().message();
+  const Crop recrop_roi = MakeCrop(middle, wrist_to_middle, 4.0 * length, 256);
+  const std::vector<float> recrop_input = CutCrop(image, recrop_roi, recrop->info().range);
+  ASSERT_TRUE(recrop->Run(recrop_input.data(), recrop_input.size()).ok());
+  const std::vector<float>& refined = recrop->output("crop").data;
+  const cv::Point2d refined_centre = recrop_roi.ToImage(refined[0] / 256.0, refined[1] / 256.0);
+  const cv::Point2d refined_edge = recrop_roi.ToImage(refined[2] / 256.0, refined[3] / 256.0);
+  const cv::Point2d hand_middle = 0.5 * (wrist + middle);
+  const cv::Point2d centre_offset = refined_centre - hand_middle;
+  const cv::Point2d half_side = refined_edge - refined_centre;
+  std::printf(
+      "hand_recrop: centre (%.0f, %.0f) px, %.2f hand lengths from the hand's middle, "
+      "half side %.2f hand lengths\n",
+      refined_centre.x,
+      refined_centre.y,
+      std::hypot(centre_offset.x, centre_offset.y) / length,
+      std::hypot(half_side.x, half_side.y) / length);
+  EXPECT_LT(std::hypot(centre_offset.x, centre_offset.y), length);
+  EXPECT_GT(std::hypot(half_side.x, half_side.y), 0.5 * length);
+  EXPECT_LT(std::hypot(half_side.x, half_side.y), 4.0 * length);
 
   // A crop of the same size on the carpet, far from the player, holds no hand (every
   // test can fail).
@@ -275,7 +343,8 @@ TEST(NetworkRun, DeterministicAcrossThreadsAndLayouts) {
   for (int threads : {1, 2}) {
     NetworkOptions options;
     options.num_threads = threads;
-    StatusOr<Network> network = Network::Load(ModelId::kPoseLandmarkLite, DefaultModelsDir(), options);
+    StatusOr<Network> network =
+        Network::Load(ModelId::kPoseLandmarkLite, DefaultModelsDir(), options);
     ASSERT_TRUE(network.ok()) << network.status().message();
     ASSERT_TRUE(network->Run(input.data(), input.size()).ok());
     results.push_back(network->outputs());

@@ -9,11 +9,10 @@
 //   (counter-clockwise, so the crop's up is the image's direction rotated by it), resized
 //   to SIZE x SIZE with bilinear interpolation and black outside the image, as a
 //   (1, SIZE, SIZE, 3) float32 RGB array in RANGE ("0,1" or "-1,1").
+#include <cstdio>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-
-#include <cstdio>
 #include <string>
 
 #include "arco/detect/network.h"
@@ -24,7 +23,9 @@ namespace {
 int Crop(int argc, char** argv) {
   using namespace arco;
   if (argc != 10 && argc != 11) {
-    std::fprintf(stderr, "usage: detect_run_model crop IMAGE CX CY SIDE_PX ANGLE_DEG SIZE RANGE OUT.npy [OUT.png]\n");
+    std::fprintf(stderr,
+                 "usage: detect_run_model crop IMAGE CX CY SIDE_PX ANGLE_DEG SIZE RANGE OUT.npy "
+                 "[OUT.png]\n");
     return 2;
   }
   const cv::Mat bgr = cv::imread(argv[2], cv::IMREAD_COLOR);
@@ -37,8 +38,8 @@ int Crop(int argc, char** argv) {
   const int size = std::stoi(argv[7]);
   const std::string range = argv[8];
   // Maps the crop's pixel centres onto the image: scale, rotate about the crop centre.
-  cv::Mat to_crop = cv::getRotationMatrix2D(cv::Point2f(static_cast<float>(cx), static_cast<float>(cy)),
-                                            -angle_deg, size / side);
+  cv::Mat to_crop = cv::getRotationMatrix2D(
+      cv::Point2f(static_cast<float>(cx), static_cast<float>(cy)), -angle_deg, size / side);
   to_crop.at<double>(0, 2) += size / 2.0 - cx;
   to_crop.at<double>(1, 2) += size / 2.0 - cy;
   // Pixel centres (docs/architecture.md): the crop covers SIDE_PX around (CX, CY), so
@@ -46,8 +47,13 @@ int Crop(int argc, char** argv) {
   to_crop.at<double>(0, 2) -= 0.5;
   to_crop.at<double>(1, 2) -= 0.5;
   cv::Mat crop;
-  cv::warpAffine(bgr, crop, to_crop, cv::Size(size, size), cv::INTER_LINEAR,
-                 cv::BORDER_CONSTANT, cv::Scalar(0, 0, 0));
+  cv::warpAffine(bgr,
+                 crop,
+                 to_crop,
+                 cv::Size(size, size),
+                 cv::INTER_LINEAR,
+                 cv::BORDER_CONSTANT,
+                 cv::Scalar(0, 0, 0));
   if (argc == 11) cv::imwrite(argv[10], crop);
   NpyArray<float> out;
   out.shape = {1, size, size, 3};
@@ -92,7 +98,8 @@ int main(int argc, char** argv) {
   if (!id.ok()) return fail(id.status());
   detect::NetworkOptions options;
   if (argc == 5) options.num_threads = std::stoi(argv[4]);
-  StatusOr<detect::Network> network = detect::Network::Load(*id, detect::DefaultModelsDir(), options);
+  StatusOr<detect::Network> network =
+      detect::Network::Load(*id, detect::DefaultModelsDir(), options);
   if (!network.ok()) return fail(network.status());
   StatusOr<NpyArray<float>> input = ReadNpy<float>(argv[2]);
   if (!input.ok()) return fail(input.status());
