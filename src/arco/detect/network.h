@@ -1,0 +1,81 @@
+// One pretrained network (detect/model_registry.h) run with OpenCV's cv::dnn on the CPU.
+//
+// Load once (reading and preparing the graph is the expensive part), then Run per crop;
+// Run writes into output tensors owned by the Network, so the per-crop call allocates
+// nothing of ours. OpenCV stays out of this header.
+//
+// Threads: cv::dnn parallelises inside each layer with OpenCV's thread pool, whose size
+// is process-wide (cv::setNumThreads). Run sets it to NetworkOptions::num_threads before
+// every forward pass, so the count is always explicit; outputs are the same for any
+// count (network_test.cc checks it bit for bit).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "arco/detect/model_registry.h"
+#include "arco/util/status.h"
+
+namespace arco::detect {
+
+struct NetworkOptions {
+  int num_threads = 1;  // OpenCV threads during Run (process-wide, see above); >= 1
+  Status Validate() const;
+};
+
+// A dense float tensor, C order.
+struct Tensor {
+  std::vector<int> shape;
+  std::vector<float> data;
+};
+
+enum class TensorLayout {
+  kNhwc,  // 1 x H x W x 3 (TFLite's order, and an RGB image's)
+  kNchw,  // 1 x 3 x H x W (the ONNX graph's)
+};
+
+class Network {
+ public:
+  // Loads models_dir/NAME.onnx. A missing file is one line naming it and pointing to
+  // scripts/setup; an unreadable or wrong graph names the file and OpenCV's reason.
+  static StatusOr<Network> Load(ModelId id,
+                                const std::string& models_dir = DefaultModelsDir(),
+                                const NetworkOptions& options = {});
+  // Loads `path` as the network `id` describes (its outputs are checked on load).
+  static StatusOr<Network> LoadFile(ModelId id,
+                                    const std::string& path,
+                                    const NetworkOptions& options = {});
+
+  Network(Network&&) noexcept;
+  Network& operator=(Network&&) noexcept;
+  ~Network();
+
+  const ModelInfo& info() const { return *info_; }
+  const std::string& path() const { return path_; }
+
+  // Runs one crop: 3 * input_height * input_width floats in `layout`, values already in
+  // info().range. Throws std::invalid_argument on a wrong size; a failure inside
+  // cv::dnn is returned as a Status naming the file.
+  Status Run(const float* input, size_t input_size, TensorLayout layout = TensorLayout::kNhwc);
+
+  // The outputs of the last Run, in info().outputs order, TFLite shapes.
+  const std::vector<Tensor>& outputs() const { return outputs_; }
+  // Output by arco's name ("landmarks"); throws std::invalid_argument if unknown.
+  const Tensor& output(const std::string& name) const;
+
+ private:
+  struct Impl;
+  Network(const ModelInfo& info,
+          std::string path,
+          NetworkOptions options,
+          std::unique_ptr<Impl> impl);
+
+  const ModelInfo* info_;
+  std::string path_;
+  NetworkOptions options_;
+  std::unique_ptr<Impl> impl_;
+  std::vector<Tensor> outputs_;
+};
+
+}  // namespace arco::detect

@@ -1,0 +1,113 @@
+#!/usr/bin/python3
+"""The converter's test: cv::dnn on each converted ONNX model against the numpy reference
+executor of its TFLite graph (reference.py), on real image crops.
+
+Crops come from ../shared/data/spd/example.jpg (a real cellist) and, when opencv-doc is
+installed, its messi5.jpg; the C++ helper detect_run_model cuts them (python here has no
+image decoder) and runs the ONNX model with arco's detect::Network. Every output must
+agree to TOLERANCE, relative to the output's largest magnitude (docs/detect.md).
+
+Models absent: skipped (exit 77) unless $CI is set, where it fails: `make test` runs
+scripts/setup, which fetches and converts them.
+"""
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from reference import Reference  # noqa: E402
+
+# max |cv::dnn - reference| / max |reference| per output; measured worst 6.7e-5 on these
+# crops (segmentation logits; 1.8e-4 on uniform noise), docs/detect.md.
+TOLERANCE = 2e-4
+
+MODELS = {  # name: (input size, value range, output names in registry order)
+    "pose_detection": (224, "-1,1", ["boxes", "scores"]),
+    "pose_landmark_lite": (256, "0,1", ["landmarks", "presence", "segmentation", "heatmaps", "world_landmarks"]),
+    "pose_landmark_full": (256, "0,1", ["landmarks", "presence", "segmentation", "heatmaps", "world_landmarks"]),
+    "pose_landmark_heavy": (256, "0,1", ["landmarks", "presence", "segmentation", "heatmaps", "world_landmarks"]),
+    "hand_landmark_lite": (224, "0,1", ["landmarks", "presence", "handedness", "world_landmarks"]),
+    "hand_landmark_full": (224, "0,1", ["landmarks", "presence", "handedness", "world_landmarks"]),
+    "hand_recrop": (256, "0,1", ["crop"]),
+    "palm_detection_full": (192, "0,1", ["boxes", "scores"]),
+}
+
+MESSI = "/usr/share/doc/opencv-doc/examples/data/messi5.jpg"
+
+
+def crops_for(name, data_dir):
+    """(label, image, cx, cy, side_px, angle_deg) crops of real photos for model `name`."""
+    example = os.path.join(data_dir, "spd", "example.jpg")
+    out = []
+    if name == "pose_detection":
+        out.append(("example whole", example, 1149.5, 1327.5, 2656, 0))
+    elif name.startswith("pose_landmark"):
+        out.append(("example player", example, 1150, 1350, 2200, 0))
+    else:
+        # The left hand on the fingerboard (docs/detect.md), fingers pointing left: the
+        # crop is turned so that they point up, as the hand models expect.
+        out.append(("example left hand", example, 1330, 880, 420, 90))
+    if os.path.exists(MESSI):
+        out.append(("messi5", MESSI, 273.5, 170.5, 548, 0))
+    return out
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--runner", required=True)
+    parser.add_argument("--models", required=True)
+    parser.add_argument("--data", required=True)
+    args = parser.parse_args()
+
+    missing = [n for n in MODELS
+               if not (os.path.exists(os.path.join(args.models, n + ".onnx")) and
+                       os.path.exists(os.path.join(args.models, "tflite", n + ".tflite")))]
+    if missing:
+        message = ("models missing in %s (%s): run scripts/setup to fetch and convert them"
+                   % (args.models, ", ".join(missing)))
+        if os.environ.get("CI"):
+            print("FAIL: " + message)
+            return 1
+        print("SKIPPED: " + message + " (CI is unset)")
+        return 77
+
+    env = dict(os.environ, ARCO_MODELS_DIR=args.models)  # the runner reads this folder
+    failures = 0
+    worst = 0.0
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, (size, value_range, outputs) in MODELS.items():
+            reference = Reference(os.path.join(args.models, "tflite", name + ".tflite"))
+            for label, image, cx, cy, side, angle in crops_for(name, args.data):
+                crop = os.path.join(tmp, "input.npy")
+                subprocess.run([args.runner, "crop", image, str(cx), str(cy), str(side),
+                                str(angle), str(size), value_range, crop], check=True)
+                subprocess.run([args.runner, name, crop, tmp, "2"], check=True, env=env)
+                expected = list(reference.run(np.load(crop)).values())
+                parts = []
+                for out_name, want in zip(outputs, expected):
+                    got = np.load(os.path.join(tmp, out_name + ".npy"))
+                    if got.shape != want.shape:
+                        print("FAIL %s %s %s: shape %s, reference %s"
+                              % (name, label, out_name, got.shape, want.shape))
+                        failures += 1
+                        continue
+                    scale = max(float(np.abs(want).max()), 1e-6)
+                    error = float(np.abs(got.astype(np.float64) - want).max()) / scale
+                    worst = max(worst, error)
+                    if not error <= TOLERANCE:
+                        failures += 1
+                        parts.append("%s %.1e FAIL" % (out_name, error))
+                    else:
+                        parts.append("%s %.1e" % (out_name, error))
+                print("%-20s %-18s %s" % (name, label, "  ".join(parts)))
+    print("worst relative error %.2e (tolerance %.0e); %d failure(s)" % (worst, TOLERANCE, failures))
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
