@@ -261,7 +261,7 @@ StatusOr<SyncEvent> FindVideoEventInEnergy(const MotionEnergy& motion,
                   &best,
                   &runner_at);
   event.strength = score[best];
-  if (runner_at >= 0) {
+  if (runner_at >= 0 && score[runner_at] > 0) {
     event.runner_up = score[runner_at];
     event.runner_up_time_s = static_cast<double>(runner_at) / fps;
   }
