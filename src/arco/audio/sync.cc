@@ -144,13 +144,18 @@ StatusOr<SyncEvent> FindAudioOnset(const std::string& path, const SyncOptions& o
   if (strength.empty()) return Status::Error(path + ": no audio samples");
   int64_t lo, hi, best, runner_at;
   const double frames_per_s = double(kRate) / kFrame;
-  Window(options.audio_near_s,
-         options.search_s,
-         frames_per_s,
-         static_cast<int64_t>(strength.size()),
-         &lo,
-         &hi);
-  PeakAndRunnerUp(strength,
+  const int64_t n = static_cast<int64_t>(strength.size());
+  Window(options.audio_near_s, options.search_s, frames_per_s, n, &lo, &hi);
+  const double floor_db = Quantile(level_db, lo, hi, 0.5);
+  // Peak level over the 50 ms from each frame; onsets that stay below the floor plus
+  // kSyncMinAboveFloorDb are no candidates.
+  std::vector<double> peak_db(level_db.size());
+  std::vector<double> candidates(strength.size(), 0.0);
+  for (int64_t k = 0; k < n; ++k) {
+    peak_db[k] = *std::max_element(level_db.begin() + k, level_db.begin() + std::min(n, k + 25));
+    candidates[k] = peak_db[k] >= floor_db + kSyncMinAboveFloorDb ? strength[k] : 0.0;
+  }
+  PeakAndRunnerUp(candidates,
                   lo,
                   hi,
                   static_cast<int64_t>(kSyncSameEventS * frames_per_s),
@@ -158,12 +163,11 @@ StatusOr<SyncEvent> FindAudioOnset(const std::string& path, const SyncOptions& o
                   &runner_at);
   if (best < 0) return Status::Error(path + ": the search window holds no audio");
   SyncEvent event;
-  event.strength = strength[best];
-  event.floor = Quantile(level_db, lo, hi, 0.5);
-  event.level = level_db[best];
-  for (int64_t k = best; k < std::min(hi, best + 25); ++k) event.level = std::max(event.level, level_db[k]);
+  event.strength = candidates[best];
+  event.floor = floor_db;
+  event.level = peak_db[best];
   if (runner_at >= 0) {
-    event.runner_up = strength[runner_at];
+    event.runner_up = candidates[runner_at];
     event.runner_up_time_s = static_cast<double>(runner_at) / frames_per_s;
   }
   // 1 - the runner-up's amplitude ratio to the winner (an onset below 0 dB is none).
@@ -171,10 +175,12 @@ StatusOr<SyncEvent> FindAudioOnset(const std::string& path, const SyncOptions& o
   if (event.strength < kSyncMinOnsetDb) {
     return Status::Error(Format(
         "%s: no sound event: the strongest onset is %.1f dB over the preceding 50 ms (needs "
-        ">= %.0f dB); peak level %.1f dBFS vs noise floor %.1f dBFS",
+        ">= %.0f dB, peaking >= %.0f dB over the noise floor); peak level %.1f dBFS vs noise "
+        "floor (median) %.1f dBFS",
         path.c_str(),
         event.strength,
         kSyncMinOnsetDb,
+        kSyncMinAboveFloorDb,
         *std::max_element(level_db.begin() + lo, level_db.begin() + hi),
         event.floor));
   }

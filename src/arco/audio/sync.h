@@ -43,6 +43,9 @@ enum class VideoEvent { kClap, kFlash };
 // Decision thresholds, defined once (docs/audio.md, "Sync").
 // An audio onset needs this much energy (dB) over the preceding 50 ms.
 inline constexpr double kSyncMinOnsetDb = 10.0;
+// ... and its peak (over the 50 ms from the onset) this much over the recording's
+// median level: a clap stands out of the room and the music, a bow change does not.
+inline constexpr double kSyncMinAboveFloorDb = 10.0;
 // A video event (a drop of motion energy for a clap, a rise for a flash) needs this
 // many times the frame-to-frame jitter of the motion energy, and at least
 // kSyncMinMotionGrey grey levels.
