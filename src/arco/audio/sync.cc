@@ -78,10 +78,11 @@ double Jitter(const std::vector<double>& v, int64_t lo, int64_t hi) {
 
 // The video event's evidence, for error messages.
 std::string MotionEvidence(const SyncEvent& e) {
-  return Format("motion energy peak %.3f vs background %.3f grey levels, frame-to-frame jitter %.3f",
-                e.level,
-                e.floor,
-                e.noise);
+  return Format(
+      "motion energy peak %.3f vs background %.3f grey levels, frame-to-frame jitter %.3f",
+      e.level,
+      e.floor,
+      e.noise);
 }
 
 // Clap: the end of a burst of motion. drop[k] = min(E[k-1], E[k]) - A(k), A(k) the mean
@@ -107,7 +108,8 @@ std::vector<double> FlashRises(const MotionEnergy& m, int64_t lo, int64_t hi, do
 }  // namespace
 
 Status SyncOptions::Validate() const {
-  if (!(video_fps >= 0 && video_fps <= 1000)) return Status::Error("video_fps must be in [0, 1000]");
+  if (!(video_fps >= 0 && video_fps <= 1000))
+    return Status::Error("video_fps must be in [0, 1000]");
   if (!(search_s > 0 && search_s <= 3600)) return Status::Error("search_s must be in (0, 3600]");
   if (!(max_seconds > 0)) return Status::Error("max_seconds must be positive");
   return Status::Ok();
@@ -155,12 +157,8 @@ StatusOr<SyncEvent> FindAudioOnset(const std::string& path, const SyncOptions& o
     peak_db[k] = *std::max_element(level_db.begin() + k, level_db.begin() + std::min(n, k + 25));
     candidates[k] = peak_db[k] >= floor_db + kSyncMinAboveFloorDb ? strength[k] : 0.0;
   }
-  PeakAndRunnerUp(candidates,
-                  lo,
-                  hi,
-                  static_cast<int64_t>(kSyncSameEventS * frames_per_s),
-                  &best,
-                  &runner_at);
+  PeakAndRunnerUp(
+      candidates, lo, hi, static_cast<int64_t>(kSyncSameEventS * frames_per_s), &best, &runner_at);
   if (best < 0) return Status::Error(path + ": the search window holds no audio");
   SyncEvent event;
   event.strength = candidates[best];
@@ -171,7 +169,8 @@ StatusOr<SyncEvent> FindAudioOnset(const std::string& path, const SyncOptions& o
     event.runner_up_time_s = static_cast<double>(runner_at) / frames_per_s;
   }
   // 1 - the runner-up's amplitude ratio to the winner (an onset below 0 dB is none).
-  event.distinctness = 1.0 - std::pow(10.0, -(event.strength - std::max(0.0, event.runner_up)) / 20.0);
+  event.distinctness =
+      1.0 - std::pow(10.0, -(event.strength - std::max(0.0, event.runner_up)) / 20.0);
   if (event.strength < kSyncMinOnsetDb) {
     return Status::Error(Format(
         "%s: no sound event: the strongest onset is %.1f dB over the preceding 50 ms (needs "
@@ -260,12 +259,8 @@ StatusOr<SyncEvent> FindVideoEventInEnergy(const MotionEnergy& motion,
   const std::vector<double> score =
       clap ? ClapDrops(e, lo, hi) : FlashRises(motion, lo, hi, Quantile(e, lo, hi, 0.25));
   int64_t best, runner_at;
-  PeakAndRunnerUp(score,
-                  lo,
-                  hi,
-                  static_cast<int64_t>(std::ceil(kSyncSameEventS * fps)),
-                  &best,
-                  &runner_at);
+  PeakAndRunnerUp(
+      score, lo, hi, static_cast<int64_t>(std::ceil(kSyncSameEventS * fps)), &best, &runner_at);
   event.strength = score[best];
   if (runner_at >= 0 && score[runner_at] > 0) {
     event.runner_up = score[runner_at];
@@ -372,12 +367,13 @@ StatusOr<SyncResult> SyncAudioToVideos(const std::string& audio_path,
   const double fps = result.views[found[0]].fps;
   for (size_t i : found) {
     if (std::abs(result.views[i].fps - fps) > 1e-6 * fps) {
-      return Status::Error(Format("%s and %s have different frame rates (%.3f and %.3f fps); "
-                                  "sync them separately",
-                                  result.views[found[0]].video.c_str(),
-                                  result.views[i].video.c_str(),
-                                  fps,
-                                  result.views[i].fps));
+      return Status::Error(
+          Format("%s and %s have different frame rates (%.3f and %.3f fps); "
+                 "sync them separately",
+                 result.views[found[0]].video.c_str(),
+                 result.views[i].video.c_str(),
+                 fps,
+                 result.views[i].fps));
     }
   }
   // Consensus: the views within half a frame of the median event.

@@ -74,11 +74,11 @@ struct SyncEvent {
   // Audio: onset strength (dB over the preceding 50 ms). Video: the size of the clap's
   // drop (or the flash's rise) of motion energy, grey levels.
   double strength = 0;
-  double runner_up = 0;             // the strongest candidate more than 0.5 s away
-  double runner_up_time_s = NAN;    // where it is (NaN: none)
-  double level = 0;   // audio: peak level near the event, dBFS; video: peak motion energy
-  double floor = 0;   // audio: median frame level, dBFS; video: background motion energy
-  double noise = 0;   // video: frame-to-frame jitter of the motion energy (grey levels)
+  double runner_up = 0;           // the strongest candidate more than 0.5 s away
+  double runner_up_time_s = NAN;  // where it is (NaN: none)
+  double level = 0;  // audio: peak level near the event, dBFS; video: peak motion energy
+  double floor = 0;  // audio: median frame level, dBFS; video: background motion energy
+  double noise = 0;  // video: frame-to-frame jitter of the motion energy (grey levels)
   // 0..1: how clearly the winner beats the runner-up (audio: 1 - amplitude ratio,
   // video: 1 - strength ratio).
   double distinctness = 0;
@@ -96,7 +96,7 @@ struct SyncView {
 struct SyncViewResult {
   std::string video;
   double fps = 0;
-  SyncEvent event;           // on this video's own clock (valid when error is empty)
+  SyncEvent event;            // on this video's own clock (valid when error is empty)
   double global_frame = NAN;  // the event on the common frame numbering
   bool used = false;          // agrees with the consensus and counts in the offset
   std::string error;          // why this view has no event (it is then left out)
@@ -107,11 +107,11 @@ struct SyncResult {
   // mapping: audio_time = video_time + offset_s).
   double offset_s = 0;
   double video_fps = 0;
-  double confidence = 0;      // 0..1 (docs/audio.md, "Sync")
-  SyncEvent audio, video;     // video: the first view that counts
-  double event_global_frame = 0;       // the consensus of the views' events
-  std::vector<SyncViewResult> views;   // one per video, in order
-  std::vector<std::string> warnings;   // low confidence, views left out
+  double confidence = 0;              // 0..1 (docs/audio.md, "Sync")
+  SyncEvent audio, video;             // video: the first view that counts
+  double event_global_frame = 0;      // the consensus of the views' events
+  std::vector<SyncViewResult> views;  // one per video, in order
+  std::vector<std::string> warnings;  // low confidence, views left out
 };
 
 StatusOr<SyncEvent> FindAudioOnset(const std::string& audio_path, const SyncOptions& options);

@@ -185,9 +185,8 @@ void DrawClapFrame(
       shade[x] = s.hand_grey + s.hand_stripes_grey * std::sin(2.0 * M_PI * u / 5.0);
     }
     for (int y = 0; y < height; ++y) {
-      const double rows = Coverage(s.center_y_px - s.hand_height_px / 2,
-                                   s.center_y_px + s.hand_height_px / 2,
-                                   y);
+      const double rows =
+          Coverage(s.center_y_px - s.hand_height_px / 2, s.center_y_px + s.hand_height_px / 2, y);
       for (int x = 0; x < width; ++x) {
         const double texture = 12.0 * (((x / 6) + (y / 6)) % 2);
         const double background = s.background_grey + texture;

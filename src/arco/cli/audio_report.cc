@@ -72,15 +72,16 @@ std::string FormatSyncReport(const pipeline::SyncRunOptions& o,
       out += "video " + v.video + ": left out\n";
       continue;
     }
-    out += Format("video %s: event at %.4f s = frame %.2f of %.3f fps%s (motion change %.3f; "
-                  "runner-up %.3f",
-                  v.video.c_str(),
-                  v.event.time_s,
-                  v.event.time_s * v.fps,
-                  v.fps,
-                  run.first_frame >= 0 ? Format(", global frame %.2f", v.global_frame).c_str() : "",
-                  v.event.strength,
-                  v.event.runner_up);
+    out += Format(
+        "video %s: event at %.4f s = frame %.2f of %.3f fps%s (motion change %.3f; "
+        "runner-up %.3f",
+        v.video.c_str(),
+        v.event.time_s,
+        v.event.time_s * v.fps,
+        v.fps,
+        run.first_frame >= 0 ? Format(", global frame %.2f", v.global_frame).c_str() : "",
+        v.event.strength,
+        v.event.runner_up);
     if (!std::isnan(v.event.runner_up_time_s)) {
       out += Format(" at %.3f s", v.event.runner_up_time_s);
     }

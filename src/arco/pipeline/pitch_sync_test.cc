@@ -178,8 +178,10 @@ ClapCapture WriteClapCapture(const std::string& name, int64_t first, bool cam1_d
   // cam1 dropped global frames 10 and 20 (1-based global numbering): its video frame
   // index j shows global frame j + 3 from there on, so its clap comes 2 frames early.
   if (cam1_drops) far.contact_s -= 2.0 / 30.0;
-  EXPECT_TRUE(testing::WriteTestVideo(JoinPath(c.dir, "cam0.mkv"), testing::ClapVideo(near, 150)).ok());
-  EXPECT_TRUE(testing::WriteTestVideo(JoinPath(c.dir, "cam1.mkv"), testing::ClapVideo(far, 150)).ok());
+  EXPECT_TRUE(
+      testing::WriteTestVideo(JoinPath(c.dir, "cam0.mkv"), testing::ClapVideo(near, 150)).ok());
+  EXPECT_TRUE(
+      testing::WriteTestVideo(JoinPath(c.dir, "cam1.mkv"), testing::ClapVideo(far, 150)).ok());
   CaptureCamera cam0, cam1;
   cam0.name = "cam0";
   cam0.video = "cam0.mkv";
@@ -193,7 +195,8 @@ ClapCapture WriteClapCapture(const std::string& name, int64_t first, bool cam1_d
   std::normal_distribution<double> gauss(0, 1);
   for (auto& v : audio) v = static_cast<float>(0.002 * gauss(rng));
   const int64_t at = std::llround(5.2 * 44100);
-  for (int i = 0; i < 80; ++i) audio[at + i] += static_cast<float>(0.9 * std::exp(-i / 20.0) * gauss(rng));
+  for (int i = 0; i < 80; ++i)
+    audio[at + i] += static_cast<float>(0.9 * std::exp(-i / 20.0) * gauss(rng));
   c.wav = JoinPath(c.dir, "take.wav");
   EXPECT_TRUE(testing::WriteWav(c.wav, audio, 44100).ok());
   return c;

@@ -22,6 +22,7 @@ struct StoppedNote {
 };
 
 // One position per note, in order (semitones_on_string - the chosen reach).
-std::vector<double> HandPositionsSemitones(InstrumentKind kind, const std::vector<StoppedNote>& notes);
+std::vector<double> HandPositionsSemitones(InstrumentKind kind,
+                                           const std::vector<StoppedNote>& notes);
 
 }  // namespace arco::refine
