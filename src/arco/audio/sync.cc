@@ -164,7 +164,7 @@ StatusOr<SyncEvent> FindAudioOnset(const std::string& path, const SyncOptions& o
   event.strength = candidates[best];
   event.floor = floor_db;
   event.level = peak_db[best];
-  if (runner_at >= 0) {
+  if (runner_at >= 0 && candidates[runner_at] > 0) {
     event.runner_up = candidates[runner_at];
     event.runner_up_time_s = static_cast<double>(runner_at) / frames_per_s;
   }
