@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "arco/audio/audio_reader.h"
 #include "arco/audio/pitch_tracker.h"
 #include "arco/audio/test_media.h"
 #include "arco/audio/test_signals.h"
@@ -128,10 +129,17 @@ TEST(SyncAudioToVideo, RecoversTheOffsetAndTheNearOptionPicksAnEvent) {
   ASSERT_TRUE(sync.ok()) << sync.status().message();
   EXPECT_NEAR(sync->offset_s, click_s - flash_s, 0.001 + 0.1 / 30.0);
   EXPECT_EQ(sync->video.frame, 37);
+  EXPECT_GT(sync->confidence, 0.5);
+  EXPECT_TRUE(sync->warnings.empty());
+  // Without --audio-near-s two clicks of nearly equal strength (the decoy is 1.6 dB
+  // stronger) are ambiguous: an error that names both, not the decoy's offset.
   options.audio_near_s = NAN;
   auto wrong = SyncAudioToVideo(audio_path, video_path, options);
-  ASSERT_TRUE(wrong.ok());
-  EXPECT_NEAR(wrong->audio.time_s, 8.0, 0.001);  // the decoy is the strongest overall
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_NE(wrong.status().message().find("ambiguous sound event"), std::string::npos)
+      << wrong.status().message();
+  EXPECT_NE(wrong.status().message().find("8.000 s"), std::string::npos);
+  EXPECT_NE(wrong.status().message().find("3.100 s"), std::string::npos);
 }
 
 TEST(TrackPitch, ReadsTheAudioTrackOfAVideo) {
@@ -184,6 +192,244 @@ TEST(Sync, BadInputsAreErrors) {
   ASSERT_FALSE(track.ok());
   EXPECT_NE(track.status().message().find("no audio stream"), std::string::npos)
       << track.status().message();
+}
+
+// The clap scenes of issue 11, all meeting at kContactS (3 s) in 5 s of 30 fps video.
+// Tolerance, from first principles: the contact model (sync.h) is exact for hands at
+// constant speed whose motion energy is proportional to their image shift (edges of
+// uniform hands). Texture breaks the proportionality once the shift per frame nears the
+// texture's scale: stripes 5 px apart shifting 2.5 px per frame put relatively more
+// energy into the partly moving frames, which makes the fast clap 0.18 frame late
+// (measured); 8-bit rounding and sensor noise add a few hundredths. So 0.25 frame,
+// inside the half a frame that decides which frame shows the contact. Timing the
+// start of the motion instead (the old behaviour) is 11 frames early for the fast clap
+// and 40 for the slow one.
+constexpr double kContactS = 3.0;
+constexpr double kClapToleranceS = 0.25 / 30.0;
+
+testing::ClapScene ConstantSpeedClap() {
+  testing::ClapScene scene;
+  scene.contact_s = kContactS;
+  scene.speed_px_s = 150;  // hands 54 px apart start moving 0.36 s before contact
+  scene.start_gap_px = 54;
+  scene.hand_stripes_grey = 40;
+  return scene;
+}
+testing::ClapScene SlowClap() {
+  testing::ClapScene scene = ConstantSpeedClap();
+  scene.speed_px_s = 40;  // 1.35 s of motion, 1.3 px per frame
+  return scene;
+}
+// The same clap four times farther from the camera: a quarter of the size and speed.
+testing::ClapScene FarClap() {
+  testing::ClapScene scene = ConstantSpeedClap();
+  scene.hand_width_px = 25.0 / 4;
+  scene.hand_height_px = 40.0 / 4;
+  scene.start_gap_px = 54.0 / 4;
+  scene.speed_px_s = 150.0 / 4;
+  scene.center_x_px = 110;
+  scene.center_y_px = 35;
+  return scene;
+}
+
+double ClapTime(const testing::ClapScene& scene, const std::string& name) {
+  const std::string path = testing::TempPath(name + ".mkv");
+  EXPECT_TRUE(testing::WriteTestVideo(path, testing::ClapVideo(scene, 150)).ok());
+  auto event = FindVideoEvent(path, SyncOptions(), nullptr);
+  EXPECT_TRUE(event.ok()) << name << ": " << event.status().message();
+  return event.ok() ? event->time_s : NAN;
+}
+
+TEST(FindVideoEvent, ClapIsTimedWhenTheHandsMeetNotWhenTheyStartMoving) {
+  // Contact at several phases inside a frame's exposure.
+  for (double shift_frames : {0.0, 0.27, 0.5, 0.81}) {
+    const double contact_s = kContactS + shift_frames / 30.0;
+    auto fast = ConstantSpeedClap(), slow = SlowClap(), far = FarClap();
+    fast.contact_s = slow.contact_s = far.contact_s = contact_s;
+    EXPECT_NEAR(ClapTime(fast, "fast_clap"), contact_s, kClapToleranceS) << shift_frames;
+    EXPECT_NEAR(ClapTime(slow, "slow_clap"), contact_s, kClapToleranceS) << shift_frames;
+    EXPECT_NEAR(ClapTime(far, "far_clap"), contact_s, kClapToleranceS) << shift_frames;
+    auto noisy = fast;
+    noisy.noise_grey = 3;  // sensor noise: the drop still stands far above the jitter
+    EXPECT_NEAR(ClapTime(noisy, "noisy_clap"), contact_s, kClapToleranceS) << shift_frames;
+  }
+}
+
+TEST(FindVideoEvent, StillVideoHasNoEvent) {
+  for (double noise : {0.0, 3.0}) {
+    testing::ClapScene still = ConstantSpeedClap();
+    still.contact_s = 100;  // the hands never move inside the video
+    still.noise_grey = noise;
+    const std::string path = testing::TempPath("still.mkv");
+    ASSERT_TRUE(testing::WriteTestVideo(path, testing::ClapVideo(still, 150)).ok());
+    for (VideoEvent kind : {VideoEvent::kClap, VideoEvent::kFlash}) {
+      SyncOptions options;
+      options.video_event = kind;
+      auto event = FindVideoEvent(path, options, nullptr);
+      ASSERT_FALSE(event.ok()) << noise << ": found an event at " << event->time_s;
+      const std::string& m = event.status().message();
+      EXPECT_NE(m.find(kind == VideoEvent::kClap ? "no clap" : "no flash"), std::string::npos) << m;
+      EXPECT_NE(m.find("motion energy peak"), std::string::npos) << m;
+      EXPECT_NE(m.find("background"), std::string::npos) << m;
+    }
+  }
+}
+
+// Two pairs of hands, one in the top half clapping at top_s, one in the bottom half
+// at bottom_s.
+testing::TestVideo TwoClaps(double top_s, double bottom_s) {
+  testing::ClapScene top = ConstantSpeedClap(), bottom = ConstantSpeedClap();
+  top.contact_s = top_s;
+  top.center_y_px = 30;
+  bottom.contact_s = bottom_s;
+  bottom.center_y_px = 90;
+  testing::TestVideo video;
+  video.frames = 180;
+  video.draw = [=](int k, std::vector<double>* grey) {
+    std::vector<double> lower;
+    testing::DrawClapFrame(top, 30, k, 160, 120, grey);
+    testing::DrawClapFrame(bottom, 30, k, 160, 120, &lower);
+    std::copy(lower.begin() + 60 * 160, lower.end(), grey->begin() + 60 * 160);
+  };
+  return video;
+}
+
+TEST(FindVideoEvent, TwoEqualClapsAreAmbiguousUnlessAWindowSeparatesThem) {
+  const std::string path = testing::TempPath("two_claps.mkv");
+  ASSERT_TRUE(testing::WriteTestVideo(path, TwoClaps(2.0, 4.0)).ok());
+  auto event = FindVideoEvent(path, SyncOptions(), nullptr);
+  ASSERT_FALSE(event.ok()) << "found " << event->time_s;
+  const std::string& m = event.status().message();
+  EXPECT_NE(m.find("ambiguous clap"), std::string::npos) << m;
+  EXPECT_NE(m.find("video_near_s"), std::string::npos) << m;
+  SyncOptions near;
+  near.video_near_s = 4.0;
+  near.search_s = 1.0;
+  auto second = FindVideoEvent(path, near, nullptr);
+  ASSERT_TRUE(second.ok()) << second.status().message();
+  EXPECT_NEAR(second->time_s, 4.0, kClapToleranceS);
+}
+
+TEST(SyncAudioToVideo, SilenceAndAStillVideoIsAnErrorWithTheEvidence) {
+  const std::string wav = testing::TempPath("silence.wav");
+  ASSERT_TRUE(testing::WriteWav(wav, std::vector<float>(5 * 48000, 0.0f), 48000).ok());
+  testing::ClapScene still = ConstantSpeedClap();
+  still.contact_s = 100;
+  const std::string mkv = testing::TempPath("still_take.mkv");
+  ASSERT_TRUE(testing::WriteTestVideo(mkv, testing::ClapVideo(still, 150)).ok());
+  auto sync = SyncAudioToVideo(wav, mkv, SyncOptions());
+  ASSERT_FALSE(sync.ok()) << "offset " << sync->offset_s;
+  const std::string& m = sync.status().message();
+  EXPECT_NE(m.find("no sound event"), std::string::npos) << m;
+  EXPECT_NE(m.find("dBFS vs noise floor"), std::string::npos) << m;
+  // With a click the audio is fine, and the still video is the error.
+  const std::string click = testing::TempPath("click_take.wav");
+  ASSERT_TRUE(testing::WriteWav(click, ClickTrack(5.0, 2.0, 48000), 48000).ok());
+  auto still_video = SyncAudioToVideo(click, mkv, SyncOptions());
+  ASSERT_FALSE(still_video.ok());
+  EXPECT_NE(still_video.status().message().find("no clap"), std::string::npos);
+}
+
+TEST(SyncAudioToVideos, SeveralCamerasAgreeOnOneOffset) {
+  // The recorder started 2.2 s before the cameras: the clap sounds at 5.2 s.
+  const std::string wav = testing::TempPath("rig.wav");
+  ASSERT_TRUE(testing::WriteWav(wav, ClickTrack(9.0, kContactS + 2.2, 48000), 48000).ok());
+  std::vector<SyncView> views;
+  int i = 0;
+  for (const testing::ClapScene& scene : {ConstantSpeedClap(), FarClap(), SlowClap()}) {
+    testing::ClapScene noisy = scene;
+    noisy.noise_grey = 2;
+    noisy.seed = 10 + i;
+    const std::string path = testing::TempPath("rig" + std::to_string(i++) + ".mkv");
+    ASSERT_TRUE(testing::WriteTestVideo(path, testing::ClapVideo(noisy, 150)).ok());
+    views.push_back({path, nullptr});
+  }
+  // A fourth camera sees nothing: left out with a warning.
+  testing::ClapScene away = ConstantSpeedClap();
+  away.contact_s = 100;
+  const std::string blind = testing::TempPath("rig_blind.mkv");
+  ASSERT_TRUE(testing::WriteTestVideo(blind, testing::ClapVideo(away, 150)).ok());
+  views.push_back({blind, nullptr});
+  auto sync = SyncAudioToVideos(wav, views, SyncOptions());
+  ASSERT_TRUE(sync.ok()) << sync.status().message();
+  ASSERT_EQ(sync->views.size(), 4u);
+  for (int v = 0; v < 3; ++v) {
+    EXPECT_TRUE(sync->views[v].used) << v;
+    EXPECT_NEAR(sync->views[v].event.time_s, kContactS, kClapToleranceS) << v;
+  }
+  EXPECT_FALSE(sync->views[3].used);
+  EXPECT_NE(sync->views[3].error.find("no clap"), std::string::npos);
+  ASSERT_EQ(sync->warnings.size(), 1u);
+  EXPECT_NE(sync->warnings[0].find("rig_blind.mkv"), std::string::npos);
+  // The click is timed within a millisecond, the mean of three views within the tolerance.
+  EXPECT_NEAR(sync->offset_s, 2.2, 0.001 + kClapToleranceS);
+  EXPECT_GT(sync->confidence, 0.9);
+  // A camera whose frames are numbered 10 frames later (its mapping) disagrees by
+  // 10 frames: two views that disagree are an error.
+  views.resize(2);
+  views[1].global_frame = [](double frame) { return frame + 10; };
+  auto disagree = SyncAudioToVideos(wav, views, SyncOptions());
+  ASSERT_FALSE(disagree.ok());
+  EXPECT_NE(disagree.status().message().find("disagree"), std::string::npos)
+      << disagree.status().message();
+}
+
+TEST(SyncAudioToVideo, ConfidenceFallsAndWarnsWithAComparableSecondOnset) {
+  testing::ClapScene scene = ConstantSpeedClap();
+  const std::string mkv = testing::TempPath("conf.mkv");
+  ASSERT_TRUE(testing::WriteTestVideo(mkv, testing::ClapVideo(scene, 150)).ok());
+  auto audio = ClickTrack(9.0, 4.0, 48000);
+  const std::string clean = testing::TempPath("conf_clean.wav");
+  ASSERT_TRUE(testing::WriteWav(clean, audio, 48000).ok());
+  auto sure = SyncAudioToVideo(clean, mkv, SyncOptions());
+  ASSERT_TRUE(sure.ok()) << sure.status().message();
+  EXPECT_GT(sure->confidence, 0.9);
+  EXPECT_TRUE(sure->warnings.empty());
+  // A second click at 0.35 of the amplitude (its onset measures about 5 dB below the
+  // first's): the audio's distinctness falls below 0.5, and the offset comes with a
+  // warning.
+  const auto second = ClickTrack(9.0, 7.0, 48000);
+  for (size_t i = 0; i < audio.size(); ++i) audio[i] += 0.35f * second[i];
+  const std::string doubled = testing::TempPath("conf_two.wav");
+  ASSERT_TRUE(testing::WriteWav(doubled, audio, 48000).ok());
+  auto unsure = SyncAudioToVideo(doubled, mkv, SyncOptions());
+  ASSERT_TRUE(unsure.ok()) << unsure.status().message();
+  EXPECT_NEAR(unsure->offset_s, 1.0, 0.001 + kClapToleranceS);
+  EXPECT_LT(unsure->confidence, kSyncLowConfidence);
+  ASSERT_FALSE(unsure->warnings.empty());
+  EXPECT_NE(unsure->warnings[0].find("low confidence"), std::string::npos);
+}
+
+// The SPD cello recordings (../shared/data/spd) hold music and no clap: no event,
+// not a bow change taken for one. The same music with a clap added (20 ms of broadband
+// noise decaying with 3 ms, 0.9 of full scale: a clap near the recorder, 9.5 s in,
+// while the cello plays) gives the clap.
+TEST(FindAudioOnset, RealCelloRecordingsHaveNoClapUntilOneIsAdded) {
+  for (const char* name : {"background.wav", "pgy.wav"}) {
+    const std::string path = std::string(ARCO_SHARED_DATA_DIR) + "/spd/" + name;
+    auto none = FindAudioOnset(path, SyncOptions());
+    ASSERT_FALSE(none.ok()) << name << ": an event at " << none->time_s;
+    EXPECT_NE(none.status().message().find("no sound event"), std::string::npos)
+        << none.status().message();
+    auto reader = OpenAudio(path);
+    ASSERT_TRUE(reader.ok());
+    const int rate = (*reader)->info().sample_rate_hz;
+    std::vector<float> music(static_cast<size_t>(30 * rate));
+    auto got = (*reader)->ReadMono(music.data(), static_cast<int64_t>(music.size()));
+    ASSERT_TRUE(got.ok());
+    music.resize(static_cast<size_t>(*got));
+    std::mt19937 rng(9);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    const int64_t at = std::llround(9.5 * rate);
+    for (int i = 0; i < rate / 50; ++i) {  // 20 ms of noise decaying with 3 ms
+      music[at + i] += static_cast<float>(0.9 * std::exp(-i / (0.003 * rate)) * gauss(rng));
+    }
+    const std::string with_clap = testing::TempPath(std::string("clap_") + name);
+    ASSERT_TRUE(testing::WriteWav(with_clap, music, rate).ok());
+    auto found = FindAudioOnset(with_clap, SyncOptions());
+    ASSERT_TRUE(found.ok()) << name << ": " << found.status().message();
+    EXPECT_NEAR(found->time_s, 9.5, 0.001) << name;
+  }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The terminal text of `arco pitch` and `arco sync` (the work is pipeline/pitch_sync.h).
 #include "arco/cli/audio_report.h"
 
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 
@@ -13,7 +14,7 @@ namespace {
 
 std::string Format(const char* format, ...) __attribute__((format(printf, 1, 2)));
 std::string Format(const char* format, ...) {
-  char buffer[512];
+  char buffer[1024];
   va_list args;
   va_start(args, format);
   std::vsnprintf(buffer, sizeof(buffer), format, args);
@@ -55,27 +56,54 @@ std::string FormatPitchReport(const pipeline::PitchRunOptions& o,
   return out;
 }
 
-std::string FormatSyncReport(const pipeline::SyncRunOptions& o, const audio::SyncResult& r) {
+std::string FormatSyncReport(const pipeline::SyncRunOptions& o,
+                             const pipeline::SyncRunResult& run) {
+  const audio::SyncResult& r = run.sync;
   std::string out;
-  out += Format("audio %s: onset at %.4f s (%.1f dB; next strongest %.1f dB)\n",
+  out += Format("audio %s: onset at %.4f s (%.1f dB over the preceding 50 ms; runner-up %.1f dB",
                 o.audio.c_str(),
                 r.audio.time_s,
                 r.audio.strength,
                 r.audio.runner_up);
-  out += Format("video %s: event at %.4f s = frame %.2f of %.3f fps (motion %.1f; next %.1f)\n",
-                o.video.c_str(),
-                r.video.time_s,
-                r.video.time_s * r.video_fps,
-                r.video_fps,
-                r.video.strength,
-                r.video.runner_up);
-  out +=
-      Format("offset_s %.4f  (audio time = video time + offset; use arco pitch --offset-s %.4f)\n",
-             r.offset_s,
-             r.offset_s);
+  if (!std::isnan(r.audio.runner_up_time_s)) out += Format(" at %.3f s", r.audio.runner_up_time_s);
+  out += Format("; peak %.1f dBFS, floor %.1f dBFS)\n", r.audio.level, r.audio.floor);
+  for (const audio::SyncViewResult& v : r.views) {
+    if (!v.error.empty()) {
+      out += "video " + v.video + ": left out\n";
+      continue;
+    }
+    out += Format(
+        "video %s: event at %.4f s = frame %.2f of %.3f fps%s (motion change %.3f; "
+        "runner-up %.3f",
+        v.video.c_str(),
+        v.event.time_s,
+        v.event.time_s * v.fps,
+        v.fps,
+        run.first_frame >= 0 ? Format(", global frame %.2f", v.global_frame).c_str() : "",
+        v.event.strength,
+        v.event.runner_up);
+    if (!std::isnan(v.event.runner_up_time_s)) {
+      out += Format(" at %.3f s", v.event.runner_up_time_s);
+    }
+    out += Format("; jitter %.3f)%s\n", v.event.noise, v.used ? "" : " disagrees: left out");
+  }
+  if (run.first_frame >= 0) {
+    out += Format("offset_s %.4f  (audio time of frame %lld, frames.first; confidence %.2f)\n",
+                  run.offset_s,
+                  static_cast<long long>(run.first_frame),
+                  r.confidence);
+  } else {
+    out += Format(
+        "offset_s %.4f  (audio time = video time + offset; use arco pitch --offset-s %.4f; "
+        "confidence %.2f)\n",
+        run.offset_s,
+        run.offset_s,
+        r.confidence);
+  }
   for (const auto& w : r.warnings) out += "warning: " + WithFlagNames(w, kSyncFlags) + "\n";
-  if (!o.capture_dir.empty()) {
-    out += "wrote audio.offset_s to " + JoinPath(o.capture_dir, kCaptureManifestName) + "\n";
+  if (run.wrote_capture) {
+    out += "wrote audio.offset_s and audio.sync_confidence to " +
+           JoinPath(o.capture_dir, kCaptureManifestName) + "\n";
   }
   return out;
 }

@@ -11,6 +11,6 @@ namespace arco::cli {
 std::string FormatPitchReport(const pipeline::PitchRunOptions& options,
                               const pipeline::PitchRunResult& result);
 std::string FormatSyncReport(const pipeline::SyncRunOptions& options,
-                             const audio::SyncResult& result);
+                             const pipeline::SyncRunResult& result);
 
 }  // namespace arco::cli

@@ -15,7 +15,11 @@ std::function<int()> SetupSync(CLI::App& app) {
       "sync", "Find a clap/flash in audio and video; print offset_s (audio = video + offset)");
   cmd->add_option("audio", o->audio, "Audio recording (or a video whose audio track to use)")
       ->required();
-  cmd->add_option("--video", o->video, "Video of one camera showing the event")->required();
+  cmd->add_option("--video",
+                  o->videos,
+                  "Video of a camera showing the event; repeat for several synchronised "
+                  "cameras (their events must agree; default with --capture: every camera's "
+                  "video)");
   cmd->add_option("--fps", o->sync.video_fps, "Video frame rate (Hz; default: the stream's)");
   cmd->add_option("--audio-near-s",
                   o->sync.audio_near_s,
@@ -35,7 +39,8 @@ std::function<int()> SetupSync(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--capture",
                   o->capture_dir,
-                  "Capture folder: store the offset as audio.offset_s in its capture.json");
+                  "Capture folder: store the offset (audio time of frames.first) and its "
+                  "confidence as audio.offset_s / audio.sync_confidence in its capture.json");
   return [o, event] {
     o->sync.video_event = *event == "flash" ? audio::VideoEvent::kFlash : audio::VideoEvent::kClap;
     auto result = pipeline::RunSync(*o);

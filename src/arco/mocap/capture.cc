@@ -155,6 +155,11 @@ StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const st
     Fields fa(*audio, source + ": audio");
     ARCO_RETURN_IF_ERROR(fa.String("file", true, &m.audio));
     ARCO_RETURN_IF_ERROR(fa.Number("offset_s", false, &m.audio_offset_s));
+    ARCO_RETURN_IF_ERROR(fa.Number("sync_confidence", false, &m.audio_sync_confidence));
+    if (!std::isnan(m.audio_sync_confidence) &&
+        !(m.audio_sync_confidence >= 0 && m.audio_sync_confidence <= 1)) {
+      return fa.Bad("sync_confidence", "must be in [0, 1]");
+    }
   }
   if (const Json* k = f.Find("keypoints2d"); k && !k->is_null()) {
     if (!k->is_object()) return f.Bad("keypoints2d", "must be an object {\"file\", \"layout\"}");
@@ -204,7 +209,12 @@ Json CaptureManifestToJson(const CaptureManifest& m) {
   j["frames"] = {{"first", m.frame_first}, {"count", m.frame_count}};
   j["tuning_a4_hz"] = m.tuning_a4_hz;
   j["calibration"] = m.calibration;
-  if (!m.audio.empty()) j["audio"] = {{"file", m.audio}, {"offset_s", m.audio_offset_s}};
+  if (!m.audio.empty()) {
+    j["audio"] = {{"file", m.audio}, {"offset_s", m.audio_offset_s}};
+    if (std::isfinite(m.audio_sync_confidence)) {
+      j["audio"]["sync_confidence"] = m.audio_sync_confidence;
+    }
+  }
   if (!m.keypoints2d.empty()) {
     j["keypoints2d"] = {{"file", m.keypoints2d}, {"layout", m.layout}};
     if (m.layout == "custom") j["keypoints2d"]["names"] = m.keypoint_names;

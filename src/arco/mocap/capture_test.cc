@@ -57,6 +57,13 @@ TEST(CaptureManifest, WriteThenReadRoundTrips) {
   EXPECT_EQ(r->FindCamera("21334237"), 1);
   EXPECT_EQ(r->FindCamera("cam0"), 0);
   EXPECT_EQ(r->FindCamera("cam9"), -1);
+  EXPECT_TRUE(std::isnan(r->audio_sync_confidence));  // not written unless arco sync set it
+  CaptureManifest synced = m;
+  synced.audio_sync_confidence = 0.87;
+  ASSERT_TRUE(WriteCaptureManifest(dir.path(), synced).ok());
+  auto s = ReadCaptureManifest(dir.path());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  EXPECT_EQ(s->audio_sync_confidence, 0.87);
 }
 
 TEST(CaptureManifest, VideoFrameNumbersSkipDroppedFrames) {
@@ -95,6 +102,7 @@ TEST(CaptureManifest, MalformedManifestsNameTheFileAndProblem) {
   expect_error(parse_with([](Json& j) { j["keypoints2d"]["layout"] = "custom"; }),
                "keypoint_names");
   expect_error(parse_with([](Json& j) { j.erase("calibration"); }), "calibration");
+  expect_error(parse_with([](Json& j) { j["audio"]["sync_confidence"] = 1.5; }), "sync_confidence");
   expect_error(ParseCaptureManifest("{\"format\": ", "cap/capture.json"), "malformed JSON");
   expect_error(
       ParseCaptureManifest("{\"format\": \"arco-capture\", \"fps\": NaN}", "cap/capture.json"), "");

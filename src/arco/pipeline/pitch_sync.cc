@@ -1,5 +1,7 @@
 #include "arco/pipeline/pitch_sync.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <utility>
@@ -84,26 +86,76 @@ StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, Progress& progress) 
   return result;
 }
 
-StatusOr<audio::SyncResult> RunSync(const SyncRunOptions& o) {
+StatusOr<SyncRunResult> RunSync(const SyncRunOptions& o) {
   ARCO_RETURN_IF_ERROR(o.sync.Validate());
+  SyncRunResult out;
   CaptureManifest manifest;
+  audio::SyncOptions sync = o.sync;
+  std::vector<audio::SyncView> views;
+  for (const std::string& video : o.videos) views.push_back({video, nullptr});
   if (!o.capture_dir.empty()) {
     ARCO_ASSIGN_OR_RETURN(manifest, ReadCaptureManifest(o.capture_dir));
+    if (sync.video_fps <= 0) sync.video_fps = manifest.fps;
+    out.first_frame = manifest.frame_first;
+    // A camera's video frame index x (0-based) is its video frame x + 1, global frame
+    // g = x + 1 + its drops up to g (docs/formats.md, "Dropped frames").
+    auto camera_of = [&](const std::string& video) -> int {
+      std::error_code ec;
+      const auto target = std::filesystem::weakly_canonical(video, ec);
+      for (size_t c = 0; c < manifest.cameras.size(); ++c) {
+        if (manifest.cameras[c].video.empty()) continue;
+        std::error_code ec2;
+        const auto path = std::filesystem::weakly_canonical(
+            ResolveCapturePath(o.capture_dir, manifest.cameras[c].video), ec2);
+        if (!ec && !ec2 && path == target) return static_cast<int>(c);
+      }
+      return -1;
+    };
+    if (views.empty()) {
+      for (const CaptureCamera& camera : manifest.cameras) {
+        if (!camera.video.empty()) {
+          views.push_back({ResolveCapturePath(o.capture_dir, camera.video), nullptr});
+        }
+      }
+      if (views.empty()) {
+        return Status::Error(JoinPath(o.capture_dir, kCaptureManifestName) +
+                             ": no camera names a video; give one or more videos");
+      }
+    }
+    for (audio::SyncView& view : views) {
+      const int c = camera_of(view.video);
+      std::vector<int64_t> drops;
+      if (c >= 0) drops = manifest.cameras[static_cast<size_t>(c)].dropped_frames;
+      std::sort(drops.begin(), drops.end());
+      view.global_frame = [drops](double x) {
+        const double whole = std::floor(x);
+        double g = whole + 1;
+        for (int64_t d : drops) {
+          if (static_cast<double>(d) <= g) g += 1;
+        }
+        return g + (x - whole);
+      };
+    }
   }
-  audio::SyncOptions sync = o.sync;
-  if (!o.capture_dir.empty() && sync.video_fps <= 0) sync.video_fps = manifest.fps;
-  ARCO_ASSIGN_OR_RETURN(audio::SyncResult result, audio::SyncAudioToVideo(o.audio, o.video, sync));
+  if (views.empty()) return Status::Error("no video to sync with: give one or a capture");
+  ARCO_ASSIGN_OR_RETURN(out.sync, audio::SyncAudioToVideos(o.audio, views, sync));
+  out.offset_s = out.sync.offset_s;
   if (!o.capture_dir.empty()) {
-    // The manifest's offset is the audio time of its first frame, video frame 0.
-    manifest.audio_offset_s = result.offset_s;
+    // sync.offset_s is the audio time of global frame 0; the manifest's offset is that
+    // of frame frames.first.
+    out.offset_s =
+        out.sync.offset_s + static_cast<double>(manifest.frame_first) / out.sync.video_fps;
+    manifest.audio_offset_s = out.offset_s;
+    manifest.audio_sync_confidence = out.sync.confidence;
     if (manifest.audio.empty()) {
       manifest.audio = std::filesystem::relative(std::filesystem::absolute(o.audio),
                                                  std::filesystem::absolute(o.capture_dir))
                            .string();
     }
     ARCO_RETURN_IF_ERROR(WriteCaptureManifest(o.capture_dir, manifest));
+    out.wrote_capture = true;
   }
-  return result;
+  return out;
 }
 
 }  // namespace arco::pipeline

@@ -45,13 +45,27 @@ StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& options,
 
 struct SyncRunOptions {
   std::string audio;
-  std::string video;
+  // Videos of synchronised cameras (their frame i shows the same instant); empty with
+  // capture_dir: every camera of the capture that names a video.
+  std::vector<std::string> videos;
   std::string capture_dir;  // optional: store the offset as the manifest's audio offset_s
   audio::SyncOptions sync;
 };
 
-// Finds the event in both files; with capture_dir, writes audio.file (when empty)
-// and audio.offset_s into CAPTURE_DIR/capture.json.
-StatusOr<audio::SyncResult> RunSync(const SyncRunOptions& options);
+struct SyncRunResult {
+  audio::SyncResult sync;
+  // The figure to use: with capture_dir the audio time of global frame frames.first
+  // (what capture.json's audio.offset_s means and `arco run` / `arco pitch --capture`
+  // read), else the audio time of the videos' frame 0 (`arco pitch --start-s`).
+  double offset_s = 0;
+  int64_t first_frame = -1;  // with capture_dir: its frames.first
+  bool wrote_capture = false;
+};
+
+// Finds the event in the audio and every video; with capture_dir, maps each camera's
+// video frames to global frames (skipping its dropped frames), writes audio.file (when
+// empty), audio.offset_s and audio.sync_confidence into CAPTURE_DIR/capture.json.
+// Nothing is written on an error.
+StatusOr<SyncRunResult> RunSync(const SyncRunOptions& options);
 
 }  // namespace arco::pipeline

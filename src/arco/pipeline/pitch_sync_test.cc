@@ -123,7 +123,7 @@ TEST(RunSyncThenPitch, OffsetGoesThroughTheCaptureManifest) {
   ASSERT_TRUE(testing::WriteWav(wav, audio, 44100).ok());
   SyncRunOptions s;
   s.audio = wav;
-  s.video = JoinPath(dir, "cam0.mkv");
+  s.videos = {JoinPath(dir, "cam0.mkv")};
   s.capture_dir = dir;
   s.sync.video_event = audio::VideoEvent::kFlash;  // a light switching on
   auto sync = RunSync(s);
@@ -133,6 +133,8 @@ TEST(RunSyncThenPitch, OffsetGoesThroughTheCaptureManifest) {
   auto stored = ReadCaptureManifest(dir);
   ASSERT_TRUE(stored.ok());
   EXPECT_DOUBLE_EQ(stored->audio_offset_s, sync->offset_s);
+  EXPECT_DOUBLE_EQ(stored->audio_sync_confidence, sync->sync.confidence);
+  EXPECT_GT(sync->sync.confidence, 0.9);
   EXPECT_EQ(stored->audio, "take.wav");
   PitchRunOptions p;
   p.capture_dir = dir;
@@ -148,6 +150,114 @@ TEST(RunSyncThenPitch, OffsetGoesThroughTheCaptureManifest) {
   EXPECT_NEAR((*rows)[30].time_s, sync->offset_s + 1.0, 1e-6);
   EXPECT_TRUE((*rows)[30].voiced);
   EXPECT_NEAR((*rows)[30].f0_hz, 98.0, 0.2);
+}
+
+// A capture of two cameras filmed a clap (hands meet at 3 s of video time); the
+// recorder started 2.2 s earlier, so the clap sounds at 5.2 s of audio.
+struct ClapCapture {
+  std::string dir, wav;
+};
+ClapCapture WriteClapCapture(const std::string& name, int64_t first, bool cam1_drops) {
+  ClapCapture c;
+  c.dir = testing::TempPath(name);
+  EXPECT_TRUE(MakeDirectories(c.dir).ok());
+  CaptureManifest manifest;
+  manifest.fps = 30;
+  manifest.frame_first = first;
+  manifest.frame_count = 100;
+  manifest.calibration = "calibration.json";
+  testing::ClapScene near;
+  near.hand_stripes_grey = 40;
+  testing::ClapScene far = near;  // smaller, noisier, elsewhere in the image
+  far.hand_width_px = 8;
+  far.hand_height_px = 12;
+  far.start_gap_px = 18;
+  far.speed_px_s = 50;
+  far.center_x_px = 40;
+  far.noise_grey = 2;
+  // cam1 dropped global frames 10 and 20 (1-based global numbering): its video frame
+  // index j shows global frame j + 3 from there on, so its clap comes 2 frames early.
+  if (cam1_drops) far.contact_s -= 2.0 / 30.0;
+  EXPECT_TRUE(
+      testing::WriteTestVideo(JoinPath(c.dir, "cam0.mkv"), testing::ClapVideo(near, 150)).ok());
+  EXPECT_TRUE(
+      testing::WriteTestVideo(JoinPath(c.dir, "cam1.mkv"), testing::ClapVideo(far, 150)).ok());
+  CaptureCamera cam0, cam1;
+  cam0.name = "cam0";
+  cam0.video = "cam0.mkv";
+  cam1.name = "cam1";
+  cam1.video = "cam1.mkv";
+  if (cam1_drops) cam1.dropped_frames = {20, 10};
+  manifest.cameras = {cam0, cam1};
+  EXPECT_TRUE(WriteCaptureManifest(c.dir, manifest).ok());
+  std::vector<float> audio(static_cast<size_t>(8 * 44100));
+  std::mt19937 rng(3);
+  std::normal_distribution<double> gauss(0, 1);
+  for (auto& v : audio) v = static_cast<float>(0.002 * gauss(rng));
+  const int64_t at = std::llround(5.2 * 44100);
+  for (int i = 0; i < 80; ++i)
+    audio[at + i] += static_cast<float>(0.9 * std::exp(-i / 20.0) * gauss(rng));
+  c.wav = JoinPath(c.dir, "take.wav");
+  EXPECT_TRUE(testing::WriteWav(c.wav, audio, 44100).ok());
+  return c;
+}
+
+TEST(RunSync, CaptureOffsetIsTheAudioTimeOfItsFirstFrame) {
+  // Video frame index 90 (3 s) is global frame 91: audio time 5.2 s. Global frame
+  // `first` is at 5.2 - (91 - first) / 30, for every numbering of the arrays.
+  for (int64_t first : {0, 1, 128}) {
+    const ClapCapture c = WriteClapCapture("clap_capture_" + std::to_string(first), first, false);
+    SyncRunOptions s;
+    s.audio = c.wav;
+    s.capture_dir = c.dir;  // no --video: both cameras' videos
+    auto sync = RunSync(s);
+    ASSERT_TRUE(sync.ok()) << sync.status().message();
+    const double expected = 5.2 - static_cast<double>(91 - first) / 30.0;
+    EXPECT_NEAR(sync->offset_s, expected, 0.001 + 0.25 / 30.0) << first;
+    EXPECT_EQ(sync->first_frame, first);
+    ASSERT_EQ(sync->sync.views.size(), 2u);
+    EXPECT_TRUE(sync->sync.views[0].used && sync->sync.views[1].used);
+    auto stored = ReadCaptureManifest(c.dir);
+    ASSERT_TRUE(stored.ok());
+    EXPECT_DOUBLE_EQ(stored->audio_offset_s, sync->offset_s) << first;
+    // What `arco pitch --capture` and `arco run` read: row i (global frame first + i)
+    // at offset + i / fps, so the clap's global frame 91 sits at 5.2 s.
+    EXPECT_NEAR(stored->audio_offset_s + static_cast<double>(91 - first) / stored->fps,
+                5.2,
+                0.001 + 0.25 / 30.0);
+  }
+}
+
+TEST(RunSync, CamerasAgreeOnceTheirDroppedFramesAreCounted) {
+  const ClapCapture c = WriteClapCapture("clap_capture_drops", 1, true);
+  SyncRunOptions s;
+  s.audio = c.wav;
+  s.capture_dir = c.dir;
+  auto sync = RunSync(s);
+  ASSERT_TRUE(sync.ok()) << sync.status().message();
+  ASSERT_EQ(sync->sync.views.size(), 2u);
+  EXPECT_NEAR(sync->sync.views[1].event.time_s, 3.0 - 2.0 / 30.0, 0.25 / 30.0);
+  EXPECT_NEAR(sync->sync.views[0].global_frame, sync->sync.views[1].global_frame, 0.5);
+  EXPECT_NEAR(sync->offset_s, 5.2 - 90.0 / 30.0, 0.001 + 0.25 / 30.0);
+  // Named on the command line, the camera's video still gets its dropped frames.
+  s.videos = {JoinPath(c.dir, "cam1.mkv")};
+  auto one = RunSync(s);
+  ASSERT_TRUE(one.ok()) << one.status().message();
+  EXPECT_NEAR(one->offset_s, sync->offset_s, 0.5 / 30.0);
+}
+
+TEST(RunSync, NoEventWritesNothing) {
+  const ClapCapture c = WriteClapCapture("clap_capture_silent", 1, false);
+  ASSERT_TRUE(testing::WriteWav(c.wav, std::vector<float>(4 * 44100, 0.0f), 44100).ok());
+  const auto before = ReadFileToString(JoinPath(c.dir, kCaptureManifestName));
+  ASSERT_TRUE(before.ok());
+  SyncRunOptions s;
+  s.audio = c.wav;
+  s.capture_dir = c.dir;
+  auto sync = RunSync(s);
+  ASSERT_FALSE(sync.ok());
+  EXPECT_NE(sync.status().message().find("no sound event"), std::string::npos);
+  EXPECT_EQ(*ReadFileToString(JoinPath(c.dir, kCaptureManifestName)), *before);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <map>
 
 #include "arco/refine/arco_decode.h"
+#include "arco/refine/hand_position.h"
 #include "arco/util/stats.h"
 
 namespace arco::refine {
@@ -66,8 +67,8 @@ std::vector<NoteFingering> Transcribe(const InstrumentModel& model,
       if (!from_nut.empty()) {
         row.from_nut_mm = UpperMedian(from_nut);  // one of the measured positions
       }
-      const double semitones = CentsBetween(model.open_hz(row.string), note.f0_hz) / 100.0;
-      row.position_semitones = semitones - FingerOffsetSemitones(model.kind(), row.finger);
+      // The hand position, set below from the whole sequence (hand_position.h).
+      row.position_semitones = CentsBetween(model.open_hz(row.string), note.f0_hz) / 100.0;
     } else if (row.open_frames > 0 && row.open_frames >= row.uncertain_frames) {
       row.state = "open";
       int best = -1;
@@ -81,6 +82,19 @@ std::vector<NoteFingering> Transcribe(const InstrumentModel& model,
       row.state = "uncertain";
     }
     out.push_back(row);
+  }
+  // Stopped notes: position_semitones holds the pitch above the open string until here;
+  // the hand positions are decoded over the whole sequence (hand_position.h).
+  std::vector<StoppedNote> stopped;
+  std::vector<size_t> stopped_rows;
+  for (size_t i = 0; i < out.size(); ++i) {
+    if (out[i].state != "pressed") continue;
+    stopped.push_back({out[i].position_semitones, out[i].finger});
+    stopped_rows.push_back(i);
+  }
+  const std::vector<double> positions = HandPositionsSemitones(model.kind(), stopped);
+  for (size_t k = 0; k < stopped_rows.size(); ++k) {
+    out[stopped_rows[k]].position_semitones = positions[k];
   }
   return out;
 }

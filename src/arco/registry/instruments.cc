@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <functional>
 #include <stdexcept>
 
 namespace arco {
@@ -110,6 +111,23 @@ double FingerOffsetSemitones(InstrumentKind kind, int finger) {
     if (offset >= 0) return offset;
   }
   throw std::logic_error("instrument hand frame without a fourth finger");
+}
+
+std::vector<FingerSpan> FingerReaches(InstrumentKind kind, int finger) {
+  const int k = std::clamp(finger, 0, 4);
+  const int largest = static_cast<int>(FingerOffsetSemitones(kind, finger));
+  std::vector<FingerSpan> closed{{k, largest, false}}, extended;
+  for (const FingerSpan& span : GetInstrumentInfo(kind).hand_frame) {
+    if (span.finger != k || span.offset_semitones == largest) continue;
+    (span.extended ? extended : closed).push_back(span);
+  }
+  auto larger = [](const FingerSpan& a, const FingerSpan& b) {
+    return a.offset_semitones > b.offset_semitones;
+  };
+  std::sort(closed.begin() + 1, closed.end(), larger);
+  std::sort(extended.begin(), extended.end(), larger);
+  closed.insert(closed.end(), extended.begin(), extended.end());
+  return closed;
 }
 
 }  // namespace arco

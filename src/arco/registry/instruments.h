@@ -70,5 +70,10 @@ const char* InstrumentKindName(InstrumentKind kind);
 // higher one (double bass finger 3 with finger 4: 0/1/2/2). Finger 0 (open) is 0; fingers
 // outside 0..4 are clamped.
 double FingerOffsetSemitones(InstrumentKind kind, int finger);
+// Every offset from finger 1's stop that finger `finger` reaches: first
+// FingerOffsetSemitones, then the other closed-frame reaches, largest first (violin and
+// viola finger 2: 2, 1; finger 3: 4, 3), then the extended ones (cello extension, the
+// violin's stretched 4th). Finger 0 (open): one reach of 0.
+std::vector<FingerSpan> FingerReaches(InstrumentKind kind, int finger);
 
 }  // namespace arco
