@@ -27,6 +27,11 @@ namespace arco {
 inline constexpr char kCaptureManifestName[] = "capture.json";
 inline constexpr char kResultManifestName[] = "result.json";
 
+// capture.json's ranges (ParseCaptureManifest).
+inline constexpr double kMaxCaptureFps = 10000;
+inline constexpr int64_t kMaxCaptureFrames = 100000000;            // frames.count
+inline constexpr int64_t kMaxCaptureFrameNumber = int64_t{1} << 40;  // frames.first
+
 struct CaptureCamera {
   std::string name;                     // matches a calibration camera's name or serial
   std::string serial;                   // optional
@@ -70,8 +75,13 @@ Status WriteCaptureManifest(const std::string& capture_dir, const CaptureManifes
 // Path of a manifest entry: relative entries are resolved against `dir`.
 std::string ResolveCapturePath(const std::string& dir, const std::string& entry);
 
-// Reads the 2D keypoints named by the manifest and checks their shape against it:
-// (frame_count, cameras, layout size, 3). Frames a camera dropped are set to NaN.
+// Checks the 2D keypoints named by the manifest from the .npy header alone (before any
+// work): the file is readable, its dtype float32/float64 (any other is an error naming
+// the dtype: integer pixels are a writer's mistake, not converted) and its shape
+// (frames.count, cameras, layout size, 3).
+Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureManifest& manifest);
+// Reads the 2D keypoints named by the manifest after CheckCaptureKeypoints2d. Frames a
+// camera dropped are set to NaN.
 StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,
                                                   const CaptureManifest& manifest);
 
