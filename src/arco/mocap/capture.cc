@@ -170,7 +170,7 @@ StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const st
   }
   ARCO_RETURN_IF_ERROR(f.Number("fps", true, &m.fps));
   if (!(m.fps > 0 && m.fps <= kMaxCaptureFps)) {
-    return f.Bad("fps", "is " + Written(Json(m.fps)) + "; must be in (0, 10000] frames per second");
+    return f.Bad("fps", "is " + Written(*f.Find("fps")) + "; must be in (0, 10000] frames per second");
   }
   const Json* frames = f.Find("frames");
   if (!frames || frames->is_null()) return f.Missing("frames");
@@ -188,7 +188,7 @@ StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const st
   }
   ARCO_RETURN_IF_ERROR(f.Number("tuning_a4_hz", false, &m.tuning_a4_hz));
   if (!(m.tuning_a4_hz >= 300 && m.tuning_a4_hz <= 600)) {
-    return f.Bad("tuning_a4_hz", "is " + Written(Json(m.tuning_a4_hz)) + "; must be in [300, 600] Hz");
+    return f.Bad("tuning_a4_hz", "is " + Written(*f.Find("tuning_a4_hz")) + "; must be in [300, 600] Hz");
   }
   ARCO_RETURN_IF_ERROR(f.String("calibration", true, &m.calibration));
   if (m.calibration.empty()) return f.Bad("calibration", "is empty; must name a calibration file");
