@@ -57,7 +57,7 @@ TEST(ResultFolder, TriangulationWritesStageFolderAndKeepsOtherStages) {
   raw.inlier_mask.shape = {4, 142, 2};
   raw.inlier_mask.data.assign(4 * 142 * 2, 1);
   TriangulationRecord info;
-  info.capture_dir = "cap";
+  info.capture_dir = dir / "captures/cap/";
   info.units = "m";
   info.summary = Summarize(raw);
   ASSERT_TRUE(ResultFolder(result_dir)
@@ -68,6 +68,11 @@ TEST(ResultFolder, TriangulationWritesStageFolderAndKeepsOtherStages) {
   EXPECT_TRUE((*manifest)["stages"].contains("arco"));
   EXPECT_EQ((*manifest)["stages"]["triangulation"]["summary"]["triangulated"], 568);
   EXPECT_EQ((*manifest)["keypoint_names"].size(), 142u);
+  // The capture path is relative to the result folder, and read back against it.
+  EXPECT_EQ((*manifest)["capture"], "../captures/cap");
+  auto header = ResultFolder(result_dir).ReadHeader();
+  ASSERT_TRUE(header.ok());
+  EXPECT_EQ(header->capture_dir, dir / "captures/cap");
   auto points = ResultFolder(result_dir).ReadPoints3d(kTriangulationStage);
   ASSERT_TRUE(points.ok());
   EXPECT_EQ(points->shape, raw.points3d.shape);
