@@ -99,6 +99,11 @@ StatusOr<audio::SyncResult> RunSync(const SyncRunOptions& o) {
   audio::SyncOptions sync = o.sync;
   if (!o.capture_dir.empty() && sync.video_fps <= 0) sync.video_fps = manifest.fps;
   ARCO_ASSIGN_OR_RETURN(audio::SyncResult result, audio::SyncAudioToVideo(o.audio, o.video, sync));
+  // A truncated audio file: the same warning as arco pitch and arco run (the header only).
+  if (auto reader = audio::OpenAudio(o.audio); reader.ok()) {
+    const std::string truncated = audio::TruncationWarning((*reader)->info());
+    if (!truncated.empty()) result.warnings.push_back(truncated);
+  }
   if (!o.capture_dir.empty()) {
     // The manifest's offset is the audio time of its first frame, video frame 0.
     manifest.audio_offset_s = result.offset_s;

@@ -90,7 +90,10 @@ StatusOr<CaptureAudioCheck> CheckCaptureAudio(const std::string& capture_dir,
     decoded += *got;
     if (*got == 0 || reader.info().frames >= 0) break;
   }
-  const int64_t frames = reader.info().frames >= 0 ? reader.info().frames : decoded;
+  // A truncated file is as long as what it holds (its warning comes from the pitch stage).
+  const int64_t frames = reader.info().frames >= 0
+                             ? reader.info().frames - reader.info().missing_frames
+                             : decoded;
   if (decoded == 0 || frames == 0) {
     return Status::Error(where + ": audio.file \"" + manifest.audio + "\": " + check.path +
                          " holds no audio samples");
