@@ -169,6 +169,12 @@ check '[ $? -eq 0 ] && [ -f "$tmp/late_result/result.json" ]' "run with a late a
 check 'grep -q "\"capture\": \"../late\"" "$tmp/late_result/result.json"' \
   "result.json's capture is relative to the result folder"
 
+# What a killed run left beside its result folder goes with the next run on that folder.
+dead=$(bash -c 'echo $$')
+mkdir -p "$tmp/.tmp-$dead.late_result/triangulation"
+"$arco" run "$tmp/late" -o "$tmp/late_result" --overwrite >"$tmp/stdout" 2>"$tmp/err"
+check '[ $? -eq 0 ] && [ ! -e "$tmp/.tmp-$dead.late_result" ]' "a dead run's temporary stays"
+
 # A truncated WAV: a warning naming the file and how much is missing, on pitch and run.
 defect trunc
 size=$(stat -c %s "$tmp/trunc/audio.wav")
