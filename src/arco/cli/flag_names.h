@@ -25,7 +25,8 @@ inline constexpr FieldFlag kSyncFlags[] = {{"video_fps", "--fps"},
 // Evaluation (EvaluateRequest, as set by `arco eval`).
 inline constexpr FieldFlag kEvalFlags[] = {{"truth_frames", "--truth-frame"}};
 // Synthesis (CaptureWriteOptions, as set by `arco synth`).
-inline constexpr FieldFlag kSynthFlags[] = {{"overwrite", "--overwrite"}};
+inline constexpr FieldFlag kSynthFlags[] = {{"overwrite", "--overwrite"},
+                                            {"max_duration_s", "--duration-s"}};
 
 // `text` with every whole-word field name of `names` replaced by its flag. A name quoted
 // or qualified (`"fps"`, `audio.offset_s`) is a file's field (mocap/capture.h writes

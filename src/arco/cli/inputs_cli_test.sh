@@ -15,7 +15,8 @@ fail=0
 check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
 
 "$arco" synth --duration-s 1.5 --seed 5 -o "$tmp/good" >"$tmp/synth.log" 2>&1
-check '[ $? -eq 0 ]' "synth the good capture: $(tail -1 "$tmp/synth.log")"
+rc=$?
+check '[ $rc -eq 0 ]' "synth the good capture: $(tail -1 "$tmp/synth.log")"
 rm -rf "$tmp/good/truth"
 
 # defect NAME: a copy of the good capture in $tmp/NAME, edited by the commands that follow.
@@ -154,7 +155,8 @@ run_bad no_points "$tmp/no_points/$M" "layout coco_wholebody_133 has no instrume
 echo file >"$tmp/out_file"
 rm -rf "$tmp/out"; mkdir -p "$tmp/out"
 "$arco" run "$tmp/good" -o "$tmp/out_file/result" >"$tmp/stdout" 2>"$tmp/err"
-check '[ $? -ne 0 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ]' "run under a file: one line, exit non-zero"
+rc=$?
+check '[ $rc -ne 0 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ]' "run under a file: one line, exit non-zero"
 check 'grep -q "^arco: error: $tmp/out_file/result: cannot create folder" "$tmp/err"' \
   "run under a file names the output: $(cat "$tmp/err")"
 check '! grep -q triangulate "$tmp/stdout" "$tmp/err"' "run under a file: a stage started"
@@ -165,26 +167,47 @@ check '[ -z "$(find "$tmp" -name ".tmp-*" -o -name ".old-*")" ]' "temporaries le
 # A good capture still runs; its audio starting after the video starts is a warning.
 defect late; json late 'j["audio"]["offset_s"] = -0.5'
 "$arco" run "$tmp/late" -o "$tmp/late_result" >"$tmp/stdout" 2>"$tmp/err"
-check '[ $? -eq 0 ] && [ -f "$tmp/late_result/result.json" ]' "run with a late audio start: $(tail -1 "$tmp/err")"
+rc=$?
+check '[ $rc -eq 0 ] && [ -f "$tmp/late_result/result.json" ]' "run with a late audio start: $(tail -1 "$tmp/err")"
 check 'grep -q "\"capture\": \"../late\"" "$tmp/late_result/result.json"' \
   "result.json's capture is relative to the result folder"
+
+# A flag's error names the flag, not a file it did not come from.
+for v in -1 nan; do
+  "$arco" synth --duration-s $v -o "$tmp/out/cap" >/dev/null 2>"$tmp/err"
+  rc=$?
+  check '[ $rc -ne 0 ] && [ "$(cat "$tmp/err")" = "arco: error: --duration-s must be >= 0 s (0 = whole piece)" ]' \
+    "synth --duration-s $v: $(cat "$tmp/err")"
+done
+
+# import-spd: a keypoint folder of a camera the calibration lacks is named, not dropped.
+mkdir -p "$tmp/spd/h/21334181" "$tmp/spd/h/21334237" "$tmp/spd/h/99999999"
+"$arco" import-spd --calibration "$ARCO_SHARED_DATA_DIR/spd/cello_1113_scale_camera.xml" \
+  --human "$tmp/spd/h" --first 1 --last 2 -o "$tmp/spd/cap" >"$tmp/stdout" 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ]' "import-spd with an uncalibrated camera folder: $(cat "$tmp/err")"
+check 'grep -q "^warning: $tmp/spd/h/99999999: camera 99999999 is not in .*cello_1113_scale_camera.xml; its keypoints are not imported$" "$tmp/stdout"' \
+  "import-spd names the camera it leaves out: $(cat "$tmp/stdout")"
 
 # What a killed run left beside its result folder goes with the next run on that folder.
 dead=$(bash -c 'echo $$')
 mkdir -p "$tmp/.tmp-$dead.late_result/triangulation"
 "$arco" run "$tmp/late" -o "$tmp/late_result" --overwrite >"$tmp/stdout" 2>"$tmp/err"
-check '[ $? -eq 0 ] && [ ! -e "$tmp/.tmp-$dead.late_result" ]' "a dead run's temporary stays"
+rc=$?
+check '[ $rc -eq 0 ] && [ ! -e "$tmp/.tmp-$dead.late_result" ]' "a dead run's temporary stays"
 
 # A truncated WAV: a warning naming the file and how much is missing, on pitch and run.
 defect trunc
 size=$(stat -c %s "$tmp/trunc/audio.wav")
 truncate -s $((size / 2)) "$tmp/trunc/audio.wav"
 "$arco" pitch "$tmp/trunc/audio.wav" -o "$tmp/trunc.csv" >"$tmp/stdout" 2>"$tmp/err"
-check '[ $? -eq 0 ]' "pitch of a truncated WAV: $(cat "$tmp/err")"
+rc=$?
+check '[ $rc -eq 0 ]' "pitch of a truncated WAV: $(cat "$tmp/err")"
 check 'grep -q "warning: $tmp/trunc/audio.wav: truncated: .* s missing" "$tmp/stdout" "$tmp/err"' \
   "pitch warns of the truncated WAV: $(cat "$tmp/stdout" "$tmp/err" | grep -i warn)"
 "$arco" run "$tmp/trunc" -o "$tmp/trunc_result" >"$tmp/stdout" 2>"$tmp/err"
-check '[ $? -eq 0 ]' "run with a truncated WAV: $(tail -1 "$tmp/err")"
+rc=$?
+check '[ $rc -eq 0 ]' "run with a truncated WAV: $(tail -1 "$tmp/err")"
 check 'grep -q "warning: pitch: $tmp/trunc/audio.wav: truncated: .* s missing" "$tmp/stdout"' \
   "run warns of the truncated WAV"
 exit $fail
