@@ -166,11 +166,11 @@ check '[ -z "$(find "$tmp" -name ".tmp-*" -o -name ".old-*")" ]' "temporaries le
 
 # A good capture still runs; its audio starting after the video starts is a warning.
 defect late; json late 'j["audio"]["offset_s"] = -0.5'
-"$arco" run "$tmp/late" -o "$tmp/late_result" >"$tmp/stdout" 2>"$tmp/err"
+(cd "$tmp" && "$arco" run late -o late_result >"$tmp/stdout" 2>"$tmp/err")
 rc=$?
 check '[ $rc -eq 0 ] && [ -f "$tmp/late_result/result.json" ]' "run with a late audio start: $(tail -1 "$tmp/err")"
 check 'grep -q "\"capture\": \"../late\"" "$tmp/late_result/result.json"' \
-  "result.json's capture is relative to the result folder"
+  "result.json's capture (given relative) is relative to the result folder"
 
 # A flag's error names the flag, not a file it did not come from.
 for v in -1 nan; do

@@ -16,9 +16,11 @@
 namespace arco::pipeline {
 namespace {
 
-// `path` relative to the folder `base` (both as given: relative to the working folder).
+// A relative `path` (from the working folder) made relative to the folder `base`; an
+// absolute one stays absolute (right from anywhere, as the user gave it).
 std::string PathRelativeTo(const std::string& path, const std::string& base) {
   namespace fs = std::filesystem;
+  if (fs::path(path).is_absolute()) return NormalizeOutputPath(path);
   const fs::path from = fs::absolute(base).lexically_normal();
   const fs::path to = fs::absolute(path).lexically_normal();
   const fs::path relative = to.lexically_relative(from);
@@ -220,8 +222,9 @@ Status ResultFolder::WriteTriangulation(const CaptureManifest& manifest,
 
   result["format"] = "arco-result";
   result["version"] = 1;
-  // Relative to the result folder (docs/formats.md), so that the two can move together;
-  // dir_ may be a temporary sibling of the final folder: the same parent, the same path.
+  // Relative to the result folder (docs/formats.md), so that the two can move together
+  // (absolute when given so); dir_ may be a temporary sibling of the final folder: the
+  // same parent, the same relative path.
   result["capture"] = PathRelativeTo(record.capture_dir, dir_);
   result["name"] = manifest.name;
   result["instrument"] = manifest.instrument;
