@@ -7,7 +7,7 @@
 # the file; a capture whose audio starts late is still run.
 # usage: inputs_cli_test.sh ARCO_BINARY SHARED_DATA_DIR
 set -uo pipefail
-arco=$1
+arco=$(realpath "$1")
 export ARCO_SHARED_DATA_DIR=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
