@@ -134,8 +134,9 @@ TEST(TruncationWarning, NamesTheFileAndWhatIsMissing) {
   EXPECT_EQ((*cut)->info().frames, 44100);  // the header's promise
   EXPECT_EQ((*cut)->info().missing_frames, 44100 - 11025);
   EXPECT_EQ(TruncationWarning((*cut)->info()),
-            cut_path + ": truncated: the header promises 44100 samples (1.000 s), the file "
-                       "holds 11025 (0.750 s missing)");
+            cut_path +
+                ": truncated: the header promises 44100 samples (1.000 s), the file "
+                "holds 11025 (0.750 s missing)");
   EXPECT_EQ(ReadAll(cut->get()).size(), 11025u);  // what exists, nothing invented
   const std::string half = bytes->substr(0, data + 2 * 22050);
   auto memory = OpenAudioFromMemory(&half, "mem.wav");

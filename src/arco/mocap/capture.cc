@@ -77,9 +77,7 @@ class Fields {
     return it == j_.end() ? nullptr : &*it;
   }
   std::string Name(const char* key) const { return "\"" + prefix_ + key + "\""; }
-  Status Missing(const char* key) const {
-    return Status::Error(where_ + ": missing " + Name(key));
-  }
+  Status Missing(const char* key) const { return Status::Error(where_ + ": missing " + Name(key)); }
   Status Bad(const char* key, const std::string& what) const {
     return Status::Error(where_ + ": " + Name(key) + " " + what);
   }
@@ -165,12 +163,13 @@ StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const st
   ARCO_RETURN_IF_ERROR(f.String("name", false, &m.name));
   ARCO_RETURN_IF_ERROR(f.String("instrument", false, &m.instrument));
   if (!Instruments().count(m.instrument)) {
-    return f.Bad("instrument", "is \"" + m.instrument +
-                                   "\"; must be cello, violin, viola, double_bass or none");
+    return f.Bad("instrument",
+                 "is \"" + m.instrument + "\"; must be cello, violin, viola, double_bass or none");
   }
   ARCO_RETURN_IF_ERROR(f.Number("fps", true, &m.fps));
   if (!(m.fps > 0 && m.fps <= kMaxCaptureFps)) {
-    return f.Bad("fps", "is " + Written(*f.Find("fps")) + "; must be in (0, 10000] frames per second");
+    return f.Bad("fps",
+                 "is " + Written(*f.Find("fps")) + "; must be in (0, 10000] frames per second");
   }
   const Json* frames = f.Find("frames");
   if (!frames || frames->is_null()) return f.Missing("frames");
@@ -183,12 +182,14 @@ StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const st
   }
   if (m.frame_first < 0 || m.frame_first > kMaxCaptureFrameNumber) {
     return ff.Bad("first",
-                  "is " + std::to_string(m.frame_first) + "; must be in [0, 2^40] (global frame "
-                  "numbers, 1 for the recording's first frame)");
+                  "is " + std::to_string(m.frame_first) +
+                      "; must be in [0, 2^40] (global frame "
+                      "numbers, 1 for the recording's first frame)");
   }
   ARCO_RETURN_IF_ERROR(f.Number("tuning_a4_hz", false, &m.tuning_a4_hz));
   if (!(m.tuning_a4_hz >= 300 && m.tuning_a4_hz <= 600)) {
-    return f.Bad("tuning_a4_hz", "is " + Written(*f.Find("tuning_a4_hz")) + "; must be in [300, 600] Hz");
+    return f.Bad("tuning_a4_hz",
+                 "is " + Written(*f.Find("tuning_a4_hz")) + "; must be in [300, 600] Hz");
   }
   ARCO_RETURN_IF_ERROR(f.String("calibration", true, &m.calibration));
   if (m.calibration.empty()) return f.Bad("calibration", "is empty; must name a calibration file");

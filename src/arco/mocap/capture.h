@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "arco/registry/keypoint_layout.h"
 #include "arco/mocap/triangulate_sequence.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/util/json_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/status.h"
@@ -29,7 +29,7 @@ inline constexpr char kResultManifestName[] = "result.json";
 
 // capture.json's ranges (ParseCaptureManifest).
 inline constexpr double kMaxCaptureFps = 10000;
-inline constexpr int64_t kMaxCaptureFrames = 100000000;            // frames.count
+inline constexpr int64_t kMaxCaptureFrames = 100000000;              // frames.count
 inline constexpr int64_t kMaxCaptureFrameNumber = int64_t{1} << 40;  // frames.first
 
 struct CaptureCamera {
@@ -47,11 +47,11 @@ struct CaptureManifest {
   int64_t frame_first = 1;  // global number of the first frame in the arrays
   int64_t frame_count = 0;
   double tuning_a4_hz = 440.0;
-  std::string calibration;                  // calibration file (any format arco reads)
-  std::string audio;                        // optional audio file
+  std::string calibration;      // calibration file (any format arco reads)
+  std::string audio;            // optional audio file
   double audio_offset_s = 0.0;  // audio time of frame `frame_first`'s timestamp (mid-exposure)
-  std::string keypoints2d;                  // optional .npy of 2D keypoints
-  std::string layout;                       // keypoint layout name, or "custom" with keypoint_names
+  std::string keypoints2d;      // optional .npy of 2D keypoints
+  std::string layout;           // keypoint layout name, or "custom" with keypoint_names
   std::vector<std::string> keypoint_names;  // only for layout "custom"
   std::vector<CaptureCamera> cameras;
 

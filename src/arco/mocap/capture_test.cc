@@ -122,7 +122,9 @@ TEST(CaptureManifest, ContentOutsideItsRangeNamesTheField) {
   EXPECT_EQ(message([](Json& j) { j["cameras"][1]["dropped_frames"] = {99999}; }),
             "cap/capture.json: \"cameras[1].dropped_frames\" holds frame 99999, outside 0..131 "
             "(frames.first + frames.count - 1)");
-  EXPECT_EQ(message([](Json& j) { j["cameras"][0]["dropped_frames"] = {130, 129, 130}; }),
+  EXPECT_EQ(message([](Json& j) {
+              j["cameras"][0]["dropped_frames"] = {130, 129, 130};
+            }),
             "cap/capture.json: \"cameras[0].dropped_frames\" lists frame 130 twice");
   EXPECT_EQ(message([](Json& j) { j["fps"] = 0; }),
             "cap/capture.json: \"fps\" is 0; must be in (0, 10000] frames per second");

@@ -63,8 +63,8 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
     std::sort(folders.begin(), folders.end());
     for (const std::string& folder : folders) {
       if (calibration.rig.FindCamera(folder) < 0) {
-        warnings.push_back(JoinPath(o.human_dir, folder) + ": camera " + folder +
-                           " is not in " + o.calibration + "; its keypoints are not imported");
+        warnings.push_back(JoinPath(o.human_dir, folder) + ": camera " + folder + " is not in " +
+                           o.calibration + "; its keypoints are not imported");
       }
     }
   } else {

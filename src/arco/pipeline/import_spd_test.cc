@@ -72,8 +72,9 @@ TEST(ImportSpdCapture, SpdFoldersToCaptureToTriangulation) {
   EXPECT_EQ(imported->points, 142);
   EXPECT_EQ(imported->files.frames_dropped, 1);
   ASSERT_EQ(imported->warnings.size(), 1u);
-  EXPECT_EQ(imported->warnings[0], (dir / "human/99999999") + ": camera 99999999 is not in " +
-                                       kCalibration + "; its keypoints are not imported");
+  EXPECT_EQ(imported->warnings[0],
+            (dir / "human/99999999") + ": camera 99999999 is not in " + kCalibration +
+                "; its keypoints are not imported");
   auto manifest = ReadCaptureManifest(o.output_dir);
   ASSERT_TRUE(manifest.ok()) << manifest.status().message();
   EXPECT_EQ(manifest->layout, "spd_cello");

@@ -91,9 +91,8 @@ StatusOr<CaptureAudioCheck> CheckCaptureAudio(const std::string& capture_dir,
     if (*got == 0 || reader.info().frames >= 0) break;
   }
   // A truncated file is as long as what it holds (its warning comes from the pitch stage).
-  const int64_t frames = reader.info().frames >= 0
-                             ? reader.info().frames - reader.info().missing_frames
-                             : decoded;
+  const int64_t frames =
+      reader.info().frames >= 0 ? reader.info().frames - reader.info().missing_frames : decoded;
   if (decoded == 0 || frames == 0) {
     return Status::Error(where + ": audio.file \"" + manifest.audio + "\": " + check.path +
                          " holds no audio samples");

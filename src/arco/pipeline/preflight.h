@@ -29,9 +29,9 @@ Status CheckCaptureCalibration(const std::string& capture_dir, const CaptureMani
 
 // What the audio check learnt (for messages and tests).
 struct CaptureAudioCheck {
-  std::string path;        // resolved audio.file
-  double duration_s = 0;   // decoded length
-  std::string format;      // the decoder's name for it
+  std::string path;       // resolved audio.file
+  double duration_s = 0;  // decoded length
+  std::string format;     // the decoder's name for it
 };
 
 // The capture's audio (`audio.file`) exists, opens and decodes (its first samples; the

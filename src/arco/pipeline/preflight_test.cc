@@ -43,8 +43,8 @@ struct TestCapture {
     k.shape = {kFrames, 2, 142, 3};
     k.data.assign(static_cast<size_t>(kFrames * 2 * 142 * 3), 100.0f);
     EXPECT_TRUE(WriteNpy(dir / "keypoints2d.npy", k).ok());
-    EXPECT_TRUE(audio::testing::WriteWav(dir / "audio.wav", std::vector<float>(88200, 0.1f), 44100)
-                    .ok());
+    EXPECT_TRUE(
+        audio::testing::WriteWav(dir / "audio.wav", std::vector<float>(88200, 0.1f), 44100).ok());
   }
   void Write() { EXPECT_TRUE(WriteCaptureManifest(dir.path(), manifest).ok()); }
   std::string Manifest() const { return dir / "capture.json"; }
@@ -75,13 +75,14 @@ TEST(PreflightRun, AnOffsetOutsideTheAudioNamesCaptureJson) {
   TestCapture c;
   c.manifest.audio_offset_s = 99;
   c.Write();
-  EXPECT_EQ(c.Preflight(), c.Manifest() + ": audio.offset_s = 99 s is outside the audio (0..2 s, " +
-                               (c.dir / "audio.wav") + ")");
+  EXPECT_EQ(c.Preflight(),
+            c.Manifest() + ": audio.offset_s = 99 s is outside the audio (0..2 s, " +
+                (c.dir / "audio.wav") + ")");
   c.manifest.audio_offset_s = -1.5;  // the last frame (0.967 s later) still before 0
   c.Write();
-  EXPECT_EQ(c.Preflight(), c.Manifest() + ": audio.offset_s = -1.5 s puts the last frame at " +
-                               "-0.533333 s, before the audio starts (0..2 s, " +
-                               (c.dir / "audio.wav") + ")");
+  EXPECT_EQ(c.Preflight(),
+            c.Manifest() + ": audio.offset_s = -1.5 s puts the last frame at " +
+                "-0.533333 s, before the audio starts (0..2 s, " + (c.dir / "audio.wav") + ")");
   c.manifest.audio_offset_s = -0.5;  // partly inside: the pitch stage's warning, not an error
   c.Write();
   EXPECT_EQ(c.Preflight(), "ok");
@@ -91,14 +92,14 @@ TEST(PreflightRun, MissingOrUndecodableAudioNamesTheField) {
   TestCapture c;
   ASSERT_TRUE(AtomicWriteFile(c.dir / "audio.wav", std::string(3000, 'x')).ok());
   const std::string undecodable = c.Preflight();
-  EXPECT_EQ(undecodable.rfind(c.Manifest() + ": audio.file: " + (c.dir / "audio.wav") +
-                                  ": cannot decode audio",
-                              0),
-            0u)
+  EXPECT_EQ(
+      undecodable.rfind(
+          c.Manifest() + ": audio.file: " + (c.dir / "audio.wav") + ": cannot decode audio", 0),
+      0u)
       << undecodable;
   fs::remove(c.dir / "audio.wav");
-  EXPECT_EQ(c.Preflight(), c.Manifest() + ": audio.file \"audio.wav\": " + (c.dir / "audio.wav") +
-                               " not found");
+  EXPECT_EQ(c.Preflight(),
+            c.Manifest() + ": audio.file \"audio.wav\": " + (c.dir / "audio.wav") + " not found");
   c.manifest.audio.clear();  // no audio at all: the vision method only, not an error
   c.Write();
   EXPECT_EQ(c.Preflight(), "ok");
@@ -108,11 +109,12 @@ TEST(PreflightRun, CalibrationAndCamerasAreChecked) {
   TestCapture c;
   c.manifest.cameras[1] = {"cam_x", "x", "", {}};
   c.Write();
-  EXPECT_EQ(c.Preflight(), c.Manifest() + ": camera \"cam_x\" is not in " +
-                               (c.dir / "calibration.xml"));
+  EXPECT_EQ(c.Preflight(),
+            c.Manifest() + ": camera \"cam_x\" is not in " + (c.dir / "calibration.xml"));
   fs::remove(c.dir / "calibration.xml");
-  EXPECT_EQ(c.Preflight(), c.Manifest() + ": calibration \"calibration.xml\": " +
-                               (c.dir / "calibration.xml") + " not found");
+  EXPECT_EQ(c.Preflight(),
+            c.Manifest() + ": calibration \"calibration.xml\": " + (c.dir / "calibration.xml") +
+                " not found");
 }
 
 TEST(PreflightRun, KeypointsDtypeAndShapeComeFromTheHeader) {
@@ -121,16 +123,18 @@ TEST(PreflightRun, KeypointsDtypeAndShapeComeFromTheHeader) {
   k.shape = {kFrames, 2, 142, 3};
   k.data.assign(static_cast<size_t>(kFrames * 2 * 142 * 3), 100);
   ASSERT_TRUE(WriteNpy(c.dir / "keypoints2d.npy", k).ok());
-  EXPECT_EQ(c.Preflight(), (c.dir / "keypoints2d.npy") +
-                               ": dtype int32; keypoints2d must be float32 or float64 (x_px, "
-                               "y_px, score; NaN = missing)");
+  EXPECT_EQ(c.Preflight(),
+            (c.dir / "keypoints2d.npy") +
+                ": dtype int32; keypoints2d must be float32 or float64 (x_px, "
+                "y_px, score; NaN = missing)");
   NpyArray<float> f;
   f.shape = {kFrames - 1, 2, 142, 3};
   f.data.assign(static_cast<size_t>((kFrames - 1) * 2 * 142 * 3), 1.0f);
   ASSERT_TRUE(WriteNpy(c.dir / "keypoints2d.npy", f).ok());
-  EXPECT_EQ(c.Preflight(), (c.dir / "keypoints2d.npy") +
-                               ": shape (29, 2, 142, 3) does not match capture.json (30, 2, 142, "
-                               "3) (frames.count, cameras, spd_cello points, 3)");
+  EXPECT_EQ(c.Preflight(),
+            (c.dir / "keypoints2d.npy") +
+                ": shape (29, 2, 142, 3) does not match capture.json (30, 2, 142, "
+                "3) (frames.count, cameras, spd_cello points, 3)");
 }
 
 TEST(PreflightRun, TheInstrumentsPointsAndTheOutputAreChecked) {

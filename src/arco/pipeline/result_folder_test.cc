@@ -58,10 +58,9 @@ TEST(ResultFolder, TriangulationWritesStageFolderAndKeepsOtherStages) {
   raw.inlier_mask.data.assign(4 * 142 * 2, 1);
   TriangulationRecord info;
   // As a user gives it: relative to the working folder.
-  info.capture_dir =
-      std::filesystem::path(dir / "captures/cap/")
-          .lexically_relative(std::filesystem::current_path())
-          .string();
+  info.capture_dir = std::filesystem::path(dir / "captures/cap/")
+                         .lexically_relative(std::filesystem::current_path())
+                         .string();
   info.units = "m";
   info.summary = Summarize(raw);
   ASSERT_TRUE(ResultFolder(result_dir)

@@ -3,9 +3,8 @@
 // JsonNumberOrNaN to read a number that may be null. Writing uses null for NaN.
 #pragma once
 
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "arco/util/status.h"
 

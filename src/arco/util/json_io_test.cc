@@ -1,8 +1,8 @@
 #include "arco/util/json_io.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace arco {
 namespace {
@@ -26,7 +26,7 @@ TEST(ParseJsonMarkingNonFinite, TellsTheTokensFromNullAndStrings) {
   EXPECT_EQ(NonFiniteToken(a[0]), "NaN");
   EXPECT_EQ(NonFiniteToken(a[1]), "-Infinity");
   EXPECT_EQ(NonFiniteToken(a[2]), "Infinity");
-  EXPECT_EQ(NonFiniteToken(a[3]), "");  // a real null
+  EXPECT_EQ(NonFiniteToken(a[3]), "");          // a real null
   EXPECT_EQ(NonFiniteToken((*json)["s"]), "");  // a string "NaN" is a string
   EXPECT_EQ((*json)["t"], "x NaN");
 }

@@ -258,8 +258,8 @@ StatusOr<NpyArray<T>> ReadNpy(const std::string& path) {
 template <typename T>
 std::string SerializeNpy(const NpyArray<T>& array) {
   ARCO_CHECK(static_cast<int64_t>(array.data.size()) == array.size()) << "npy shape/data mismatch";
-  std::string dict = std::string("{'descr': '") + DescrFor<T>() +
-                     "', 'fortran_order': False, 'shape': (";
+  std::string dict =
+      std::string("{'descr': '") + DescrFor<T>() + "', 'fortran_order': False, 'shape': (";
   for (size_t i = 0; i < array.shape.size(); ++i) {
     dict += std::to_string(array.shape[i]);
     if (array.shape.size() == 1 || i + 1 < array.shape.size()) dict += ",";

@@ -38,9 +38,9 @@ StatusOr<NpyArray<T>> ParseNpy(const std::string& bytes, const std::string& sour
 
 // The header of an .npy file, read without its data (checks before the work).
 struct NpyHeader {
-  std::string descr;            // as stored, e.g. "<f4"
-  std::string dtype;            // NumPy's name, e.g. "float32", "int32"
-  bool is_float = false;        // float32 or float64
+  std::string descr;      // as stored, e.g. "<f4"
+  std::string dtype;      // NumPy's name, e.g. "float32", "int32"
+  bool is_float = false;  // float32 or float64
   std::vector<int64_t> shape;
 };
 StatusOr<NpyHeader> ReadNpyHeader(const std::string& path);

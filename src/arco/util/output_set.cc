@@ -47,7 +47,8 @@ long TemporaryOwner(const std::string& entry, const std::string& what, const std
   const std::string prefix = "." + what + "-";
   if (entry.compare(0, prefix.size(), prefix) != 0) return -1;
   const size_t dot = entry.find('.', prefix.size());
-  if (dot == std::string::npos || dot == prefix.size() || entry.compare(dot + 1, std::string::npos, name) != 0) {
+  if (dot == std::string::npos || dot == prefix.size() ||
+      entry.compare(dot + 1, std::string::npos, name) != 0) {
     return -1;
   }
   const std::string digits = entry.substr(prefix.size(), dot - prefix.size());

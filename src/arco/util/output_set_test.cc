@@ -240,17 +240,23 @@ TEST(OutputSet, StaleTemporariesOfDeadProcessesAreRemoved) {
   testing::TempDir tmp;
   const std::string dead = std::to_string(DeadPid());
   const std::string live = std::to_string(::getppid());
-  for (const std::string& name :
-       {".tmp-" + dead + ".result", ".old-" + dead + ".result", ".tmp-" + live + ".result",
-        ".tmp-" + dead + ".other", ".old-" + dead + ".gone", std::string(".tmp-x1.result")}) {
+  for (const std::string& name : {".tmp-" + dead + ".result",
+                                  ".old-" + dead + ".result",
+                                  ".tmp-" + live + ".result",
+                                  ".tmp-" + dead + ".other",
+                                  ".old-" + dead + ".gone",
+                                  std::string(".tmp-x1.result")}) {
     ASSERT_TRUE(MakeDirectories(tmp / name).ok());
   }
   ASSERT_TRUE(MakeDirectories(tmp / "result").ok());
-  ASSERT_TRUE(AtomicWriteDirectory(tmp / "result", FolderReplace{true, "", "folder"}, WriteNew)
-                  .ok());
+  ASSERT_TRUE(
+      AtomicWriteDirectory(tmp / "result", FolderReplace{true, "", "folder"}, WriteNew).ok());
   EXPECT_EQ(Entries(tmp.path()),
-            (std::set<std::string>{"result", ".tmp-" + live + ".result", ".tmp-" + dead + ".other",
-                                   ".old-" + dead + ".gone", ".tmp-x1.result"}));
+            (std::set<std::string>{"result",
+                                   ".tmp-" + live + ".result",
+                                   ".tmp-" + dead + ".other",
+                                   ".old-" + dead + ".gone",
+                                   ".tmp-x1.result"}));
   // The same for a file output.
   ASSERT_TRUE(AtomicWriteFile(tmp / ".tmp-" + dead + ".p.csv", "partial").ok());
   ASSERT_TRUE(AtomicWriteFile(tmp / "p.csv", "whole").ok());
