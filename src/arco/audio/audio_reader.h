@@ -24,7 +24,17 @@ struct AudioInfo {
   // streams). A file that delivers fewer is reported as truncated.
   int64_t frames = -1;
   std::string format;  // e.g. "WAV (Microsoft) 16 bit PCM" or "ffmpeg aac"
+  std::string source;  // the file (or name) opened, for messages
+  // Of `frames`, how many the file is known at open time not to hold (a WAV whose data
+  // chunk is cut short); 0 when none or unknown.
+  int64_t missing_frames = 0;
 };
+
+// One line for a source that delivered fewer frames than its header promised ("" when it
+// did not): "FILE: truncated: the header promises N samples (X s), the file holds M
+// (Y s missing)". `delivered` is what was decoded (-1: what the file is known to hold).
+// Every command that decodes audio reports it through this one function.
+std::string TruncationWarning(const AudioInfo& info, int64_t delivered = -1);
 
 class AudioReader {
  public:

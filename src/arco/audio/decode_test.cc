@@ -114,6 +114,38 @@ TEST(OpenAudioFromMemory, DecodesAndRejectsTruncatedHeaders) {
   for (size_t i = 0; i < samples.size(); ++i) ASSERT_NEAR(samples[i], tone[i], 1e-4);
 }
 
+// The header's promise against what a cut file holds: one warning naming the file and the
+// seconds missing, from a file and from memory; a whole file has none.
+TEST(TruncationWarning, NamesTheFileAndWhatIsMissing) {
+  auto tone = testing::RenderTone([](double) { return 330.0; }, 1.0, {});
+  const std::string path = TempPath("whole.wav");
+  ASSERT_TRUE(WriteWav(path, tone, 44100).ok());
+  auto whole = OpenAudio(path);
+  ASSERT_TRUE(whole.ok());
+  EXPECT_EQ((*whole)->info().frames, 44100);
+  EXPECT_EQ(TruncationWarning((*whole)->info()), "");
+  auto bytes = ReadFileToString(path);
+  ASSERT_TRUE(bytes.ok());
+  const size_t data = bytes->find("data") + 8;  // 16-bit mono: 2 bytes a sample
+  const std::string cut_path = TempPath("cut.wav");
+  ASSERT_TRUE(AtomicWriteFile(cut_path, bytes->substr(0, data + 2 * 11025)).ok());
+  auto cut = OpenAudio(cut_path);
+  ASSERT_TRUE(cut.ok());
+  EXPECT_EQ((*cut)->info().frames, 44100);  // the header's promise
+  EXPECT_EQ((*cut)->info().missing_frames, 44100 - 11025);
+  EXPECT_EQ(TruncationWarning((*cut)->info()),
+            cut_path +
+                ": truncated: the header promises 44100 samples (1.000 s), the file "
+                "holds 11025 (0.750 s missing)");
+  EXPECT_EQ(ReadAll(cut->get()).size(), 11025u);  // what exists, nothing invented
+  const std::string half = bytes->substr(0, data + 2 * 22050);
+  auto memory = OpenAudioFromMemory(&half, "mem.wav");
+  ASSERT_TRUE(memory.ok());
+  EXPECT_EQ(TruncationWarning((*memory)->info()),
+            "mem.wav: truncated: the header promises 44100 samples (1.000 s), the file holds "
+            "22050 (0.500 s missing)");
+}
+
 // Resampled sine must equal the sine evaluated at n / output_rate: any timing
 // offset or drift shows up as a phase error.
 void ExpectExactTiming(int in_rate, int out_rate, double seconds) {

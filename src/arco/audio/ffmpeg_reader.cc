@@ -11,6 +11,7 @@ extern "C" {
 }
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <vector>
 
@@ -69,6 +70,7 @@ class FfmpegReader : public AudioReader {
     r->info_.sample_rate_hz = rate;
     r->info_.channels = channels;
     r->info_.format = std::string("ffmpeg ") + decoder->name;
+    r->info_.source = path;
     if (stream->duration > 0 && stream->time_base.den > 0) {
       r->info_.frames = av_rescale_q(stream->duration, stream->time_base, AVRational{1, rate});
     }
@@ -194,6 +196,22 @@ class FfmpegReader : public AudioReader {
 
 StatusOr<std::unique_ptr<AudioReader>> OpenAudioWithFfmpeg(const std::string& path) {
   return FfmpegReader::Open(path);
+}
+
+std::string TruncationWarning(const AudioInfo& info, int64_t delivered) {
+  if (delivered < 0) delivered = info.frames - info.missing_frames;
+  if (info.frames <= 0 || delivered >= info.frames || info.sample_rate_hz <= 0) return "";
+  const double rate = info.sample_rate_hz;
+  char text[160];
+  std::snprintf(text,
+                sizeof(text),
+                ": truncated: the header promises %lld samples (%.3f s), the file holds %lld "
+                "(%.3f s missing)",
+                static_cast<long long>(info.frames),
+                static_cast<double>(info.frames) / rate,
+                static_cast<long long>(delivered),
+                static_cast<double>(info.frames - delivered) / rate);
+  return info.source + text;
 }
 
 StatusOr<std::unique_ptr<AudioReader>> OpenAudio(const std::string& path) {

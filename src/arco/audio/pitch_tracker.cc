@@ -150,10 +150,12 @@ StatusOr<PitchTrack> TrackPitch(std::unique_ptr<AudioReader> reader,
     summary->voiced_fraction =
         track.frames.empty() ? 0.0 : static_cast<double>(voiced) / track.frames.size();
     // Only a source that ran out early is truncated; stopping at max_frames is not.
-    if (stream.finished() && info.frames > 0 && stream.source_samples() < info.frames) {
-      summary->warnings.push_back("truncated: the header promises " + std::to_string(info.frames) +
-                                  " samples, only " + std::to_string(stream.source_samples()) +
-                                  " decoded");
+    // A file known at open to be cut short is reported even when the frames asked for end
+    // before the cut; otherwise a source that ran out early.
+    if (info.missing_frames > 0) {
+      summary->warnings.push_back(TruncationWarning(info));
+    } else if (stream.finished() && info.frames > 0 && stream.source_samples() < info.frames) {
+      summary->warnings.push_back(TruncationWarning(info, stream.source_samples()));
     }
     if (stream.source_samples() == 0) {
       summary->warnings.push_back("empty: the file holds no audio samples");

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <fstream>
 #include <vector>
 
 #include "arco/audio/audio_reader.h"
@@ -44,6 +45,44 @@ sf_count_t MemRead(void* ptr, sf_count_t count, void* user) {
 sf_count_t MemWrite(const void*, sf_count_t, void*) { return 0; }
 sf_count_t MemTell(void* user) { return static_cast<MemoryFile*>(user)->position; }
 
+// The frames a RIFF/WAVE header promises (its data chunk's size over the fmt chunk's
+// block size), or -1 when it does not say (not a WAV, a streaming size of 0 or ~0, a
+// compressed format). libsndfile silently shortens a truncated file's length to what is
+// there; comparing the two tells a truncated file. `read(offset, n)` returns up to n bytes.
+template <typename Read>
+int64_t WavPromisedFrames(const Read& read) {
+  auto u32 = [](const std::string& b, size_t at) {
+    return static_cast<uint32_t>(static_cast<unsigned char>(b[at])) |
+           static_cast<uint32_t>(static_cast<unsigned char>(b[at + 1])) << 8 |
+           static_cast<uint32_t>(static_cast<unsigned char>(b[at + 2])) << 16 |
+           static_cast<uint32_t>(static_cast<unsigned char>(b[at + 3])) << 24;
+  };
+  const std::string riff = read(0, 12);
+  if (riff.size() < 12 || riff.compare(0, 4, "RIFF") != 0 || riff.compare(8, 4, "WAVE") != 0) {
+    return -1;
+  }
+  int64_t at = 12;
+  int64_t block_align = 0;
+  for (int chunks = 0; chunks < 64; ++chunks) {  // bounded: a corrupt file cannot loop
+    const std::string head = read(at, 8);
+    if (head.size() < 8) return -1;
+    const uint32_t size = u32(head, 4);
+    if (head.compare(0, 4, "fmt ") == 0) {
+      const std::string fmt = read(at + 8, 16);
+      if (fmt.size() < 16) return -1;
+      const int tag = static_cast<unsigned char>(fmt[0]) | static_cast<unsigned char>(fmt[1]) << 8;
+      // PCM, IEEE float, extensible: one block per frame.
+      if (tag != 1 && tag != 3 && tag != 0xFFFE) return -1;
+      block_align = static_cast<unsigned char>(fmt[12]) | static_cast<unsigned char>(fmt[13]) << 8;
+    } else if (head.compare(0, 4, "data") == 0) {
+      if (block_align <= 0 || size == 0 || size == 0xFFFFFFFFu) return -1;
+      return static_cast<int64_t>(size) / block_align;
+    }
+    at += 8 + static_cast<int64_t>(size) + (size & 1);
+  }
+  return -1;
+}
+
 class SndfileReader : public AudioReader {
  public:
   ~SndfileReader() override {
@@ -76,6 +115,25 @@ class SndfileReader : public AudioReader {
     reader->info_.sample_rate_hz = sf_info.samplerate;
     reader->info_.channels = sf_info.channels;
     reader->info_.frames = sf_info.frames;
+    reader->info_.source = name;
+    // A header promising more than the file holds: the promise is the length, so the
+    // reader's shortfall is reported (TruncationWarning).
+    const int64_t promised = bytes != nullptr ? WavPromisedFrames([&](int64_t at, int64_t n) {
+      return at < static_cast<int64_t>(bytes->size()) ? bytes->substr(at, n) : std::string();
+    })
+                                              : WavPromisedFrames([&](int64_t at, int64_t n) {
+                                                  std::ifstream in(name, std::ios::binary);
+                                                  std::string out(static_cast<size_t>(n), '\0');
+                                                  in.seekg(at);
+                                                  in.read(out.data(), n);
+                                                  out.resize(static_cast<size_t>(
+                                                      std::max<std::streamsize>(0, in.gcount())));
+                                                  return out;
+                                                });
+    if (promised > sf_info.frames) {
+      reader->info_.frames = promised;
+      reader->info_.missing_frames = promised - sf_info.frames;
+    }
     SF_FORMAT_INFO format_info;
     format_info.format = sf_info.format & SF_FORMAT_TYPEMASK;
     reader->info_.format = "sndfile";

@@ -25,9 +25,13 @@ inline constexpr FieldFlag kSyncFlags[] = {{"video_fps", "--fps"},
 // Evaluation (EvaluateRequest, as set by `arco eval`).
 inline constexpr FieldFlag kEvalFlags[] = {{"truth_frames", "--truth-frame"}};
 // Synthesis (CaptureWriteOptions, as set by `arco synth`).
-inline constexpr FieldFlag kSynthFlags[] = {{"overwrite", "--overwrite"}};
+inline constexpr FieldFlag kSynthFlags[] = {{"overwrite", "--overwrite"},
+                                            {"max_duration_s", "--duration-s"}};
 
-// `text` with every whole-word field name of `names` replaced by its flag.
+// `text` with every whole-word field name of `names` replaced by its flag. A name quoted
+// or qualified (`"fps"`, `audio.offset_s`) is a file's field (mocap/capture.h writes
+// them so), and one between slashes part of a path: never rewritten (a message about
+// capture.json must not name a flag).
 template <size_t N>
 std::string WithFlagNames(std::string text, const FieldFlag (&names)[N]) {
   auto word_char = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
@@ -36,8 +40,9 @@ std::string WithFlagNames(std::string text, const FieldFlag (&names)[N]) {
          at = text.find(name.field, at)) {
       const size_t end = at + name.field.size();
       const bool whole = (at == 0 || !word_char(text[at - 1])) &&
-                         (end == text.size() || !word_char(text[end])) &&
-                         (at == 0 || text[at - 1] != '-');
+                         (end == text.size() || (!word_char(text[end]) && text[end] != '/')) &&
+                         (at == 0 || (text[at - 1] != '-' && text[at - 1] != '"' &&
+                                      text[at - 1] != '.' && text[at - 1] != '/'));
       if (!whole) {
         at = end;
         continue;

@@ -68,6 +68,9 @@ int Run(Args& a) {
   a.w.audio = !a.no_audio;
   a.w.audio_render.tune_soundfont = !a.no_sample_tuning;
   a.w.calibration_source = a.calibration;
+  // The options are the user's flags, not the calibration's: checked first, named as flags.
+  const Status valid = a.o.Validate();
+  if (!valid.ok()) return PrintError(WithFlagNames(valid.message(), kSynthFlags));
   // The output is checked before the work (docs/architecture.md, "Outputs").
   const Status writable = synth::CheckCaptureOutput(a.output, a.w);
   if (!writable.ok()) return PrintError(writable.message());

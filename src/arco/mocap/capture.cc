@@ -24,22 +24,39 @@ const std::set<std::string>& Instruments() {
   return k;
 }
 
-// Typed field access that reports problems instead of throwing.
+// The value as the user wrote it, for messages ("NaN", "\"abc\"", "[1]").
+std::string Written(const Json& v) {
+  const std::string token = NonFiniteToken(v);
+  if (!token.empty()) return token;
+  std::string text = v.dump();
+  if (text.size() > 40) text = text.substr(0, 37) + "...";
+  return text;
+}
+
+// Typed field access that reports problems instead of throwing. Messages name the file
+// and the field, quoted and dotted from the top ("frames.first"), never bare: a bare
+// name reads as an option field (cli/flag_names.h rewrites those into flags).
 class Fields {
  public:
-  Fields(const Json& object, std::string where) : j_(object), where_(std::move(where)) {}
+  Fields(const Json& object, std::string where, std::string prefix = "")
+      : j_(object), where_(std::move(where)), prefix_(std::move(prefix)) {}
 
   Status String(const char* key, bool required, std::string* out) const {
     const Json* v = Find(key);
     if (!v || v->is_null()) return required ? Missing(key) : Status::Ok();
-    if (!v->is_string()) return Bad(key, "must be a string");
+    if (!v->is_string() || !NonFiniteToken(*v).empty()) {
+      return Bad(key, "is " + Written(*v) + "; must be a string");
+    }
     *out = v->get<std::string>();
     return Status::Ok();
   }
   Status Number(const char* key, bool required, double* out) const {
     const Json* v = Find(key);
     if (!v || v->is_null()) return required ? Missing(key) : Status::Ok();
-    if (!v->is_number()) return Bad(key, "must be a number");
+    if (!NonFiniteToken(*v).empty()) {
+      return Bad(key, "is " + Written(*v) + "; must be a finite number");
+    }
+    if (!v->is_number()) return Bad(key, "is " + Written(*v) + "; must be a number");
     *out = v->get<double>();
     if (!std::isfinite(*out)) return Bad(key, "must be finite");
     return Status::Ok();
@@ -47,7 +64,11 @@ class Fields {
   Status Integer(const char* key, bool required, int64_t* out) const {
     const Json* v = Find(key);
     if (!v || v->is_null()) return required ? Missing(key) : Status::Ok();
-    if (!v->is_number_integer()) return Bad(key, "must be an integer");
+    if (!v->is_number_integer()) return Bad(key, "is " + Written(*v) + "; must be an integer");
+    // A uint64 above INT64_MAX would wrap.
+    if (v->is_number_unsigned() && v->get<uint64_t>() > uint64_t{INT64_MAX}) {
+      return Bad(key, "is " + Written(*v) + ", out of range");
+    }
     *out = v->get<int64_t>();
     return Status::Ok();
   }
@@ -55,21 +76,24 @@ class Fields {
     const auto it = j_.find(key);
     return it == j_.end() ? nullptr : &*it;
   }
-  Status Missing(const char* key) const {
-    return Status::Error(where_ + ": missing \"" + key + "\"");
-  }
+  std::string Name(const char* key) const { return "\"" + prefix_ + key + "\""; }
+  Status Missing(const char* key) const { return Status::Error(where_ + ": missing " + Name(key)); }
   Status Bad(const char* key, const std::string& what) const {
-    return Status::Error(where_ + ": \"" + key + "\" " + what);
+    return Status::Error(where_ + ": " + Name(key) + " " + what);
   }
 
  private:
   const Json& j_;
   std::string where_;
+  std::string prefix_;  // "frames.", "cameras[2]."
 };
 
-Status ParseCamera(const Json& j, const std::string& where, CaptureCamera* cam) {
-  if (!j.is_object()) return Status::Error(where + ": must be an object");
-  Fields f(j, where);
+Status ParseCamera(const Json& j,
+                   const std::string& source,
+                   const std::string& prefix,
+                   CaptureCamera* cam) {
+  if (!j.is_object()) return Status::Error(source + ": \"" + prefix + "\" must be an object");
+  Fields f(j, source, prefix + ".");
   ARCO_RETURN_IF_ERROR(f.String("name", true, &cam->name));
   if (cam->name.empty()) return f.Bad("name", "must not be empty");
   ARCO_RETURN_IF_ERROR(f.String("serial", false, &cam->serial));
@@ -77,12 +101,18 @@ Status ParseCamera(const Json& j, const std::string& where, CaptureCamera* cam) 
   if (const Json* drops = f.Find("dropped_frames"); drops && !drops->is_null()) {
     if (!drops->is_array()) return f.Bad("dropped_frames", "must be an array of frame numbers");
     for (const Json& d : *drops) {
-      if (!d.is_number_integer()) return f.Bad("dropped_frames", "must hold integers");
+      if (!d.is_number_integer() ||
+          (d.is_number_unsigned() && d.get<uint64_t>() > uint64_t{INT64_MAX})) {
+        return f.Bad("dropped_frames", "holds " + Written(d) + "; must hold integer frame numbers");
+      }
       cam->dropped_frames.push_back(d.get<int64_t>());
     }
+    // Any order; a frame listed twice means the file's writer is broken.
     std::sort(cam->dropped_frames.begin(), cam->dropped_frames.end());
-    cam->dropped_frames.erase(std::unique(cam->dropped_frames.begin(), cam->dropped_frames.end()),
-                              cam->dropped_frames.end());
+    const auto twice = std::adjacent_find(cam->dropped_frames.begin(), cam->dropped_frames.end());
+    if (twice != cam->dropped_frames.end()) {
+      return f.Bad("dropped_frames", "lists frame " + std::to_string(*twice) + " twice");
+    }
   }
   return Status::Ok();
 }
@@ -116,7 +146,8 @@ int64_t CaptureManifest::VideoFrameNumber(int view, int64_t global_frame) const 
 }
 
 StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const std::string& source) {
-  ARCO_ASSIGN_OR_RETURN(Json j, ParseJsonLenient(text, source));
+  // NaN / Infinity tokens (not JSON, but Python writes them) are told from absent fields.
+  ARCO_ASSIGN_OR_RETURN(Json j, ParseJsonMarkingNonFinite(text, source));
   if (!j.is_object()) return Status::Error(source + ": a capture manifest must be a JSON object");
   Fields f(j, source);
   std::string format;
@@ -132,28 +163,41 @@ StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const st
   ARCO_RETURN_IF_ERROR(f.String("name", false, &m.name));
   ARCO_RETURN_IF_ERROR(f.String("instrument", false, &m.instrument));
   if (!Instruments().count(m.instrument)) {
-    return f.Bad("instrument", "must be cello, violin, viola, double_bass or none");
+    return f.Bad("instrument",
+                 "is \"" + m.instrument + "\"; must be cello, violin, viola, double_bass or none");
   }
   ARCO_RETURN_IF_ERROR(f.Number("fps", true, &m.fps));
-  if (!(m.fps > 0 && m.fps <= 10000)) return f.Bad("fps", "must be in (0, 10000]");
+  if (!(m.fps > 0 && m.fps <= kMaxCaptureFps)) {
+    return f.Bad("fps",
+                 "is " + Written(*f.Find("fps")) + "; must be in (0, 10000] frames per second");
+  }
   const Json* frames = f.Find("frames");
-  if (!frames || !frames->is_object()) return f.Missing("frames");
-  Fields ff(*frames, source + ": frames");
+  if (!frames || frames->is_null()) return f.Missing("frames");
+  if (!frames->is_object()) return f.Bad("frames", "must be an object {\"first\", \"count\"}");
+  Fields ff(*frames, source, "frames.");
   ARCO_RETURN_IF_ERROR(ff.Integer("first", true, &m.frame_first));
   ARCO_RETURN_IF_ERROR(ff.Integer("count", true, &m.frame_count));
-  if (m.frame_count < 0 || m.frame_count > 100000000) {
-    return ff.Bad("count", "must be in [0, 1e8]");
+  if (m.frame_count < 0 || m.frame_count > kMaxCaptureFrames) {
+    return ff.Bad("count", "is " + std::to_string(m.frame_count) + "; must be in [0, 1e8]");
   }
-  if (std::abs(m.frame_first) > (int64_t{1} << 40)) return ff.Bad("first", "is out of range");
+  if (m.frame_first < 0 || m.frame_first > kMaxCaptureFrameNumber) {
+    return ff.Bad("first",
+                  "is " + std::to_string(m.frame_first) +
+                      "; must be in [0, 2^40] (global frame "
+                      "numbers, 1 for the recording's first frame)");
+  }
   ARCO_RETURN_IF_ERROR(f.Number("tuning_a4_hz", false, &m.tuning_a4_hz));
   if (!(m.tuning_a4_hz >= 300 && m.tuning_a4_hz <= 600)) {
-    return f.Bad("tuning_a4_hz", "must be in [300, 600] Hz");
+    return f.Bad("tuning_a4_hz",
+                 "is " + Written(*f.Find("tuning_a4_hz")) + "; must be in [300, 600] Hz");
   }
   ARCO_RETURN_IF_ERROR(f.String("calibration", true, &m.calibration));
+  if (m.calibration.empty()) return f.Bad("calibration", "is empty; must name a calibration file");
   if (const Json* audio = f.Find("audio"); audio && !audio->is_null()) {
     if (!audio->is_object()) return f.Bad("audio", "must be an object {\"file\", \"offset_s\"}");
-    Fields fa(*audio, source + ": audio");
+    Fields fa(*audio, source, "audio.");
     ARCO_RETURN_IF_ERROR(fa.String("file", true, &m.audio));
+    if (m.audio.empty()) return fa.Bad("file", "is empty; must name an audio file");
     ARCO_RETURN_IF_ERROR(fa.Number("offset_s", false, &m.audio_offset_s));
     ARCO_RETURN_IF_ERROR(fa.Number("sync_confidence", false, &m.audio_sync_confidence));
     if (!std::isnan(m.audio_sync_confidence) &&
@@ -163,13 +207,16 @@ StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const st
   }
   if (const Json* k = f.Find("keypoints2d"); k && !k->is_null()) {
     if (!k->is_object()) return f.Bad("keypoints2d", "must be an object {\"file\", \"layout\"}");
-    Fields fk(*k, source + ": keypoints2d");
+    Fields fk(*k, source, "keypoints2d.");
     ARCO_RETURN_IF_ERROR(fk.String("file", true, &m.keypoints2d));
+    if (m.keypoints2d.empty()) return fk.Bad("file", "is empty; must name a .npy file");
     ARCO_RETURN_IF_ERROR(fk.String("layout", true, &m.layout));
     if (const Json* names = fk.Find("names"); names && !names->is_null()) {
       if (!names->is_array()) return fk.Bad("names", "must be an array of strings");
       for (const Json& n : *names) {
-        if (!n.is_string()) return fk.Bad("names", "must be an array of strings");
+        if (!n.is_string() || !NonFiniteToken(n).empty()) {
+          return fk.Bad("names", "must be an array of strings");
+        }
         m.keypoint_names.push_back(n.get<std::string>());
       }
     }
@@ -180,13 +227,23 @@ StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const st
   if (!cams || !cams->is_array() || cams->empty()) {
     return Status::Error(source + ": \"cameras\" must be a non-empty array");
   }
+  const int64_t frame_last = m.frame_first + m.frame_count - 1;
   std::set<std::string> names;
   for (size_t i = 0; i < cams->size(); ++i) {
     CaptureCamera cam;
-    ARCO_RETURN_IF_ERROR(
-        ParseCamera((*cams)[i], source + ": cameras[" + std::to_string(i) + "]", &cam));
+    const std::string prefix = "cameras[" + std::to_string(i) + "]";
+    ARCO_RETURN_IF_ERROR(ParseCamera((*cams)[i], source, prefix, &cam));
     if (!names.insert(cam.name).second) {
       return Status::Error(source + ": camera \"" + cam.name + "\" is listed twice");
+    }
+    // Drops before frames.first still number the video's frames; after the last frame
+    // or below 0 they name no frame of this recording.
+    for (int64_t g : cam.dropped_frames) {
+      if (g < 0 || g > frame_last) {
+        return Status::Error(source + ": \"" + prefix + ".dropped_frames\" holds frame " +
+                             std::to_string(g) + ", outside 0.." + std::to_string(frame_last) +
+                             " (frames.first + frames.count - 1)");
+      }
     }
     m.cameras.push_back(std::move(cam));
   }
@@ -241,27 +298,50 @@ std::string ResolveCapturePath(const std::string& dir, const std::string& entry)
   return JoinPath(dir, entry);
 }
 
-StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,
-                                                  const CaptureManifest& m) {
+namespace {
+
+std::string ShapeString(const std::vector<int64_t>& s) {
+  std::string out = "(";
+  for (size_t i = 0; i < s.size(); ++i) out += (i ? ", " : "") + std::to_string(s[i]);
+  return out + ")";
+}
+
+}  // namespace
+
+Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureManifest& m) {
   const std::string manifest_path = JoinPath(capture_dir, kCaptureManifestName);
   if (m.keypoints2d.empty()) {
     return Status::Error(manifest_path +
                          ": no \"keypoints2d\" entry (2D keypoints to triangulate)");
   }
   const std::string path = ResolveCapturePath(capture_dir, m.keypoints2d);
+  ARCO_ASSIGN_OR_RETURN(const NpyHeader header, ReadNpyHeader(path));
+  // Pixel coordinates are fractional: an integer array is a writer's mistake (rounded
+  // pixels, or scores of 0/1), not something to convert silently.
+  if (!header.is_float) {
+    return Status::Error(path + ": dtype " + header.dtype +
+                         "; keypoints2d must be float32 or float64 (x_px, y_px, score; NaN = "
+                         "missing)");
+  }
+  StatusOr<KeypointLayout> layout = m.Layout();
+  if (!layout.ok()) return layout.status().WithContext(manifest_path);
+  const std::vector<int64_t> expected = {
+      m.frame_count, static_cast<int64_t>(m.cameras.size()), layout->size(), 3};
+  if (header.shape != expected) {
+    return Status::Error(path + ": shape " + ShapeString(header.shape) +
+                         " does not match capture.json " + ShapeString(expected) +
+                         " (frames.count, cameras, " + layout->name + " points, 3)");
+  }
+  return Status::Ok();
+}
+
+StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,
+                                                  const CaptureManifest& m) {
+  ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(capture_dir, m));
+  const std::string path = ResolveCapturePath(capture_dir, m.keypoints2d);
   ARCO_ASSIGN_OR_RETURN(NpyArray<double> k, ReadNpy<double>(path));
   ARCO_ASSIGN_OR_RETURN(KeypointLayout layout, m.Layout());
-  const std::vector<int64_t> expected = {
-      m.frame_count, static_cast<int64_t>(m.cameras.size()), layout.size(), 3};
-  if (k.shape != expected) {
-    auto str = [](const std::vector<int64_t>& s) {
-      std::string out = "(";
-      for (size_t i = 0; i < s.size(); ++i) out += (i ? ", " : "") + std::to_string(s[i]);
-      return out + ")";
-    };
-    return Status::Error(path + ": shape " + str(k.shape) + " does not match the manifest " +
-                         str(expected) + " (frames, cameras, " + layout.name + " points, 3)");
-  }
+  if (k.shape.size() != 4) return Status::Error(path + ": changed while being read");
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (size_t v = 0; v < m.cameras.size(); ++v) {
     for (int64_t g : m.cameras[v].dropped_frames) {

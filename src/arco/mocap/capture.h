@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "arco/registry/keypoint_layout.h"
 #include "arco/mocap/triangulate_sequence.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/util/json_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/status.h"
@@ -27,6 +27,11 @@ namespace arco {
 
 inline constexpr char kCaptureManifestName[] = "capture.json";
 inline constexpr char kResultManifestName[] = "result.json";
+
+// capture.json's ranges (ParseCaptureManifest).
+inline constexpr double kMaxCaptureFps = 10000;
+inline constexpr int64_t kMaxCaptureFrames = 100000000;              // frames.count
+inline constexpr int64_t kMaxCaptureFrameNumber = int64_t{1} << 40;  // frames.first
 
 struct CaptureCamera {
   std::string name;                     // matches a calibration camera's name or serial
@@ -43,12 +48,12 @@ struct CaptureManifest {
   int64_t frame_first = 1;  // global number of the first frame in the arrays
   int64_t frame_count = 0;
   double tuning_a4_hz = 440.0;
-  std::string calibration;                  // calibration file (any format arco reads)
-  std::string audio;                        // optional audio file
+  std::string calibration;      // calibration file (any format arco reads)
+  std::string audio;            // optional audio file
   double audio_offset_s = 0.0;  // audio time of frame `frame_first`'s timestamp (mid-exposure)
   double audio_sync_confidence = NAN;  // arco sync's confidence in audio_offset_s (NaN: none)
-  std::string keypoints2d;                  // optional .npy of 2D keypoints
-  std::string layout;                       // keypoint layout name, or "custom" with keypoint_names
+  std::string keypoints2d;      // optional .npy of 2D keypoints
+  std::string layout;           // keypoint layout name, or "custom" with keypoint_names
   std::vector<std::string> keypoint_names;  // only for layout "custom"
   std::vector<CaptureCamera> cameras;
 
@@ -72,8 +77,13 @@ Status WriteCaptureManifest(const std::string& capture_dir, const CaptureManifes
 // Path of a manifest entry: relative entries are resolved against `dir`.
 std::string ResolveCapturePath(const std::string& dir, const std::string& entry);
 
-// Reads the 2D keypoints named by the manifest and checks their shape against it:
-// (frame_count, cameras, layout size, 3). Frames a camera dropped are set to NaN.
+// Checks the 2D keypoints named by the manifest from the .npy header alone (before any
+// work): the file is readable, its dtype float32/float64 (any other is an error naming
+// the dtype: integer pixels are a writer's mistake, not converted) and its shape
+// (frames.count, cameras, layout size, 3).
+Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureManifest& manifest);
+// Reads the 2D keypoints named by the manifest after CheckCaptureKeypoints2d. Frames a
+// camera dropped are set to NaN.
 StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,
                                                   const CaptureManifest& manifest);
 

@@ -53,7 +53,7 @@ TEST(CaptureManifest, WriteThenReadRoundTrips) {
   auto r = ReadCaptureManifest(dir.path());
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_EQ(CaptureManifestToJson(*r), CaptureManifestToJson(m));
-  EXPECT_EQ(r->cameras[0].dropped_frames, (std::vector<int64_t>{129, 300}));
+  EXPECT_EQ(r->cameras[0].dropped_frames, (std::vector<int64_t>{129, 131}));
   EXPECT_EQ(r->FindCamera("21334237"), 1);
   EXPECT_EQ(r->FindCamera("cam0"), 0);
   EXPECT_EQ(r->FindCamera("cam9"), -1);
@@ -67,7 +67,7 @@ TEST(CaptureManifest, WriteThenReadRoundTrips) {
 }
 
 TEST(CaptureManifest, VideoFrameNumbersSkipDroppedFrames) {
-  const CaptureManifest m = SampleManifest();  // cam0 dropped 129 and 300
+  const CaptureManifest m = SampleManifest();  // cam0 dropped 129 and 131
   EXPECT_EQ(m.VideoFrameNumber(0, 128), 128);
   EXPECT_EQ(m.VideoFrameNumber(0, 129), -1);
   EXPECT_EQ(m.VideoFrameNumber(0, 130), 129);
@@ -108,6 +108,82 @@ TEST(CaptureManifest, MalformedManifestsNameTheFileAndProblem) {
       ParseCaptureManifest("{\"format\": \"arco-capture\", \"fps\": NaN}", "cap/capture.json"), "");
   expect_error(ParseCaptureManifest("[1, 2]", "cap/capture.json"), "object");
   EXPECT_FALSE(ReadCaptureManifest("/nonexistent/dir").ok());
+}
+
+// issue 11: values that were accepted silently, each rejected naming the file and field.
+TEST(CaptureManifest, ContentOutsideItsRangeNamesTheField) {
+  const Json good = CaptureManifestToJson(SampleManifest());
+  auto message = [&](auto edit) -> std::string {
+    Json j = good;
+    edit(j);
+    auto r = ParseCaptureManifest(j.dump(), "cap/capture.json");
+    return r.ok() ? "accepted" : r.status().message();
+  };
+  EXPECT_EQ(message([](Json& j) { j["frames"]["first"] = -5; }),
+            "cap/capture.json: \"frames.first\" is -5; must be in [0, 2^40] (global frame "
+            "numbers, 1 for the recording's first frame)");
+  EXPECT_EQ(message([](Json& j) { j["frames"]["count"] = -1; }),
+            "cap/capture.json: \"frames.count\" is -1; must be in [0, 1e8]");
+  EXPECT_EQ(message([](Json& j) { j["cameras"][0]["dropped_frames"] = {-3}; }),
+            "cap/capture.json: \"cameras[0].dropped_frames\" holds frame -3, outside 0..131 "
+            "(frames.first + frames.count - 1)");
+  EXPECT_EQ(message([](Json& j) { j["cameras"][1]["dropped_frames"] = {99999}; }),
+            "cap/capture.json: \"cameras[1].dropped_frames\" holds frame 99999, outside 0..131 "
+            "(frames.first + frames.count - 1)");
+  EXPECT_EQ(message([](Json& j) {
+              j["cameras"][0]["dropped_frames"] = {130, 129, 130};
+            }),
+            "cap/capture.json: \"cameras[0].dropped_frames\" lists frame 130 twice");
+  EXPECT_EQ(message([](Json& j) { j["fps"] = 0; }),
+            "cap/capture.json: \"fps\" is 0; must be in (0, 10000] frames per second");
+  EXPECT_EQ(message([](Json& j) { j["fps"] = "30"; }),
+            "cap/capture.json: \"fps\" is \"30\"; must be a number");
+  EXPECT_EQ(message([](Json& j) { j["audio"]["file"] = ""; }),
+            "cap/capture.json: \"audio.file\" is empty; must name an audio file");
+  // Any order is accepted and sorted.
+  EXPECT_EQ(message([](Json& j) { j["cameras"][0]["dropped_frames"] = {131, 128}; }), "accepted");
+}
+
+// JSON has no NaN: a Python-written NaN / Infinity is named as such, not as a missing field.
+TEST(CaptureManifest, NonFiniteTokensAreNamedNotMissing) {
+  const std::string good = CaptureManifestToJson(SampleManifest()).dump();
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string text = good;
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+    auto r = ParseCaptureManifest(text, "cap/capture.json");
+    return r.ok() ? std::string("accepted") : r.status().message();
+  };
+  EXPECT_EQ(with("\"fps\":30.0", "\"fps\":NaN"),
+            "cap/capture.json: \"fps\" is NaN; must be a finite number");
+  EXPECT_EQ(with("\"fps\":30.0", "\"fps\":Infinity"),
+            "cap/capture.json: \"fps\" is Infinity; must be a finite number");
+  EXPECT_EQ(with("\"fps\":30.0", "\"fps\":-Infinity"),
+            "cap/capture.json: \"fps\" is -Infinity; must be a finite number");
+  EXPECT_EQ(with("\"offset_s\":1.25", "\"offset_s\":NaN"),
+            "cap/capture.json: \"audio.offset_s\" is NaN; must be a finite number");
+  EXPECT_EQ(with("\"first\":128", "\"first\":NaN"),
+            "cap/capture.json: \"frames.first\" is NaN; must be an integer");
+  EXPECT_EQ(with("\"name\":\"cam0\"", "\"name\":NaN"),
+            "cap/capture.json: \"cameras[0].name\" is NaN; must be a string");
+}
+
+TEST(CaptureKeypoints, IntegerDtypeIsRejectedNamingIt) {
+  TempDir dir;
+  CaptureManifest m = SampleManifest();
+  ASSERT_TRUE(WriteCaptureManifest(dir.path(), m).ok());
+  NpyArray<int32_t> k;
+  k.shape = {4, 2, 142, 3};
+  k.data.assign(4 * 2 * 142 * 3, 5);
+  ASSERT_TRUE(WriteNpy(dir / "keypoints2d.npy", k).ok());
+  const Status checked = CheckCaptureKeypoints2d(dir.path(), m);
+  ASSERT_FALSE(checked.ok());
+  EXPECT_EQ(checked.message(),
+            (dir / "keypoints2d.npy") +
+                ": dtype int32; keypoints2d must be float32 or float64 (x_px, y_px, score; NaN = "
+                "missing)");
+  EXPECT_FALSE(ReadCaptureKeypoints2d(dir.path(), m).ok());
 }
 
 TEST(CaptureKeypoints, ShapeIsCheckedAndDroppedFramesBecomeNaN) {

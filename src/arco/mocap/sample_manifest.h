@@ -19,7 +19,7 @@ inline CaptureManifest SampleManifest() {
   m.audio_offset_s = 1.25;
   m.keypoints2d = "keypoints2d.npy";
   m.layout = "spd_cello";
-  m.cameras = {{"cam0", "21334181", "videos/21334181.avi", {129, 300}},
+  m.cameras = {{"cam0", "21334181", "videos/21334181.avi", {129, 131}},  // inside frames 128..131
                {"cam1", "21334237", "", {}}};
   return m;
 }

@@ -1,5 +1,6 @@
 #include "arco/pipeline/import_spd.h"
 
+#include <algorithm>
 #include <filesystem>
 
 #include "arco/calibration/calibration_file.h"
@@ -41,6 +42,7 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
   }
   // Views: the serials given, else every calibrated camera with a keypoint folder.
   std::vector<int> cameras;
+  std::vector<std::string> warnings;
   if (o.serials.empty()) {
     for (size_t c = 0; c < calibration.rig.cameras.size(); ++c) {
       const std::string& serial = calibration.rig.cameras[c].serial;
@@ -50,6 +52,20 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
     }
     if (cameras.empty()) {
       return Status::Error(o.human_dir + ": no <serial> folder of any camera in " + o.calibration);
+    }
+    // A keypoint folder of a camera the calibration lacks cannot be triangulated: the
+    // import goes on with the calibrated ones (a camera that failed to calibrate should
+    // not block a session), but says which it leaves out.
+    std::vector<std::string> folders;
+    for (fs::directory_iterator it(o.human_dir, ec), end; !ec && it != end; it.increment(ec)) {
+      if (it->is_directory(ec)) folders.push_back(it->path().filename().string());
+    }
+    std::sort(folders.begin(), folders.end());
+    for (const std::string& folder : folders) {
+      if (calibration.rig.FindCamera(folder) < 0) {
+        warnings.push_back(JoinPath(o.human_dir, folder) + ": camera " + folder + " is not in " +
+                           o.calibration + "; its keypoints are not imported");
+      }
     }
   } else {
     for (const std::string& s : o.serials) {
@@ -84,7 +100,14 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
     const Camera& cam = calibration.rig.cameras[cameras[v]];
     CaptureCamera cc{cam.name, cam.serial, "", {}};
     if (auto it = spd.frame_drops.find(spd.serials[v]); it != spd.frame_drops.end()) {
-      cc.dropped_frames = it->second;
+      // The session's log covers the whole recording: drops before the first frame still
+      // number the video's frames; those after the last name no frame of this capture.
+      for (int64_t g : it->second) {
+        if (g >= 0 && g <= spd.frame_last) cc.dropped_frames.push_back(g);
+      }
+      std::sort(cc.dropped_frames.begin(), cc.dropped_frames.end());
+      cc.dropped_frames.erase(std::unique(cc.dropped_frames.begin(), cc.dropped_frames.end()),
+                              cc.dropped_frames.end());
     }
     m.cameras.push_back(cc);
   }
@@ -109,6 +132,7 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
   out.frames = keypoints.shape[0];
   out.views = keypoints.shape[1];
   out.points = keypoints.shape[2];
+  out.warnings = warnings;
   return out;
 }
 

@@ -30,6 +30,8 @@ struct ImportSpdOptions {
 struct ImportSpdSummary {
   SpdImportReport files;
   int64_t frames = 0, views = 0, points = 0;
+  // A keypoint folder of a camera the calibration lacks (not imported), one line each.
+  std::vector<std::string> warnings;
 };
 
 // Writes OUTPUT_DIR/{capture.json, keypoints2d.npy, calibration file[, audio]}; built in

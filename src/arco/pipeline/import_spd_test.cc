@@ -50,9 +50,13 @@ TEST(ImportSpdCapture, SpdFoldersToCaptureToTriangulation) {
     for (int c = 0; c < 3; ++c) k.at(1, 2, p, c) = NAN;
   }
   ASSERT_TRUE(ExportSpdKeypoints(spd, k).ok());
+
+  // A keypoint folder of a camera the calibration lacks; the log's drops after the last
+  // frame name no frame of the capture.
+  ASSERT_TRUE(MakeDirectories(dir / "human/99999999").ok());
   ASSERT_TRUE(AtomicWriteFile(dir / "summary.json",
                               "{\"StartFrame\": 10, \"EndFrame\": 12, \"FrameDropIDLog\": {\"" +
-                                  spd.serials[2] + "\": [11]}}")
+                                  spd.serials[2] + "\": [11, 11, 400]}}")
                   .ok());
 
   ImportSpdOptions o;
@@ -67,6 +71,10 @@ TEST(ImportSpdCapture, SpdFoldersToCaptureToTriangulation) {
   EXPECT_EQ(imported->views, 6);  // the cameras with a folder, in calibration order
   EXPECT_EQ(imported->points, 142);
   EXPECT_EQ(imported->files.frames_dropped, 1);
+  ASSERT_EQ(imported->warnings.size(), 1u);
+  EXPECT_EQ(imported->warnings[0],
+            (dir / "human/99999999") + ": camera 99999999 is not in " + kCalibration +
+                "; its keypoints are not imported");
   auto manifest = ReadCaptureManifest(o.output_dir);
   ASSERT_TRUE(manifest.ok()) << manifest.status().message();
   EXPECT_EQ(manifest->layout, "spd_cello");

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "arco/mocap/capture.h"
+#include "arco/pipeline/preflight.h"
 #include "arco/util/file_io.h"
 #include "arco/util/output_set.h"
 
@@ -40,6 +41,11 @@ StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, Progress& progress) 
     if (std::isnan(start_s)) start_s = manifest.audio_offset_s;
     if (std::isnan(a4_hz)) a4_hz = manifest.tuning_a4_hz;
     if (frames < 0 && manifest.frame_count > 0) frames = manifest.frame_count;
+    // The manifest's audio at the manifest's offset: a bad offset is capture.json's
+    // audio.offset_s, not a --start-s the user did not give.
+    if (o.input.empty() && std::isnan(o.start_s)) {
+      ARCO_RETURN_IF_ERROR(CheckCaptureAudio(o.capture_dir, manifest).status());
+    }
   }
   if (result.input.empty()) return Status::Error("no input: give an audio file or --capture");
   ARCO_ASSIGN_OR_RETURN(auto range,
@@ -139,6 +145,11 @@ StatusOr<SyncRunResult> RunSync(const SyncRunOptions& o) {
   }
   if (views.empty()) return Status::Error("no video to sync with: give one or a capture");
   ARCO_ASSIGN_OR_RETURN(out.sync, audio::SyncAudioToVideos(o.audio, views, sync));
+  // A truncated audio file: the same warning as arco pitch and arco run (the header only).
+  if (auto reader = audio::OpenAudio(o.audio); reader.ok()) {
+    const std::string truncated = audio::TruncationWarning((*reader)->info());
+    if (!truncated.empty()) out.sync.warnings.push_back(truncated);
+  }
   out.offset_s = out.sync.offset_s;
   if (!o.capture_dir.empty()) {
     // sync.offset_s is the audio time of global frame 0; the manifest's offset is that

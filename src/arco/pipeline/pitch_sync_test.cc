@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -258,6 +259,45 @@ TEST(RunSync, NoEventWritesNothing) {
   ASSERT_FALSE(sync.ok());
   EXPECT_NE(sync.status().message().find("no sound event"), std::string::npos);
   EXPECT_EQ(*ReadFileToString(JoinPath(c.dir, kCaptureManifestName)), *before);
+}
+
+// A WAV cut short: arco sync and arco pitch give the same warning (audio::TruncationWarning).
+TEST(RunSyncAndPitch, TruncatedWavIsAWarningNamingTheFile) {
+  testing::TestVideo video;
+  video.frames = 60;
+  video.brightness = [](int k) { return k >= 15 ? 200.0 : 40.0; };
+  const std::string mkv = testing::TempPath("trunc_sync.mkv");
+  ASSERT_TRUE(testing::WriteTestVideo(mkv, video).ok());
+  std::vector<float> audio(4 * 44100, 0.0f);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> gauss(0, 1);
+  for (int i = 0; i < 60; ++i)
+    audio[88200 + i] += static_cast<float>(0.9 * std::exp(-i / 20.0) * gauss(rng));
+  const std::string whole = testing::TempPath("trunc_sync_whole.wav");
+  ASSERT_TRUE(testing::WriteWav(whole, audio, 44100).ok());
+  auto bytes = ReadFileToString(whole);
+  ASSERT_TRUE(bytes.ok());
+  const size_t data = bytes->find("data") + 8;  // 16-bit mono: 2 bytes a sample
+  const std::string wav = testing::TempPath("trunc_sync.wav");
+  ASSERT_TRUE(AtomicWriteFile(wav, bytes->substr(0, data + 2 * 3 * 44100)).ok());  // 3 of 4 s
+  const std::string expected = wav +
+                               ": truncated: the header promises 176400 samples (4.000 s), the "
+                               "file holds 132300 (1.000 s missing)";
+  SyncRunOptions s;
+  s.audio = wav;
+  s.videos = {mkv};
+  s.sync.video_event = audio::VideoEvent::kFlash;
+  auto sync = RunSync(s);
+  ASSERT_TRUE(sync.ok()) << sync.status().message();
+  EXPECT_NE(std::find(sync->sync.warnings.begin(), sync->sync.warnings.end(), expected),
+            sync->sync.warnings.end());
+  PitchRunOptions p;
+  p.input = wav;
+  p.output = testing::TempPath("trunc_pitch.csv");
+  auto pitch = RunPitch(p);
+  ASSERT_TRUE(pitch.ok()) << pitch.status().message();
+  EXPECT_NE(std::find(pitch->summary.warnings.begin(), pitch->summary.warnings.end(), expected),
+            pitch->summary.warnings.end());
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <sstream>
 
@@ -13,6 +14,23 @@
 #include "arco/util/output_set.h"
 
 namespace arco::pipeline {
+namespace {
+
+// A relative `path` (from the working folder) made relative to the folder `base`; an
+// absolute one stays absolute (right from anywhere, as the user gave it).
+std::string PathRelativeTo(const std::string& path, const std::string& base) {
+  namespace fs = std::filesystem;
+  if (fs::path(path).is_absolute()) return NormalizeOutputPath(path);
+  const fs::path from = fs::absolute(base).lexically_normal();
+  const fs::path to = fs::absolute(path).lexically_normal();
+  const fs::path relative = to.lexically_relative(from);
+  std::string out = relative.empty() ? to.string() : relative.string();
+  while (out.size() > 1 && out.back() == '/') out.pop_back();
+  return out;
+}
+
+}  // namespace
+
 namespace {
 
 // File names inside the stage folders.
@@ -97,6 +115,11 @@ StatusOr<ResultHeader> ResultFolder::ReadHeader() const {
   if (result.contains("frames")) {
     h.frame_first = result["frames"].value("first", int64_t{1});
     h.frame_count = result["frames"].value("count", int64_t{0});
+  }
+  // "capture" is relative to the result folder (absolute stays absolute).
+  if (result.contains("capture") && result["capture"].is_string()) {
+    const std::string capture = result["capture"].get<std::string>();
+    if (!capture.empty()) h.capture_dir = NormalizeOutputPath(ResolveCapturePath(dir_, capture));
   }
   return h;
 }
@@ -199,7 +222,10 @@ Status ResultFolder::WriteTriangulation(const CaptureManifest& manifest,
 
   result["format"] = "arco-result";
   result["version"] = 1;
-  result["capture"] = record.capture_dir;
+  // Relative to the result folder (docs/formats.md), so that the two can move together
+  // (absolute when given so); dir_ may be a temporary sibling of the final folder: the
+  // same parent, the same relative path.
+  result["capture"] = PathRelativeTo(record.capture_dir, dir_);
   result["name"] = manifest.name;
   result["instrument"] = manifest.instrument;
   result["fps"] = manifest.fps;

@@ -120,6 +120,7 @@ struct ResultHeader {
   int64_t frame_first = 1;
   int64_t frame_count = 0;
   std::vector<std::string> keypoint_names;
+  std::string capture_dir;  // "capture", resolved against the result folder ("" when absent)
 };
 
 class ResultFolder {

@@ -57,7 +57,10 @@ TEST(ResultFolder, TriangulationWritesStageFolderAndKeepsOtherStages) {
   raw.inlier_mask.shape = {4, 142, 2};
   raw.inlier_mask.data.assign(4 * 142 * 2, 1);
   TriangulationRecord info;
-  info.capture_dir = "cap";
+  // As a user gives it: relative to the working folder.
+  info.capture_dir = std::filesystem::path(dir / "captures/cap/")
+                         .lexically_relative(std::filesystem::current_path())
+                         .string();
   info.units = "m";
   info.summary = Summarize(raw);
   ASSERT_TRUE(ResultFolder(result_dir)
@@ -68,6 +71,17 @@ TEST(ResultFolder, TriangulationWritesStageFolderAndKeepsOtherStages) {
   EXPECT_TRUE((*manifest)["stages"].contains("arco"));
   EXPECT_EQ((*manifest)["stages"]["triangulation"]["summary"]["triangulated"], 568);
   EXPECT_EQ((*manifest)["keypoint_names"].size(), 142u);
+  // The capture path is relative to the result folder, and read back against it.
+  EXPECT_EQ((*manifest)["capture"], "../captures/cap");
+  auto header = ResultFolder(result_dir).ReadHeader();
+  ASSERT_TRUE(header.ok());
+  EXPECT_EQ(header->capture_dir, dir / "captures/cap");
+  // An absolute path stays absolute.
+  info.capture_dir = dir / "captures/cap/";
+  ASSERT_TRUE(ResultFolder(result_dir)
+                  .WriteTriangulation(m, *FindKeypointLayout("spd_cello"), raw, raw.points3d, info)
+                  .ok());
+  EXPECT_EQ((*ResultFolder(result_dir).ReadManifest())["capture"], dir / "captures/cap");
   auto points = ResultFolder(result_dir).ReadPoints3d(kTriangulationStage);
   ASSERT_TRUE(points.ok());
   EXPECT_EQ(points->shape, raw.points3d.shape);

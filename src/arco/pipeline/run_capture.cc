@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "arco/pipeline/capture_context.h"
+#include "arco/pipeline/preflight.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/util/atomic_dir.h"
 
@@ -131,9 +132,8 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
 }  // namespace
 
 StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
-  ARCO_RETURN_IF_ERROR(options.Validate());
-  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options.result_dir, options.Replace()));
-  ARCO_ASSIGN_OR_RETURN(const CaptureContext capture, OpenCapture(options.capture_dir));
+  // Every input checked before the first stage (and before the result folder exists).
+  ARCO_ASSIGN_OR_RETURN(const CaptureContext capture, PreflightRun(options));
   // The stages fill a hidden temporary result folder, moved into place once all are done:
   // a failed run leaves no result folder and an old one as it was.
   RunSummary summary;

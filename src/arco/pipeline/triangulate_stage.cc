@@ -2,6 +2,7 @@
 
 #include "arco/calibration/calibration_file.h"
 #include "arco/mocap/capture.h"
+#include "arco/pipeline/preflight.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/util/file_io.h"
 
@@ -39,42 +40,22 @@ StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOpti
     if (!l.ok()) return l.status().WithContext(manifest_path);
     return l;
   }());
-  // Filters refer to groups of the layout; check them before any work.
+  // Filters refer to groups of the layout; checked before any work (pipeline/preflight.h).
+  ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(o, layout, manifest.fps, manifest_path));
   std::vector<const std::vector<int>*> filter_groups;
-  for (const auto& [group, filter] : o.filters) {
-    const std::vector<int>* indices = layout.Group(group);
-    if (!indices) {
-      std::string known;
-      for (const auto& g : layout.groups) known += (known.empty() ? "" : ", ") + g.name;
-      return Status::Error("filter group \"" + group + "\" is not in layout " + layout.name +
-                           " (groups: " + known + ")");
-    }
-    const Status valid = filter.Validate(manifest.fps);
-    if (!valid.ok()) {
-      return Status::Error("filter " + group + "=" + FilterSpecToString(filter) + " at " +
-                           std::to_string(manifest.fps) + " fps (" + manifest_path +
-                           "): " + valid.message());
-    }
-    filter_groups.push_back(indices);
-  }
+  for (const auto& entry : o.filters) filter_groups.push_back(layout.Group(entry.first));
   const std::string calibration_path = ResolveCapturePath(o.capture_dir, manifest.calibration);
-  ARCO_ASSIGN_OR_RETURN(Calibration calibration, LoadCalibration(calibration_path));
-  std::vector<int> view_to_camera;
-  for (const auto& cam : manifest.cameras) {
-    int c = calibration.rig.FindCamera(cam.name);
-    if (c < 0 && !cam.serial.empty()) c = calibration.rig.FindCamera(cam.serial);
-    if (c < 0) {
-      return Status::Error(manifest_path + ": camera \"" + cam.name + "\" is not in " +
-                           calibration_path);
-    }
-    view_to_camera.push_back(c);
-  }
+  StatusOr<Calibration> calibration = LoadCalibration(calibration_path);
+  if (!calibration.ok()) return calibration.status().WithContext(manifest_path + ": calibration");
+  ARCO_ASSIGN_OR_RETURN(
+      const std::vector<int> view_to_camera,
+      MatchCaptureCameras(o.capture_dir, manifest, calibration->rig, calibration_path));
   ARCO_ASSIGN_OR_RETURN(NpyArray<double> keypoints,
                         ReadCaptureKeypoints2d(o.capture_dir, manifest));
   progress.SetTotal(manifest.frame_count);
   ARCO_ASSIGN_OR_RETURN(
       SequenceTriangulation raw,
-      TriangulateSequence(calibration.rig,
+      TriangulateSequence(calibration->rig,
                           view_to_camera,
                           keypoints,
                           o.triangulation,
@@ -86,7 +67,7 @@ StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOpti
   }
   TriangulationRecord record;
   record.capture_dir = o.capture_dir;
-  record.units = calibration.rig.units;
+  record.units = calibration->rig.units;
   record.summary = Summarize(raw);
   record.options = ToJson(o);
   ARCO_RETURN_IF_ERROR(

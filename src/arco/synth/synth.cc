@@ -24,7 +24,7 @@ Status SynthOptions::Validate() const {
   if (!(tempo_scale > 0.05 && tempo_scale < 20))
     return Status::Error("tempo scale must be in (0.05, 20)");
   if (!(max_duration_s >= 0) || !std::isfinite(max_duration_s)) {
-    return Status::Error("max duration must be >= 0 s (0 = whole piece)");
+    return Status::Error("max_duration_s must be >= 0 s (0 = whole piece)");
   }
   if (!(a4_hz >= 300 && a4_hz <= 600)) return Status::Error("a4 must be in [300, 600] Hz");
   if (num_threads < 0) return Status::Error("threads must be >= 0");

@@ -2,15 +2,21 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "arco/util/file_io.h"
 
 namespace arco {
 namespace {
 
+// Marker strings ParseJsonMarkingNonFinite puts in place of the tokens: a control
+// character no JSON text written by a person starts a string with.
+constexpr char kMarkerPrefix = '\x01';
+
 // Replaces NaN/Infinity/-Infinity tokens outside strings by `null` padded with
-// spaces, so byte offsets in parse errors still point at the original text.
-std::string ReplaceNonFiniteTokens(const std::string& text) {
+// spaces, so byte offsets in parse errors still point at the original text; with `mark`,
+// by marker strings instead (offsets after them shift).
+std::string ReplaceNonFiniteTokens(const std::string& text, bool mark = false) {
   std::string out = text;
   bool in_string = false;
   for (size_t i = 0; i < out.size(); ++i) {
@@ -30,6 +36,17 @@ std::string ReplaceNonFiniteTokens(const std::string& text) {
     auto replace = [&](size_t start, size_t len) {
       out.replace(start, len, "null" + std::string(len - 4, ' '));
     };
+    if (mark) {
+      for (const char* token : {"-Infinity", "Infinity", "NaN"}) {
+        const size_t len = std::char_traits<char>::length(token);
+        if (out.compare(i, len, token) != 0) continue;
+        const std::string marker = std::string("\"\\u0001") + token + "\"";  // kMarkerPrefix
+        out.replace(i, len, marker);
+        i += marker.size() - 1;
+        break;
+      }
+      continue;
+    }
     if (out.compare(i, 3, "NaN") == 0) {
       // "NaN" is 3 chars, one short of "null": widen into a preceding sign or fail over.
       if (i > 0 && (out[i - 1] == '-' || out[i - 1] == '+')) {
@@ -63,6 +80,22 @@ StatusOr<Json> ParseJsonLenient(const std::string& text, const std::string& sour
   } catch (const Json::exception& e) {
     return Status::Error(source + ": malformed JSON (" + e.what() + ")");
   }
+}
+
+StatusOr<Json> ParseJsonMarkingNonFinite(const std::string& text, const std::string& source) {
+  try {
+    return Json::parse(ReplaceNonFiniteTokens(text, /*mark=*/true));
+  } catch (const Json::exception& e) {
+    return Status::Error(source + ": malformed JSON (" + e.what() + ")");
+  }
+}
+
+std::string NonFiniteToken(const Json& value) {
+  if (!value.is_string()) return "";
+  const std::string& s = value.get_ref<const std::string&>();
+  if (s.empty() || s[0] != kMarkerPrefix) return "";
+  const std::string token = s.substr(1);
+  return token == "NaN" || token == "Infinity" || token == "-Infinity" ? token : "";
 }
 
 StatusOr<Json> ReadJsonFile(const std::string& path) {

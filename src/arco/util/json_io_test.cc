@@ -1,8 +1,8 @@
 #include "arco/util/json_io.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace arco {
 namespace {
@@ -16,6 +16,19 @@ TEST(ParseJsonLenient, AcceptsBareNaNAndInfinityTokens) {
   EXPECT_TRUE(std::isnan(JsonNumberOrNaN(a[2])));
   EXPECT_TRUE(std::isnan(JsonNumberOrNaN(a[3])));
   EXPECT_EQ((*json)["s"], "NaN");  // strings untouched
+}
+
+TEST(ParseJsonMarkingNonFinite, TellsTheTokensFromNullAndStrings) {
+  auto json = ParseJsonMarkingNonFinite(
+      R"({"a": [NaN, -Infinity, Infinity, null], "s": "NaN", "t": "x NaN"})", "x.json");
+  ASSERT_TRUE(json.ok()) << json.status().message();
+  const Json& a = (*json)["a"];
+  EXPECT_EQ(NonFiniteToken(a[0]), "NaN");
+  EXPECT_EQ(NonFiniteToken(a[1]), "-Infinity");
+  EXPECT_EQ(NonFiniteToken(a[2]), "Infinity");
+  EXPECT_EQ(NonFiniteToken(a[3]), "");          // a real null
+  EXPECT_EQ(NonFiniteToken((*json)["s"]), "");  // a string "NaN" is a string
+  EXPECT_EQ((*json)["t"], "x NaN");
 }
 
 TEST(ParseJsonLenient, MalformedJsonNamesTheSource) {

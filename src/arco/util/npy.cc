@@ -1,7 +1,11 @@
 #include "arco/util/npy.h"
 
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <sstream>
 #include <type_traits>
@@ -95,7 +99,87 @@ Status Convert(const char* raw, int64_t count, const std::string& source, std::v
   return Status::Ok();
 }
 
+// The magic, version and header dict of `bytes` (at least the whole preamble); sets
+// `data_offset` to where the array data starts.
+Status ParsePreamble(const std::string& bytes,
+                     const std::string& source,
+                     Header* header,
+                     size_t* data_offset) {
+  static const char kMagic[] = "\x93NUMPY";
+  if (bytes.size() < 10 || bytes.compare(0, 6, std::string(kMagic, 6)) != 0) {
+    return Status::Error(source + ": not a .npy file (bad magic)");
+  }
+  const int major = static_cast<unsigned char>(bytes[6]);
+  size_t header_len = 0, offset = 0;
+  if (major == 1) {
+    header_len = static_cast<unsigned char>(bytes[8]) |
+                 (static_cast<size_t>(static_cast<unsigned char>(bytes[9])) << 8);
+    offset = 10;
+  } else if (major == 2 || major == 3) {
+    if (bytes.size() < 12) return Status::Error(source + ": truncated .npy header");
+    for (int i = 0; i < 4; ++i) {
+      header_len |= static_cast<size_t>(static_cast<unsigned char>(bytes[8 + i])) << (8 * i);
+    }
+    offset = 12;
+  } else {
+    return Status::Error(source + ": unsupported .npy version " + std::to_string(major));
+  }
+  if (header_len > bytes.size() - offset) return Status::Error(source + ": truncated .npy header");
+  ARCO_RETURN_IF_ERROR(ParseHeader(bytes.substr(offset, header_len), source, header));
+  if (header->fortran_order) return Status::Error(source + ": Fortran-order .npy not supported");
+  *data_offset = offset + header_len;
+  return Status::Ok();
+}
+
 }  // namespace
+
+std::string NpyDtypeName(const std::string& descr) {
+  if (descr == "<f4") return "float32";
+  if (descr == "<f8") return "float64";
+  if (descr == "<i4") return "int32";
+  if (descr == "<i8") return "int64";
+  if (descr == "|u1" || descr == "<u1") return "uint8";
+  if (descr == "|b1") return "bool";
+  return "'" + descr + "'";
+}
+
+StatusOr<NpyHeader> ReadNpyHeader(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return Status::Error(path + ": file not found");
+  if (std::filesystem::is_directory(path, ec)) {
+    return Status::Error(path + ": is a directory, expected a file");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::Error(path + ": cannot open: " + std::strerror(errno));
+  // The preamble is 10 or 12 bytes; the dict's length is in it.
+  std::string bytes(12, '\0');
+  in.read(bytes.data(), 12);
+  bytes.resize(static_cast<size_t>(in.gcount()));
+  size_t header_len = 0;
+  if (bytes.size() >= 10 && bytes[6] == 1) {
+    header_len = static_cast<unsigned char>(bytes[8]) |
+                 (static_cast<size_t>(static_cast<unsigned char>(bytes[9])) << 8);
+  } else if (bytes.size() >= 12) {
+    for (int i = 0; i < 4; ++i) {
+      header_len |= static_cast<size_t>(static_cast<unsigned char>(bytes[8 + i])) << (8 * i);
+    }
+  }
+  // A header dict is a few hundred bytes; cap what a corrupt length makes us read.
+  const size_t more = std::min<size_t>(header_len, size_t{1} << 20);
+  std::string rest(more, '\0');
+  in.read(rest.data(), static_cast<std::streamsize>(more));
+  rest.resize(static_cast<size_t>(in.gcount()));
+  bytes += rest;
+  Header header;
+  size_t data_offset = 0;
+  ARCO_RETURN_IF_ERROR(ParsePreamble(bytes, path, &header, &data_offset));
+  NpyHeader out;
+  out.descr = header.descr;
+  out.dtype = NpyDtypeName(header.descr);
+  out.is_float = header.descr == "<f4" || header.descr == "<f8";
+  out.shape = header.shape;
+  return out;
+}
 
 template <typename T>
 int64_t NpyArray<T>::size() const {
@@ -122,29 +206,9 @@ const T& NpyArray<T>::at(int64_t i0, int64_t i1, int64_t i2, int64_t i3) const {
 
 template <typename T>
 StatusOr<NpyArray<T>> ParseNpy(const std::string& bytes, const std::string& source) {
-  static const char kMagic[] = "\x93NUMPY";
-  if (bytes.size() < 10 || bytes.compare(0, 6, std::string(kMagic, 6)) != 0) {
-    return Status::Error(source + ": not a .npy file (bad magic)");
-  }
-  const int major = static_cast<unsigned char>(bytes[6]);
-  size_t header_len = 0, offset = 0;
-  if (major == 1) {
-    header_len = static_cast<unsigned char>(bytes[8]) |
-                 (static_cast<size_t>(static_cast<unsigned char>(bytes[9])) << 8);
-    offset = 10;
-  } else if (major == 2 || major == 3) {
-    if (bytes.size() < 12) return Status::Error(source + ": truncated .npy header");
-    for (int i = 0; i < 4; ++i) {
-      header_len |= static_cast<size_t>(static_cast<unsigned char>(bytes[8 + i])) << (8 * i);
-    }
-    offset = 12;
-  } else {
-    return Status::Error(source + ": unsupported .npy version " + std::to_string(major));
-  }
-  if (header_len > bytes.size() - offset) return Status::Error(source + ": truncated .npy header");
   Header header;
-  ARCO_RETURN_IF_ERROR(ParseHeader(bytes.substr(offset, header_len), source, &header));
-  if (header.fortran_order) return Status::Error(source + ": Fortran-order .npy not supported");
+  size_t data_offset = 0;
+  ARCO_RETURN_IF_ERROR(ParsePreamble(bytes, source, &header, &data_offset));
   NpyArray<T> array;
   array.shape = header.shape;
   int64_t count = 1;
@@ -154,7 +218,6 @@ StatusOr<NpyArray<T>> ParseNpy(const std::string& bytes, const std::string& sour
     }
     count *= d;
   }
-  const size_t data_offset = offset + header_len;
   const size_t available = bytes.size() - data_offset;
   const char* raw = bytes.data() + data_offset;
   auto need = [&](size_t item) -> Status {
@@ -195,8 +258,8 @@ StatusOr<NpyArray<T>> ReadNpy(const std::string& path) {
 template <typename T>
 std::string SerializeNpy(const NpyArray<T>& array) {
   ARCO_CHECK(static_cast<int64_t>(array.data.size()) == array.size()) << "npy shape/data mismatch";
-  std::string dict = std::string("{'descr': '") + DescrFor<T>() +
-                     "', 'fortran_order': False, 'shape': (";
+  std::string dict =
+      std::string("{'descr': '") + DescrFor<T>() + "', 'fortran_order': False, 'shape': (";
   for (size_t i = 0; i < array.shape.size(); ++i) {
     dict += std::to_string(array.shape[i]);
     if (array.shape.size() == 1 || i + 1 < array.shape.size()) dict += ",";

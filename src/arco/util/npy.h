@@ -36,6 +36,17 @@ StatusOr<NpyArray<T>> ReadNpy(const std::string& path);
 template <typename T>
 StatusOr<NpyArray<T>> ParseNpy(const std::string& bytes, const std::string& source);
 
+// The header of an .npy file, read without its data (checks before the work).
+struct NpyHeader {
+  std::string descr;      // as stored, e.g. "<f4"
+  std::string dtype;      // NumPy's name, e.g. "float32", "int32"
+  bool is_float = false;  // float32 or float64
+  std::vector<int64_t> shape;
+};
+StatusOr<NpyHeader> ReadNpyHeader(const std::string& path);
+// "float32", "int32", ... for a stored descr ("'<c8'" quoted for others).
+std::string NpyDtypeName(const std::string& descr);
+
 // Writes atomically with the dtype that matches T.
 template <typename T>
 Status WriteNpy(const std::string& path, const NpyArray<T>& array);

@@ -1,6 +1,7 @@
 #include "arco/util/output_set.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -41,7 +42,43 @@ bool IsEmptyFolder(const std::string& path) {
   return fs::is_empty(path, ec) && !ec;
 }
 
+// ".tmp-PID.NAME" / ".old-PID.NAME" of `name`: the PID, or -1 for any other name.
+long TemporaryOwner(const std::string& entry, const std::string& what, const std::string& name) {
+  const std::string prefix = "." + what + "-";
+  if (entry.compare(0, prefix.size(), prefix) != 0) return -1;
+  const size_t dot = entry.find('.', prefix.size());
+  if (dot == std::string::npos || dot == prefix.size() ||
+      entry.compare(dot + 1, std::string::npos, name) != 0) {
+    return -1;
+  }
+  const std::string digits = entry.substr(prefix.size(), dot - prefix.size());
+  if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) return -1;
+  return std::stol(digits);
+}
+
+bool ProcessAlive(long pid) { return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH; }
+
 }  // namespace
+
+void RemoveStaleTemporaries(const std::string& given) {
+  const std::string path = NormalizeOutputPath(given);
+  const fs::path p(path);
+  const std::string name = p.filename().string();
+  if (name.empty() || name == "." || name == "..") return;
+  std::error_code ec;
+  for (fs::directory_iterator it(ParentOf(path), ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string entry = it->path().filename().string();
+    for (const char* what : {"tmp", "old"}) {
+      const long pid = TemporaryOwner(entry, what, name);
+      if (pid <= 0 || pid == ::getpid() || ProcessAlive(pid)) continue;
+      // An old output moved aside is deleted only once the new one is in place: otherwise
+      // it may be the only copy (a command killed mid-commit), and is left for the user.
+      if (std::string(what) == "old" && !fs::exists(fs::symlink_status(path, ec))) continue;
+      std::error_code ignored;
+      fs::remove_all(it->path(), ignored);
+    }
+  }
+}
 
 std::string NormalizeOutputPath(const std::string& path) {
   if (path.empty()) return path;
@@ -132,6 +169,7 @@ StatusOr<std::string> OutputSet::AddFile(const std::string& given) {
     if (o.path == path) return Status::Error(path + ": given for two outputs");
   }
   Output o{path, HiddenSibling(path, "tmp"), HiddenSibling(path, "old"), false};
+  RemoveStaleTemporaries(path);
   std::error_code ec;
   fs::remove_all(o.tmp, ec);
   const int fd = ::open(o.tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
@@ -152,6 +190,7 @@ StatusOr<std::string> OutputSet::AddFolder(const std::string& given, const Folde
   }
   ARCO_RETURN_IF_ERROR(CheckParent(path, ParentOf(path), /*create=*/true));
   Output o{path, HiddenSibling(path, "tmp"), HiddenSibling(path, "old"), true};
+  RemoveStaleTemporaries(path);
   std::error_code ec;
   fs::remove_all(o.tmp, ec);
   fs::create_directory(o.tmp, ec);

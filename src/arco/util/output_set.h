@@ -69,4 +69,10 @@ class OutputSet {
 // The hidden sibling of `path` used for its temporary (".<what>-<pid>.NAME").
 std::string HiddenSibling(const std::string& path, const std::string& what);
 
+// Removes what a killed command left beside `path`: every ".tmp-PID.NAME" of `path`'s
+// NAME whose process PID no longer exists, and its ".old-PID.NAME" when `path` itself
+// exists (else the old one may be the only copy and is left alone). Temporaries of live
+// processes and of other names are never touched. OutputSet::AddFile / AddFolder call it.
+void RemoveStaleTemporaries(const std::string& path);
+
 }  // namespace arco

@@ -1,6 +1,7 @@
 #include "arco/util/output_set.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -221,6 +222,46 @@ TEST(OutputSet, CommitWritesEveryOutput) {
   EXPECT_EQ(Read(tmp / "a.csv"), "a");
   EXPECT_EQ(Read(tmp / "sub/b/new.txt"), "new");
   EXPECT_EQ(Entries(tmp.path()), (std::set<std::string>{"a.csv", "sub"}));
+}
+
+// A pid no process has: a child that has exited and been reaped.
+long DeadPid() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  return child;
+}
+
+// What a killed command leaves (its temporary, or its old output moved aside after the new
+// one was in) goes the next time an output of that name is written; a live process's
+// temporaries, other names, and an old output whose new one never arrived stay.
+TEST(OutputSet, StaleTemporariesOfDeadProcessesAreRemoved) {
+  testing::TempDir tmp;
+  const std::string dead = std::to_string(DeadPid());
+  const std::string live = std::to_string(::getppid());
+  for (const std::string& name : {".tmp-" + dead + ".result",
+                                  ".old-" + dead + ".result",
+                                  ".tmp-" + live + ".result",
+                                  ".tmp-" + dead + ".other",
+                                  ".old-" + dead + ".gone",
+                                  std::string(".tmp-x1.result")}) {
+    ASSERT_TRUE(MakeDirectories(tmp / name).ok());
+  }
+  ASSERT_TRUE(MakeDirectories(tmp / "result").ok());
+  ASSERT_TRUE(
+      AtomicWriteDirectory(tmp / "result", FolderReplace{true, "", "folder"}, WriteNew).ok());
+  EXPECT_EQ(Entries(tmp.path()),
+            (std::set<std::string>{"result",
+                                   ".tmp-" + live + ".result",
+                                   ".tmp-" + dead + ".other",
+                                   ".old-" + dead + ".gone",
+                                   ".tmp-x1.result"}));
+  // The same for a file output.
+  ASSERT_TRUE(AtomicWriteFile(tmp / ".tmp-" + dead + ".p.csv", "partial").ok());
+  ASSERT_TRUE(AtomicWriteFile(tmp / "p.csv", "whole").ok());
+  EXPECT_FALSE(fs::exists(tmp / ".tmp-" + dead + ".p.csv"));
+  EXPECT_EQ(Read(tmp / "p.csv"), "whole");
 }
 
 }  // namespace

@@ -1,0 +1,59 @@
+// Fail early: every input `arco run` will need is checked before its first stage, so a
+// bad capture costs milliseconds, not the triangulation and hand fitting before it, and
+// leaves no result folder (docs/architecture.md, "Validation rules"). Each check is also
+// a function of its own for the commands that read the same input (arco triangulate,
+// arco pitch --capture). Errors are one line naming the file and the field.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "arco/camera/rig.h"
+#include "arco/mocap/capture.h"
+#include "arco/pipeline/capture_context.h"
+#include "arco/pipeline/run_capture.h"
+#include "arco/util/status.h"
+
+namespace arco::pipeline {
+
+// The calibration camera of each capture camera (by name, else serial), in the manifest's
+// order. Error naming capture.json, the camera and the calibration file for one absent.
+StatusOr<std::vector<int>> MatchCaptureCameras(const std::string& capture_dir,
+                                               const CaptureManifest& manifest,
+                                               const Rig& rig,
+                                               const std::string& calibration_path);
+
+// The capture's calibration (`calibration` in capture.json) is readable and holds every
+// capture camera.
+Status CheckCaptureCalibration(const std::string& capture_dir, const CaptureManifest& manifest);
+
+// What the audio check learnt (for messages and tests).
+struct CaptureAudioCheck {
+  std::string path;       // resolved audio.file
+  double duration_s = 0;  // decoded length
+  std::string format;     // the decoder's name for it
+};
+
+// The capture's audio (`audio.file`) exists, opens and decodes (its first samples; the
+// length from the header, or by decoding it all when the container does not say), and
+// `audio.offset_s` puts at least one video frame inside it: an offset at or after the
+// audio's end, or one whose last frame comes before the audio starts, is an error naming
+// capture.json's audio.offset_s (frames partly outside are the pitch stage's warning).
+// A capture without audio passes.
+StatusOr<CaptureAudioCheck> CheckCaptureAudio(const std::string& capture_dir,
+                                              const CaptureManifest& manifest);
+
+// The temporal filters of the triangulation options name groups of `layout` and suit the
+// capture's frame rate.
+Status CheckTriangulationFilters(const TriangulateStageOptions& options,
+                                 const KeypointLayout& layout,
+                                 double fps,
+                                 const std::string& manifest_path);
+
+// Every check of `arco run`, in the order a user fixes them: options, the result folder
+// (writable; replaceable only with --overwrite), capture.json and its instrument and
+// layout (OpenCapture), the calibration and cameras, keypoints2d.npy (dtype and shape,
+// from its header), the filters, the audio and its offset. Returns the opened capture.
+StatusOr<CaptureContext> PreflightRun(const RunOptions& options);
+
+}  // namespace arco::pipeline

@@ -1,0 +1,159 @@
+// PreflightRun and its checks on a small hand-written capture (the real SPD calibration,
+// a 2-camera keypoint array, a generated WAV): each defect is one error naming the file
+// and the field, found before any result folder exists.
+#include "arco/pipeline/preflight.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "arco/audio/test_signals.h"
+#include "arco/util/file_io.h"
+#include "arco/util/test_dir.h"
+
+namespace arco::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+using arco::testing::TempDir;
+
+constexpr int kFrames = 30;  // 1 s at 30 fps
+
+// A capture the preflight accepts: cello, spd_cello, two calibrated cameras, 2 s of audio.
+struct TestCapture {
+  TempDir dir;
+  CaptureManifest manifest;
+
+  TestCapture() {
+    fs::copy_file(std::string(ARCO_SHARED_DATA_DIR) + "/spd/cello_1113_scale_camera.xml",
+                  dir / "calibration.xml");
+    manifest.instrument = "cello";
+    manifest.fps = 30;
+    manifest.frame_first = 1;
+    manifest.frame_count = kFrames;
+    manifest.calibration = "calibration.xml";
+    manifest.audio = "audio.wav";
+    manifest.audio_offset_s = 0.5;
+    manifest.keypoints2d = "keypoints2d.npy";
+    manifest.layout = "spd_cello";
+    manifest.cameras = {{"camera_21334181_1", "21334181", "", {}},
+                        {"camera_21334237_1", "21334237", "", {}}};
+    Write();
+    NpyArray<float> k;
+    k.shape = {kFrames, 2, 142, 3};
+    k.data.assign(static_cast<size_t>(kFrames * 2 * 142 * 3), 100.0f);
+    EXPECT_TRUE(WriteNpy(dir / "keypoints2d.npy", k).ok());
+    EXPECT_TRUE(
+        audio::testing::WriteWav(dir / "audio.wav", std::vector<float>(88200, 0.1f), 44100).ok());
+  }
+  void Write() { EXPECT_TRUE(WriteCaptureManifest(dir.path(), manifest).ok()); }
+  std::string Manifest() const { return dir / "capture.json"; }
+  RunOptions Options() const {
+    RunOptions o;
+    o.capture_dir = dir.path();
+    o.result_dir = dir / "result";
+    return o;
+  }
+  // The preflight's message ("ok" when it passes); no result folder either way.
+  std::string Preflight() const {
+    auto r = PreflightRun(Options());
+    EXPECT_FALSE(fs::exists(dir / "result"));
+    return r.ok() ? "ok" : r.status().message();
+  }
+};
+
+TEST(PreflightRun, AcceptsAGoodCaptureAndCreatesNothing) {
+  TestCapture c;
+  EXPECT_EQ(c.Preflight(), "ok");
+  auto audio = CheckCaptureAudio(c.dir.path(), c.manifest);
+  ASSERT_TRUE(audio.ok()) << audio.status().message();
+  EXPECT_DOUBLE_EQ(audio->duration_s, 2.0);
+  EXPECT_EQ(audio->path, c.dir / "audio.wav");
+}
+
+TEST(PreflightRun, AnOffsetOutsideTheAudioNamesCaptureJson) {
+  TestCapture c;
+  c.manifest.audio_offset_s = 99;
+  c.Write();
+  EXPECT_EQ(c.Preflight(),
+            c.Manifest() + ": audio.offset_s = 99 s is outside the audio (0..2 s, " +
+                (c.dir / "audio.wav") + ")");
+  c.manifest.audio_offset_s = -1.5;  // the last frame (0.967 s later) still before 0
+  c.Write();
+  EXPECT_EQ(c.Preflight(),
+            c.Manifest() + ": audio.offset_s = -1.5 s puts the last frame at " +
+                "-0.533333 s, before the audio starts (0..2 s, " + (c.dir / "audio.wav") + ")");
+  c.manifest.audio_offset_s = -0.5;  // partly inside: the pitch stage's warning, not an error
+  c.Write();
+  EXPECT_EQ(c.Preflight(), "ok");
+}
+
+TEST(PreflightRun, MissingOrUndecodableAudioNamesTheField) {
+  TestCapture c;
+  ASSERT_TRUE(AtomicWriteFile(c.dir / "audio.wav", std::string(3000, 'x')).ok());
+  const std::string undecodable = c.Preflight();
+  EXPECT_EQ(
+      undecodable.rfind(
+          c.Manifest() + ": audio.file: " + (c.dir / "audio.wav") + ": cannot decode audio", 0),
+      0u)
+      << undecodable;
+  fs::remove(c.dir / "audio.wav");
+  EXPECT_EQ(c.Preflight(),
+            c.Manifest() + ": audio.file \"audio.wav\": " + (c.dir / "audio.wav") + " not found");
+  c.manifest.audio.clear();  // no audio at all: the vision method only, not an error
+  c.Write();
+  EXPECT_EQ(c.Preflight(), "ok");
+}
+
+TEST(PreflightRun, CalibrationAndCamerasAreChecked) {
+  TestCapture c;
+  c.manifest.cameras[1] = {"cam_x", "x", "", {}};
+  c.Write();
+  EXPECT_EQ(c.Preflight(),
+            c.Manifest() + ": camera \"cam_x\" is not in " + (c.dir / "calibration.xml"));
+  fs::remove(c.dir / "calibration.xml");
+  EXPECT_EQ(c.Preflight(),
+            c.Manifest() + ": calibration \"calibration.xml\": " + (c.dir / "calibration.xml") +
+                " not found");
+}
+
+TEST(PreflightRun, KeypointsDtypeAndShapeComeFromTheHeader) {
+  TestCapture c;
+  NpyArray<int32_t> k;
+  k.shape = {kFrames, 2, 142, 3};
+  k.data.assign(static_cast<size_t>(kFrames * 2 * 142 * 3), 100);
+  ASSERT_TRUE(WriteNpy(c.dir / "keypoints2d.npy", k).ok());
+  EXPECT_EQ(c.Preflight(),
+            (c.dir / "keypoints2d.npy") +
+                ": dtype int32; keypoints2d must be float32 or float64 (x_px, "
+                "y_px, score; NaN = missing)");
+  NpyArray<float> f;
+  f.shape = {kFrames - 1, 2, 142, 3};
+  f.data.assign(static_cast<size_t>((kFrames - 1) * 2 * 142 * 3), 1.0f);
+  ASSERT_TRUE(WriteNpy(c.dir / "keypoints2d.npy", f).ok());
+  EXPECT_EQ(c.Preflight(),
+            (c.dir / "keypoints2d.npy") +
+                ": shape (29, 2, 142, 3) does not match capture.json (30, 2, 142, "
+                "3) (frames.count, cameras, spd_cello points, 3)");
+}
+
+TEST(PreflightRun, TheInstrumentsPointsAndTheOutputAreChecked) {
+  TestCapture c;
+  c.manifest.layout = "coco_wholebody_133";
+  c.Write();
+  EXPECT_EQ(c.Preflight().rfind(c.Manifest() + ": layout coco_wholebody_133 has no instrument "
+                                               "point ",
+                                0),
+            0u);
+  TestCapture d;
+  ASSERT_TRUE(AtomicWriteFile(d.dir / "file", "x").ok());
+  RunOptions o = d.Options();
+  o.result_dir = d.dir / "file/result";
+  auto r = PreflightRun(o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().message(),
+            o.result_dir + ": cannot create folder: " + (d.dir / "file") + " is not a folder");
+}
+
+}  // namespace
+}  // namespace arco::pipeline
