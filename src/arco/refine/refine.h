@@ -177,7 +177,8 @@ RefineResult Refine(const RefineInput& input, const RefineOptions& options);
 
 // The options as the refinement applies them, recorded with a method's result: mode,
 // min_confidence, binding_cents, ik_joints (the paper always solves PIP and DIP),
-// max_residual_mm, audio_onsets (arco only).
+// max_residual_mm, audio_onsets (arco only), num_threads, and every field of the nested
+// options as given: "pitch", "paper", "decode" (with "boundaries"), "ik".
 Json ToJson(const RefineOptions& options);
 
 // The counts and distances of a refinement recorded with a method's result (mean tip
