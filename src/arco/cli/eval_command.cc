@@ -40,7 +40,11 @@ int Run(Args& a) {
   auto report = eval::Evaluate(a.r);
   if (!report.ok()) return PrintError(WithFlagNames(report.status().message(), kEvalFlags));
   Status written = Status::Ok();
-  if (!json_tmp.empty()) written = WriteJsonFile(json_tmp, report->ToJson(a.r.metrics));
+  if (!json_tmp.empty()) {
+    Json json = report->ToJson(a.r.metrics);
+    json["options"] = eval::ToJson(a.r);  // every option used (docs/evaluation.md)
+    written = WriteJsonFile(json_tmp, json);
+  }
   if (written.ok() && !plot_tmp.empty()) {
     written = AtomicWriteFile(plot_tmp, eval::EvalPlotSvg(*report, report->fps));
   }

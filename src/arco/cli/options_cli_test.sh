@@ -58,4 +58,13 @@ expect '["ik"]["joints"]' '"pip_dip"' --joints
 expect '["paper"]["binding_cents"]' 25.0 --binding-cents
 expect '["num_threads"]' 1 --threads
 expect '["pitch"]["min_confidence"]' 0.5 "(default --min-confidence)"
+
+# eval.json records its options too.
+"$arco" eval "$tmp/res" --truth "$tmp/cap/truth" --pck-mm 7 15 --limit-tolerance-deg 4 \
+  -o "$tmp/eval.json" > "$tmp/eval.log" 2>&1
+check '[ $? -eq 0 ]' "eval"
+check '[ "$(json "$tmp/eval.json" "d[\"options\"][\"pck_thresholds_mm\"]")" = "[7.0, 15.0]" ]' \
+  "eval.json options.pck_thresholds_mm = --pck-mm"
+check '[ "$(json "$tmp/eval.json" "d[\"options\"][\"joint_limit_tolerance_deg\"]")" = 4.0 ]' \
+  "eval.json options.joint_limit_tolerance_deg = --limit-tolerance-deg"
 exit $fail
