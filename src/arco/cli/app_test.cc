@@ -174,9 +174,9 @@ TEST_F(AppOptions, EveryNumericOptionRejectsBadValuesAtParse) {
                                       "18446744073709551616",  // 2^64
                                       "abc",
                                       "",
-                                      FormatNumber(range.min_open ? range.min
+                                      NumberText(range.min_open ? range.min
                                                                   : range.min - step_min),
-                                      FormatNumber(range.max_open ? range.max
+                                      NumberText(range.max_open ? range.max
                                                                   : range.max + step_max)};
       if (!range.Contains(-1)) bad.push_back("-1");
       for (const std::string& value : bad) {
@@ -197,8 +197,8 @@ TEST_F(AppOptions, EveryNumericOptionRejectsBadValuesAtParse) {
       }
       // The range's own ends and the default are accepted.
       std::vector<std::string> good;
-      if (!range.min_open) good.push_back(FormatNumber(range.min));
-      if (!range.max_open) good.push_back(FormatNumber(range.max));
+      if (!range.min_open) good.push_back(NumberText(range.min));
+      if (!range.max_open) good.push_back(NumberText(range.max));
       std::string defaults = option->get_default_str();
       if (!defaults.empty() && defaults.front() == '[') {  // a list: "[5,10,20]"
         defaults = defaults.substr(1, defaults.size() - 2);

@@ -82,8 +82,8 @@ std::function<int()> SetupInstrument(CLI::App& app) {
             "--offset-cents",
             options->offset_cents,
             "Scordatura: cents per string from standard tuning, string 1 (highest) "
-            "first, e.g. 0,0,-100,-100 (each within an octave)",
-            Closed(-1200, 1200))
+            "first, e.g. 0,0,-100,-100 (each within two octaves)",
+            kTuningOffsetRangeCents)
       ->delimiter(',');
   AddNumber(cmd,
             "--f0-hz",

@@ -53,7 +53,6 @@ namespace arco::cli {
 // Ranges several commands share (one definition each).
 inline constexpr NumberRange kThreadsRange = Closed(0, 1024);     // 0 = all cores
 inline constexpr NumberRange kVideoFpsRange = AboveZero(1000);    // frames per second
-inline constexpr NumberRange kA4RangeHz = Closed(400, 480);       // baroque 415 .. 466 and more
 inline constexpr NumberRange kFractionRange = Closed(0, 1);       // confidences, rates
 inline constexpr NumberRange kWeightRange = Closed(0, 1e6);       // cost weights (finite, >= 0)
 inline constexpr NumberRange kAudioTimeRangeS = Closed(-86400, 86400);  // offsets: +-1 day

@@ -27,17 +27,17 @@ std::function<int()> SetupPitch(CLI::App& app) {
       "--instrument",
       o->instrument,
       "violin | viola | cello | double_bass (alias bass) | any: the pitch range (default cello)");
-  AddNumber(cmd, "--fps", o->fps, "Video frame rate: one row per frame (Hz; default 30)", kVideoFpsRange);
+  AddNumber(cmd, "--fps", o->fps, "Video frame rate: one row per frame (Hz; default 30)", audio::kTrackerFpsRange);
   auto* start = AddNumber(cmd,
                           "--start-s",
                           o->start_s,
                           "Audio time of video frame 0 (s; default 0); row i at start + i/fps",
-                          kAudioTimeRangeS);
+                          audio::kTrackerStartRangeS);
   AddNumber(cmd,
             "--offset-s",
             o->start_s,
             "Same as --start-s: the offset `arco sync` prints (s)",
-            kAudioTimeRangeS)
+            audio::kTrackerStartRangeS)
       ->excludes(start);
   AddNumber(cmd,
             "--frames",
@@ -48,7 +48,7 @@ std::function<int()> SetupPitch(CLI::App& app) {
             "--hops-per-frame",
             o->hops_per_frame,
             "Analysis hops per video frame (0: auto, fine rate >= 100 Hz)",
-            Closed(0, 64))
+            audio::kHopsPerFrameRange)
       ->capture_default_str();
   AddNumber(cmd, "--fmin", o->min_f0_hz, "Override the lowest f0 (Hz; 0 = the instrument's)", kF0OverrideRangeHz);
   AddNumber(cmd, "--fmax", o->max_f0_hz, "Override the highest f0 (Hz; 0 = the instrument's)", kF0OverrideRangeHz);

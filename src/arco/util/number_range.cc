@@ -13,7 +13,7 @@ bool NumberRange::Contains(double value) const {
   return above_min && below_max;
 }
 
-std::string FormatNumber(double value) {
+std::string NumberText(double value) {
   char text[64];
   if (std::isfinite(value) && value == std::floor(value) && std::abs(value) <= 1e16) {
     std::snprintf(text, sizeof text, "%.0f", value);  // whole numbers in full: 1000, 2^53
@@ -28,14 +28,14 @@ std::string FormatNumber(double value) {
 }
 
 std::string NumberRange::ToString() const {
-  return std::string(min_open ? "(" : "[") + FormatNumber(min) + ", " + FormatNumber(max) +
+  return std::string(min_open ? "(" : "[") + NumberText(min) + ", " + NumberText(max) +
          (max_open ? ")" : "]");
 }
 
 Status CheckInRange(std::string_view field, double value, const NumberRange& range) {
   if (range.Contains(value)) return Status::Ok();
   return Status::Error(std::string(field) + " must be a finite number in " + range.ToString() +
-                       ", got " + FormatNumber(value));
+                       ", got " + NumberText(value));
 }
 
 }  // namespace arco

@@ -34,7 +34,7 @@ constexpr NumberRange AboveZero(double max) { return {0, max, true, false}; }
 inline constexpr double kMaxExactInteger = 9007199254740992.0;
 
 // `value` formatted for a message ("nan", "inf", "-3", "0.25", "1e+300").
-std::string FormatNumber(double value);
+std::string NumberText(double value);
 
 // Ok, or "FIELD must be a finite number in RANGE, got VALUE".
 Status CheckInRange(std::string_view field, double value, const NumberRange& range);
