@@ -54,7 +54,6 @@ namespace arco::cli {
 inline constexpr NumberRange kThreadsRange = Closed(0, 1024);     // 0 = all cores
 inline constexpr NumberRange kVideoFpsRange = AboveZero(1000);    // frames per second
 inline constexpr NumberRange kFractionRange = Closed(0, 1);       // confidences, rates
-inline constexpr NumberRange kWeightRange = Closed(0, 1e6);       // cost weights (finite, >= 0)
 inline constexpr NumberRange kAudioTimeRangeS = Closed(-86400, 86400);  // offsets: +-1 day
 inline constexpr NumberRange kFrameCountRange = Closed(0, 1e9);   // frame numbers and counts
 

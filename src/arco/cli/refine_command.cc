@@ -105,13 +105,13 @@ std::function<int()> SetupRefine(CLI::App& app) {
             "--reference-weight",
             r.ik.reference_weight_mm_per_rad,
             "arco: IK prior toward the fitted angles (mm per rad)",
-            kWeightRange)
+            refine::kCostWeightRange)
       ->capture_default_str();
   AddNumber(sub,
             "--temporal-weight",
             r.ik.temporal_weight_mm_per_rad,
             "arco: IK prior toward the previous frame's solution (mm per rad)",
-            kWeightRange)
+            refine::kCostWeightRange)
       ->capture_default_str();
   sub->add_flag("--exact-reach",
                 a->exact_reach,
@@ -145,26 +145,26 @@ std::function<int()> SetupRefine(CLI::App& app) {
             r.decode.normal_weight,
             "arco decoding: weight of the tip-to-contact distance along the string "
             "plane's normal",
-            kWeightRange)
+            refine::kCostWeightRange)
       ->capture_default_str();
   AddNumber(sub,
             "--lateral-weight",
             r.decode.lateral_weight,
             "arco decoding: weight of the tip-to-contact distance across the string",
-            kWeightRange)
+            refine::kCostWeightRange)
       ->capture_default_str();
   AddNumber(sub,
             "--hand-lateral-weight",
             r.decode.hand_lateral_weight,
             "arco decoding: weight of the hand's median fingertip offset across the "
             "strings",
-            kWeightRange)
+            refine::kCostWeightRange)
       ->capture_default_str();
   AddNumber(sub,
             "--shift-cost",
             r.decode.shift_cost_per_semitone,
             "arco decoding: cost per semitone of hand-position change between notes (mm)",
-            kWeightRange)
+            refine::kCostWeightRange)
       ->capture_default_str();
   sub->parse_complete_callback([a] { ApplyAndValidate(*a); });
   return [a]() { return RunRefine(*a); };

@@ -135,24 +135,24 @@ Status PaperOptions::Validate() const {
 }
 
 Status ArcoDecodeOptions::Validate() const {
-  const double values[] = {normal_weight,
-                           lateral_weight,
-                           hand_lateral_weight,
-                           order_margin_mm,
-                           order_weight,
-                           open_cost_mm,
-                           shift_cost_per_semitone,
-                           string_cross_cost,
-                           same_pitch_change_cost,
-                           same_pitch_cents,
-                           rest_gap_s,
-                           rest_factor,
-                           infeasible_cost,
-                           onset_lead_margin_mm};
-  for (double v : values) {
-    if (!(v >= 0 && Finite(v))) {
-      return Status::Error("arco decode options: every weight and cost must be finite and >= 0");
-    }
+  const std::pair<const char*, double> values[] = {
+      {"normal_weight", normal_weight},
+      {"lateral_weight", lateral_weight},
+      {"hand_lateral_weight", hand_lateral_weight},
+      {"order_margin_mm", order_margin_mm},
+      {"order_weight", order_weight},
+      {"open_cost_mm", open_cost_mm},
+      {"shift_cost_per_semitone", shift_cost_per_semitone},
+      {"string_cross_cost", string_cross_cost},
+      {"same_pitch_change_cost", same_pitch_change_cost},
+      {"same_pitch_cents", same_pitch_cents},
+      {"rest_gap_s", rest_gap_s},
+      {"rest_factor", rest_factor},
+      {"infeasible_cost", infeasible_cost},
+      {"onset_lead_margin_mm", onset_lead_margin_mm}};
+  for (const auto& [name, value] : values) {
+    ARCO_RETURN_IF_ERROR(CheckInRange(name, value, kCostWeightRange)
+                             .WithContext("arco decode options"));
   }
   if (!(handover_margin_mm >= 0)) {
     return Status::Error("arco decode options: handover_margin_mm must be >= 0 (infinity: off)");
@@ -173,12 +173,12 @@ Status ArcoDecodeOptions::Validate() const {
 }
 
 Status ArcoIkOptions::Validate() const {
-  if (!(reference_weight_mm_per_rad >= 0 && Finite(reference_weight_mm_per_rad))) {
-    return Status::Error("arco IK options: reference_weight_mm_per_rad must be >= 0");
-  }
-  if (!(temporal_weight_mm_per_rad >= 0 && Finite(temporal_weight_mm_per_rad))) {
-    return Status::Error("arco IK options: temporal_weight_mm_per_rad must be >= 0");
-  }
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("reference_weight_mm_per_rad", reference_weight_mm_per_rad, kCostWeightRange)
+          .WithContext("arco IK options"));
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("temporal_weight_mm_per_rad", temporal_weight_mm_per_rad, kCostWeightRange)
+          .WithContext("arco IK options"));
   if (!(lift_max_distance_mm >= 0 && Finite(lift_max_distance_mm))) {
     return Status::Error("arco IK options: lift_max_distance_mm must be >= 0 (0 = automatic)");
   }
