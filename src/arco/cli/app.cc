@@ -68,6 +68,69 @@ Status CheckCommandName(const App& app, const std::string& first_arg) {
                        "; see `arco --help`)");
 }
 
+namespace {
+
+std::string Escape(std::string text) {
+  for (size_t at = text.find('|'); at != std::string::npos; at = text.find('|', at + 2)) {
+    text.replace(at, 1, "\\|");
+  }
+  return text;
+}
+
+void AppendCommand(const CLI::App& command, const std::string& path, std::string* out) {
+  std::string rows;
+  for (const CLI::Option* o : command.get_options()) {
+    if (o->get_name() == "--help") continue;
+    const std::string type_name = o->get_type_name();
+    const size_t colon = type_name.find(':');
+    std::string type = type_name.substr(0, colon);
+    if (o->get_type_size_max() == 0 || type.empty()) type = "flag";
+    const std::string check = colon == std::string::npos ? "" : type_name.substr(colon + 1);
+    std::string names;
+    if (o->nonpositional()) {
+      const std::string all = o->get_name(false, true);
+      for (size_t start = 0; start < all.size();) {
+        const size_t comma = std::min(all.find(',', start), all.size());
+        names += (names.empty() ? "`" : ", `") + all.substr(start, comma - start) + "`";
+        start = comma + 1;
+      }
+    } else {
+      names = "`" + o->get_name(true) + "`";
+    }
+    rows += "| " + names + " | " + type + (o->get_required() ? ", required" : "") + " | " +
+            Escape(check) + " | " + Escape(o->get_default_str()) + " | " +
+            Escape(o->get_description()) + " |\n";
+  }
+  if (!rows.empty()) {
+    *out += "\n## arco " + path + "\n\n" + Escape(command.get_description()) +
+            "\n\n| option | type | range / choices | default | meaning |\n|---|---|---|---|---|\n" +
+            rows;
+  }
+  for (const CLI::App* sub : command.get_subcommands({})) {
+    AppendCommand(*sub, path + " " + sub->get_name(), out);
+  }
+}
+
+}  // namespace
+
+std::string OptionsMarkdown(const App& app) {
+  std::string out =
+      "# Command-line options\n\n"
+      "Every option of every command with the values it accepts, generated from the commands'\n"
+      "own definitions (cli/app.h OptionsMarkdown; `cli_app_test` fails when this page is out\n"
+      "of date, and `ARCO_WRITE_OPTIONS_DOC=1 build/tests/cli_app_test` rewrites it).\n\n"
+      "A number outside its range, NaN, an infinity, a value that would wrap (`--seed -1`)\n"
+      "or text where a number belongs is rejected before any work with one line naming the\n"
+      "flag, the value and the range (`arco: error: --fps: nan is not a finite number in\n"
+      "(0, 1000]`), exit status 1, nothing written. `[a, b]` includes both ends, `(a, b]`\n"
+      "excludes a. `arco <command> --help` shows the same ranges after the type\n"
+      "(`FLOAT:(0, 1000]`). The options applied are recorded with the results: result.json\n"
+      "\"options\" (`arco run`) and each method's \"options\" (`arco run`, `arco refine`),\n"
+      "eval.json \"options\" (`arco eval`); docs/formats.md.\n";
+  for (const auto& [sub, run] : app.commands) AppendCommand(*sub, sub->get_name(), &out);
+  return out;
+}
+
 int Main(int argc, char** argv) {
   App app = BuildApp();
   if (argc > 1) {

@@ -37,6 +37,11 @@ App BuildApp();
 // (CLI11 would say "A subcommand is required").
 Status CheckCommandName(const App& app, const std::string& first_arg);
 
+// docs/options.md: every command's options (type, range or choices, default, meaning) as
+// the app defines them; app_test.cc checks the page is current (and rewrites it with
+// ARCO_WRITE_OPTIONS_DOC=1).
+std::string OptionsMarkdown(const App& app);
+
 // `arco ARGS...`: parse, print a parse error or help, run.
 int Main(int argc, char** argv);
 

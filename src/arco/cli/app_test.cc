@@ -256,6 +256,28 @@ TEST_F(AppOptions, GoodValuesParseAndNothingRuns) {
   ExpectNothingWritten();
 }
 
+// docs/options.md lists every option with its range as the app defines it.
+TEST(OptionsMarkdown, DocsPageIsCurrent) {
+  const std::string expected = OptionsMarkdown(BuildApp());
+  const fs::path page = fs::path(ARCO_SOURCE_DIR) / "docs" / "options.md";
+  if (std::getenv("ARCO_WRITE_OPTIONS_DOC") != nullptr) {
+    std::FILE* f = std::fopen(page.c_str(), "wb");
+    ASSERT_NE(f, nullptr) << page;
+    std::fwrite(expected.data(), 1, expected.size(), f);
+    std::fclose(f);
+  }
+  std::string actual;
+  if (std::FILE* f = std::fopen(page.c_str(), "rb")) {
+    char buffer[4096];
+    for (size_t n; (n = std::fread(buffer, 1, sizeof buffer, f)) > 0;) actual.append(buffer, n);
+    std::fclose(f);
+  }
+  EXPECT_EQ(actual, expected) << page
+                              << " is out of date: ARCO_WRITE_OPTIONS_DOC=1 build/tests/cli_app_test "
+                                 "--gtest_filter=OptionsMarkdown.* rewrites it";
+  EXPECT_NE(expected.find("| `--fps` | FLOAT | (0, 1000] | 30 |"), std::string::npos);
+}
+
 TEST(CheckCommandName, NamesAnUnknownCommand) {
   const App app = BuildApp();
   EXPECT_TRUE(CheckCommandName(app, "run").ok());
