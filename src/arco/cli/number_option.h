@@ -56,6 +56,9 @@ inline constexpr NumberRange kVideoFpsRange = AboveZero(1000);    // frames per 
 inline constexpr NumberRange kFractionRange = Closed(0, 1);       // confidences, rates
 inline constexpr NumberRange kAudioTimeRangeS = Closed(-86400, 86400);  // offsets: +-1 day
 inline constexpr NumberRange kFrameCountRange = Closed(0, 1e9);   // frame numbers and counts
+// --min-confidence of run and refine: not below the pitch model's in-note threshold
+// (refine::PitchModelOptions::min_confidence_in_note, 0.2), which Validate() requires.
+inline constexpr NumberRange kMinConfidenceRange = Closed(0.2, 1);
 
 // Throws CLI::ValidationError with `status`'s message (a command's Validate() in its
 // parse-complete callback, so that a bad combination fails the parse, before any work).

@@ -69,7 +69,7 @@ std::function<int()> SetupRefine(CLI::App& app) {
             "--min-confidence",
             r.pitch.min_confidence,
             "Pitch confidence below which a frame gets no contact",
-            Closed(0.2, 1))  // >= the in-note threshold, pitch_model.h
+            kMinConfidenceRange)
       ->capture_default_str();
   AddNumber(sub,
             "--binding-cents",

@@ -62,7 +62,7 @@ std::function<int()> SetupRun(CLI::App& app) {
             "--min-confidence",
             a->o.refine.pitch.min_confidence,
             "Pitch confidence below which a frame gets no contact",
-            Closed(0.2, 1))  // >= the in-note threshold, refine/pitch_model.h
+            kMinConfidenceRange)
       ->capture_default_str();
   sub->parse_complete_callback([a] {
     const Status valid = a->o.Validate();
