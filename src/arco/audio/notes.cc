@@ -61,7 +61,7 @@ Vibrato DetectVibrato(const std::vector<double>& semis, double fps, const NoteOp
 }  // namespace
 
 Status NoteOptions::Validate() const {
-  if (!(a4_hz >= 300 && a4_hz <= 600)) return Status::Error("a4_hz must be in [300, 600]");
+  ARCO_RETURN_IF_ERROR(CheckInRange("a4_hz", a4_hz, kA4RangeHz));
   if (!(min_note_s > 0 && max_gap_s >= 0 && smoothing_s >= 0 && split_semitones > 0)) {
     return Status::Error("note durations and thresholds must be positive");
   }

@@ -37,19 +37,11 @@ StatusOr<InstrumentRange> InstrumentRangeByName(const std::string& name) {
 }
 
 Status PitchTrackerOptions::Validate() const {
-  if (!(fps > 0 && fps <= 1000)) {
-    return Status::Error("fps must be in (0, 1000], got " + std::to_string(fps));
-  }
-  if (!std::isfinite(start_s) || start_s < -3600 || start_s > 1e6) {
-    return Status::Error(
-        "start_s must be in [-3600, 1e6] s (video may start at most an hour "
-        "before the audio)");
-  }
-  if (hops_per_frame < 0 || hops_per_frame > 100) {
-    return Status::Error("hops per frame must be in [0, 100]");
-  }
+  ARCO_RETURN_IF_ERROR(CheckInRange("fps", fps, kTrackerFpsRange));
+  ARCO_RETURN_IF_ERROR(CheckInRange("start_s", start_s, kTrackerStartRangeS));
+  ARCO_RETURN_IF_ERROR(CheckInRange("hops_per_frame", hops_per_frame, kHopsPerFrameRange));
   if (max_frames < -1) return Status::Error("max_frames must be >= -1");
-  if (!(a4_hz >= 300 && a4_hz <= 600)) return Status::Error("a4_hz must be in [300, 600] Hz");
+  ARCO_RETURN_IF_ERROR(CheckInRange("a4_hz", a4_hz, kA4RangeHz));
   if (!(range.min_f0_hz >= 20 && range.max_f0_hz > range.min_f0_hz &&
         range.max_f0_hz <= range.analysis_rate_hz / 4.0)) {
     return Status::Error("pitch range must satisfy 20 <= min < max <= analysis rate / 4");

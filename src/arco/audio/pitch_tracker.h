@@ -14,6 +14,8 @@
 #include "arco/audio/audio_reader.h"
 #include "arco/audio/pitch_hmm.h"
 #include "arco/audio/yin.h"
+#include "arco/registry/instruments.h"
+#include "arco/util/number_range.h"
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
 
@@ -30,6 +32,12 @@ struct InstrumentRange {
 // Any name ParseInstrumentKind accepts ("violin", "viola", "cello", "double_bass" and
 // the aliases, e.g. "bass"); "any" covers them all. Error for unknown names.
 StatusOr<InstrumentRange> InstrumentRangeByName(const std::string& name);
+
+// The declared ranges of PitchTrackerOptions (Validate(); `arco pitch` declares the same).
+inline constexpr NumberRange kTrackerFpsRange = AboveZero(1000);
+// The video may start at most an hour before the audio.
+inline constexpr NumberRange kTrackerStartRangeS = Closed(-3600, 1e6);
+inline constexpr NumberRange kHopsPerFrameRange = Closed(0, 100);
 
 struct PitchTrackerOptions {
   InstrumentRange range;    // from InstrumentRangeByName

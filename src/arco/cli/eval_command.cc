@@ -5,6 +5,7 @@
 
 #include "arco/cli/command.h"
 #include "arco/cli/flag_names.h"
+#include "arco/cli/number_option.h"
 #include "arco/eval/evaluate.h"
 #include "arco/eval/plot.h"
 #include "arco/util/file_io.h"
@@ -39,7 +40,11 @@ int Run(Args& a) {
   auto report = eval::Evaluate(a.r);
   if (!report.ok()) return PrintError(WithFlagNames(report.status().message(), kEvalFlags));
   Status written = Status::Ok();
-  if (!json_tmp.empty()) written = WriteJsonFile(json_tmp, report->ToJson(a.r.metrics));
+  if (!json_tmp.empty()) {
+    Json json = report->ToJson(a.r.metrics);
+    json["options"] = eval::ToJson(a.r);  // every option used (docs/evaluation.md)
+    written = WriteJsonFile(json_tmp, json);
+  }
   if (written.ok() && !plot_tmp.empty()) {
     written = AtomicWriteFile(plot_tmp, eval::EvalPlotSvg(*report, report->fps));
   }
@@ -69,17 +74,21 @@ std::function<int()> SetupEval(CLI::App& app) {
                   "Truth: an `arco synth` truth folder, or points JSONs from `arco triangulate "
                   "--view ...` (repeat, one per labelled frame, each with a --truth-frame)")
       ->required();
-  cmd->add_option("--truth-frame",
-                  a->r.truth_frames,
-                  "Frame number (capture numbering, from 1) each points JSON labels, in order");
+  AddNumber(cmd,
+            "--truth-frame",
+            a->r.truth_frames,
+            "Frame number (capture numbering, from 1) each points JSON labels, in order",
+            kFrameCountRange);
   cmd->add_option("--pitch",
                   a->r.pitch_csv,
                   "Estimated pitch.csv (default: RESULT_DIR/pitch.csv when present)");
-  cmd->add_option("--pck-mm", a->r.metrics.pck_thresholds_mm, "PCK thresholds (mm)")
+  AddNumber(cmd, "--pck-mm", a->r.metrics.pck_thresholds_mm, "PCK thresholds (mm)", AboveZero(1000))
       ->capture_default_str();
-  cmd->add_option("--limit-tolerance-deg",
-                  a->r.joint_limit_tolerance_deg,
-                  "Tolerance before a geometric joint angle counts as a limit violation (deg)")
+  AddNumber(cmd,
+            "--limit-tolerance-deg",
+            a->r.joint_limit_tolerance_deg,
+            "Tolerance before a geometric joint angle counts as a limit violation (deg)",
+            Closed(0, 180))
       ->capture_default_str();
   cmd->add_option("-o,--output", a->output, "Write the metrics as JSON here");
   cmd->add_option(

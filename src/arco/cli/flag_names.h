@@ -22,11 +22,34 @@ inline constexpr FieldFlag kSyncFlags[] = {{"video_fps", "--fps"},
                                            {"audio_near_s", "--audio-near-s"},
                                            {"video_near_s", "--video-near-s"},
                                            {"max_seconds", "--max-s"}};
+// Refinement (RefineOptions, as set by `arco refine` and `arco run`).
+inline constexpr FieldFlag kRefineFlags[] = {
+    {"num_threads", "--threads"},
+    {"min_confidence", "--min-confidence"},
+    {"binding_cents", "--binding-cents"},
+    {"max_residual_mm", "--max-residual-mm"},
+    {"max_hand_shift_mm", "--max-hand-shift-mm"},
+    {"lift_max_distance_mm", "--lift-max-mm"},
+    {"reference_weight_mm_per_rad", "--reference-weight"},
+    {"temporal_weight_mm_per_rad", "--temporal-weight"},
+    {"onset_tolerance_s", "--onset-tolerance-s"},
+    {"neighbour_shift_frames", "--neighbour-shift-frames"},
+    {"straddle_s", "--straddle-s"},
+    {"normal_weight", "--normal-weight"},
+    {"lateral_weight", "--lateral-weight"},
+    {"hand_lateral_weight", "--hand-lateral-weight"},
+    {"shift_cost_per_semitone", "--shift-cost"}};
 // Evaluation (EvaluateRequest, as set by `arco eval`).
 inline constexpr FieldFlag kEvalFlags[] = {{"truth_frames", "--truth-frame"}};
 // Synthesis (CaptureWriteOptions, as set by `arco synth`).
 inline constexpr FieldFlag kSynthFlags[] = {{"overwrite", "--overwrite"},
-                                            {"max_duration_s", "--duration-s"}};
+                                            {"max_duration_s", "--duration-s"},
+                                            {"noise_px", "--noise-px"},
+                                            {"outlier_rate", "--outlier-rate"},
+                                            {"occlusion_rate", "--occlusion-rate"},
+                                            {"finger_bias_mm", "--finger-bias-mm"},
+                                            {"jitter_mm", "--jitter-mm"},
+                                            {"mm_per_unit", "--mm-per-unit"}};
 
 // `text` with every whole-word field name of `names` replaced by its flag. A name quoted
 // or qualified (`"fps"`, `audio.offset_s`) is a file's field (mocap/capture.h writes

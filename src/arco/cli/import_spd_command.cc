@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "arco/cli/command.h"
+#include "arco/cli/number_option.h"
 #include "arco/pipeline/import_spd.h"
 
 namespace arco::cli {
@@ -29,12 +30,24 @@ std::function<int()> Setup(CLI::App& app) {
   sub->add_option("--serials",
                   o->serials,
                   "Cameras in view order (default: every calibrated camera with a folder)");
-  sub->add_option("--first", o->frame_first, "First global frame (default: StartFrame)");
-  sub->add_option("--last", o->frame_last, "Last global frame, inclusive (default: EndFrame)");
-  sub->add_option("--fps", o->fps, "Video frame rate, frames per second")->capture_default_str();
+  AddNumber(sub,
+            "--first",
+            o->frame_first,
+            "First global frame (default: StartFrame)",
+            Closed(1, kFrameCountRange.max));
+  AddNumber(sub,
+            "--last",
+            o->frame_last,
+            "Last global frame, inclusive (default: EndFrame)",
+            Closed(1, kFrameCountRange.max));
+  AddNumber(sub, "--fps", o->fps, "Video frame rate, frames per second", kVideoFpsRange)
+      ->capture_default_str();
   sub->add_option("--audio", o->audio, "Audio file of the session (copied)");
-  sub->add_option(
-         "--audio-offset-s", o->audio_offset_s, "Audio time (s) at the start of the first frame")
+  AddNumber(sub,
+            "--audio-offset-s",
+            o->audio_offset_s,
+            "Audio time (s) at the start of the first frame",
+            kAudioTimeRangeS)
       ->capture_default_str();
   sub->add_option("--name", o->name, "Session name (default: the output folder's name)");
   sub->add_option("-o,--output",

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "arco/cli/command.h"
+#include "arco/cli/number_option.h"
 #include "arco/instrument/contact.h"
 #include "arco/instrument/instrument_model.h"
 
@@ -75,13 +76,20 @@ std::function<int()> SetupInstrument(CLI::App& app) {
       "instrument", "Print an instrument model and where a pitch is played on each string");
   cmd->add_option("name", options->instrument, "violin, viola, cello or double_bass")
       ->capture_default_str();
-  cmd->add_option("--a4-hz", options->a4_hz, "Concert pitch A4 in Hz")->capture_default_str();
-  cmd->add_option("--offset-cents",
-                  options->offset_cents,
-                  "Scordatura: cents per string from standard tuning, string 1 (highest) "
-                  "first, e.g. 0,0,-100,-100")
+  AddNumber(cmd, "--a4-hz", options->a4_hz, "Concert pitch A4 in Hz", kA4RangeHz)
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--offset-cents",
+            options->offset_cents,
+            "Scordatura: cents per string from standard tuning, string 1 (highest) "
+            "first, e.g. 0,0,-100,-100 (each within two octaves)",
+            kTuningOffsetRangeCents)
       ->delimiter(',');
-  cmd->add_option("--f0-hz", options->f0_hz, "Pitch to locate on every string (Hz); 0 = none")
+  AddNumber(cmd,
+            "--f0-hz",
+            options->f0_hz,
+            "Pitch to locate on every string (Hz); 0 = none",
+            Closed(0, 20000))
       ->capture_default_str();
   cmd->add_flag("--correction",
                 options->correction,

@@ -5,10 +5,14 @@
 #include "arco/cli/audio_report.h"
 #include "arco/cli/command.h"
 #include "arco/cli/flag_names.h"
+#include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
 
 namespace arco::cli {
 namespace {
+
+// --fmin / --fmax: 0 keeps the instrument's limit; else within hearing.
+constexpr NumberRange kF0OverrideRangeHz = Closed(0, 20000);
 
 std::function<int()> SetupPitch(CLI::App& app) {
   auto o = std::make_shared<pipeline::PitchRunOptions>();
@@ -23,21 +27,32 @@ std::function<int()> SetupPitch(CLI::App& app) {
       "--instrument",
       o->instrument,
       "violin | viola | cello | double_bass (alias bass) | any: the pitch range (default cello)");
-  cmd->add_option("--fps", o->fps, "Video frame rate: one row per frame (Hz; default 30)");
-  auto* start =
-      cmd->add_option("--start-s",
-                      o->start_s,
-                      "Audio time of video frame 0 (s; default 0); row i at start + i/fps");
-  cmd->add_option("--offset-s", o->start_s, "Same as --start-s: the offset `arco sync` prints (s)")
+  AddNumber(cmd, "--fps", o->fps, "Video frame rate: one row per frame (Hz; default 30)", audio::kTrackerFpsRange);
+  auto* start = AddNumber(cmd,
+                          "--start-s",
+                          o->start_s,
+                          "Audio time of video frame 0 (s; default 0); row i at start + i/fps",
+                          audio::kTrackerStartRangeS);
+  AddNumber(cmd,
+            "--offset-s",
+            o->start_s,
+            "Same as --start-s: the offset `arco sync` prints (s)",
+            audio::kTrackerStartRangeS)
       ->excludes(start);
-  cmd->add_option("--frames", o->frames, "Number of video frames (default: to the end of audio)");
-  cmd->add_option("--hops-per-frame",
-                  o->hops_per_frame,
-                  "Analysis hops per video frame (0: auto, fine rate >= 100 Hz)")
+  AddNumber(cmd,
+            "--frames",
+            o->frames,
+            "Number of video frames (default: to the end of audio)",
+            Closed(1, kFrameCountRange.max));
+  AddNumber(cmd,
+            "--hops-per-frame",
+            o->hops_per_frame,
+            "Analysis hops per video frame (0: auto, fine rate >= 100 Hz)",
+            audio::kHopsPerFrameRange)
       ->capture_default_str();
-  cmd->add_option("--fmin", o->min_f0_hz, "Override the lowest f0 (Hz)");
-  cmd->add_option("--fmax", o->max_f0_hz, "Override the highest f0 (Hz)");
-  cmd->add_option("--a4", o->a4_hz, "Tuning reference A4 (Hz; default 440)");
+  AddNumber(cmd, "--fmin", o->min_f0_hz, "Override the lowest f0 (Hz; 0 = the instrument's)", kF0OverrideRangeHz);
+  AddNumber(cmd, "--fmax", o->max_f0_hz, "Override the highest f0 (Hz; 0 = the instrument's)", kF0OverrideRangeHz);
+  AddNumber(cmd, "--a4", o->a4_hz, "Tuning reference A4 (Hz; default 440)", kA4RangeHz);
   cmd->add_option(
          "-o,--output", o->output, "pitch.csv to write: frame,time_s,f0_hz,confidence,voiced")
       ->capture_default_str();
@@ -49,6 +64,11 @@ std::function<int()> SetupPitch(CLI::App& app) {
   cmd->add_option("--midi",
                   o->midi_output,
                   "Write the notes as a standard MIDI file with pitch bends (+-2 semitones)");
+  cmd->parse_complete_callback([o] {
+    if (o->min_f0_hz > 0 && o->max_f0_hz > 0 && !(o->min_f0_hz < o->max_f0_hz)) {
+      throw CLI::ValidationError("--fmin must be below --fmax");
+    }
+  });
   return [o] {
     ProgressBar bar("pitch");  // the bar starts at TrackPitch's SetTotal
     auto result = pipeline::RunPitch(*o, bar);

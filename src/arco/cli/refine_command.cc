@@ -5,6 +5,8 @@
 #include <memory>
 
 #include "arco/cli/command.h"
+#include "arco/cli/flag_names.h"
+#include "arco/cli/number_option.h"
 #include "arco/cli/report.h"
 #include "arco/pipeline/refine_stage.h"
 
@@ -12,61 +14,35 @@ namespace arco::cli {
 namespace {
 
 struct RefineArgs {
-  std::string result;
+  // Bound to the flags directly: the defaults shown by --help are the library's.
+  pipeline::RefineStageOptions o;
   std::string mode = "arco";
-  int threads = 0;
-  double min_confidence = 0.5;
-  double binding_cents = 30.0;
-  double max_residual_mm = 3.0;
-  double lift_max_mm = 0.0;
-  double max_hand_shift_mm = 15.0;
   std::string joints = "mcp_flex_pip_dip";
-  double reference_weight = -1;  // < 0: the default
-  double temporal_weight = -1;
   bool exact_reach = false;
   bool no_audio_onsets = false;
-  double onset_tolerance_s = -1;  // < 0: the default
-  double straddle_s = -1;
-  int neighbour_shift_frames = -1;
-  double normal_weight = -1;
-  double lateral_weight = -1;
-  double hand_lateral_weight = -1;
-  double shift_cost = -1;
 };
 
-int RunRefine(const RefineArgs& a) {
-  pipeline::RefineStageOptions o;
-  o.result_dir = a.result;
+// The parse-complete step: the named choices into the options, then their Validate().
+void ApplyAndValidate(RefineArgs& a) {
   auto mode = refine::ParseRefineMode(a.mode);
-  if (!mode.ok()) return PrintError(mode.status().message());
-  o.refine.mode = *mode;
-  o.refine.num_threads = a.threads;
-  o.refine.pitch.min_confidence = a.min_confidence;
-  o.refine.paper.binding_cents = a.binding_cents;
-  o.refine.ik.max_residual_mm = a.max_residual_mm;
-  o.refine.ik.lift_max_distance_mm = a.lift_max_mm;
-  o.refine.ik.max_hand_shift_mm = a.max_hand_shift_mm;
-  if (a.joints == "pip_dip") o.refine.ik.joints = hand::FingerIkJoints::kPipDip;
-  if (a.joints == "all") o.refine.ik.joints = hand::FingerIkJoints::kAll;
-  if (a.reference_weight >= 0) o.refine.ik.reference_weight_mm_per_rad = a.reference_weight;
-  if (a.temporal_weight >= 0) o.refine.ik.temporal_weight_mm_per_rad = a.temporal_weight;
-  if (a.exact_reach) o.refine.ik.exact_reach = true;
-  if (a.no_audio_onsets) o.refine.decode.audio_onsets = false;
-  if (a.normal_weight >= 0) o.refine.decode.normal_weight = a.normal_weight;
-  if (a.lateral_weight >= 0) o.refine.decode.lateral_weight = a.lateral_weight;
-  if (a.hand_lateral_weight >= 0) o.refine.decode.hand_lateral_weight = a.hand_lateral_weight;
-  if (a.shift_cost >= 0) o.refine.decode.shift_cost_per_semitone = a.shift_cost;
-  if (a.neighbour_shift_frames >= 0) o.refine.ik.neighbour_shift_frames = a.neighbour_shift_frames;
-  if (a.straddle_s >= 0) o.refine.decode.boundaries.straddle_s = a.straddle_s;
-  if (a.onset_tolerance_s >= 0) o.refine.decode.boundaries.onset_tolerance_s = a.onset_tolerance_s;
-  const Status valid = o.Validate();
-  if (!valid.ok()) return PrintError(valid.message());
-  auto summary = pipeline::RunRefineStage(o);
+  ThrowIfInvalid(mode.status());
+  a.o.refine.mode = *mode;
+  if (a.joints == "pip_dip") a.o.refine.ik.joints = hand::FingerIkJoints::kPipDip;
+  if (a.joints == "all") a.o.refine.ik.joints = hand::FingerIkJoints::kAll;
+  if (a.joints == "mcp_flex_pip_dip") a.o.refine.ik.joints = hand::FingerIkJoints::kMcpFlexPipDip;
+  a.o.refine.ik.exact_reach = a.exact_reach;
+  a.o.refine.decode.audio_onsets = !a.no_audio_onsets;
+  const Status valid = a.o.Validate();
+  if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kRefineFlags)));
+}
+
+int RunRefine(const RefineArgs& a) {
+  auto summary = pipeline::RunRefineStage(a.o);
   if (!summary.ok()) return PrintError(summary.status().message());
   std::printf("%s\nwrote %s/%s/\n",
               FormatRefineSummary(*summary).c_str(),
-              a.result.c_str(),
-              refine::RefineModeName(*mode));
+              a.o.result_dir.c_str(),
+              refine::RefineModeName(a.o.refine.mode));
   return 0;
 }
 
@@ -74,7 +50,8 @@ std::function<int()> SetupRefine(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "refine", "Re-run only the audio-guided refinement on a result folder of `arco run`");
   auto a = std::make_shared<RefineArgs>();
-  sub->add_option("result", a->result, "Result folder written by `arco run`")->required();
+  refine::RefineOptions& r = a->o.refine;
+  sub->add_option("result", a->o.result_dir, "Result folder written by `arco run`")->required();
   sub->add_option("--mode",
                   a->mode,
                   "paper: the published method (wrist-nearest candidate, nearest fingertip, "
@@ -82,41 +59,60 @@ std::function<int()> SetupRefine(CLI::App& app) {
                   "MCP/PIP/DIP IK with a lift test; vision: the fitted hand as is")
       ->check(CLI::IsMember({"paper", "arco", "vision"}))
       ->capture_default_str();
-  sub->add_option(
-         "--threads", a->threads, "Worker threads (0 = all cores; results do not depend on it)")
+  AddNumber(sub,
+            "--threads",
+            r.num_threads,
+            "Worker threads (0 = all cores; results do not depend on it)",
+            kThreadsRange)
       ->capture_default_str();
-  sub->add_option("--min-confidence",
-                  a->min_confidence,
-                  "Pitch confidence below which a frame gets no contact (0-1)")
+  AddNumber(sub,
+            "--min-confidence",
+            r.pitch.min_confidence,
+            "Pitch confidence below which a frame gets no contact",
+            kMinConfidenceRange)
       ->capture_default_str();
-  sub->add_option("--binding-cents",
-                  a->binding_cents,
-                  "paper: keep the finger binding while the pitch stays within this many cents")
+  AddNumber(sub,
+            "--binding-cents",
+            r.paper.binding_cents,
+            "paper: keep the finger binding while the pitch stays within this many cents",
+            AboveZero(1200))
       ->capture_default_str();
-  sub->add_option("--max-residual-mm",
-                  a->max_residual_mm,
-                  "arco: reject a contact the bounded IK cannot bring the tip within this "
-                  "distance of (mm)")
+  AddNumber(sub,
+            "--max-residual-mm",
+            r.ik.max_residual_mm,
+            "arco: reject a contact the bounded IK cannot bring the tip within this "
+            "distance of (mm)",
+            AboveZero(1000))
       ->capture_default_str();
-  sub->add_option("--max-hand-shift-mm",
-                  a->max_hand_shift_mm,
-                  "arco: when the finger alone cannot reach, move the whole hand up to this far "
-                  "(mm); beyond it the contact is rejected")
+  AddNumber(sub,
+            "--max-hand-shift-mm",
+            r.ik.max_hand_shift_mm,
+            "arco: when the finger alone cannot reach, move the whole hand up to this far "
+            "(mm); beyond it the contact is rejected",
+            Closed(0, 1000))
       ->capture_default_str();
-  sub->add_option("--lift-max-mm",
-                  a->lift_max_mm,
-                  "arco: reject contacts farther than this from the fitted fingertip (mm; 0 = "
-                  "the finger's tip-to-PIP length)")
+  AddNumber(sub,
+            "--lift-max-mm",
+            r.ik.lift_max_distance_mm,
+            "arco: reject contacts farther than this from the fitted fingertip (mm; 0 = "
+            "the finger's tip-to-PIP length)",
+            Closed(0, 1000))
       ->capture_default_str();
   sub->add_option("--joints", a->joints, "arco: free joints of the playing finger")
       ->check(CLI::IsMember({"all", "mcp_flex_pip_dip", "pip_dip"}))
       ->capture_default_str();
-  sub->add_option("--reference-weight",
-                  a->reference_weight,
-                  "arco: IK prior toward the fitted angles (mm per rad; default 1)");
-  sub->add_option("--temporal-weight",
-                  a->temporal_weight,
-                  "arco: IK prior toward the previous frame's solution (mm per rad; default 4)");
+  AddNumber(sub,
+            "--reference-weight",
+            r.ik.reference_weight_mm_per_rad,
+            "arco: IK prior toward the fitted angles (mm per rad)",
+            refine::kCostWeightRange)
+      ->capture_default_str();
+  AddNumber(sub,
+            "--temporal-weight",
+            r.ik.temporal_weight_mm_per_rad,
+            "arco: IK prior toward the previous frame's solution (mm per rad)",
+            refine::kCostWeightRange)
+      ->capture_default_str();
   sub->add_flag("--exact-reach",
                 a->exact_reach,
                 "arco: the hand IK's exact reach instead of one regularised (least change) solve");
@@ -124,33 +120,53 @@ std::function<int()> SetupRefine(CLI::App& app) {
                 a->no_audio_onsets,
                 "arco: assign the frames at note changes by their own pitch only, not by the "
                 "onsets of the audio's notes (notes.csv)");
-  sub->add_option("--onset-tolerance-s",
-                  a->onset_tolerance_s,
-                  "arco: a frame this long before an audio onset belongs to the new note (s; "
-                  "default 0.017)");
-  sub->add_option("--neighbour-shift-frames",
-                  a->neighbour_shift_frames,
-                  "arco: a frame the lift test rejected starts from the hand shift of its "
-                  "accepted neighbours of the same note within this many frames (0: off; "
-                  "default 2)");
-  sub->add_option("--straddle-s",
-                  a->straddle_s,
-                  "arco: a note's frames this soon after its audio onset whose pitch is off "
-                  "the note's take the note's pitch (s; default 0.034, 0: off)");
-  sub->add_option("--normal-weight",
-                  a->normal_weight,
-                  "arco decoding: weight of the tip-to-contact distance along the string "
-                  "plane's normal");
-  sub->add_option("--lateral-weight",
-                  a->lateral_weight,
-                  "arco decoding: weight of the tip-to-contact distance across the string");
-  sub->add_option("--hand-lateral-weight",
-                  a->hand_lateral_weight,
-                  "arco decoding: weight of the hand's median fingertip offset across the "
-                  "strings");
-  sub->add_option("--shift-cost",
-                  a->shift_cost,
-                  "arco decoding: cost per semitone of hand-position change between notes");
+  AddNumber(sub,
+            "--onset-tolerance-s",
+            r.decode.boundaries.onset_tolerance_s,
+            "arco: a frame this long before an audio onset belongs to the new note (s)",
+            Closed(0, 10))
+      ->capture_default_str();
+  AddNumber(sub,
+            "--neighbour-shift-frames",
+            r.ik.neighbour_shift_frames,
+            "arco: a frame the lift test rejected starts from the hand shift of its "
+            "accepted neighbours of the same note within this many frames (0: off)",
+            Closed(0, 1000))
+      ->capture_default_str();
+  AddNumber(sub,
+            "--straddle-s",
+            r.decode.boundaries.straddle_s,
+            "arco: a note's frames this soon after its audio onset whose pitch is off "
+            "the note's take the note's pitch (s; 0: off)",
+            Closed(0, 10))
+      ->capture_default_str();
+  AddNumber(sub,
+            "--normal-weight",
+            r.decode.normal_weight,
+            "arco decoding: weight of the tip-to-contact distance along the string "
+            "plane's normal",
+            refine::kCostWeightRange)
+      ->capture_default_str();
+  AddNumber(sub,
+            "--lateral-weight",
+            r.decode.lateral_weight,
+            "arco decoding: weight of the tip-to-contact distance across the string",
+            refine::kCostWeightRange)
+      ->capture_default_str();
+  AddNumber(sub,
+            "--hand-lateral-weight",
+            r.decode.hand_lateral_weight,
+            "arco decoding: weight of the hand's median fingertip offset across the "
+            "strings",
+            refine::kCostWeightRange)
+      ->capture_default_str();
+  AddNumber(sub,
+            "--shift-cost",
+            r.decode.shift_cost_per_semitone,
+            "arco decoding: cost per semitone of hand-position change between notes (mm)",
+            refine::kCostWeightRange)
+      ->capture_default_str();
+  sub->parse_complete_callback([a] { ApplyAndValidate(*a); });
   return [a]() { return RunRefine(*a); };
 }
 

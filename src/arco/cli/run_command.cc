@@ -4,6 +4,8 @@
 #include <memory>
 
 #include "arco/cli/command.h"
+#include "arco/cli/flag_names.h"
+#include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
 #include "arco/cli/report.h"
 #include "arco/pipeline/run_capture.h"
@@ -13,19 +15,11 @@ namespace arco::cli {
 namespace {
 
 struct RunArgs {
-  std::string capture, output;
-  int threads = 0;
-  double min_confidence = 0.5;
-  bool overwrite = false;
+  pipeline::RunOptions o;  // bound to the flags: --help shows the library's defaults
 };
 
 int RunRun(const RunArgs& a) {
-  pipeline::RunOptions o;
-  o.capture_dir = a.capture;
-  o.result_dir = a.output;
-  o.num_threads = a.threads;
-  o.overwrite = a.overwrite;
-  o.refine.pitch.min_confidence = a.min_confidence;
+  const pipeline::RunOptions& o = a.o;
   ProgressBar progress;
   auto summary = pipeline::RunCapture(o, progress);
   progress.Finish();
@@ -45,7 +39,7 @@ int RunRun(const RunArgs& a) {
   }
   std::printf("total %.2f s -> %s (%s: points3d.npy, contacts.csv, fingering.csv)\n",
               total_s,
-              a.output.c_str(),
+              o.result_dir.c_str(),
               folders.c_str());
   return 0;
 }
@@ -54,17 +48,26 @@ std::function<int()> SetupRun(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "run", "Run every stage on a capture: triangulate, fit hands, pitch, refine, write");
   auto a = std::make_shared<RunArgs>();
-  sub->add_option("capture", a->capture, "Capture folder (capture.json, docs/formats.md)")
+  sub->add_option("capture", a->o.capture_dir, "Capture folder (capture.json, docs/formats.md)")
       ->required();
-  sub->add_option("-o,--output", a->output, "Result folder to write")->required();
-  sub->add_flag("--overwrite", a->overwrite, "Replace an existing result folder");
-  sub->add_option(
-         "--threads", a->threads, "Worker threads (0 = all cores; results do not depend on it)")
-      ->default_val(0);
-  sub->add_option("--min-confidence",
-                  a->min_confidence,
-                  "Pitch confidence below which a frame gets no contact (0-1)")
-      ->default_val(0.5);
+  sub->add_option("-o,--output", a->o.result_dir, "Result folder to write")->required();
+  sub->add_flag("--overwrite", a->o.overwrite, "Replace an existing result folder");
+  AddNumber(sub,
+            "--threads",
+            a->o.num_threads,
+            "Worker threads (0 = all cores; results do not depend on it)",
+            kThreadsRange)
+      ->capture_default_str();
+  AddNumber(sub,
+            "--min-confidence",
+            a->o.refine.pitch.min_confidence,
+            "Pitch confidence below which a frame gets no contact",
+            kMinConfidenceRange)
+      ->capture_default_str();
+  sub->parse_complete_callback([a] {
+    const Status valid = a->o.Validate();
+    if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kRefineFlags)));
+  });
   return [a]() { return RunRun(*a); };
 }
 

@@ -5,6 +5,7 @@
 #include "arco/cli/audio_report.h"
 #include "arco/cli/command.h"
 #include "arco/cli/flag_names.h"
+#include "arco/cli/number_option.h"
 
 namespace arco::cli {
 namespace {
@@ -20,15 +21,24 @@ std::function<int()> SetupSync(CLI::App& app) {
                   "Video of a camera showing the event; repeat for several synchronised "
                   "cameras (their events must agree; default with --capture: every camera's "
                   "video)");
-  cmd->add_option("--fps", o->sync.video_fps, "Video frame rate (Hz; default: the stream's)");
-  cmd->add_option("--audio-near-s",
-                  o->sync.audio_near_s,
-                  "Look for the audio event near this time (s; default: strongest anywhere)");
-  cmd->add_option(
-      "--video-near-s", o->sync.video_near_s, "Look for the video event near this video time (s)");
-  cmd->add_option("--search-s", o->sync.search_s, "Half-width of the windows above (s)")
+  AddNumber(cmd,
+            "--fps",
+            o->sync.video_fps,
+            "Video frame rate (Hz; default: the stream's)",
+            Closed(0, kVideoFpsRange.max));  // 0 = the stream's
+  AddNumber(cmd,
+            "--audio-near-s",
+            o->sync.audio_near_s,
+            "Look for the audio event near this time (s; default: strongest anywhere)",
+            Closed(0, 86400));
+  AddNumber(cmd,
+            "--video-near-s",
+            o->sync.video_near_s,
+            "Look for the video event near this video time (s)",
+            Closed(0, 86400));
+  AddNumber(cmd, "--search-s", o->sync.search_s, "Half-width of the windows above (s)", AboveZero(3600))
       ->capture_default_str();
-  cmd->add_option("--max-s", o->sync.max_seconds, "Scan at most this much of each file (s)")
+  AddNumber(cmd, "--max-s", o->sync.max_seconds, "Scan at most this much of each file (s)", AboveZero(86400))
       ->capture_default_str();
   auto event = std::make_shared<std::string>("clap");
   cmd->add_option("--event",

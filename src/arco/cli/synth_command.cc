@@ -10,6 +10,7 @@
 #include "arco/calibration/calibration_file.h"
 #include "arco/cli/command.h"
 #include "arco/cli/flag_names.h"
+#include "arco/cli/number_option.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"
 
@@ -164,52 +165,82 @@ std::function<int()> SetupSynth(CLI::App& app) {
                   "Camera calibration (any format arco reads); default: the SPD rig " +
                       std::string(kDefaultRig) +
                       " found via $ARCO_SHARED_DATA_DIR or ../shared/data");
-  cmd->add_option("--seed", a->o.seed, "Random seed (same seed, same capture)")
+  AddNumber(cmd,
+            "--seed",
+            a->o.seed,
+            "Random seed (same seed, same capture)",
+            Closed(0, kMaxExactInteger))
       ->capture_default_str();
-  cmd->add_option("--fps", a->o.fps, "Video frame rate (Hz)")->capture_default_str();
-  cmd->add_option(
-         "--duration-s", a->o.max_duration_s, "Keep only the first seconds of the piece (0 = all)")
+  AddNumber(cmd, "--fps", a->o.fps, "Video frame rate (Hz)", Closed(1, kVideoFpsRange.max))
       ->capture_default_str();
-  cmd->add_option("--tempo-scale", a->o.tempo_scale, "Stretch all durations (> 1 plays slower)")
+  AddNumber(cmd,
+            "--duration-s",
+            a->o.max_duration_s,
+            "Keep only the first seconds of the piece (0 = all)",
+            Closed(0, 86400))
       ->capture_default_str();
-  cmd->add_option("--a4", a->o.a4_hz, "Concert pitch A4 (Hz)")->capture_default_str();
-  cmd->add_option("--intonation-cents",
-                  a->o.expression.intonation_sigma_cents,
-                  "Std. dev. of per-note intonation error (cents, clipped to +-15)")
+  AddNumber(cmd,
+            "--tempo-scale",
+            a->o.tempo_scale,
+            "Stretch all durations (> 1 plays slower)",
+            NumberRange{0.05, 20, true, true})
+      ->capture_default_str();
+  AddNumber(cmd, "--a4", a->o.a4_hz, "Concert pitch A4 (Hz)", kA4RangeHz)->capture_default_str();
+  AddNumber(cmd,
+            "--intonation-cents",
+            a->o.expression.intonation_sigma_cents,
+            "Std. dev. of per-note intonation error (cents, clipped to +-15)",
+            Closed(0, 100))
       ->capture_default_str();
   cmd->add_flag("--no-vibrato", a->no_vibrato, "Play every note straight");
-  cmd->add_option("--vibrato-max-cents",
-                  a->o.expression.vibrato_extent_max_cents,
-                  "Largest vibrato extent (half peak-to-peak, cents)")
+  AddNumber(cmd,
+            "--vibrato-max-cents",
+            a->o.expression.vibrato_extent_max_cents,
+            "Largest vibrato extent (half peak-to-peak, cents; at least the smallest drawn "
+            "extent, 12; --no-vibrato for none)",
+            Closed(12, 100))
       ->capture_default_str();
-  cmd->add_option("--noise-px", a->o.detection.noise_px, "2D detection noise per axis (px)")
+  AddNumber(cmd,
+            "--noise-px",
+            a->o.detection.noise_px,
+            "2D detection noise per axis (px)",
+            NumberRange{0, 200, false, true})
       ->capture_default_str();
-  cmd->add_option("--outlier-rate",
-                  a->o.detection.outlier_rate,
-                  "Gross outliers per keypoint, and hand swaps per view and frame (fraction)")
+  AddNumber(cmd,
+            "--outlier-rate",
+            a->o.detection.outlier_rate,
+            "Gross outliers per keypoint, and hand swaps per view and frame (fraction)",
+            kFractionRange)
       ->capture_default_str();
-  cmd->add_option(
-         "--occlusion-rate",
-         a->o.detection.occlusion_rate,
-         "Random detector drop-outs per keypoint (fraction), on top of geometric occlusion")
+  AddNumber(cmd,
+            "--occlusion-rate",
+            a->o.detection.occlusion_rate,
+            "Random detector drop-outs per keypoint (fraction), on top of geometric occlusion",
+            kFractionRange)
       ->capture_default_str();
   cmd->add_flag("--no-geometric-occlusion",
                 a->no_geometric_occlusion,
                 "Do not occlude points hidden by the instrument body or the torso");
-  cmd->add_option(
-         "--finger-bias-mm",
-         a->o.detection.finger_bias_mm,
-         "3D offset of the playing fingertip off the string as the detector sees it (mm; DIP half)")
+  AddNumber(
+      cmd,
+      "--finger-bias-mm",
+      a->o.detection.finger_bias_mm,
+      "3D offset of the playing fingertip off the string as the detector sees it (mm; DIP half)",
+      NumberRange{0, 200, false, true})
       ->capture_default_str();
-  cmd->add_option("--jitter-mm",
-                  a->o.detection.jitter_mm,
-                  "View-consistent 3D detector error per axis for hand points (mm; body x1.5, "
-                  "instrument x0.3)")
+  AddNumber(cmd,
+            "--jitter-mm",
+            a->o.detection.jitter_mm,
+            "View-consistent 3D detector error per axis for hand points (mm; body x1.5, "
+            "instrument x0.3)",
+            NumberRange{0, 100, false, true})
       ->capture_default_str();
-  cmd->add_option("--mm-per-unit",
-                  a->o.stage.mm_per_unit,
-                  "Millimetres per calibration unit (0 = automatic: from the units, else the SPD "
-                  "rig's camera distance)")
+  AddNumber(cmd,
+            "--mm-per-unit",
+            a->o.stage.mm_per_unit,
+            "Millimetres per calibration unit (0 = automatic: from the units, else the SPD "
+            "rig's camera distance)",
+            Closed(0, 1e6))
       ->capture_default_str();
   cmd->add_flag("--no-audio", a->no_audio, "Skip rendering audio.wav");
   cmd->add_option("--soundfont", a->w.audio_render.soundfont, "SoundFont for fluidsynth")
@@ -217,15 +248,23 @@ std::function<int()> SetupSynth(CLI::App& app) {
   cmd->add_flag("--no-sample-tuning",
                 a->no_sample_tuning,
                 "Do not measure and compensate the soundfont samples' own pitch");
-  cmd->add_option("--room-noise-dbfs",
-                  a->w.audio_render.room_noise_dbfs,
-                  "Room noise RMS level (dBFS, e.g. -50; 0 = none)")
+  AddNumber(cmd,
+            "--room-noise-dbfs",
+            a->w.audio_render.room_noise_dbfs,
+            "Room noise RMS level (dBFS, e.g. -50; 0 = none)",
+            NumberRange{-200, 0, true, false})
       ->capture_default_str();
-  cmd->add_option("--threads",
-                  a->o.num_threads,
-                  "Worker threads (0 = all cores; results do not depend on it)")
+  AddNumber(cmd,
+            "--threads",
+            a->o.num_threads,
+            "Worker threads (0 = all cores; results do not depend on it)",
+            kThreadsRange)
       ->capture_default_str();
   cmd->add_flag("--overwrite", a->w.overwrite, "Replace an existing output folder");
+  cmd->parse_complete_callback([a] {
+    const Status valid = a->o.Validate();  // combinations the ranges above cannot see
+    if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kSynthFlags)));
+  });
   return [a] { return Run(*a); };
 }
 

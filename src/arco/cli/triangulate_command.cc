@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "arco/cli/command.h"
+#include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
 #include "arco/cli/report.h"
 #include "arco/pipeline/label_views.h"
@@ -118,17 +119,25 @@ std::function<int()> Setup(CLI::App& app) {
                   "Calibration file (Metashape XML, SPD JSON, OpenCV YAML/XML, arco JSON)");
   sub->add_option(
       "--view", a->views, "CAMERA=LABELME.json, CAMERA a camera name or serial; repeat per view");
-  sub->add_option("--min-score", a->t.min_score, "Ignore detections below this score [0..1]")
+  AddNumber(sub, "--min-score", a->t.min_score, "Ignore detections below this score", kFractionRange)
       ->capture_default_str();
-  sub->add_option("--max-reprojection-px", a->t.max_reprojection_px, "RANSAC inlier gate, pixels")
+  AddNumber(sub,
+            "--max-reprojection-px",
+            a->t.max_reprojection_px,
+            "RANSAC inlier gate, pixels",
+            AboveZero(10000))
       ->capture_default_str();
-  sub->add_option("--max-ransac-trials",
-                  a->t.max_ransac_trials,
-                  "Most camera pairs tried per point (all pairs when fewer)")
+  AddNumber(sub,
+            "--max-ransac-trials",
+            a->t.max_ransac_trials,
+            "Most camera pairs tried per point (all pairs when fewer)",
+            Closed(1, 1000000))
       ->capture_default_str();
-  sub->add_option("--robust-loss-px",
-                  a->t.robust_loss_scale_px,
-                  "Soft-L1 loss scale of the refinement, pixels")
+  AddNumber(sub,
+            "--robust-loss-px",
+            a->t.robust_loss_scale_px,
+            "Soft-L1 loss scale of the refinement, pixels",
+            AboveZero(10000))
       ->capture_default_str();
   sub->add_flag("--no-refine", a->no_refine, "Skip the Levenberg-Marquardt refinement");
   sub->add_flag("--ignore-distortion",
@@ -143,16 +152,23 @@ std::function<int()> Setup(CLI::App& app) {
                   a->scale_instrument,
                   "Also report lengths in mm, taking the mean string side (nut-bridge) as this "
                   "instrument's string length (cello 695 mm, violin 328 mm)");
-  sub->add_option("--threads", a->threads, "Worker threads (0 = all cores); results do not change")
+  AddNumber(sub,
+            "--threads",
+            a->threads,
+            "Worker threads (0 = all cores); results do not change",
+            kThreadsRange)
       ->capture_default_str();
   sub->add_option("--filter",
                   a->filters,
                   "GROUP=SPEC temporal filter, e.g. body=butterworth:6:4, left_hand=savgol:9:2, "
                   "instrument=oneeuro:1:0.5, all=none; repeatable, later wins");
-  sub->add_option("--max-gap-frames",
-                  a->max_gap_frames,
-                  "Fill NaN gaps up to this many frames before filtering (0 = none)")
+  AddNumber(sub,
+            "--max-gap-frames",
+            a->max_gap_frames,
+            "Fill NaN gaps up to this many frames before filtering (0 = none)",
+            Closed(0, 1000000))
       ->capture_default_str();
+  sub->parse_complete_callback([a] { ThrowIfInvalid(a->t.Validate()); });
   return [a]() {
     a->t.refine = !a->no_refine;
     const bool views_mode = !a->views.empty() || !a->calibration.empty();

@@ -261,6 +261,12 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
   return report;
 }
 
+Json ToJson(const EvalRequest& r) {
+  return {{"pck_thresholds_mm", r.metrics.pck_thresholds_mm},
+          {"joint_limit_tolerance_deg", r.joint_limit_tolerance_deg},
+          {"truth_frames", r.truth_frames}};
+}
+
 Json EvalReport::ToJson(const EvalOptions& options) const {
   Json j;
   j["format"] = "arco-eval";

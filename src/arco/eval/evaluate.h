@@ -50,6 +50,11 @@ struct EvalReport {
 
 StatusOr<EvalReport> Evaluate(const EvalRequest& request);
 
+// The scoring options of a request as applied, recorded in eval.json "options":
+// pck_thresholds_mm, joint_limit_tolerance_deg, truth_frames (labelled frames; empty for a
+// synthetic truth). File paths are not repeated: they are the command's arguments.
+Json ToJson(const EvalRequest& request);
+
 // Reads a contact CSV (refine/contacts_csv.h: columns by header name; extra columns
 // ignored) as a track of num_frames frames; rows past the last frame are ignored.
 StatusOr<ContactTrack> ReadContactCsv(const std::string& path, int num_frames);

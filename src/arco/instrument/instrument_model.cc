@@ -74,14 +74,11 @@ double CentsBetween(double reference_hz, double f_hz) {
 }
 
 Status TuningOptions::Validate(int num_strings) const {
-  if (!(a4_hz >= 300.0 && a4_hz <= 600.0)) {
-    return Status::Error("tuning: a4_hz must be within [300, 600] Hz, got " +
-                         std::to_string(a4_hz));
-  }
+  ARCO_RETURN_IF_ERROR(CheckInRange("tuning: a4_hz", a4_hz, kA4RangeHz));
   ARCO_RETURN_IF_ERROR(CheckPerString(offset_cents, num_strings, "tuning offset_cents", true));
   ARCO_RETURN_IF_ERROR(CheckPerString(open_hz, num_strings, "tuning open_hz", false));
   for (double c : offset_cents) {
-    if (std::abs(c) > 2400.0) return Status::Error("tuning: offset_cents beyond two octaves");
+    ARCO_RETURN_IF_ERROR(CheckInRange("tuning: offset_cents", c, kTuningOffsetRangeCents));
   }
   return Status::Ok();
 }

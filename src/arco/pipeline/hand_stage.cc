@@ -27,6 +27,30 @@ Status HandStageOptions::Validate() const {
   return fit.Validate().WithContext("fit");
 }
 
+Json ToJson(const HandStageOptions& o) {
+  const hand::HandFitOptions& f = o.fit;
+  return {{"bones",
+           {{"min_samples", o.bones.min_samples},
+            {"mad_gate", o.bones.mad_gate},
+            {"min_mad_mm", o.bones.min_mad_mm},
+            {"min_ratio", o.bones.min_ratio},
+            {"max_ratio", o.bones.max_ratio}}},
+          {"fit",
+           {{"min_score", f.min_score},
+            {"weight_by_score", f.weight_by_score},
+            {"robust_loss_px", f.robust_loss_px},
+            {"view_gate_px", f.view_gate_px},
+            {"min_keypoints_per_view", f.min_keypoints_per_view},
+            {"min_views", f.min_views},
+            {"min_initial_points", f.min_initial_points},
+            {"temporal_angle_weight_px_per_rad", f.temporal_angle_weight_px_per_rad},
+            {"temporal_rotation_weight_px_per_rad", f.temporal_rotation_weight_px_per_rad},
+            {"temporal_translation_weight_px_per_mm", f.temporal_translation_weight_px_per_mm},
+            {"max_iterations", f.max_iterations}}},
+          {"chunk_frames", o.chunk_frames},
+          {"num_threads", o.num_threads}};
+}
+
 StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
                                         const CaptureContext& capture,
                                         Progress& progress) {

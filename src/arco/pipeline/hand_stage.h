@@ -28,6 +28,9 @@ struct HandStageOptions {
 };
 
 // Progress: the total is the frame count, advanced per finished chunk.
+// Every option but result_dir, as result.json records it ("options"."hands").
+Json ToJson(const HandStageOptions& options);
+
 StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
                                         const CaptureContext& capture,
                                         Progress& progress = NoProgress());

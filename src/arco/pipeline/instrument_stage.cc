@@ -21,6 +21,40 @@ Status InstrumentStageOptions::Validate() const {
   return smoothing.Validate().WithContext("smoothing");
 }
 
+Json ToJson(const InstrumentStageOptions& o) {
+  const InstrumentFitOptions& f = o.fit;
+  const char* scale = f.scale == InstrumentFitOptions::Scale::kFromStringLength ? "from_string_length"
+                      : f.scale == InstrumentFitOptions::Scale::kWorldIsMillimetres ? "world_is_mm"
+                                                                                 : "given";
+  return {{"fit",
+           {{"scale", scale},
+            {"world_units_per_mm", f.world_units_per_mm},
+            {"max_iterations", f.max_iterations},
+            {"convergence_mm", f.convergence_mm},
+            {"point_gate_factor", f.point_gate_factor},
+            {"min_point_gate_mm", f.min_point_gate_mm},
+            {"max_point_gate_mm", f.max_point_gate_mm},
+            {"frame_gate_sigmas", f.frame_gate_sigmas},
+            {"min_spread_mm", f.min_spread_mm},
+            {"min_observations_per_point", f.min_observations_per_point},
+            {"min_front_agreement", f.min_front_agreement},
+            {"strings",
+             {{"spacing",
+               f.strings.spacing == StringGeometryOptions::Spacing::kInstrument
+                   ? "instrument"
+                   : "even_between_labels"},
+              {"min_front_margin_mm", f.strings.min_front_margin_mm},
+              {"min_front_angle_deg", f.strings.min_front_angle_deg},
+              {"max_edge_angle_deg", f.strings.max_edge_angle_deg},
+              {"world_units_per_mm", f.strings.world_units_per_mm}}}}},
+          {"smoothing",
+           {{"sigma_frames", o.smoothing.sigma_frames},
+            {"radius_frames", o.smoothing.radius_frames},
+            {"max_fill_gap_frames", o.smoothing.max_fill_gap_frames},
+            {"replace_high_residual", o.smoothing.replace_high_residual}}},
+          {"num_threads", o.num_threads}};
+}
+
 StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions& options,
                                                     const CaptureContext& capture,
                                                     Progress& /*progress*/) {

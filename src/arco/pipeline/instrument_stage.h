@@ -30,6 +30,9 @@ struct InstrumentStageOptions {
   Status Validate() const;
 };
 
+// Every option but result_dir, as result.json records it ("options"."instrument").
+Json ToJson(const InstrumentStageOptions& options);
+
 StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions& options,
                                                     const CaptureContext& capture,
                                                     Progress& progress = NoProgress());

@@ -194,6 +194,15 @@ Status ResultFolder::WriteStageFolder(const std::string& stage,
   return outputs.Commit();
 }
 
+Status ResultFolder::WriteRunOptions(const Json& options) const {
+  ARCO_ASSIGN_OR_RETURN(Json manifest, ReadManifest());
+  manifest["options"] = options;
+  OutputSet outputs;
+  ARCO_ASSIGN_OR_RETURN(const std::string tmp_manifest, outputs.AddFile(ManifestPath()));
+  ARCO_RETURN_IF_ERROR(WriteJsonFile(tmp_manifest, manifest));
+  return outputs.Commit();
+}
+
 // ---- triangulation/
 
 Status ResultFolder::WriteTriangulation(const CaptureManifest& manifest,

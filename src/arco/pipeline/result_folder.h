@@ -5,7 +5,8 @@
 //
 //   RESULT_DIR/result.json      the manifest: the capture's header (name, instrument, fps,
 //                               frames, units, layout, keypoint_names, cameras) and
-//                               "stages"."<stage>" = {dir, files, options, summary, ...}
+//                               "stages"."<stage>" = {dir, files, options, summary, ...},
+//                               "options": every option of the run (RunOptions, as applied)
 //   triangulation/              points3d.npy (F, P, 3) filtered, points3d_raw.npy,
 //                               reprojection_rms_px.npy (F, P), inlier_count.npy,
 //                               view_count.npy, inlier_mask.npy (F, P, V); world units
@@ -176,6 +177,10 @@ class ResultFolder {
 
   Status WriteMethod(const MethodRecord& record) const;
   std::string ContactsPath(const std::string& method) const;
+
+  // result.json "options": every option `arco run` applied (pipeline::ToJson(RunOptions)),
+  // written once all stages are done.
+  Status WriteRunOptions(const Json& options) const;
 
  private:
   // Writes RESULT_DIR/<stage>/ and result.json "stages"."<stage>" = `entry` plus "dir"

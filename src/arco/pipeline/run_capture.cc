@@ -68,6 +68,17 @@ Status RunOptions::Validate() const {
   return ForRefine(refine.mode).Validate().WithContext("refine");
 }
 
+Json ToJson(const RunOptions& o) {
+  Json triangulate = ToJson(o.ForTriangulate());
+  triangulate["num_threads"] = o.ForTriangulate().triangulation.num_threads;
+  return {{"num_threads", o.num_threads},
+          {"overwrite", o.overwrite},
+          {"triangulate", triangulate},
+          {"instrument", ToJson(o.ForInstrument())},
+          {"hands", ToJson(o.ForHands())},
+          {"refine", refine::ToJson(o.ForRefine(refine::RefineMode::kArco).refine)}};
+}
+
 FolderReplace RunOptions::Replace() const {
   FolderReplace r;
   r.overwrite = overwrite;
@@ -153,7 +164,7 @@ StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
           return Status::Error(message);
         }
         summary = std::move(ran).value();
-        return Status::Ok();
+        return ResultFolder(tmp_dir).WriteRunOptions(ToJson(options));
       }));
   return summary;
 }

@@ -66,6 +66,12 @@ struct RunSummary {
   std::vector<std::string> warnings;           // of all stages, in order
 };
 
+// Every option as the stages receive them (result.json "options", docs/formats.md):
+// num_threads, overwrite and "triangulate", "instrument", "hands", "refine" (the refine
+// options of the arco method; paper and vision record theirs in their stage entries).
+// The folders are not repeated (result.json has "capture"; the result is the folder).
+Json ToJson(const RunOptions& options);
+
 inline constexpr int kRunStages = 5;
 
 // Progress: StartStage(i, 5, name) for each stage, then that stage's SetTotal / Advance.

@@ -135,24 +135,24 @@ Status PaperOptions::Validate() const {
 }
 
 Status ArcoDecodeOptions::Validate() const {
-  const double values[] = {normal_weight,
-                           lateral_weight,
-                           hand_lateral_weight,
-                           order_margin_mm,
-                           order_weight,
-                           open_cost_mm,
-                           shift_cost_per_semitone,
-                           string_cross_cost,
-                           same_pitch_change_cost,
-                           same_pitch_cents,
-                           rest_gap_s,
-                           rest_factor,
-                           infeasible_cost,
-                           onset_lead_margin_mm};
-  for (double v : values) {
-    if (!(v >= 0 && Finite(v))) {
-      return Status::Error("arco decode options: every weight and cost must be finite and >= 0");
-    }
+  const std::pair<const char*, double> values[] = {
+      {"normal_weight", normal_weight},
+      {"lateral_weight", lateral_weight},
+      {"hand_lateral_weight", hand_lateral_weight},
+      {"order_margin_mm", order_margin_mm},
+      {"order_weight", order_weight},
+      {"open_cost_mm", open_cost_mm},
+      {"shift_cost_per_semitone", shift_cost_per_semitone},
+      {"string_cross_cost", string_cross_cost},
+      {"same_pitch_change_cost", same_pitch_change_cost},
+      {"same_pitch_cents", same_pitch_cents},
+      {"rest_gap_s", rest_gap_s},
+      {"rest_factor", rest_factor},
+      {"infeasible_cost", infeasible_cost},
+      {"onset_lead_margin_mm", onset_lead_margin_mm}};
+  for (const auto& [name, value] : values) {
+    ARCO_RETURN_IF_ERROR(CheckInRange(name, value, kCostWeightRange)
+                             .WithContext("arco decode options"));
   }
   if (!(handover_margin_mm >= 0)) {
     return Status::Error("arco decode options: handover_margin_mm must be >= 0 (infinity: off)");
@@ -173,12 +173,12 @@ Status ArcoDecodeOptions::Validate() const {
 }
 
 Status ArcoIkOptions::Validate() const {
-  if (!(reference_weight_mm_per_rad >= 0 && Finite(reference_weight_mm_per_rad))) {
-    return Status::Error("arco IK options: reference_weight_mm_per_rad must be >= 0");
-  }
-  if (!(temporal_weight_mm_per_rad >= 0 && Finite(temporal_weight_mm_per_rad))) {
-    return Status::Error("arco IK options: temporal_weight_mm_per_rad must be >= 0");
-  }
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("reference_weight_mm_per_rad", reference_weight_mm_per_rad, kCostWeightRange)
+          .WithContext("arco IK options"));
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("temporal_weight_mm_per_rad", temporal_weight_mm_per_rad, kCostWeightRange)
+          .WithContext("arco IK options"));
   if (!(lift_max_distance_mm >= 0 && Finite(lift_max_distance_mm))) {
     return Status::Error("arco IK options: lift_max_distance_mm must be >= 0 (0 = automatic)");
   }
@@ -256,7 +256,61 @@ Json ToJson(const RefineOptions& o) {
            hand::FingerIkJointsName(o.mode == RefineMode::kPaper ? hand::FingerIkJoints::kPipDip
                                                                  : o.ik.joints)},
           {"max_residual_mm", o.ik.max_residual_mm},
-          {"audio_onsets", o.mode == RefineMode::kArco && o.decode.audio_onsets}};
+          {"audio_onsets", o.mode == RefineMode::kArco && o.decode.audio_onsets},
+          {"num_threads", o.num_threads},
+          {"pitch",
+           {{"min_confidence", o.pitch.min_confidence},
+            {"min_confidence_in_note", o.pitch.min_confidence_in_note},
+            {"note_change_cents", o.pitch.note_change_cents},
+            {"note_change_frames", o.pitch.note_change_frames},
+            {"median_window_frames", o.pitch.median_window_frames},
+            {"min_note_frames", o.pitch.min_note_frames},
+            {"max_outlier_fraction", o.pitch.max_outlier_fraction},
+            {"jump_cents", o.pitch.jump_cents},
+            {"jump_window_frames", o.pitch.jump_window_frames},
+            {"max_jumps_in_window", o.pitch.max_jumps_in_window},
+            {"vibrato_min_cents", o.pitch.vibrato_min_cents},
+            {"contact",
+             {{"open_tolerance_cents", o.pitch.contact.open_tolerance_cents},
+              {"range_tolerance_cents", o.pitch.contact.range_tolerance_cents},
+              {"physical_correction", o.pitch.contact.physical_correction}}}}},
+          {"paper",
+           {{"binding_cents", o.paper.binding_cents},
+            {"reference_weight_mm_per_rad", o.paper.reference_weight_mm_per_rad},
+            {"max_iterations", o.paper.max_iterations}}},
+          {"decode",
+           {{"normal_weight", o.decode.normal_weight},
+            {"lateral_weight", o.decode.lateral_weight},
+            {"hand_lateral_weight", o.decode.hand_lateral_weight},
+            {"order_margin_mm", o.decode.order_margin_mm},
+            {"order_weight", o.decode.order_weight},
+            {"open_cost_mm", o.decode.open_cost_mm},
+            {"shift_cost_per_semitone", o.decode.shift_cost_per_semitone},
+            {"string_cross_cost", o.decode.string_cross_cost},
+            {"same_pitch_change_cost", o.decode.same_pitch_change_cost},
+            {"same_pitch_cents", o.decode.same_pitch_cents},
+            {"rest_gap_s", o.decode.rest_gap_s},
+            {"rest_factor", o.decode.rest_factor},
+            {"infeasible_cost", o.decode.infeasible_cost},
+            {"onset_lead_frames", o.decode.onset_lead_frames},
+            {"onset_lead_margin_mm", o.decode.onset_lead_margin_mm},
+            {"handover_margin_mm", JsonFromDouble(o.decode.handover_margin_mm)},  // inf: off
+            {"audio_onsets", o.decode.audio_onsets},
+            {"boundaries",
+             {{"onset_tolerance_s", o.decode.boundaries.onset_tolerance_s},
+              {"match_cents", o.decode.boundaries.match_cents},
+              {"straddle_s", o.decode.boundaries.straddle_s},
+              {"straddle_cents", o.decode.boundaries.straddle_cents}}}}},
+          {"ik",
+           {{"joints", hand::FingerIkJointsName(o.ik.joints)},
+            {"exact_reach", o.ik.exact_reach},
+            {"reference_weight_mm_per_rad", o.ik.reference_weight_mm_per_rad},
+            {"temporal_weight_mm_per_rad", o.ik.temporal_weight_mm_per_rad},
+            {"lift_max_distance_mm", o.ik.lift_max_distance_mm},
+            {"max_residual_mm", o.ik.max_residual_mm},
+            {"max_hand_shift_mm", o.ik.max_hand_shift_mm},
+            {"neighbour_shift_frames", o.ik.neighbour_shift_frames},
+            {"max_iterations", o.ik.max_iterations}}}};
 }
 
 Json ToJson(const RefineSummary& s) {

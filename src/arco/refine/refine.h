@@ -28,6 +28,7 @@
 #include "arco/refine/note_boundaries.h"
 #include "arco/refine/pitch_model.h"
 #include "arco/util/json_io.h"
+#include "arco/util/number_range.h"
 #include "arco/util/status.h"
 
 namespace arco::refine {
@@ -54,6 +55,10 @@ struct RefineInput {
   // with a wrong string count or non-finite ends.
   Status Validate() const;
 };
+
+// Every weight and cost of the decoding and the IK priors (mm-equivalents): finite, >= 0,
+// and small enough that sums over a clip stay finite.
+inline constexpr NumberRange kCostWeightRange = Closed(0, 1e6);
 
 // The paper's choices (paper_decode.h).
 struct PaperOptions {
@@ -177,7 +182,8 @@ RefineResult Refine(const RefineInput& input, const RefineOptions& options);
 
 // The options as the refinement applies them, recorded with a method's result: mode,
 // min_confidence, binding_cents, ik_joints (the paper always solves PIP and DIP),
-// max_residual_mm, audio_onsets (arco only).
+// max_residual_mm, audio_onsets (arco only), num_threads, and every field of the nested
+// options as given: "pitch", "paper", "decode" (with "boundaries"), "ik".
 Json ToJson(const RefineOptions& options);
 
 // The counts and distances of a refinement recorded with a method's result (mean tip

@@ -174,6 +174,14 @@ TEST(Refine, InvalidInputAndOptionsThrowWithAMessage) {
   ob.ik.temporal_weight_mm_per_rad = NAN;
   EXPECT_FALSE(ob.Validate().ok());
   ob = {};
+  ob.decode.shift_cost_per_semitone = 1e300;  // huge: the sums over a clip overflow
+  EXPECT_EQ(ob.Validate().message(),
+            "arco decode options: shift_cost_per_semitone must be a finite number in "
+            "[0, 1000000], got 1e+300");
+  ob = {};
+  ob.ik.reference_weight_mm_per_rad = -1;
+  EXPECT_FALSE(ob.Validate().ok());
+  ob = {};
   ob.num_threads = -1;
   EXPECT_FALSE(ob.Validate().ok());
   EXPECT_THROW(Refine(scene.input, ob), std::invalid_argument);

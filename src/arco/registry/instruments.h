@@ -14,9 +14,18 @@
 #include <string_view>
 #include <vector>
 
+#include "arco/util/number_range.h"
 #include "arco/util/status.h"
 
 namespace arco {
+
+// The concert pitch every A4 (tuning reference) must lie in: the pitch tracker's, the
+// notes', the synthesis', the instrument models', capture.json's tuning and the CLI's --a4
+// flags all check this one range. French baroque 392 Hz, baroque 415, modern 440-446,
+// with a margin on both sides.
+inline constexpr NumberRange kA4RangeHz = Closed(300, 600);
+// A string's tuning offset from standard (scordatura), cents: within two octaves.
+inline constexpr NumberRange kTuningOffsetRangeCents = Closed(-2400, 2400);
 
 enum class InstrumentKind { kViolin, kViola, kCello, kDoubleBass };
 

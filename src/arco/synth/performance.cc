@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "arco/registry/instruments.h"
 #include "arco/synth/random.h"
 
 namespace arco::synth {
@@ -21,7 +22,7 @@ double SmoothRamp(double x) {
 }  // namespace
 
 Status ExpressionOptions::Validate() const {
-  if (!(a4_hz > 200 && a4_hz < 600)) return Status::Error("a4_hz must be in (200, 600)");
+  ARCO_RETURN_IF_ERROR(CheckInRange("a4_hz", a4_hz, kA4RangeHz));
   if (!(intonation_sigma_cents >= 0) || !(max_intonation_cents >= 0) || max_intonation_cents > 50) {
     return Status::Error("intonation: sigma >= 0 and max in [0, 50] cents");
   }

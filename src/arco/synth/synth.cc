@@ -1,5 +1,7 @@
 #include "arco/synth/synth.h"
 
+#include "arco/registry/instruments.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -26,7 +28,7 @@ Status SynthOptions::Validate() const {
   if (!(max_duration_s >= 0) || !std::isfinite(max_duration_s)) {
     return Status::Error("max_duration_s must be >= 0 s (0 = whole piece)");
   }
-  if (!(a4_hz >= 300 && a4_hz <= 600)) return Status::Error("a4 must be in [300, 600] Hz");
+  ARCO_RETURN_IF_ERROR(CheckInRange("a4_hz", a4_hz, kA4RangeHz));
   if (num_threads < 0) return Status::Error("threads must be >= 0");
   ARCO_RETURN_IF_ERROR(stage.Validate());
   ARCO_RETURN_IF_ERROR(fingering.Validate());

@@ -1,0 +1,151 @@
+#include "arco/cli/app.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+
+#include "arco/cli/command.h"
+
+namespace arco::cli {
+
+std::vector<CommandEntry>& CommandRegistry() {
+  static std::vector<CommandEntry> registry;
+  return registry;
+}
+
+int PrintError(const std::string& message) {
+  std::fprintf(stderr, "arco: error: %s\n", message.c_str());
+  return 1;
+}
+
+App BuildApp() {
+  App built;
+  built.app = std::make_unique<CLI::App>(
+      "arco: audio-guided markerless motion capture of string-instrument performance.\n"
+      "Run `arco <command> --help` for a command's options (units, ranges and defaults).");
+  CLI::App& app = *built.app;
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "arco 0.1.0");
+  auto registry = CommandRegistry();
+  std::stable_sort(registry.begin(),
+                   registry.end(),
+                   [](const CommandEntry& a, const CommandEntry& b) { return a.order < b.order; });
+  for (auto& entry : registry) {
+    const size_t before = app.get_subcommands({}).size();
+    auto run = entry.setup(app);
+    auto subs = app.get_subcommands({});
+    if (subs.size() > before) built.commands.emplace_back(subs.back(), run);
+  }
+  return built;
+}
+
+void App::Parse(std::vector<std::string> args) {
+  std::reverse(args.begin(), args.end());  // CLI11 takes them last first
+  app->parse(args);
+}
+
+int App::Run() {
+  try {
+    for (auto& [sub, run] : commands) {
+      if (sub->parsed()) return run();
+    }
+  } catch (const std::exception& e) {
+    return PrintError(e.what());
+  }
+  return PrintError("no command given; see `arco --help`");
+}
+
+Status CheckCommandName(const App& app, const std::string& first_arg) {
+  if (first_arg.empty() || first_arg[0] == '-') return Status::Ok();
+  std::string known;
+  bool found = false;
+  for (const auto& [sub, run] : app.commands) {
+    found = found || sub->get_name() == first_arg;
+    known += (known.empty() ? "" : ", ") + sub->get_name();
+  }
+  if (found) return Status::Ok();
+  return Status::Error("unknown command '" + first_arg + "' (commands: " + known +
+                       "; see `arco --help`)");
+}
+
+namespace {
+
+std::string Escape(std::string text) {
+  for (size_t at = text.find('|'); at != std::string::npos; at = text.find('|', at + 2)) {
+    text.replace(at, 1, "\\|");
+  }
+  return text;
+}
+
+void AppendCommand(const CLI::App& command, const std::string& path, std::string* out) {
+  std::string rows;
+  for (const CLI::Option* o : command.get_options()) {
+    if (o->get_name() == "--help") continue;
+    const std::string type_name = o->get_type_name();
+    const size_t colon = type_name.find(':');
+    std::string type = type_name.substr(0, colon);
+    if (o->get_type_size_max() == 0 || type.empty()) type = "flag";
+    const std::string check = colon == std::string::npos ? "" : type_name.substr(colon + 1);
+    std::string names;
+    if (o->nonpositional()) {
+      const std::string all = o->get_name(false, true);
+      for (size_t start = 0; start < all.size();) {
+        const size_t comma = std::min(all.find(',', start), all.size());
+        names += (names.empty() ? "`" : ", `") + all.substr(start, comma - start) + "`";
+        start = comma + 1;
+      }
+    } else {
+      names = "`" + o->get_name(true) + "`";
+    }
+    rows += "| " + names + " | " + type + (o->get_required() ? ", required" : "") + " | " +
+            Escape(check) + " | " + Escape(o->get_default_str()) + " | " +
+            Escape(o->get_description()) + " |\n";
+  }
+  if (!rows.empty()) {
+    *out += "\n## arco " + path + "\n\n" + Escape(command.get_description()) +
+            "\n\n| option | type | range / choices | default | meaning |\n|---|---|---|---|---|\n" +
+            rows;
+  }
+  for (const CLI::App* sub : command.get_subcommands({})) {
+    AppendCommand(*sub, path + " " + sub->get_name(), out);
+  }
+}
+
+}  // namespace
+
+std::string OptionsMarkdown(const App& app) {
+  std::string out =
+      "# Command-line options\n\n"
+      "Every option of every command with the values it accepts, generated from the commands'\n"
+      "own definitions (cli/app.h OptionsMarkdown; `cli_app_test` fails when this page is out\n"
+      "of date, and `ARCO_WRITE_OPTIONS_DOC=1 build/tests/cli_app_test` rewrites it).\n\n"
+      "A number outside its range, NaN, an infinity, a value that would wrap (`--seed -1`)\n"
+      "or text where a number belongs is rejected before any work with one line naming the\n"
+      "flag, the value and the range (`arco: error: --fps: nan is not a finite number in\n"
+      "(0, 1000]`), exit status 1, nothing written. `[a, b]` includes both ends, `(a, b]`\n"
+      "excludes a. `arco <command> --help` shows the same ranges after the type\n"
+      "(`FLOAT:(0, 1000]`). The options applied are recorded with the results: result.json\n"
+      "\"options\" (`arco run`) and each method's \"options\" (`arco run`, `arco refine`),\n"
+      "eval.json \"options\" (`arco eval`); docs/formats.md.\n";
+  for (const auto& [sub, run] : app.commands) AppendCommand(*sub, sub->get_name(), &out);
+  return out;
+}
+
+int Main(int argc, char** argv) {
+  App app = BuildApp();
+  if (argc > 1) {
+    const Status known = CheckCommandName(app, argv[1]);
+    if (!known.ok()) return PrintError(known.message());
+  }
+  try {
+    app.Parse(std::vector<std::string>(argv + 1, argv + argc));
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() != 0) return PrintError(e.what());
+    return app.app->exit(e);
+  } catch (const std::exception& e) {  // a bug (the fuzzer looks for these): one line still
+    return PrintError(e.what());
+  }
+  return app.Run();
+}
+
+}  // namespace arco::cli

@@ -1,0 +1,48 @@
+// The `arco` command-line app, built the same way for main.cc, the tests and the fuzzer
+// (fuzz/cli_args_fuzz.cc): every registered command (command.h) as a subcommand.
+//
+// Parsing is separate from running: Parse() checks every flag (types, declared ranges,
+// cli/number_option.h) and each command's options struct (its Validate(), run by the
+// command's parse-complete callback) and throws only CLI::ParseError; nothing is read or
+// written until Run().
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "arco/util/status.h"
+
+namespace arco::cli {
+
+struct App {
+  std::unique_ptr<CLI::App> app;
+  // Each command's subcommand and the function that runs it after a successful parse.
+  std::vector<std::pair<CLI::App*, std::function<int()>>> commands;
+
+  // Throws CLI::ParseError (CallForHelp and CallForVersion included) and nothing else for
+  // any argv. args excludes the program name.
+  void Parse(std::vector<std::string> args);
+  // The parsed command's exit code (0 ok, 1 error printed).
+  int Run();
+};
+
+App BuildApp();
+
+// Ok, or "unknown command 'X' (commands: ...)" for a first word that names no command
+// (CLI11 would say "A subcommand is required").
+Status CheckCommandName(const App& app, const std::string& first_arg);
+
+// docs/options.md: every command's options (type, range or choices, default, meaning) as
+// the app defines them; app_test.cc checks the page is current (and rewrites it with
+// ARCO_WRITE_OPTIONS_DOC=1).
+std::string OptionsMarkdown(const App& app);
+
+// `arco ARGS...`: parse, print a parse error or help, run.
+int Main(int argc, char** argv);
+
+}  // namespace arco::cli
