@@ -38,6 +38,8 @@ inline constexpr NumberRange kTrackerFpsRange = AboveZero(1000);
 // The video may start at most an hour before the audio.
 inline constexpr NumberRange kTrackerStartRangeS = Closed(-3600, 1e6);
 inline constexpr NumberRange kHopsPerFrameRange = Closed(0, 100);
+// Overrides of an instrument's f0 limits: 0 keeps the instrument's; else within hearing.
+inline constexpr NumberRange kF0OverrideRangeHz = Closed(0, 20000);
 
 struct PitchTrackerOptions {
   InstrumentRange range;    // from InstrumentRangeByName

@@ -78,21 +78,29 @@ std::function<int()> SetupEval(CLI::App& app) {
             "--truth-frame",
             a->r.truth_frames,
             "Frame number (capture numbering, from 1) each points JSON labels, in order",
-            kFrameCountRange);
+            eval::kTruthFrameRange);
   cmd->add_option("--pitch",
                   a->r.pitch_csv,
                   "Estimated pitch.csv (default: RESULT_DIR/pitch.csv when present)");
-  AddNumber(cmd, "--pck-mm", a->r.metrics.pck_thresholds_mm, "PCK thresholds (mm)", AboveZero(1000))
+  AddNumber(cmd,
+            "--pck-mm",
+            a->r.metrics.pck_thresholds_mm,
+            "PCK thresholds (mm)",
+            eval::kPckThresholdRangeMm)
       ->capture_default_str();
   AddNumber(cmd,
             "--limit-tolerance-deg",
             a->r.joint_limit_tolerance_deg,
             "Tolerance before a geometric joint angle counts as a limit violation (deg)",
-            Closed(0, 180))
+            eval::kJointLimitToleranceRangeDeg)
       ->capture_default_str();
   cmd->add_option("-o,--output", a->output, "Write the metrics as JSON here");
   cmd->add_option(
       "--plot", a->plot, "Write an SVG plot (pitch; hand error and contact deviation per frame)");
+  cmd->parse_complete_callback([a] {
+    const Status valid = a->r.Validate();
+    if (!valid.ok()) throw CLI::ValidationError(WithFlagNames(valid.message(), kEvalFlags));
+  });
   return [a] { return Run(*a); };
 }
 

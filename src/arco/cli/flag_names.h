@@ -14,8 +14,11 @@ struct FieldFlag {
 };
 
 // Pitch (PitchTrackerOptions, as set by `arco pitch`).
-inline constexpr FieldFlag kPitchFlags[] = {
-    {"fps", "--fps"}, {"start_s", "--start-s"}, {"a4_hz", "--a4"}};
+inline constexpr FieldFlag kPitchFlags[] = {{"fps", "--fps"},
+                                            {"start_s", "--start-s"},
+                                            {"a4_hz", "--a4"},
+                                            {"min_f0_hz", "--fmin"},
+                                            {"max_f0_hz", "--fmax"}};
 // Sync (SyncOptions, as set by `arco sync`).
 inline constexpr FieldFlag kSyncFlags[] = {{"video_fps", "--fps"},
                                            {"search_s", "--search-s"},
@@ -23,24 +26,25 @@ inline constexpr FieldFlag kSyncFlags[] = {{"video_fps", "--fps"},
                                            {"video_near_s", "--video-near-s"},
                                            {"max_seconds", "--max-s"}};
 // Refinement (RefineOptions, as set by `arco refine` and `arco run`).
-inline constexpr FieldFlag kRefineFlags[] = {
-    {"num_threads", "--threads"},
-    {"min_confidence", "--min-confidence"},
-    {"binding_cents", "--binding-cents"},
-    {"max_residual_mm", "--max-residual-mm"},
-    {"max_hand_shift_mm", "--max-hand-shift-mm"},
-    {"lift_max_distance_mm", "--lift-max-mm"},
-    {"reference_weight_mm_per_rad", "--reference-weight"},
-    {"temporal_weight_mm_per_rad", "--temporal-weight"},
-    {"onset_tolerance_s", "--onset-tolerance-s"},
-    {"neighbour_shift_frames", "--neighbour-shift-frames"},
-    {"straddle_s", "--straddle-s"},
-    {"normal_weight", "--normal-weight"},
-    {"lateral_weight", "--lateral-weight"},
-    {"hand_lateral_weight", "--hand-lateral-weight"},
-    {"shift_cost_per_semitone", "--shift-cost"}};
+inline constexpr FieldFlag kRefineFlags[] = {{"num_threads", "--threads"},
+                                             {"min_confidence", "--min-confidence"},
+                                             {"binding_cents", "--binding-cents"},
+                                             {"max_residual_mm", "--max-residual-mm"},
+                                             {"max_hand_shift_mm", "--max-hand-shift-mm"},
+                                             {"lift_max_distance_mm", "--lift-max-mm"},
+                                             {"reference_weight_mm_per_rad", "--reference-weight"},
+                                             {"temporal_weight_mm_per_rad", "--temporal-weight"},
+                                             {"onset_tolerance_s", "--onset-tolerance-s"},
+                                             {"neighbour_shift_frames", "--neighbour-shift-frames"},
+                                             {"straddle_s", "--straddle-s"},
+                                             {"normal_weight", "--normal-weight"},
+                                             {"lateral_weight", "--lateral-weight"},
+                                             {"hand_lateral_weight", "--hand-lateral-weight"},
+                                             {"shift_cost_per_semitone", "--shift-cost"}};
 // Evaluation (EvaluateRequest, as set by `arco eval`).
-inline constexpr FieldFlag kEvalFlags[] = {{"truth_frames", "--truth-frame"}};
+inline constexpr FieldFlag kEvalFlags[] = {{"truth_frames", "--truth-frame"},
+                                           {"pck_thresholds_mm", "--pck-mm"},
+                                           {"joint_limit_tolerance_deg", "--limit-tolerance-deg"}};
 // Synthesis (CaptureWriteOptions, as set by `arco synth`).
 inline constexpr FieldFlag kSynthFlags[] = {{"overwrite", "--overwrite"},
                                             {"max_duration_s", "--duration-s"},

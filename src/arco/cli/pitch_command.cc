@@ -11,9 +11,6 @@
 namespace arco::cli {
 namespace {
 
-// --fmin / --fmax: 0 keeps the instrument's limit; else within hearing.
-constexpr NumberRange kF0OverrideRangeHz = Closed(0, 20000);
-
 std::function<int()> SetupPitch(CLI::App& app) {
   auto o = std::make_shared<pipeline::PitchRunOptions>();
   auto* cmd = app.add_subcommand(
@@ -27,7 +24,11 @@ std::function<int()> SetupPitch(CLI::App& app) {
       "--instrument",
       o->instrument,
       "violin | viola | cello | double_bass (alias bass) | any: the pitch range (default cello)");
-  AddNumber(cmd, "--fps", o->fps, "Video frame rate: one row per frame (Hz; default 30)", audio::kTrackerFpsRange);
+  AddNumber(cmd,
+            "--fps",
+            o->fps,
+            "Video frame rate: one row per frame (Hz; default 30)",
+            audio::kTrackerFpsRange);
   auto* start = AddNumber(cmd,
                           "--start-s",
                           o->start_s,
@@ -50,8 +51,16 @@ std::function<int()> SetupPitch(CLI::App& app) {
             "Analysis hops per video frame (0: auto, fine rate >= 100 Hz)",
             audio::kHopsPerFrameRange)
       ->capture_default_str();
-  AddNumber(cmd, "--fmin", o->min_f0_hz, "Override the lowest f0 (Hz; 0 = the instrument's)", kF0OverrideRangeHz);
-  AddNumber(cmd, "--fmax", o->max_f0_hz, "Override the highest f0 (Hz; 0 = the instrument's)", kF0OverrideRangeHz);
+  AddNumber(cmd,
+            "--fmin",
+            o->min_f0_hz,
+            "Override the lowest f0 (Hz; 0 = the instrument's)",
+            audio::kF0OverrideRangeHz);
+  AddNumber(cmd,
+            "--fmax",
+            o->max_f0_hz,
+            "Override the highest f0 (Hz; 0 = the instrument's)",
+            audio::kF0OverrideRangeHz);
   AddNumber(cmd, "--a4", o->a4_hz, "Tuning reference A4 (Hz; default 440)", kA4RangeHz);
   cmd->add_option(
          "-o,--output", o->output, "pitch.csv to write: frame,time_s,f0_hz,confidence,voiced")
@@ -65,9 +74,8 @@ std::function<int()> SetupPitch(CLI::App& app) {
                   o->midi_output,
                   "Write the notes as a standard MIDI file with pitch bends (+-2 semitones)");
   cmd->parse_complete_callback([o] {
-    if (o->min_f0_hz > 0 && o->max_f0_hz > 0 && !(o->min_f0_hz < o->max_f0_hz)) {
-      throw CLI::ValidationError("--fmin must be below --fmax");
-    }
+    const Status valid = o->Validate();
+    if (!valid.ok()) throw CLI::ValidationError(WithFlagNames(valid.message(), kPitchFlags));
   });
   return [o] {
     ProgressBar bar("pitch");  // the bar starts at TrackPitch's SetTotal

@@ -36,9 +36,14 @@ std::function<int()> SetupSync(CLI::App& app) {
             o->sync.video_near_s,
             "Look for the video event near this video time (s)",
             Closed(0, 86400));
-  AddNumber(cmd, "--search-s", o->sync.search_s, "Half-width of the windows above (s)", AboveZero(3600))
+  AddNumber(
+      cmd, "--search-s", o->sync.search_s, "Half-width of the windows above (s)", AboveZero(3600))
       ->capture_default_str();
-  AddNumber(cmd, "--max-s", o->sync.max_seconds, "Scan at most this much of each file (s)", AboveZero(86400))
+  AddNumber(cmd,
+            "--max-s",
+            o->sync.max_seconds,
+            "Scan at most this much of each file (s)",
+            AboveZero(86400))
       ->capture_default_str();
   auto event = std::make_shared<std::string>("clap");
   cmd->add_option("--event",

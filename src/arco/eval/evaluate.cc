@@ -99,7 +99,21 @@ StatusOr<ContactTrack> ReadContactCsv(const std::string& path, int num_frames) {
   return ContactTrackFromRows(rows, num_frames);
 }
 
+Status EvalRequest::Validate() const {
+  for (double mm : metrics.pck_thresholds_mm) {
+    ARCO_RETURN_IF_ERROR(CheckInRange("pck_thresholds_mm", mm, kPckThresholdRangeMm));
+  }
+  ARCO_RETURN_IF_ERROR(CheckInRange(
+      "joint_limit_tolerance_deg", joint_limit_tolerance_deg, kJointLimitToleranceRangeDeg));
+  for (int64_t frame : truth_frames) {
+    ARCO_RETURN_IF_ERROR(
+        CheckInRange("truth_frames", static_cast<double>(frame), kTruthFrameRange));
+  }
+  return Status::Ok();
+}
+
 StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
+  ARCO_RETURN_IF_ERROR(r.Validate());
   EvalReport report;
   const pipeline::ResultFolder result(r.result_dir);
   ARCO_ASSIGN_OR_RETURN(const std::vector<pipeline::PointStage> point_stages, result.PointStages());

@@ -8,9 +8,9 @@
 // contact_y_mm, contact_z_mm as truth/contact.csv): then string and finger
 // identification are scored.
 // Truth: a synthetic truth folder (arco synth's truth/, read by synth/truth_folder.h:
-// points3d.npy, contact.csv, pitch.csv are scored), or points JSONs of `arco triangulate --view ...` (manually labelled
-// views triangulated: the paper's real-data protocol), one per labelled frame.
-// Pitch: RESULT_DIR/pitch.csv (or --pitch FILE) against truth/pitch.csv.
+// points3d.npy, contact.csv, pitch.csv are scored), or points JSONs of `arco triangulate --view
+// ...` (manually labelled views triangulated: the paper's real-data protocol), one per labelled
+// frame. Pitch: RESULT_DIR/pitch.csv (or --pitch FILE) against truth/pitch.csv.
 #pragma once
 
 #include <optional>
@@ -19,9 +19,15 @@
 
 #include "arco/eval/metrics.h"
 #include "arco/util/json_io.h"
+#include "arco/util/number_range.h"
 #include "arco/util/status.h"
 
 namespace arco::eval {
+
+// The declared ranges of EvalRequest (Validate(); `arco eval` declares the same).
+inline constexpr NumberRange kPckThresholdRangeMm = AboveZero(1000);
+inline constexpr NumberRange kJointLimitToleranceRangeDeg = Closed(0, 180);
+inline constexpr NumberRange kTruthFrameRange = Closed(0, 1e9);  // frames.first may be 0
 
 struct EvalRequest {
   std::string result_dir;
@@ -31,6 +37,9 @@ struct EvalRequest {
   std::string pitch_csv;  // optional estimate; default RESULT_DIR/pitch.csv when present
   EvalOptions metrics;
   double joint_limit_tolerance_deg = 5.0;
+
+  // Every number in its range; one truth frame per labels file when labels are given.
+  Status Validate() const;
 };
 
 struct EvalReport {

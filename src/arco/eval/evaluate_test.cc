@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -153,6 +154,23 @@ TEST(DefaultLeftHandLimits, TruthHandsHaveNoViolationsAndBentFingersDo) {
     s.set(f, kLeftHandFirst + 8, 2 * (dip + (tip - dip).dot(u) * u) - tip);
   }
   EXPECT_GT(CountJointLimitViolations(s, kLeftHandFirst, true, limits, 5.0), s.num_frames / 2);
+}
+
+TEST(EvalRequest, NumbersOutsideTheirRangesAreErrorsBeforeAnyFileIsRead) {
+  EvalRequest r;
+  r.result_dir = "does-not-exist";
+  r.metrics.pck_thresholds_mm = {10, -5};
+  auto report = Evaluate(r);
+  ASSERT_FALSE(report.ok());
+  EXPECT_NE(report.status().message().find("pck_thresholds_mm"), std::string::npos);
+  r.metrics.pck_thresholds_mm = {10};
+  r.joint_limit_tolerance_deg = std::nan("");
+  EXPECT_NE(r.Validate().message().find("joint_limit_tolerance_deg"), std::string::npos);
+  r.joint_limit_tolerance_deg = 5;
+  r.truth_frames = {-3};
+  EXPECT_NE(r.Validate().message().find("truth_frames"), std::string::npos);
+  r.truth_frames = {0, 12};
+  EXPECT_TRUE(r.Validate().ok());
 }
 
 }  // namespace

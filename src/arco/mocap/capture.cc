@@ -187,9 +187,10 @@ StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const st
                       "numbers, 1 for the recording's first frame)");
   }
   ARCO_RETURN_IF_ERROR(f.Number("tuning_a4_hz", false, &m.tuning_a4_hz));
-  if (!(m.tuning_a4_hz >= 300 && m.tuning_a4_hz <= 600)) {
-    return f.Bad("tuning_a4_hz",
-                 "is " + Written(*f.Find("tuning_a4_hz")) + "; must be in [300, 600] Hz");
+  if (!kA4RangeHz.Contains(m.tuning_a4_hz)) {
+    return f.Bad(
+        "tuning_a4_hz",
+        "is " + Written(*f.Find("tuning_a4_hz")) + "; must be in " + kA4RangeHz.ToString() + " Hz");
   }
   ARCO_RETURN_IF_ERROR(f.String("calibration", true, &m.calibration));
   if (m.calibration.empty()) return f.Bad("calibration", "is empty; must name a calibration file");

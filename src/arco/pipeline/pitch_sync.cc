@@ -21,7 +21,17 @@ std::string InstrumentFromManifest(const std::string& name) {
 
 }  // namespace
 
+Status PitchRunOptions::Validate() const {
+  ARCO_RETURN_IF_ERROR(CheckInRange("min_f0_hz", min_f0_hz, audio::kF0OverrideRangeHz));
+  ARCO_RETURN_IF_ERROR(CheckInRange("max_f0_hz", max_f0_hz, audio::kF0OverrideRangeHz));
+  if (min_f0_hz > 0 && max_f0_hz > 0 && !(min_f0_hz < max_f0_hz)) {
+    return Status::Error("min_f0_hz must be below max_f0_hz");
+  }
+  return Status::Ok();
+}
+
 StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, Progress& progress) {
+  ARCO_RETURN_IF_ERROR(o.Validate());
   PitchRunResult result;
   std::string instrument = o.instrument;
   double fps = o.fps, start_s = o.start_s, a4_hz = o.a4_hz;

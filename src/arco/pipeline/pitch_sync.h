@@ -28,6 +28,10 @@ struct PitchRunOptions {
   double min_f0_hz = 0, max_f0_hz = 0;  // overrides of the instrument range
   std::string output = "pitch.csv";
   std::string fine_output, notes_output, midi_output;
+
+  // The overrides' ranges (audio::kF0OverrideRangeHz) and min below max when both are
+  // given; the rest is checked by the tracker once the manifest's values are in.
+  Status Validate() const;
 };
 
 struct PitchRunResult {

@@ -300,5 +300,26 @@ TEST(RunSyncAndPitch, TruncatedWavIsAWarningNamingTheFile) {
             pitch->summary.warnings.end());
 }
 
+// The library checks the f0 overrides itself (Python and workflows call RunPitch directly):
+// a negative or NaN override is an error, not "the instrument's".
+TEST(RunPitch, F0OverridesOutsideTheirRangeAreErrors) {
+  for (double bad : {-10.0, std::nan(""), 1e9}) {
+    PitchRunOptions p;
+    p.input = "unused.wav";
+    p.min_f0_hz = bad;
+    auto result = RunPitch(p);
+    ASSERT_FALSE(result.ok());
+    EXPECT_NE(result.status().message().find("min_f0_hz"), std::string::npos)
+        << result.status().message();
+  }
+  PitchRunOptions p;
+  p.input = "unused.wav";
+  p.min_f0_hz = 500;
+  p.max_f0_hz = 200;
+  auto result = RunPitch(p);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.status().message(), "min_f0_hz must be below max_f0_hz");
+}
+
 }  // namespace
 }  // namespace arco::pipeline
