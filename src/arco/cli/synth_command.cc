@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <string>
 
 #include "arco/calibration/calibration_file.h"
 #include "arco/cli/command.h"
@@ -139,10 +140,13 @@ int Run(Args& a) {
         ws.audio.key_offset_cents.size(),
         worst);
   }
-  std::printf("  wrote         %s (%.1f MB) and %s/truth/ in %.1f s\n",
-              a.output.c_str(),
+  // "cap/" and "cap" name the same folder: print it once, without the slash.
+  std::string folder = a.output;
+  while (folder.size() > 1 && folder.back() == '/') folder.pop_back();
+  std::printf("  wrote         %s/ (%.1f MB) and %s/truth/ in %.1f s\n",
+              folder.c_str(),
               ws.bytes / 1e6,
-              a.output.c_str(),
+              folder.c_str(),
               total_s);
   return 0;
 }
