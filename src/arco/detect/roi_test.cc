@@ -135,9 +135,9 @@ TEST(DecodeSsd, BoxesAndKeypointsRelativeToAnchors) {
   EXPECT_NEAR(d[0].y_min, 0.2 - 0.2, 1e-9);
   EXPECT_NEAR(d[0].width, 0.2, 1e-9);
   EXPECT_NEAR(d[0].height, 0.4, 1e-9);
-  ExpectNear(d[0].keypoints[0], {0.26, 0.27}, 1e-6);
+  ExpectNear(d[0].keypoints[0], {0.26, 0.27});
   EXPECT_DOUBLE_EQ(d[1].score, 1.0);  // the logit is clipped to 100
-  ExpectNear(d[1].keypoints[0], {0.4, 0.5}, 1e-6);
+  ExpectNear(d[1].keypoints[0], {0.4, 0.5});
 }
 
 SsdDetection Box(double score, double x, double y, double side, Point2 keypoint) {

@@ -48,18 +48,18 @@ std::vector<SsdDetection> DecodeSsd(const float* boxes,
     const double score = 1.0 / (1.0 + std::exp(-logit));
     if (!(score >= min_score)) continue;
     const float* raw = boxes + i * stride;
+    const double size = input_size;  // divide in double, not float
     SsdDetection d;
     d.score = score;
-    const double cx = raw[0] / input_size + anchors[i].x;
-    const double cy = raw[1] / input_size + anchors[i].y;
-    d.width = raw[2] / static_cast<double>(input_size);
-    d.height = raw[3] / static_cast<double>(input_size);
+    const double cx = raw[0] / size + anchors[i].x;
+    const double cy = raw[1] / size + anchors[i].y;
+    d.width = raw[2] / size;
+    d.height = raw[3] / size;
     d.x_min = cx - d.width / 2;
     d.y_min = cy - d.height / 2;
     d.keypoints.resize(num_keypoints);
     for (int k = 0; k < num_keypoints; ++k) {
-      d.keypoints[k] = {raw[4 + 2 * k] / input_size + anchors[i].x,
-                        raw[5 + 2 * k] / input_size + anchors[i].y};
+      d.keypoints[k] = {raw[4 + 2 * k] / size + anchors[i].x, raw[5 + 2 * k] / size + anchors[i].y};
     }
     detections.push_back(std::move(d));
   }
