@@ -14,31 +14,10 @@
 #include <string>
 #include <vector>
 
+#include "arco/detect/models_for_test.h"
+
 namespace arco::detect {
 namespace {
-
-// Tests on the real models skip only when the models are absent and CI is unset; under
-// CI they must run (make test runs scripts/setup, which fetches them).
-bool ModelsPresentOrSkip(std::string* why) {
-  for (const ModelInfo& info : AllModels()) {
-    const std::string path = ModelPath(info.id);
-    if (!std::filesystem::exists(path)) {
-      *why = path + " is missing: run scripts/setup to fetch and convert the models";
-      const char* ci = std::getenv("CI");
-      if (ci != nullptr && ci[0] != '\0') {
-        ADD_FAILURE() << *why << " (CI is set, so this is a failure)";
-      }
-      return false;
-    }
-  }
-  return true;
-}
-
-#define ARCO_REQUIRE_MODELS()                            \
-  do {                                                   \
-    std::string why;                                     \
-    if (!ModelsPresentOrSkip(&why)) GTEST_SKIP() << why; \
-  } while (0)
 
 TEST(NetworkLoad, MissingFileNamesItAndScriptsSetup) {
   StatusOr<Network> network = Network::Load(ModelId::kPoseDetection, "/nonexistent/models");

@@ -1,0 +1,383 @@
+#include "arco/detect/wholebody.h"
+
+#include <chrono>
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include "arco/detect/network.h"
+#include "arco/detect/roi.h"
+#include "arco/detect/ssd.h"
+#include "arco/detect/wholebody_mapping.h"
+
+namespace arco::detect {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// MediaPipe's graph constants (pose_detection_to_roi, pose_landmarks_to_roi,
+// hand_landmarks_from_pose_to_recrop_roi, hand_recrop_by_roi).
+constexpr double kPoseRoiScale = 1.25;
+constexpr double kHandRecropRoiScale = 2.7;
+constexpr double kHandRecropRoiShiftY = -0.1;
+constexpr double kHandRoiFromRecropShiftY = -0.1;
+// Without hand_recrop: a square of 4 wrist-to-middle lengths centred on the middle
+// finger's base (network_test.cc: presence 0.99 on the cellist's left hand).
+constexpr double kHandRoiFallbackScale = 2.0;
+// A ROI smaller than this (image pixels) holds nothing the models can see.
+constexpr double kMinRoiSidePx = 8.0;
+constexpr int kNumHandLandmarks = 21;
+
+enum ModelSlot { kDetectorSlot = 0, kPoseSlot = 1, kRecropSlot = 2, kHandSlot = 3 };
+
+using Clock = std::chrono::steady_clock;
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+double Sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
+
+bool InsideImage(Point2 p, int width, int height) {
+  return p.x >= -0.5 && p.y >= -0.5 && p.x <= width - 0.5 && p.y <= height - 0.5;
+}
+
+void SetPoint(ScoredPoint* point, Point2 p, double score) {
+  point->x_px = static_cast<float>(p.x);
+  point->y_px = static_cast<float>(p.y);
+  point->score = static_cast<float>(score);
+}
+
+}  // namespace
+
+const char* PoseModelName(PoseModel model) {
+  switch (model) {
+    case PoseModel::kLite:
+      return "lite";
+    case PoseModel::kFull:
+      return "full";
+    case PoseModel::kHeavy:
+      return "heavy";
+  }
+  return "?";
+}
+
+StatusOr<PoseModel> ParsePoseModel(const std::string& name) {
+  for (PoseModel model : {PoseModel::kLite, PoseModel::kFull, PoseModel::kHeavy}) {
+    if (name == PoseModelName(model)) return model;
+  }
+  return Status::Error("unknown pose model '" + name + "' (lite, full or heavy)");
+}
+
+ModelId PoseLandmarkModel(PoseModel model) {
+  switch (model) {
+    case PoseModel::kLite:
+      return ModelId::kPoseLandmarkLite;
+    case PoseModel::kHeavy:
+      return ModelId::kPoseLandmarkHeavy;
+    case PoseModel::kFull:
+      break;
+  }
+  return ModelId::kPoseLandmarkFull;
+}
+
+Status WholeBodyOptions::Validate() const {
+  if (pose_model != PoseModel::kLite && pose_model != PoseModel::kFull &&
+      pose_model != PoseModel::kHeavy) {
+    return Status::Error("WholeBodyOptions.pose_model must be lite, full or heavy");
+  }
+  ARCO_RETURN_IF_ERROR(CheckInRange(
+      "WholeBodyOptions.min_detection_score", min_detection_score, kWholeBodyScoreRange));
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("WholeBodyOptions.nms_min_iou", nms_min_iou, kWholeBodyScoreRange));
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("WholeBodyOptions.min_pose_presence", min_pose_presence, kWholeBodyScoreRange));
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("WholeBodyOptions.min_hand_presence", min_hand_presence, kWholeBodyScoreRange));
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("WholeBodyOptions.num_threads", num_threads, kWholeBodyThreadsRange));
+  return Status::Ok();
+}
+
+void WholeBodySummary::Merge(const WholeBodySummary& other) {
+  frames += other.frames;
+  frames_with_person += other.frames_with_person;
+  frames_with_left_hand += other.frames_with_left_hand;
+  frames_with_right_hand += other.frames_with_right_hand;
+  detector_runs += other.detector_runs;
+  redetections += other.redetections;
+  for (size_t k = 0; k < models.size(); ++k) {
+    models[k].runs += other.models[k].runs;
+    models[k].inference_s += other.models[k].inference_s;
+  }
+  inference_s += other.inference_s;
+  preprocess_s += other.preprocess_s;
+  postprocess_s += other.postprocess_s;
+}
+
+struct WholeBodyTracker::Impl {
+  WholeBodyOptions options;
+  std::array<std::optional<Network>, 4> networks;  // by ModelSlot; no recrop without it
+  std::array<std::vector<float>, 4> inputs;        // one NHWC float input per network
+  cv::Mat crop;                                    // the 8-bit crop being cut
+  WholeBodySummary summary;
+  // Tracking state (all of it: Reset clears it).
+  bool tracking = false;
+  Roi pose_roi;
+  bool person_seen = false;  // since creation or Reset: later detector runs re-detect
+  // Per-frame scratch, allocated once.
+  std::vector<SsdDetection> detections;
+  std::array<Point2, mediapipe_pose::kNumWithAuxiliary> pose_points{};
+  std::array<double, mediapipe_pose::kNumWithAuxiliary> pose_scores{};
+
+  // Cuts `roi` from `image` into slot's input (its size and value range).
+  void CutCrop(const cv::Mat& image, const Roi& roi, ModelSlot slot) {
+    const auto start = Clock::now();
+    const ModelInfo& info = networks[slot]->info();
+    const int size = info.input_width;
+    double m[6];
+    roi.CropPixelToImageAffine(size, m);
+    const cv::Mat to_image(2, 3, CV_64F, m);
+    cv::warpAffine(image,
+                   crop,
+                   to_image,
+                   cv::Size(size, size),
+                   cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
+                   cv::BORDER_CONSTANT,
+                   cv::Scalar::all(0));
+    std::vector<float>& input = inputs[slot];
+    const float scale = info.range == ValueRange::kZeroToOne ? 1.0f / 255.0f : 1.0f / 127.5f;
+    const float offset = info.range == ValueRange::kZeroToOne ? 0.0f : -1.0f;
+    for (int y = 0; y < size; ++y) {
+      const uint8_t* row = crop.ptr<uint8_t>(y);
+      float* out = input.data() + static_cast<size_t>(y) * size * 3;
+      for (int i = 0; i < size * 3; ++i) out[i] = row[i] * scale + offset;
+    }
+    summary.preprocess_s += Seconds(start);
+  }
+
+  Status Run(ModelSlot slot) {
+    const auto start = Clock::now();
+    ARCO_RETURN_IF_ERROR(networks[slot]->Run(inputs[slot].data(), inputs[slot].size()));
+    const double s = Seconds(start);
+    summary.models[slot].runs += 1;
+    summary.models[slot].inference_s += s;
+    summary.inference_s += s;
+    return Status::Ok();
+  }
+
+  // The best person on the whole frame, as the ROI of its keypoints 0 (hip centre) and
+  // 1 (full-body circle); false when no detection reaches min_detection_score.
+  StatusOr<bool> Detect(const cv::Mat& image, Roi* roi) {
+    const Roi whole = WholeImageRoi(image.cols, image.rows);
+    CutCrop(image, whole, kDetectorSlot);
+    ARCO_RETURN_IF_ERROR(Run(kDetectorSlot));
+    const auto start = Clock::now();
+    const Network& net = *networks[kDetectorSlot];
+    detections = DecodeSsd(net.output("boxes").data.data(),
+                           net.output("scores").data.data(),
+                           PoseDetectionAnchors(),
+                           kPoseDetectionKeypoints,
+                           kPoseDetectionInputSize,
+                           options.min_detection_score);
+    detections = WeightedNonMaxSuppression(std::move(detections), options.nms_min_iou);
+    bool found = false;
+    if (!detections.empty()) {
+      const SsdDetection& best = detections.front();
+      const Point2 hip = whole.ToImage(best.keypoints[0].x, best.keypoints[0].y);
+      const Point2 circle = whole.ToImage(best.keypoints[1].x, best.keypoints[1].y);
+      *roi = RoiFromAlignmentPoints(hip, circle, kPi / 2, kPoseRoiScale);
+      found = roi->IsFinite() && roi->side_px >= kMinRoiSidePx;
+    }
+    summary.postprocess_s += Seconds(start);
+    return found;
+  }
+
+  // Pose landmarks in `roi` into pose_points / pose_scores; returns the presence.
+  StatusOr<double> PoseLandmarks(const cv::Mat& image, const Roi& roi) {
+    CutCrop(image, roi, kPoseSlot);
+    ARCO_RETURN_IF_ERROR(Run(kPoseSlot));
+    const auto start = Clock::now();
+    const Network& net = *networks[kPoseSlot];
+    const int size = net.info().input_width;
+    const std::vector<float>& raw = net.output("landmarks").data;
+    for (int i = 0; i < mediapipe_pose::kNumWithAuxiliary; ++i) {
+      const float* p = &raw[5 * i];
+      pose_points[i] = roi.CropPixelToImage(p[0], p[1], size);
+      pose_scores[i] = std::min(Sigmoid(p[3]), Sigmoid(p[4]));
+    }
+    const double presence = net.output("presence").data[0];
+    summary.postprocess_s += Seconds(start);
+    return presence;
+  }
+
+  // One hand from the pose's wrist, index and little-finger points: writes 21 points
+  // from `first` and returns the presence (NaN when the hand was not looked for).
+  StatusOr<double> Hand(
+      const cv::Mat& image, int wrist_index, int index_index, int pinky_index, ScoredPoint* first) {
+    const auto start = Clock::now();
+    const Point2 wrist = pose_points[wrist_index];
+    const Point2 index = pose_points[index_index], pinky = pose_points[pinky_index];
+    const Point2 middle = (1.0 / 3.0) * (2.0 * index + pinky);
+    const double length = Norm(middle - wrist);
+    summary.postprocess_s += Seconds(start);
+    if (!(length * 4 >= kMinRoiSidePx) || !InsideImage(middle, image.cols, image.rows)) {
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+    Roi roi = HandRoiFromPose(wrist, index, pinky, kHandRoiFallbackScale, 0.0);
+    if (options.hand_recrop) {
+      const Roi recrop_roi =
+          HandRoiFromPose(wrist, index, pinky, kHandRecropRoiScale, kHandRecropRoiShiftY);
+      CutCrop(image, recrop_roi, kRecropSlot);
+      ARCO_RETURN_IF_ERROR(Run(kRecropSlot));
+      const auto decode = Clock::now();
+      const Network& net = *networks[kRecropSlot];
+      const int size = net.info().input_width;
+      const std::vector<float>& raw = net.output("crop").data;
+      const Point2 centre = recrop_roi.CropPixelToImage(raw[0], raw[1], size);
+      const Point2 edge = recrop_roi.CropPixelToImage(raw[2], raw[3], size);
+      const Roi refined =
+          RoiFromAlignmentPoints(centre, edge, -kPi / 2, 1.0, kHandRoiFromRecropShiftY);
+      // Keep the refinement only when it is plausible: on this hand, and between 1 and
+      // 8 wrist-to-middle lengths wide (else the pose-derived crop).
+      if (refined.IsFinite() && Norm(refined.centre - middle) < 2 * length &&
+          refined.side_px > length && refined.side_px < 8 * length) {
+        roi = refined;
+      }
+      summary.postprocess_s += Seconds(decode);
+    }
+    CutCrop(image, roi, kHandSlot);
+    ARCO_RETURN_IF_ERROR(Run(kHandSlot));
+    const auto decode = Clock::now();
+    const Network& net = *networks[kHandSlot];
+    const double presence = net.output("presence").data[0];
+    if (presence >= options.min_hand_presence) {
+      const int size = net.info().input_width;
+      const std::vector<float>& raw = net.output("landmarks").data;
+      for (int i = 0; i < kNumHandLandmarks; ++i) {
+        SetPoint(first + i, roi.CropPixelToImage(raw[3 * i], raw[3 * i + 1], size), presence);
+      }
+    }
+    summary.postprocess_s += Seconds(decode);
+    return presence;
+  }
+};
+
+StatusOr<WholeBodyTracker> WholeBodyTracker::Create(const WholeBodyOptions& options) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  auto impl = std::make_unique<Impl>();
+  impl->options = options;
+  const std::string dir = options.models_dir.empty() ? DefaultModelsDir() : options.models_dir;
+  NetworkOptions network_options;
+  network_options.num_threads = options.num_threads;
+  const std::array<ModelId, 4> ids = {ModelId::kPoseDetection,
+                                      PoseLandmarkModel(options.pose_model),
+                                      ModelId::kHandRecrop,
+                                      ModelId::kHandLandmarkFull};
+  for (size_t k = 0; k < ids.size(); ++k) {
+    impl->summary.models[k].model = ids[k];
+    if (k == kRecropSlot && !options.hand_recrop) continue;
+    ARCO_ASSIGN_OR_RETURN(Network network, Network::Load(ids[k], dir, network_options));
+    impl->networks[k].emplace(std::move(network));
+    const Network* net = &*impl->networks[k];
+    impl->inputs[k].assign(
+        3 * static_cast<size_t>(net->info().input_width) * net->info().input_height, 0.0f);
+  }
+  return WholeBodyTracker(std::move(impl));
+}
+
+WholeBodyTracker::WholeBodyTracker(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+WholeBodyTracker::WholeBodyTracker(WholeBodyTracker&&) noexcept = default;
+WholeBodyTracker& WholeBodyTracker::operator=(WholeBodyTracker&&) noexcept = default;
+WholeBodyTracker::~WholeBodyTracker() = default;
+
+const WholeBodyOptions& WholeBodyTracker::options() const { return impl_->options; }
+const WholeBodySummary& WholeBodyTracker::summary() const { return impl_->summary; }
+
+void WholeBodyTracker::Reset() {
+  impl_->tracking = false;
+  impl_->pose_roi = Roi();
+  impl_->person_seen = false;
+}
+
+StatusOr<WholeBodyFrame> WholeBodyTracker::Track(const media::Image& frame) {
+  if (frame.format != media::PixelFormat::kRgb8 || frame.width < 2 || frame.height < 2 ||
+      frame.pixels.size() != frame.row_bytes() * static_cast<size_t>(frame.height)) {
+    throw std::invalid_argument("WholeBodyTracker::Track takes an RGB8 image of at least 2 x 2");
+  }
+  Impl& s = *impl_;
+  // A view of the caller's pixels; cv::warpAffine only reads them.
+  const cv::Mat image(
+      frame.height, frame.width, CV_8UC3, const_cast<uint8_t*>(frame.pixels.data()));
+  WholeBodyFrame out;
+  s.summary.frames += 1;
+
+  double presence = std::numeric_limits<double>::quiet_NaN();
+  bool have_pose = false;
+  if (s.tracking) {
+    ARCO_ASSIGN_OR_RETURN(presence, s.PoseLandmarks(image, s.pose_roi));
+    have_pose = presence >= s.options.min_pose_presence;
+  }
+  if (!have_pose) {
+    s.tracking = false;
+    out.detector_ran = true;
+    s.summary.detector_runs += 1;
+    if (s.person_seen) s.summary.redetections += 1;
+    Roi roi;
+    ARCO_ASSIGN_OR_RETURN(bool found, s.Detect(image, &roi));
+    if (found) {
+      ARCO_ASSIGN_OR_RETURN(presence, s.PoseLandmarks(image, roi));
+      have_pose = presence >= s.options.min_pose_presence;
+    }
+  }
+  out.pose_presence = static_cast<float>(presence);
+  if (!have_pose) return out;
+
+  // The body points, and the next frame's ROI from the auxiliary alignment points.
+  const auto start = Clock::now();
+  out.person = true;
+  s.person_seen = true;
+  s.summary.frames_with_person += 1;
+  const std::array<int, wholebody::kNumBody>& body = MediaPipeOfCocoBody();
+  for (int i = 0; i < wholebody::kNumBody; ++i) {
+    SetPoint(
+        &out.points[wholebody::kBodyFirst + i], s.pose_points[body[i]], s.pose_scores[body[i]]);
+  }
+  const std::array<int, wholebody::kNumFeet>& feet = MediaPipeOfCocoFeet();
+  for (int i = 0; i < wholebody::kNumFeet; ++i) {
+    if (feet[i] < 0) continue;
+    SetPoint(
+        &out.points[wholebody::kFeetFirst + i], s.pose_points[feet[i]], s.pose_scores[feet[i]]);
+  }
+  s.pose_roi = RoiFromAlignmentPoints(s.pose_points[mediapipe_pose::kAuxHipCentre],
+                                      s.pose_points[mediapipe_pose::kAuxBodyCircle],
+                                      kPi / 2,
+                                      kPoseRoiScale);
+  s.tracking = s.pose_roi.IsFinite() && s.pose_roi.side_px >= kMinRoiSidePx;
+  s.summary.postprocess_s += Seconds(start);
+
+  // The person's left hand is MediaPipe's left (15, 17, 19) and COCO's left.
+  ARCO_ASSIGN_OR_RETURN(const double left,
+                        s.Hand(image,
+                               mediapipe_pose::kLeftWrist,
+                               mediapipe_pose::kLeftIndex,
+                               mediapipe_pose::kLeftPinky,
+                               &out.points[wholebody::kLeftHandFirst]));
+  ARCO_ASSIGN_OR_RETURN(const double right,
+                        s.Hand(image,
+                               mediapipe_pose::kRightWrist,
+                               mediapipe_pose::kRightIndex,
+                               mediapipe_pose::kRightPinky,
+                               &out.points[wholebody::kRightHandFirst]));
+  out.left_hand_presence = static_cast<float>(left);
+  out.right_hand_presence = static_cast<float>(right);
+  out.left_hand = left >= s.options.min_hand_presence;
+  out.right_hand = right >= s.options.min_hand_presence;
+  s.summary.frames_with_left_hand += out.left_hand ? 1 : 0;
+  s.summary.frames_with_right_hand += out.right_hand ? 1 : 0;
+  return out;
+}
+
+}  // namespace arco::detect

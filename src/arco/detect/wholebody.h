@@ -1,0 +1,155 @@
+// Body and both hands in COCO-WholeBody-133 from the frames of one camera, with
+// MediaPipe's pose detector, pose landmarker, hand re-crop and hand landmarker
+// (docs/detect.md, "The detection method").
+//
+//   detect::WholeBodyOptions options;          // pose_model, thresholds, num_threads
+//   ARCO_ASSIGN_OR_RETURN(detect::WholeBodyTracker tracker,
+//                         detect::WholeBodyTracker::Create(options));
+//   for (each frame of one camera, in order) {
+//     ARCO_ASSIGN_OR_RETURN(detect::WholeBodyFrame out, tracker.Track(frame));
+//     out.points[p] = {x_px, y_px, score}, p < wholebody::kNumPoints
+//   }
+//   tracker.summary();                         // counts and timings
+//
+// Per frame: the pose landmarker runs in the ROI carried from the previous frame's
+// landmarks; on the first frame, after Reset(), and when the pose presence falls below
+// min_pose_presence, the person detector runs on the whole frame first (the same frame
+// is then tracked from the detection). Hand ROIs come from the pose's wrist, index and
+// little-finger points, refined by hand_recrop, and the hand landmarker runs on both.
+// Left and right come from the pose (the person's left is COCO's left), never from the
+// hand model's handedness output.
+//
+// Output: pixels of the given image in OpenCV's convention (origin at the centre of the
+// top-left pixel); NaN x, y and score where nothing was found: every point of a frame
+// without a person, a hand below min_hand_presence, and always the 68 face points and
+// the two small toes, which MediaPipe does not give (wholebody_mapping.h). Scores in
+// [0, 1]: a body point's is min(visibility, presence), the pose model's two per-point
+// sigmoids (in the frame, and not occluded); a hand point's is the hand's presence (the
+// hand model gives no per-point confidence). Body points stay even when their score is
+// low (an occluded elbow is still estimated): filter by score downstream.
+//
+// Determinism: the output depends only on the frames since creation or the last Reset,
+// in order, bit for bit the same for any num_threads (cv::dnn is bit-exact across thread
+// counts; everything else here is sequential). To process a video in parallel, cut it
+// into fixed-size chunks, give each worker its own tracker and call Reset() at each
+// chunk's first frame: chunk boundaries must then depend on the chunk size only, never
+// on the number of threads, or the output would. A tracker is not thread-safe; trackers
+// are independent of each other. OpenCV's thread pool is process-wide (network.h): run
+// several trackers in parallel with num_threads = 1 each.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "arco/detect/model_registry.h"
+#include "arco/media/image.h"
+#include "arco/registry/keypoint_layout.h"
+#include "arco/util/number_range.h"
+#include "arco/util/status.h"
+
+namespace arco::detect {
+
+// The pose landmark model's size: lite / full / heavy (about 11 / 17 / 58 ms per frame).
+enum class PoseModel { kLite, kFull, kHeavy };
+const char* PoseModelName(PoseModel model);  // "lite", "full", "heavy"
+// "lite" | "full" | "heavy"; an error listing them otherwise.
+StatusOr<PoseModel> ParsePoseModel(const std::string& name);
+ModelId PoseLandmarkModel(PoseModel model);
+
+// Declared ranges of WholeBodyOptions' numbers (util/number_range.h).
+inline constexpr NumberRange kWholeBodyScoreRange = Closed(0, 1);  // thresholds on scores
+inline constexpr NumberRange kWholeBodyThreadsRange = Closed(1, 1024);
+
+struct WholeBodyOptions {
+  PoseModel pose_model = PoseModel::kFull;
+  std::string models_dir;  // empty: DefaultModelsDir()
+  // pose_detection: detections below this score are ignored (MediaPipe's 0.5).
+  double min_detection_score = 0.5;
+  // Weighted NMS merges detections overlapping the best one by more than this IoU.
+  double nms_min_iou = 0.3;
+  // Tracking is lost (and the detector runs) when the pose presence is below this.
+  double min_pose_presence = 0.5;
+  // A hand whose presence is below this is NaN.
+  double min_hand_presence = 0.5;
+  // Refine the pose-derived hand ROI with hand_recrop (as MediaPipe Holistic); false:
+  // the hand landmarker sees a square of 4 wrist-to-middle-finger lengths around the
+  // pose's estimate of the middle finger's base.
+  bool hand_recrop = true;
+  int num_threads = 1;  // cv::dnn threads (network.h)
+  // Every number inside its declared range; messages name the field.
+  Status Validate() const;
+};
+
+struct ScoredPoint {
+  float x_px = std::numeric_limits<float>::quiet_NaN();
+  float y_px = std::numeric_limits<float>::quiet_NaN();
+  float score = std::numeric_limits<float>::quiet_NaN();
+};
+
+struct WholeBodyFrame {
+  std::array<ScoredPoint, wholebody::kNumPoints> points;  // COCO-WholeBody order
+  bool person = false;                                    // pose presence >= min_pose_presence
+  bool left_hand = false;   // the person's left hand, points kLeftHandFirst..
+  bool right_hand = false;  // points kRightHandFirst..
+  bool detector_ran = false;
+  // The models' presence sigmoids (NaN where the model did not run).
+  float pose_presence = std::numeric_limits<float>::quiet_NaN();
+  float left_hand_presence = std::numeric_limits<float>::quiet_NaN();
+  float right_hand_presence = std::numeric_limits<float>::quiet_NaN();
+};
+
+struct WholeBodySummary {
+  int64_t frames = 0;
+  int64_t frames_with_person = 0;
+  int64_t frames_with_left_hand = 0;
+  int64_t frames_with_right_hand = 0;
+  int64_t detector_runs = 0;  // pose_detection runs
+  // Detector runs after a person had been found since creation or the last Reset:
+  // tracking was lost.
+  int64_t redetections = 0;
+  // Wall time of the forward passes (Network::Run) per model kind, and of the rest:
+  // cutting and converting crops (preprocess), decoding outputs and ROI geometry
+  // (postprocess). Not deterministic; never part of the output.
+  struct ModelTime {
+    ModelId model = ModelId::kPoseDetection;
+    int64_t runs = 0;
+    double inference_s = 0;
+  };
+  std::array<ModelTime, 4> models;  // detector, pose landmarks, hand recrop, hand landmarks
+  double inference_s = 0;
+  double preprocess_s = 0;
+  double postprocess_s = 0;
+
+  // Adds another tracker's counts and times (chunks of one video, several cameras).
+  void Merge(const WholeBodySummary& other);
+};
+
+class WholeBodyTracker {
+ public:
+  // Validates the options and loads the networks (a missing model file is one line
+  // naming it and pointing to scripts/setup).
+  static StatusOr<WholeBodyTracker> Create(const WholeBodyOptions& options);
+
+  WholeBodyTracker(WholeBodyTracker&&) noexcept;
+  WholeBodyTracker& operator=(WholeBodyTracker&&) noexcept;
+  ~WholeBodyTracker();
+
+  // The next frame of the camera: RGB8, at least 2 x 2 pixels (throws
+  // std::invalid_argument otherwise). An error only when inference fails.
+  StatusOr<WholeBodyFrame> Track(const media::Image& frame);
+  // Forgets the tracked person: the next frame starts with detection. Keeps summary().
+  void Reset();
+
+  const WholeBodyOptions& options() const;
+  const WholeBodySummary& summary() const;
+
+ private:
+  struct Impl;
+  explicit WholeBodyTracker(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace arco::detect

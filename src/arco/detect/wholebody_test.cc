@@ -1,0 +1,407 @@
+// WholeBodyTracker on real images (the models from scripts/setup): a real SPD cellist,
+// opencv-doc's messi5.jpg and vtest.avi. docs/detect.md quotes the printed figures.
+#include "arco/detect/wholebody.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "arco/detect/models_for_test.h"
+#include "arco/detect/roi.h"
+#include "arco/media/video_reader.h"
+
+namespace arco::detect {
+namespace {
+
+constexpr char kOpencvData[] = "/usr/share/doc/opencv-doc/examples/data/";
+
+media::Image ReadImage(const std::string& path) {
+  StatusOr<media::VideoReader> reader = media::VideoReader::Open(path);
+  EXPECT_TRUE(reader.ok()) << reader.status().message();
+  if (!reader.ok()) return {};
+  StatusOr<media::Image> image = reader->ReadFrame(0);
+  EXPECT_TRUE(image.ok()) << image.status().message();
+  return image.ok() ? *image : media::Image();
+}
+
+WholeBodyOptions TestOptions(int threads = 2) {
+  WholeBodyOptions options;
+  options.num_threads = threads;
+  return options;
+}
+
+// With ARCO_DETECT_DEBUG_DIR set, writes the frame with its keypoints (body red, left
+// hand green, right hand blue) for a look by eye.
+void MaybeWriteOverlay(const media::Image& image,
+                       const WholeBodyFrame& out,
+                       const std::string& name) {
+  const char* dir = std::getenv("ARCO_DETECT_DEBUG_DIR");
+  if (dir == nullptr) return;
+  cv::Mat rgb(image.height, image.width, CV_8UC3, const_cast<uint8_t*>(image.pixels.data()));
+  cv::Mat bgr;
+  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+  const int radius = std::max(2, image.width / 400);
+  for (int p = 0; p < wholebody::kNumPoints; ++p) {
+    const ScoredPoint& k = out.points[p];
+    if (std::isnan(k.x_px)) continue;
+    const cv::Scalar colour = p >= wholebody::kRightHandFirst  ? cv::Scalar(255, 0, 0)
+                              : p >= wholebody::kLeftHandFirst ? cv::Scalar(0, 255, 0)
+                                                               : cv::Scalar(0, 0, 255);
+    cv::circle(bgr, cv::Point(std::lround(k.x_px), std::lround(k.y_px)), radius, colour, -1);
+  }
+  cv::imwrite(std::string(dir) + "/" + name + ".png", bgr);
+}
+
+// Every point NaN in x, y and score together, or finite with a score in [0, 1].
+void ExpectWellFormed(const WholeBodyFrame& out) {
+  for (int p = 0; p < wholebody::kNumPoints; ++p) {
+    const ScoredPoint& k = out.points[p];
+    if (std::isnan(k.score)) {
+      EXPECT_TRUE(std::isnan(k.x_px) && std::isnan(k.y_px)) << p;
+    } else {
+      EXPECT_TRUE(std::isfinite(k.x_px) && std::isfinite(k.y_px)) << p;
+      EXPECT_GE(k.score, 0.0f) << p;
+      EXPECT_LE(k.score, 1.0f) << p;
+    }
+  }
+  // MediaPipe gives no face points and no small toes.
+  for (int p = wholebody::kFaceFirst; p < wholebody::kFaceFirst + wholebody::kNumFace; ++p) {
+    EXPECT_TRUE(std::isnan(out.points[p].x_px)) << p;
+  }
+  EXPECT_TRUE(std::isnan(out.points[wholebody::kFeetFirst + 1].x_px));
+  EXPECT_TRUE(std::isnan(out.points[wholebody::kFeetFirst + 4].x_px));
+}
+
+bool SameBits(const WholeBodyFrame& a, const WholeBodyFrame& b) {
+  return std::memcmp(a.points.data(), b.points.data(), sizeof(a.points)) == 0 &&
+         a.person == b.person && a.left_hand == b.left_hand && a.right_hand == b.right_hand;
+}
+
+// How far the points scoring >= 0.5 in both frames moved between them: the largest
+// and the median move.
+struct Moves {
+  double largest = 0, median = 0;
+};
+Moves PointMoves(const WholeBodyFrame& a, const WholeBodyFrame& b) {
+  std::vector<double> moves;
+  for (int p = 0; p < wholebody::kNumPoints; ++p) {
+    const ScoredPoint& pa = a.points[p];
+    const ScoredPoint& pb = b.points[p];
+    if (std::isnan(pa.score) || std::isnan(pb.score) || pa.score < 0.5 || pb.score < 0.5) continue;
+    moves.push_back(std::hypot(pa.x_px - pb.x_px, pa.y_px - pb.y_px));
+  }
+  Moves result;
+  if (moves.empty()) return result;
+  std::sort(moves.begin(), moves.end());
+  result.largest = moves.back();
+  result.median = moves[moves.size() / 2];
+  return result;
+}
+
+// The real SPD cellist: the player is found, the left hand on the fingerboard, its four
+// fingertips between the nut and the neck's lower end near the string line, and the
+// right (bow) hand near the frog. A second Track of the same picture tracks (no
+// detector) and agrees with the first to a few pixels.
+TEST(WholeBodyTracker, CellistLeftHandOnTheFingerboard) {
+  ARCO_REQUIRE_MODELS();
+  const media::Image image = ReadImage(ARCO_SHARED_DATA_DIR "/spd/example.jpg");
+  ASSERT_FALSE(image.empty());
+  StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(TestOptions());
+  ASSERT_TRUE(tracker.ok()) << tracker.status().message();
+  StatusOr<WholeBodyFrame> out = tracker->Track(image);
+  ASSERT_TRUE(out.ok()) << out.status().message();
+  MaybeWriteOverlay(image, *out, "cellist");
+  ExpectWellFormed(*out);
+  std::printf("cellist: pose presence %.3f, left hand %.3f, right hand %.3f\n",
+              out->pose_presence,
+              out->left_hand_presence,
+              out->right_hand_presence);
+  EXPECT_TRUE(out->detector_ran);
+  ASSERT_TRUE(out->person);
+  ASSERT_TRUE(out->left_hand);
+
+  // The fingerboard from example.json: nut and neck's lower end (centres of the
+  // labelled left/right points); 40 px is about its width (37 px at the nut, 62 px at
+  // the neck's end).
+  const double nut_x = (1205.3 + 1242.0) / 2, nut_y = (734.8 + 731.3) / 2;
+  const double end_x = (1140.2 + 1201.8) / 2, end_y = (1102.3 + 1104.6) / 2;
+  const double neck_length = std::hypot(end_x - nut_x, end_y - nut_y);
+  const double ax = (end_x - nut_x) / neck_length, ay = (end_y - nut_y) / neck_length;
+  for (int tip : {8, 12, 16, 20}) {
+    const ScoredPoint& p = out->points[wholebody::kLeftHandFirst + tip];
+    const double dx = p.x_px - nut_x, dy = p.y_px - nut_y;
+    const double t = dx * ax + dy * ay;
+    const double off_line = std::abs(dx * ay - dy * ax);
+    std::printf("left fingertip %d: (%.0f, %.0f) px, %.2f nut -> neck end, %.0f px off the line\n",
+                tip,
+                p.x_px,
+                p.y_px,
+                t / neck_length,
+                off_line);
+    EXPECT_GT(t, 0.0) << tip;
+    EXPECT_LT(t, neck_length) << tip;
+    EXPECT_LT(off_line, 40.0) << tip;
+  }
+  // The body's left wrist (COCO 9) and the hand's wrist agree.
+  const ScoredPoint& body_wrist = out->points[wholebody::kBodyFirst + 9];
+  const ScoredPoint& hand_wrist = out->points[wholebody::kLeftHandFirst];
+  std::printf("left wrist: body (%.0f, %.0f), hand (%.0f, %.0f) px\n",
+              body_wrist.x_px,
+              body_wrist.y_px,
+              hand_wrist.x_px,
+              hand_wrist.y_px);
+  EXPECT_LT(std::hypot(body_wrist.x_px - hand_wrist.x_px, body_wrist.y_px - hand_wrist.y_px), 80.0);
+
+  // The bow hand (the person's right) holds the frog (labelled at (968.8, 1533.2)).
+  ASSERT_TRUE(out->right_hand);
+  double cx = 0, cy = 0;
+  for (int i = 0; i < wholebody::kNumHandPoints; ++i) {
+    cx += out->points[wholebody::kRightHandFirst + i].x_px / wholebody::kNumHandPoints;
+    cy += out->points[wholebody::kRightHandFirst + i].y_px / wholebody::kNumHandPoints;
+  }
+  std::printf("right hand centre (%.0f, %.0f) px, %.0f px from the frog\n",
+              cx,
+              cy,
+              std::hypot(cx - 968.8, cy - 1533.2));
+  EXPECT_LT(std::hypot(cx - 968.8, cy - 1533.2), 150.0);
+
+  // Tracking: the same picture twice more runs no detector. The ROI then comes from the
+  // landmarks instead of the detector, and each frame's ROI from the last frame's
+  // landmarks: it moves by a few pixels, and the points the model is unsure of (the
+  // elbow and knees half hidden by the cello, the heels) follow by up to 2 % of the
+  // image height (raw output: no temporal smoothing here), the rest by a few pixels.
+  StatusOr<WholeBodyFrame> second = tracker->Track(image);
+  StatusOr<WholeBodyFrame> third = tracker->Track(image);
+  ASSERT_TRUE(second.ok() && third.ok());
+  EXPECT_FALSE(second->detector_ran);
+  EXPECT_FALSE(third->detector_ran);
+  EXPECT_TRUE(second->person && third->person && third->left_hand && third->right_hand);
+  for (const Moves& moves : {PointMoves(*out, *second), PointMoves(*second, *third)}) {
+    std::printf(
+        "cellist tracked: points scoring >= 0.5 moved by %.1f px (median), %.1f px "
+        "(largest)\n",
+        moves.median,
+        moves.largest);
+    EXPECT_LT(moves.largest, 0.025 * image.height);  // 66 px
+    EXPECT_LT(moves.median, 6.0);
+  }
+  const WholeBodySummary& summary = tracker->summary();
+  EXPECT_EQ(summary.frames, 3);
+  EXPECT_EQ(summary.frames_with_person, 3);
+  EXPECT_EQ(summary.detector_runs, 1);
+  EXPECT_EQ(summary.redetections, 0);
+  EXPECT_EQ(summary.models[0].runs, 1);
+  EXPECT_EQ(summary.models[1].runs, 3);
+  EXPECT_EQ(summary.models[2].runs, 6);
+  EXPECT_EQ(summary.models[3].runs, 6);
+  EXPECT_GT(summary.inference_s, 0.0);
+  EXPECT_GT(summary.preprocess_s, 0.0);
+}
+
+TEST(WholeBodyTracker, RejectsAGrayFrame) {
+  ARCO_REQUIRE_MODELS();
+  StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(TestOptions(1));
+  ASSERT_TRUE(tracker.ok()) << tracker.status().message();
+  EXPECT_THROW((void)tracker->Track(media::MakeImage(64, 64, media::PixelFormat::kGray8)),
+               std::invalid_argument);
+  // A black frame holds nobody: every point NaN, the detector ran.
+  StatusOr<WholeBodyFrame> out =
+      tracker->Track(media::MakeImage(320, 240, media::PixelFormat::kRgb8));
+  ASSERT_TRUE(out.ok());
+  EXPECT_FALSE(out->person);
+  EXPECT_TRUE(out->detector_ran);
+  for (const ScoredPoint& p : out->points) EXPECT_TRUE(std::isnan(p.x_px));
+}
+
+// opencv-doc's messi5.jpg (548 x 342): the player is found, every point scoring >= 0.5
+// lies inside his box (judged by eye: x 55..470, y 50..342, the bottom edge), the points
+// spread over most of it, and the hands are on the right sides: he faces the camera,
+// so his right hand is on the image's left.
+TEST(WholeBodyTracker, MessiInsideHisBox) {
+  ARCO_REQUIRE_MODELS();
+  const media::Image image = ReadImage(std::string(kOpencvData) + "messi5.jpg");
+  if (image.empty()) GTEST_SKIP() << "opencv-doc's messi5.jpg is not installed (scripts/setup)";
+  StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(TestOptions());
+  ASSERT_TRUE(tracker.ok()) << tracker.status().message();
+  StatusOr<WholeBodyFrame> out = tracker->Track(image);
+  ASSERT_TRUE(out.ok());
+  MaybeWriteOverlay(image, *out, "messi");
+  ExpectWellFormed(*out);
+  ASSERT_TRUE(out->person);
+  ASSERT_TRUE(out->left_hand);
+  ASSERT_TRUE(out->right_hand);
+  double x_min = 1e9, x_max = -1e9, y_min = 1e9, y_max = -1e9;
+  int confident = 0;
+  for (int p = 0; p < wholebody::kNumPoints; ++p) {
+    const ScoredPoint& k = out->points[p];
+    if (std::isnan(k.score) || k.score < 0.5) continue;
+    ++confident;
+    EXPECT_GE(k.x_px, 55) << p;
+    EXPECT_LE(k.x_px, 470) << p;
+    EXPECT_GE(k.y_px, 50) << p;
+    EXPECT_LE(k.y_px, 342) << p;
+    x_min = std::min<double>(x_min, k.x_px);
+    x_max = std::max<double>(x_max, k.x_px);
+    y_min = std::min<double>(y_min, k.y_px);
+    y_max = std::max<double>(y_max, k.y_px);
+  }
+  std::printf("messi: %d points scoring >= 0.5, spanning x %.0f..%.0f, y %.0f..%.0f px\n",
+              confident,
+              x_min,
+              x_max,
+              y_min,
+              y_max);
+  EXPECT_GE(confident, 17 + 2 * wholebody::kNumHandPoints);
+  EXPECT_GT(x_max - x_min, 0.7 * (470 - 55));
+  EXPECT_GT(y_max - y_min, 0.7 * (342 - 50));
+  EXPECT_LT(out->points[wholebody::kRightHandFirst].x_px, 150);
+  EXPECT_GT(out->points[wholebody::kLeftHandFirst].x_px, 300);
+}
+
+// vtest.avi's walkers are about 90 px tall in 768 x 576 frames: too small for the
+// person detector on the whole frame (it sees 224 x 224; docs/detect.md), so the test
+// tracks them in a 240 x 240 window of the frames, read with media::VideoReader.
+std::vector<media::Image> VtestWindow(int frames) {
+  std::vector<media::Image> window;
+  StatusOr<media::VideoReader> reader =
+      media::VideoReader::Open(std::string(kOpencvData) + "vtest.avi");
+  if (!reader.ok()) return window;
+  constexpr int kX = 528, kY = 160, kSide = 240;
+  media::Image frame;
+  for (int f = 0; f < frames; ++f) {
+    StatusOr<bool> more = reader->Read(&frame);
+    if (!more.ok() || !*more) break;
+    media::Image crop = media::MakeImage(kSide, kSide, media::PixelFormat::kRgb8);
+    for (int y = 0; y < kSide; ++y) {
+      std::memcpy(crop.row(y), frame.row(kY + y) + 3 * kX, crop.row_bytes());
+    }
+    window.push_back(std::move(crop));
+  }
+  return window;
+}
+
+Point2 Mid(const WholeBodyFrame& out, int a, int b) {
+  return {(out.points[a].x_px + out.points[b].x_px) / 2.0,
+          (out.points[a].y_px + out.points[b].y_px) / 2.0};
+}
+
+// A walker is found and tracked: a person in every frame, the detector only on the
+// first frame and when the tracked walker leaves the window (then counted as a
+// re-detection), and between tracked frames the torso moves smoothly.
+TEST(WholeBodyTracker, VtestWalkerTrackedAcrossFrames) {
+  ARCO_REQUIRE_MODELS();
+  const std::vector<media::Image> frames = VtestWindow(30);
+  if (frames.empty()) GTEST_SKIP() << "opencv-doc's vtest.avi is not installed (scripts/setup)";
+  ASSERT_EQ(frames.size(), 30u);
+  StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(TestOptions());
+  ASSERT_TRUE(tracker.ok()) << tracker.status().message();
+  std::vector<WholeBodyFrame> outs;
+  for (const media::Image& frame : frames) {
+    StatusOr<WholeBodyFrame> out = tracker->Track(frame);
+    ASSERT_TRUE(out.ok());
+    ExpectWellFormed(*out);
+    outs.push_back(*out);
+  }
+  MaybeWriteOverlay(frames[0], outs[0], "vtest_0");
+  MaybeWriteOverlay(frames[29], outs[29], "vtest_29");
+  const WholeBodySummary& summary = tracker->summary();
+  std::printf("vtest: %lld of %lld frames with a person, %lld detector runs, %lld re-detections\n",
+              static_cast<long long>(summary.frames_with_person),
+              static_cast<long long>(summary.frames),
+              static_cast<long long>(summary.detector_runs),
+              static_cast<long long>(summary.redetections));
+  EXPECT_TRUE(outs[0].person);
+  EXPECT_GE(summary.frames_with_person, 28);
+  EXPECT_LE(summary.detector_runs, 4);
+  int64_t redetections = 0;
+  bool seen = false;
+  for (const WholeBodyFrame& out : outs) {
+    redetections += out.detector_ran && seen ? 1 : 0;
+    seen = seen || out.person;
+  }
+  EXPECT_EQ(summary.redetections, redetections);
+  EXPECT_GE(summary.redetections, 1);  // the first walker leaves the window at frame 13
+
+  // Frame to frame, the torso's centre (mid-shoulders + mid-hips) / 2 moves by less
+  // than 0.75 torso lengths (mid-shoulders to mid-hips, 27-35 px here). Measured: the
+  // walkers' steps are 0.1-0.35 torso lengths (3-11 px), and up to 0.63 on the two
+  // frames where vtest's capture timing is uneven (15 and 17 px between pictures
+  // otherwise 8 px apart); the other walkers near this window are 2+ torso lengths
+  // away, so a jump to one of them fails.
+  double largest_step = 0;
+  int tracked_pairs = 0;
+  for (size_t f = 1; f < outs.size(); ++f) {
+    if (!outs[f - 1].person || !outs[f].person || outs[f].detector_ran) continue;
+    const Point2 shoulders0 = Mid(outs[f - 1], 5, 6), hips0 = Mid(outs[f - 1], 11, 12);
+    const Point2 shoulders1 = Mid(outs[f], 5, 6), hips1 = Mid(outs[f], 11, 12);
+    const double torso = Norm(shoulders0 - hips0);
+    const double step = Norm(0.5 * (shoulders1 + hips1) - 0.5 * (shoulders0 + hips0)) / torso;
+    largest_step = std::max(largest_step, step);
+    ++tracked_pairs;
+    EXPECT_LT(step, 0.75) << "frame " << f;
+    // The torso keeps its length (no collapse, no swap to a far larger person).
+    EXPECT_NEAR(Norm(shoulders1 - hips1) / torso, 1.0, 0.3) << "frame " << f;
+  }
+  std::printf("vtest: %d tracked frame pairs, largest torso-centre step %.2f torso lengths\n",
+              tracked_pairs,
+              largest_step);
+  EXPECT_GE(tracked_pairs, 25);
+}
+
+// The same frames give the same output bit for bit with 1 and 2 threads; and Reset()
+// makes a tracker continue exactly as a fresh one would (chunks of a video can run in
+// parallel, each starting with detection).
+TEST(WholeBodyTracker, DeterministicAcrossThreadsAndChunks) {
+  ARCO_REQUIRE_MODELS();
+  std::vector<media::Image> frames = VtestWindow(8);
+  if (frames.empty()) GTEST_SKIP() << "opencv-doc's vtest.avi is not installed (scripts/setup)";
+  frames.push_back(ReadImage(ARCO_SHARED_DATA_DIR "/spd/example.jpg"));
+  std::vector<std::vector<WholeBodyFrame>> runs;
+  for (int threads : {1, 2}) {
+    StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(TestOptions(threads));
+    ASSERT_TRUE(tracker.ok()) << tracker.status().message();
+    runs.emplace_back();
+    for (const media::Image& frame : frames) {
+      StatusOr<WholeBodyFrame> out = tracker->Track(frame);
+      ASSERT_TRUE(out.ok());
+      runs.back().push_back(*out);
+    }
+  }
+  int with_hands = 0;
+  for (size_t f = 0; f < frames.size(); ++f) {
+    EXPECT_TRUE(SameBits(runs[0][f], runs[1][f])) << "frame " << f;
+    with_hands += runs[0][f].left_hand || runs[0][f].right_hand ? 1 : 0;
+  }
+  EXPECT_GE(with_hands, 2);  // the hand path ran, too
+
+  // Chunks [0, 4) and [4, 9): one tracker with Reset() between them, and a fresh
+  // tracker on the second chunk, agree bit for bit with each other.
+  StatusOr<WholeBodyTracker> chunked = WholeBodyTracker::Create(TestOptions(2));
+  StatusOr<WholeBodyTracker> fresh = WholeBodyTracker::Create(TestOptions(1));
+  ASSERT_TRUE(chunked.ok() && fresh.ok());
+  for (size_t f = 0; f < 4; ++f) ASSERT_TRUE(chunked->Track(frames[f]).ok());
+  chunked->Reset();
+  for (size_t f = 4; f < frames.size(); ++f) {
+    StatusOr<WholeBodyFrame> a = chunked->Track(frames[f]);
+    StatusOr<WholeBodyFrame> b = fresh->Track(frames[f]);
+    ASSERT_TRUE(a.ok() && b.ok());
+    EXPECT_TRUE(SameBits(*a, *b)) << "frame " << f;
+    if (f == 4) {
+      EXPECT_TRUE(a->detector_ran);
+    }
+  }
+  EXPECT_EQ(chunked->summary().frames, static_cast<int64_t>(frames.size()));
+}
+
+}  // namespace
+}  // namespace arco::detect
