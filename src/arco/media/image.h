@@ -42,4 +42,9 @@ struct Image {
 // A zero-filled image; throws std::invalid_argument on a negative size.
 Image MakeImage(int width, int height, PixelFormat format);
 
+// `image` turned clockwise by `degrees` (0, 90, 180 or 270; throws
+// std::invalid_argument otherwise), as a player turns a video with that display
+// rotation: a 90 turn maps pixel (x, y) to (height - 1 - y, x).
+Image RotateClockwise(const Image& image, int degrees);
+
 }  // namespace arco::media

@@ -1,0 +1,152 @@
+// `arco detect CAPTURE`: the body and both hands in every camera's video
+// (pipeline/detect_stage.h, docs/detect.md).
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "arco/cli/command.h"
+#include "arco/cli/flag_names.h"
+#include "arco/cli/number_option.h"
+#include "arco/cli/progress.h"
+#include "arco/pipeline/detect_stage.h"
+
+namespace arco::cli {
+namespace {
+
+// Detection options as set by `arco detect` (the library names the fields).
+inline constexpr FieldFlag kDetectFlags[] = {{"num_threads", "--threads"},
+                                             {"chunk_frames", "--chunk-frames"},
+                                             {"min_detection_score", "--min-detection-score"},
+                                             {"min_pose_presence", "--min-pose-presence"},
+                                             {"min_hand_presence", "--min-hand-presence"}};
+
+struct DetectArgs {
+  pipeline::DetectStageOptions o;
+  std::string model = "full";
+  std::string frames;  // FIRST:LAST
+  bool no_hand_recrop = false;
+};
+
+// "FIRST:LAST" (global frame numbers, either side may be empty) into the options.
+Status ParseFrames(const std::string& text, pipeline::DetectStageOptions* o) {
+  if (text.empty()) return Status::Ok();
+  const size_t colon = text.find(':');
+  const auto bad = [&] {
+    return Status::Error("--frames \"" + text + "\" must look like FIRST:LAST (frame numbers)");
+  };
+  if (colon == std::string::npos) return bad();
+  const auto number = [&](const std::string& s, int64_t* out) {
+    if (s.empty()) return true;
+    if (s.size() > 12 || s.find_first_not_of("0123456789") != std::string::npos) return false;
+    *out = std::stoll(s);
+    return true;
+  };
+  if (!number(text.substr(0, colon), &o->first_frame) ||
+      !number(text.substr(colon + 1), &o->last_frame)) {
+    return bad();
+  }
+  return Status::Ok();
+}
+
+void ApplyAndValidate(DetectArgs& a) {
+  auto model = detect::ParsePoseModel(a.model);
+  ThrowIfInvalid(model.status());
+  a.o.detector.pose_model = *model;
+  a.o.detector.hand_recrop = !a.no_hand_recrop;
+  ThrowIfInvalid(ParseFrames(a.frames, &a.o));
+  const Status valid = a.o.Validate();
+  if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kDetectFlags)));
+}
+
+int RunDetect(const DetectArgs& a) {
+  ProgressBar bar("detect");
+  auto summary = pipeline::RunDetectStage(a.o, bar);
+  bar.Finish();
+  if (!summary.ok()) return PrintError(summary.status().message());
+  const auto& s = *summary;
+  const auto percent = [](int64_t part, int64_t whole) {
+    return whole > 0 ? 100.0 * static_cast<double>(part) / static_cast<double>(whole) : 0.0;
+  };
+  std::printf("detected frames %lld:%lld in %zu cameras (layout %s)\n",
+              static_cast<long long>(s.first_frame),
+              static_cast<long long>(s.last_frame),
+              s.cameras.size(),
+              s.layout.c_str());
+  for (const auto& c : s.cameras) {
+    std::printf("  %-12s %6lld frames  person %5.1f%%  left hand %5.1f%%  right hand %5.1f%%  "
+                "re-detections %lld%s\n",
+                c.camera.c_str(),
+                static_cast<long long>(c.frames),
+                percent(c.tracker.frames_with_person, c.tracker.frames),
+                percent(c.tracker.frames_with_left_hand, c.tracker.frames),
+                percent(c.tracker.frames_with_right_hand, c.tracker.frames),
+                static_cast<long long>(c.tracker.redetections),
+                c.dropped > 0 ? (", " + std::to_string(c.dropped) + " dropped").c_str() : "");
+  }
+  const int64_t frames = s.total.frames;
+  std::printf("time %.1f s: inference %.1f ms, decoding %.1f ms per view-frame (all workers)\n",
+              s.wall_s,
+              frames > 0 ? 1e3 * s.total.inference_s / frames : 0.0,
+              frames > 0 ? 1e3 * s.decode_s / frames : 0.0);
+  if (s.kept_other_points) std::printf("kept the instrument and bow points already there\n");
+  std::printf("wrote %s/keypoints2d.npy and capture.json\n", a.o.capture_dir.c_str());
+  return 0;
+}
+
+std::function<int()> SetupDetect(CLI::App& app) {
+  auto* sub = app.add_subcommand(
+      "detect",
+      "Body and both hands in every camera's video of a capture (MediaPipe models, "
+      "docs/detect.md) into its keypoints2d.npy");
+  auto a = std::make_shared<DetectArgs>();
+  detect::WholeBodyOptions& d = a->o.detector;
+  sub->add_option("capture", a->o.capture_dir, "Capture folder made by `arco capture new`")
+      ->required();
+  sub->add_option("--model", a->model, "Pose landmark model: lite, full or heavy")
+      ->check(CLI::IsMember({"lite", "full", "heavy"}))
+      ->capture_default_str();
+  sub->add_option("--frames",
+                  a->frames,
+                  "FIRST:LAST global frame numbers to detect (default all; the other frames "
+                  "keep what keypoints2d.npy held)");
+  AddNumber(sub,
+            "--threads",
+            a->o.num_threads,
+            "Worker threads (0 = all cores); results do not change",
+            kThreadsRange)
+      ->capture_default_str();
+  AddNumber(sub,
+            "--chunk-frames",
+            a->o.chunk_frames,
+            "Frames per work item; tracking restarts with person detection at each chunk",
+            pipeline::kDetectChunkFramesRange)
+      ->capture_default_str();
+  AddNumber(sub,
+            "--min-detection-score",
+            d.min_detection_score,
+            "Person detections below this score are ignored",
+            detect::kWholeBodyScoreRange)
+      ->capture_default_str();
+  AddNumber(sub,
+            "--min-pose-presence",
+            d.min_pose_presence,
+            "Tracking is lost (and the person detector runs) below this pose presence",
+            detect::kWholeBodyScoreRange)
+      ->capture_default_str();
+  AddNumber(sub,
+            "--min-hand-presence",
+            d.min_hand_presence,
+            "A hand below this presence is left empty (NaN)",
+            detect::kWholeBodyScoreRange)
+      ->capture_default_str();
+  sub->add_flag("--no-hand-recrop",
+                a->no_hand_recrop,
+                "Hand crops straight from the pose, without hand_recrop's refinement");
+  sub->add_option("--models-dir", d.models_dir, "Folder of the converted models (scripts/setup)");
+  sub->parse_complete_callback([a] { ApplyAndValidate(*a); });
+  return [a]() { return RunDetect(*a); };
+}
+
+}  // namespace
+ARCO_REGISTER_COMMAND(detect, 19, SetupDetect);
+}  // namespace arco::cli

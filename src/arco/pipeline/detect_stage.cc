@@ -1,0 +1,359 @@
+#include "arco/pipeline/detect_stage.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <utility>
+
+#include "arco/calibration/calibration_file.h"
+#include "arco/media/video_reader.h"
+#include "arco/mocap/capture.h"
+#include "arco/pipeline/preflight.h"
+#include "arco/registry/keypoint_layout.h"
+#include "arco/util/file_io.h"
+#include "arco/util/npy.h"
+#include "arco/util/output_set.h"
+#include "arco/util/parallel.h"
+
+namespace arco::pipeline {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr char kKeypointsFile[] = "keypoints2d.npy";
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// One camera's video as the stage reads it.
+struct CameraInput {
+  std::string name;
+  std::string video;  // resolved path
+  int rotate_deg = 0;
+  int width = 0, height = 0;  // the calibration camera's image
+  int64_t video_frames = 0;
+};
+
+// One work item: frames [first, last] (global numbers) of one camera.
+struct Chunk {
+  int view = 0;
+  int64_t first = 0, last = 0;
+};
+
+// Per-worker state: its tracker and the videos it has open.
+struct Worker {
+  std::optional<detect::WholeBodyTracker> tracker;
+  std::map<int, media::VideoReader> readers;
+  double decode_s = 0;
+};
+
+Json SummaryJson(const detect::WholeBodySummary& s) {
+  Json models = Json::array();
+  for (const auto& m : s.models) {
+    if (m.runs == 0) continue;
+    models.push_back({{"model", GetModelInfo(m.model).name},
+                      {"runs", m.runs},
+                      {"inference_ms_per_run", 1e3 * m.inference_s / m.runs}});
+  }
+  return Json{{"frames", s.frames},
+              {"frames_with_person", s.frames_with_person},
+              {"frames_with_left_hand", s.frames_with_left_hand},
+              {"frames_with_right_hand", s.frames_with_right_hand},
+              {"detector_runs", s.detector_runs},
+              {"redetections", s.redetections},
+              {"models", models},
+              {"inference_s", s.inference_s},
+              {"preprocess_s", s.preprocess_s},
+              {"postprocess_s", s.postprocess_s}};
+}
+
+// after - before: one chunk's counts and times from a worker's running totals.
+detect::WholeBodySummary Difference(const detect::WholeBodySummary& after,
+                                    const detect::WholeBodySummary& before) {
+  detect::WholeBodySummary d = after;
+  d.frames -= before.frames;
+  d.frames_with_person -= before.frames_with_person;
+  d.frames_with_left_hand -= before.frames_with_left_hand;
+  d.frames_with_right_hand -= before.frames_with_right_hand;
+  d.detector_runs -= before.detector_runs;
+  d.redetections -= before.redetections;
+  for (size_t k = 0; k < d.models.size(); ++k) {
+    d.models[k].runs -= before.models[k].runs;
+    d.models[k].inference_s -= before.models[k].inference_s;
+  }
+  d.inference_s -= before.inference_s;
+  d.preprocess_s -= before.preprocess_s;
+  d.postprocess_s -= before.postprocess_s;
+  return d;
+}
+
+}  // namespace
+
+Status DetectStageOptions::Validate() const {
+  if (capture_dir.empty()) return Status::Error("capture_dir is empty");
+  detect::WholeBodyOptions d = detector;
+  d.num_threads = 1;  // the stage's own
+  ARCO_RETURN_IF_ERROR(d.Validate().WithContext("detector"));
+  ARCO_RETURN_IF_ERROR(CheckInRange("num_threads", num_threads, Closed(0, 1024)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("chunk_frames", chunk_frames, kDetectChunkFramesRange));
+  if (first_frame < -1) return Status::Error("first_frame must be -1 (the first) or >= 0");
+  if (last_frame < -1) return Status::Error("last_frame must be -1 (the last) or >= 0");
+  if (first_frame >= 0 && last_frame >= 0 && last_frame < first_frame) {
+    return Status::Error("last_frame " + std::to_string(last_frame) + " is before first_frame " +
+                         std::to_string(first_frame));
+  }
+  return Status::Ok();
+}
+
+Json ToJson(const DetectStageOptions& o) {
+  return Json{{"pose_model", detect::PoseModelName(o.detector.pose_model)},
+              {"min_detection_score", o.detector.min_detection_score},
+              {"nms_min_iou", o.detector.nms_min_iou},
+              {"min_pose_presence", o.detector.min_pose_presence},
+              {"min_hand_presence", o.detector.min_hand_presence},
+              {"hand_recrop", o.detector.hand_recrop},
+              {"chunk_frames", o.chunk_frames},
+              {"first_frame", o.first_frame},
+              {"last_frame", o.last_frame}};
+}
+
+Json ToJson(const DetectStageSummary& s) {
+  Json cameras = Json::array();
+  for (const auto& c : s.cameras) {
+    Json j = SummaryJson(c.tracker);
+    j["camera"] = c.camera;
+    j["video"] = c.video;
+    j["frames_read"] = c.frames;
+    j["dropped"] = c.dropped;
+    cameras.push_back(std::move(j));
+  }
+  return Json{{"layout", s.layout},
+              {"first_frame", s.first_frame},
+              {"last_frame", s.last_frame},
+              {"points", s.points},
+              {"kept_other_points", s.kept_other_points},
+              {"total", SummaryJson(s.total)},
+              {"cameras", cameras},
+              {"decode_s", s.decode_s},
+              {"wall_s", s.wall_s}};
+}
+
+StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options,
+                                            Progress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  const std::string& dir = options.capture_dir;
+  const std::string manifest_path = JoinPath(dir, kCaptureManifestName);
+  ARCO_ASSIGN_OR_RETURN(CaptureManifest manifest, ReadCaptureManifest(dir));
+
+  // --- Checks before any frame is decoded -------------------------------------------
+  ARCO_ASSIGN_OR_RETURN(const std::string layout_name, DetectionLayoutName(manifest.instrument));
+  const KeypointLayout* layout = FindKeypointLayout(layout_name);
+  if (layout == nullptr) return Status::Error(manifest_path + ": no layout " + layout_name);
+  const int64_t points = static_cast<int64_t>(layout->names.size());
+  if (manifest.frame_count <= 0) return Status::Error(manifest_path + ": frames.count is 0");
+  const int64_t capture_first = manifest.frame_first;
+  const int64_t capture_last = manifest.frame_first + manifest.frame_count - 1;
+  const int64_t first = options.first_frame >= 0 ? options.first_frame : capture_first;
+  const int64_t last = options.last_frame >= 0 ? options.last_frame : capture_last;
+  if (first < capture_first || last > capture_last || last < first) {
+    return Status::Error("frames " + std::to_string(first) + ":" + std::to_string(last) +
+                         " are outside the capture's frames " + std::to_string(capture_first) +
+                         ":" + std::to_string(capture_last) + " (" + manifest_path + ")");
+  }
+
+  const std::string calibration_path = ResolveCapturePath(dir, manifest.calibration);
+  StatusOr<Calibration> calibration = LoadCalibration(calibration_path);
+  if (!calibration.ok()) return calibration.status().WithContext(manifest_path + ": calibration");
+  ARCO_ASSIGN_OR_RETURN(const std::vector<int> rig_index,
+                        MatchCaptureCameras(dir, manifest, calibration->rig, calibration_path));
+
+  const int views = static_cast<int>(manifest.cameras.size());
+  std::vector<CameraInput> inputs(views);
+  for (int v = 0; v < views; ++v) {
+    const CaptureCamera& cam = manifest.cameras[v];
+    CameraInput& in = inputs[v];
+    in.name = cam.name;
+    if (cam.video.empty()) {
+      return Status::Error(manifest_path + ": camera " + cam.name +
+                           " has no video (make the capture with `arco capture new --video "
+                           "CAMERA=FILE`)");
+    }
+    in.video = ResolveCapturePath(dir, cam.video);
+    in.rotate_deg = cam.rotate_deg;
+    const Camera& calib = calibration->rig.cameras[rig_index[v]];
+    in.width = calib.width;
+    in.height = calib.height;
+    ARCO_ASSIGN_OR_RETURN(media::VideoReader reader, media::VideoReader::Open(in.video));
+    const media::VideoProperties& p = reader.properties();
+    const bool swap = in.rotate_deg == 90 || in.rotate_deg == 270;
+    const int w = swap ? p.height : p.width, h = swap ? p.width : p.height;
+    if (w != in.width || h != in.height) {
+      return Status::Error(in.video + ": frames are " + std::to_string(w) + "x" +
+                           std::to_string(h) + " after rotate_deg " +
+                           std::to_string(in.rotate_deg) + ", camera " + cam.name + " of " +
+                           calibration_path + " is " + std::to_string(in.width) + "x" +
+                           std::to_string(in.height));
+    }
+    in.video_frames = p.frame_count;
+    // The last global frame this camera recorded must be in its video.
+    for (int64_t g = last; g >= first; --g) {
+      const int64_t n = manifest.VideoFrameNumber(v, g);
+      if (n < 0) continue;
+      if (n > in.video_frames) {
+        return Status::Error(in.video + ": has " + std::to_string(in.video_frames) +
+                             " frames, capture frame " + std::to_string(g) + " is its frame " +
+                             std::to_string(n) + " (" + manifest_path + ")");
+      }
+      break;
+    }
+  }
+
+  // Keypoints already in the capture: the slots after the body and hands (instrument and
+  // bow, from `arco track`) and the frames outside [first, last] are kept.
+  NpyArray<float> out;
+  out.shape = {manifest.frame_count, views, points, 3};
+  out.data.assign(static_cast<size_t>(manifest.frame_count * views * points * 3), kNaN);
+  bool kept = false;
+  if (!manifest.keypoints2d.empty() && manifest.layout == layout_name) {
+    ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(dir, manifest));
+    ARCO_ASSIGN_OR_RETURN(NpyArray<double> old, ReadCaptureKeypoints2d(dir, manifest));
+    for (size_t i = 0; i < out.data.size(); ++i) out.data[i] = static_cast<float>(old.data[i]);
+    kept = true;
+  }
+  const auto at = [&](int64_t f, int v, int64_t p) {
+    return static_cast<size_t>(((f * views + v) * points + p) * 3);
+  };
+  // The body and hand slots of the detected range start empty.
+  for (int64_t g = first; g <= last; ++g)
+    for (int v = 0; v < views; ++v)
+      for (int64_t p = 0; p < wholebody::kNumPoints; ++p) {
+        const size_t k = at(g - capture_first, v, p);
+        out.data[k] = out.data[k + 1] = out.data[k + 2] = kNaN;
+      }
+
+  // Outputs declared (and their locations checked) before the work.
+  OutputSet outputs;
+  ARCO_ASSIGN_OR_RETURN(const std::string npy_tmp, outputs.AddFile(JoinPath(dir, kKeypointsFile)));
+  ARCO_ASSIGN_OR_RETURN(const std::string manifest_tmp, outputs.AddFile(manifest_path));
+
+  // The models load here (a missing file is one line naming it).
+  const int threads = ResolveThreadCount(options.num_threads);
+  std::vector<Chunk> chunks;
+  for (int v = 0; v < views; ++v)
+    for (int64_t f = first; f <= last; f += options.chunk_frames)
+      chunks.push_back({v, f, std::min<int64_t>(last, f + options.chunk_frames - 1)});
+  const int workers = static_cast<int>(std::min<int64_t>(threads, chunks.size()));
+  detect::WholeBodyOptions detector = options.detector;
+  // cv::dnn's pool is process-wide: every tracker asks for the same size.
+  detector.num_threads = std::max(1, threads / std::max(1, workers));
+  std::vector<Worker> pool(workers);
+  {
+    ARCO_ASSIGN_OR_RETURN(detect::WholeBodyTracker first_tracker,
+                          detect::WholeBodyTracker::Create(detector));
+    pool[0].tracker.emplace(std::move(first_tracker));
+  }
+
+  // --- The work: (camera, chunk) items, each tracker restarted at its chunk ----------
+  std::vector<detect::WholeBodySummary> chunk_summary(chunks.size());
+  std::vector<int64_t> chunk_read(chunks.size(), 0), chunk_dropped(chunks.size(), 0);
+  std::vector<Status> chunk_status(chunks.size(), Status::Ok());
+  progress.SetTotal((last - first + 1) * views);
+  ParallelFor(
+      static_cast<int64_t>(chunks.size()),
+      workers,
+      [&](int64_t i, int t) {
+        Worker& w = pool[t];
+        const Chunk& c = chunks[i];
+        const CameraInput& in = inputs[c.view];
+        const auto fail = [&](Status s) { chunk_status[i] = std::move(s); };
+        if (!w.tracker) {
+          auto tracker = detect::WholeBodyTracker::Create(detector);
+          if (!tracker.ok()) return fail(tracker.status());
+          w.tracker.emplace(std::move(*tracker));
+        }
+        auto reader_it = w.readers.find(c.view);
+        if (reader_it == w.readers.end()) {
+          auto reader = media::VideoReader::Open(in.video);
+          if (!reader.ok()) return fail(reader.status());
+          reader_it = w.readers.emplace(c.view, std::move(*reader)).first;
+        }
+        media::VideoReader& reader = reader_it->second;
+        const detect::WholeBodySummary before = w.tracker->summary();
+        w.tracker->Reset();
+        media::Image frame;
+        for (int64_t g = c.first; g <= c.last; ++g) {
+          const int64_t n = manifest.VideoFrameNumber(c.view, g);  // 1-based, -1 dropped
+          progress.Advance(1);
+          if (n < 0) {
+            ++chunk_dropped[i];
+            continue;
+          }
+          const auto decode_start = std::chrono::steady_clock::now();
+          if (reader.next_frame() != n - 1) {
+            const Status s = reader.Seek(n - 1);
+            if (!s.ok()) return fail(s);
+          }
+          auto more = reader.Read(&frame);
+          if (!more.ok()) return fail(more.status());
+          if (!*more) {
+            return fail(Status::Error(in.video + ": frame " + std::to_string(n - 1) +
+                                      " could not be read (the video ends early)"));
+          }
+          const media::Image turned = media::RotateClockwise(frame, in.rotate_deg);
+          w.decode_s += SecondsSince(decode_start);
+          auto found = w.tracker->Track(turned);
+          if (!found.ok()) return fail(found.status());
+          ++chunk_read[i];
+          for (int p = 0; p < wholebody::kNumPoints; ++p) {
+            const detect::ScoredPoint& q = found->points[p];
+            const size_t k = at(g - capture_first, c.view, p);
+            out.data[k] = q.x_px;
+            out.data[k + 1] = q.y_px;
+            out.data[k + 2] = q.score;
+          }
+        }
+        // This chunk's share of the worker's counts and times.
+        const detect::WholeBodySummary delta = Difference(w.tracker->summary(), before);
+        chunk_summary[i] = delta;
+      },
+      /*chunk=*/1);
+  // The first failing item in item order (deterministic message).
+  for (const Status& s : chunk_status) ARCO_RETURN_IF_ERROR(s);
+
+  DetectStageSummary summary;
+  summary.layout = layout_name;
+  summary.first_frame = first;
+  summary.last_frame = last;
+  summary.points = points;
+  summary.kept_other_points = kept;
+  summary.cameras.resize(views);
+  for (int v = 0; v < views; ++v) {
+    summary.cameras[v].camera = inputs[v].name;
+    summary.cameras[v].video = inputs[v].video;
+  }
+  for (size_t i = 0; i < chunks.size(); ++i) {
+    DetectCameraSummary& c = summary.cameras[chunks[i].view];
+    c.frames += chunk_read[i];
+    c.dropped += chunk_dropped[i];
+    c.tracker.Merge(chunk_summary[i]);
+    summary.total.Merge(chunk_summary[i]);
+  }
+  for (const Worker& w : pool) summary.decode_s += w.decode_s;
+
+  // --- Both files replaced together ----------------------------------------------------
+  ARCO_RETURN_IF_ERROR(WriteNpy(npy_tmp, out));
+  manifest.keypoints2d = kKeypointsFile;
+  manifest.layout = layout_name;
+  manifest.keypoint_names.clear();
+  ARCO_RETURN_IF_ERROR(WriteJsonFile(manifest_tmp, CaptureManifestToJson(manifest)));
+  ARCO_RETURN_IF_ERROR(outputs.Commit());
+  summary.wall_s = SecondsSince(start);
+  return summary;
+}
+
+}  // namespace arco::pipeline
