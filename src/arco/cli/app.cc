@@ -68,6 +68,32 @@ Status CheckCommandName(const App& app, const std::string& first_arg) {
                        "; see `arco --help`)");
 }
 
+Status CheckCommandNames(const App& app, const std::vector<std::string>& args) {
+  if (args.empty()) return Status::Ok();
+  ARCO_RETURN_IF_ERROR(CheckCommandName(app, args[0]));
+  const CLI::App* command = nullptr;
+  for (const auto& [sub, run] : app.commands) {
+    if (sub->get_name() == args[0]) command = sub;
+  }
+  if (!command || command->get_subcommands({}).empty() ||
+      command->get_require_subcommand_min() == 0) {
+    return Status::Ok();
+  }
+  std::string known;
+  bool found = false;
+  for (const CLI::App* sub : command->get_subcommands({})) {
+    found = found || (args.size() > 1 && sub->get_name() == args[1]);
+    known += (known.empty() ? "" : ", ") + sub->get_name();
+  }
+  const std::string help = "see `arco " + args[0] + " --help`";
+  if (args.size() == 1) {
+    return Status::Error("'" + args[0] + "' needs a command (" + known + "; " + help + ")");
+  }
+  if (found || args[1].empty() || args[1][0] == '-') return Status::Ok();
+  return Status::Error("unknown command '" + args[0] + " " + args[1] + "' (" + args[0] +
+                       " commands: " + known + "; " + help + ")");
+}
+
 namespace {
 
 std::string Escape(std::string text) {
@@ -134,7 +160,7 @@ std::string OptionsMarkdown(const App& app) {
 int Main(int argc, char** argv) {
   App app = BuildApp();
   if (argc > 1) {
-    const Status known = CheckCommandName(app, argv[1]);
+    const Status known = CheckCommandNames(app, std::vector<std::string>(argv + 1, argv + argc));
     if (!known.ok()) return PrintError(known.message());
   }
   try {

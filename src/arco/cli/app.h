@@ -36,6 +36,10 @@ App BuildApp();
 // Ok, or "unknown command 'X' (commands: ...)" for a first word that names no command
 // (CLI11 would say "A subcommand is required").
 Status CheckCommandName(const App& app, const std::string& first_arg);
+// The same for every word that names a command: also the second word of a command made of
+// subcommands (`arco capture new`, `arco calibration show`), which must name one of them
+// ("unknown command 'capture frob' (capture commands: new, import-keypoints; ...)").
+Status CheckCommandNames(const App& app, const std::vector<std::string>& args);
 
 // docs/options.md: every command's options (type, range or choices, default, meaning) as
 // the app defines them; app_test.cc checks the page is current (and rewrites it with

@@ -287,5 +287,23 @@ TEST(CheckCommandName, NamesAnUnknownCommand) {
   EXPECT_NE(unknown.message().find("unknown command 'frobnicate'"), std::string::npos);
 }
 
+TEST(CheckCommandNames, NamesAnUnknownSubcommand) {
+  const App app = BuildApp();
+  EXPECT_TRUE(CheckCommandNames(app, {"capture", "new", "-o", "x"}).ok());
+  EXPECT_TRUE(CheckCommandNames(app, {"capture", "--help"}).ok());
+  EXPECT_TRUE(CheckCommandNames(app, {"calibration", "show", "x"}).ok());
+  EXPECT_TRUE(CheckCommandNames(app, {"run", "frobnicate"}).ok());  // a positional
+  const Status unknown = CheckCommandNames(app, {"capture", "frobnicate"});
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.message().find("unknown command 'capture frobnicate'"), std::string::npos)
+      << unknown.message();
+  EXPECT_NE(unknown.message().find("new, import-keypoints"), std::string::npos)
+      << unknown.message();
+  const Status bare = CheckCommandNames(app, {"calibration"});
+  ASSERT_FALSE(bare.ok());
+  EXPECT_NE(bare.message().find("show, convert"), std::string::npos) << bare.message();
+  EXPECT_FALSE(CheckCommandNames(app, {"frobnicate", "new"}).ok());
+}
+
 }  // namespace
 }  // namespace arco::cli

@@ -64,6 +64,32 @@ ok "import-spd --overwrite" "${I[@]}" -o "$w/imp/" --overwrite
 bad "import-spd --overwrite over another folder" "$w/photos" "${I[@]}" -o "$w/photos/" --overwrite
 bad "import-spd under a file" "$w/file/imp" "${I[@]}" -o "$w/file/imp"
 
+# capture new: a capture folder referencing its videos (here one 2300x2656 image, SPD's
+# rotated frame size); capture import-keypoints: keypoints2d.npy and capture.json together.
+python3 - "$tmp/in/frame.png" <<'PY'
+import struct, sys, zlib
+def chunk(kind, data):
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+rows = b"".join(b"\0" + b"\x80" * 2300 for _ in range(2656))
+header = struct.pack(">IIBBBBB", 2300, 2656, 8, 0, 0, 0, 0)
+open(sys.argv[1], "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) +
+                              chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+PY
+C=(capture new --calibration "$calib" --video "21334181=$tmp/in/frame.png" --fps 30)
+ok "capture new -o new/" "${C[@]}" -o "$w/new/"
+check '[ -f "$w/new/capture.json" ] && grep -q "\"name\": \"new\"" "$w/new/capture.json"' "capture new -o new/ writes new"
+bad "capture new over a capture" "$w/new" "${C[@]}" -o "$w/new"
+ok "capture new --overwrite" "${C[@]}" -o "$w/new/" --overwrite
+bad "capture new --overwrite over another folder" "$w/photos" "${C[@]}" -o "$w/photos/" --overwrite
+bad "capture new under a file" "$w/file/new" "${C[@]}" -o "$w/file/new"
+echo '[{"frame_id": 0, "instances": []}]' >"$tmp/in/mm.json"
+K=(capture import-keypoints --format mmpose --camera "21334181=$tmp/in/mm.json")
+mkdir "$w/new/keypoints2d.npy"
+bad "capture import-keypoints onto a folder" "$w/new/keypoints2d.npy" "${K[@]}" "$w/new"
+rmdir "$w/new/keypoints2d.npy"
+ok "capture import-keypoints" "${K[@]}" "$w/new/"
+check '[ -f "$w/new/keypoints2d.npy" ] && grep -q "keypoints2d.npy" "$w/new/capture.json"' "capture import-keypoints writes both"
+
 # run: a result folder.
 ok "run -o res/" run "$w/cap" -o "$w/res/" --threads 2
 check '[ -f "$w/res/result.json" ] && [ -f "$w/res/vision/points3d.npy" ]' "run -o res/ writes res"

@@ -7,6 +7,7 @@
 #include <system_error>
 
 #include "arco/media/frame_source.h"
+#include "arco/util/file_io.h"
 
 namespace arco::media {
 namespace {
@@ -21,34 +22,6 @@ bool HasImageExtension(const std::filesystem::path& path) {
     if (ext == known) return true;
   }
   return false;
-}
-
-// Natural order: runs of digits compare as numbers, so frame2.png < frame10.png.
-bool NaturalLess(const std::string& a, const std::string& b) {
-  size_t i = 0, j = 0;
-  while (i < a.size() && j < b.size()) {
-    const bool da = std::isdigit(static_cast<unsigned char>(a[i])) != 0;
-    const bool db = std::isdigit(static_cast<unsigned char>(b[j])) != 0;
-    if (da && db) {
-      size_t ie = i, je = j;
-      while (ie < a.size() && std::isdigit(static_cast<unsigned char>(a[ie]))) ++ie;
-      while (je < b.size() && std::isdigit(static_cast<unsigned char>(b[je]))) ++je;
-      size_t is = i, js = j;  // skip leading zeros, then longer is larger
-      while (is + 1 < ie && a[is] == '0') ++is;
-      while (js + 1 < je && b[js] == '0') ++js;
-      const std::string_view na(a.data() + is, ie - is), nb(b.data() + js, je - js);
-      if (na.size() != nb.size()) return na.size() < nb.size();
-      if (na != nb) return na < nb;
-      i = ie;
-      j = je;
-      continue;
-    }
-    if (a[i] != b[j]) return a[i] < b[j];
-    ++i;
-    ++j;
-  }
-  if (a.size() - i != b.size() - j) return a.size() - i < b.size() - j;
-  return a < b;  // equal up to leading zeros: any fixed order
 }
 
 class ImageFiles : public FrameSource {
@@ -116,7 +89,8 @@ void ScaledSize(int coded_width, int coded_height, int max_width, int* width, in
   }
   *width = max_width;
   *height = std::max(
-      2, static_cast<int>(std::lround(static_cast<double>(coded_height) * max_width / coded_width)));
+      2,
+      static_cast<int>(std::lround(static_cast<double>(coded_height) * max_width / coded_width)));
 }
 
 StatusOr<std::unique_ptr<FrameSource>> OpenImageFiles(const std::string& path,
@@ -132,7 +106,8 @@ Status VideoReaderOptions::Validate() const {
   if (image_fps.num < 0 || image_fps.den <= 0) {
     return Status::Error("image_fps must be a non-negative num / positive den");
   }
-  if (decoder_threads < 0) return Status::Error("decoder_threads must be >= 0 (0: FFmpeg's choice)");
+  if (decoder_threads < 0)
+    return Status::Error("decoder_threads must be >= 0 (0: FFmpeg's choice)");
   return Status::Ok();
 }
 
@@ -179,7 +154,8 @@ StatusOr<Image> VideoReader::ReadFrame(int64_t index) {
   ARCO_RETURN_IF_ERROR(Seek(index));
   Image image;
   ARCO_ASSIGN_OR_RETURN(const bool got, Read(&image));
-  if (!got) return Status::Error(properties().path + ": frame " + std::to_string(index) + " not found");
+  if (!got)
+    return Status::Error(properties().path + ": frame " + std::to_string(index) + " not found");
   return image;
 }
 

@@ -98,6 +98,12 @@ Status ParseCamera(const Json& j,
   if (cam->name.empty()) return f.Bad("name", "must not be empty");
   ARCO_RETURN_IF_ERROR(f.String("serial", false, &cam->serial));
   ARCO_RETURN_IF_ERROR(f.String("video", false, &cam->video));
+  int64_t rotate_deg = 0;
+  ARCO_RETURN_IF_ERROR(f.Integer("rotate_deg", false, &rotate_deg));
+  if (rotate_deg != 0 && rotate_deg != 90 && rotate_deg != 180 && rotate_deg != 270) {
+    return f.Bad("rotate_deg", "is " + std::to_string(rotate_deg) + "; must be 0, 90, 180 or 270");
+  }
+  cam->rotate_deg = static_cast<int>(rotate_deg);
   if (const Json* drops = f.Find("dropped_frames"); drops && !drops->is_null()) {
     if (!drops->is_array()) return f.Bad("dropped_frames", "must be an array of frame numbers");
     for (const Json& d : *drops) {
@@ -282,6 +288,7 @@ Json CaptureManifestToJson(const CaptureManifest& m) {
     Json cj = {{"name", c.name}};
     if (!c.serial.empty()) cj["serial"] = c.serial;
     if (!c.video.empty()) cj["video"] = c.video;
+    if (c.rotate_deg != 0) cj["rotate_deg"] = c.rotate_deg;
     cj["dropped_frames"] = c.dropped_frames;
     j["cameras"].push_back(cj);
   }
@@ -299,6 +306,19 @@ std::string ResolveCapturePath(const std::string& dir, const std::string& entry)
   return JoinPath(dir, entry);
 }
 
+StatusOr<std::string> DetectionLayoutName(const std::string& instrument) {
+  if (instrument.empty() || instrument == "none") return std::string("coco_wholebody_133");
+  ARCO_ASSIGN_OR_RETURN(const InstrumentKind kind, ParseInstrumentKind(instrument));
+  return std::string(GetInstrumentInfo(kind).spd_layout);
+}
+
+Status CheckCaptureHasKeypoints2d(const std::string& capture_dir, const CaptureManifest& m) {
+  if (!m.keypoints2d.empty()) return Status::Ok();
+  return Status::Error(JoinPath(capture_dir, kCaptureManifestName) +
+                       ": no 2D keypoints yet (no \"keypoints2d\" entry); run `arco detect " +
+                       capture_dir + "` (or `arco capture import-keypoints`) first");
+}
+
 namespace {
 
 std::string ShapeString(const std::vector<int64_t>& s) {
@@ -311,10 +331,7 @@ std::string ShapeString(const std::vector<int64_t>& s) {
 
 Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureManifest& m) {
   const std::string manifest_path = JoinPath(capture_dir, kCaptureManifestName);
-  if (m.keypoints2d.empty()) {
-    return Status::Error(manifest_path +
-                         ": no \"keypoints2d\" entry (2D keypoints to triangulate)");
-  }
+  ARCO_RETURN_IF_ERROR(CheckCaptureHasKeypoints2d(capture_dir, m));
   const std::string path = ResolveCapturePath(capture_dir, m.keypoints2d);
   ARCO_ASSIGN_OR_RETURN(const NpyHeader header, ReadNpyHeader(path));
   // Pixel coordinates are fractional: an integer array is a writer's mistake (rounded

@@ -36,8 +36,11 @@ inline constexpr int64_t kMaxCaptureFrameNumber = int64_t{1} << 40;  // frames.f
 struct CaptureCamera {
   std::string name;                     // matches a calibration camera's name or serial
   std::string serial;                   // optional
-  std::string video;                    // optional, relative path
+  std::string video;                    // optional: video file, image folder or image
   std::vector<int64_t> dropped_frames;  // global frame numbers this camera did not record
+  // Clockwise rotation (0, 90, 180, 270) applied to the video's decoded frames (coded
+  // orientation, media::VideoReader) to get the calibration's image; SPD's are 90.
+  int rotate_deg = 0;
 };
 
 struct CaptureManifest {
@@ -74,8 +77,19 @@ StatusOr<CaptureManifest> ReadCaptureManifest(const std::string& capture_dir);
 Json CaptureManifestToJson(const CaptureManifest& manifest);
 Status WriteCaptureManifest(const std::string& capture_dir, const CaptureManifest& manifest);
 
-// Path of a manifest entry: relative entries are resolved against `dir`.
+// Path of a manifest entry: relative entries are resolved against `dir` (the writers
+// store them with PathRelativeTo, util/file_io.h).
 std::string ResolveCapturePath(const std::string& dir, const std::string& entry);
+
+// The layout a detector or an importer writes for a capture of this instrument:
+// coco_wholebody_133 for "none", else the instrument's SPD layout (spd_cello,
+// spd_violin: COCO-WholeBody then the instrument's points, left NaN by a body detector).
+StatusOr<std::string> DetectionLayoutName(const std::string& instrument);
+
+// Ok when the manifest names 2D keypoints; else one line naming capture.json that says
+// how to make them (a capture from videos has none until `arco detect` or
+// `arco capture import-keypoints` writes them). Every reader of the keypoints calls it.
+Status CheckCaptureHasKeypoints2d(const std::string& capture_dir, const CaptureManifest& manifest);
 
 // Checks the 2D keypoints named by the manifest from the .npy header alone (before any
 // work): the file is readable, its dtype float32/float64 (any other is an error naming

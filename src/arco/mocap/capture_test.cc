@@ -140,8 +140,35 @@ TEST(CaptureManifest, ContentOutsideItsRangeNamesTheField) {
             "cap/capture.json: \"fps\" is \"30\"; must be a number");
   EXPECT_EQ(message([](Json& j) { j["audio"]["file"] = ""; }),
             "cap/capture.json: \"audio.file\" is empty; must name an audio file");
+  EXPECT_EQ(message([](Json& j) { j["cameras"][1]["rotate_deg"] = 45; }),
+            "cap/capture.json: \"cameras[1].rotate_deg\" is 45; must be 0, 90, 180 or 270");
+  EXPECT_EQ(message([](Json& j) { j["cameras"][1]["rotate_deg"] = "90"; }),
+            "cap/capture.json: \"cameras[1].rotate_deg\" is \"90\"; must be an integer");
   // Any order is accepted and sorted.
   EXPECT_EQ(message([](Json& j) { j["cameras"][0]["dropped_frames"] = {131, 128}; }), "accepted");
+}
+
+// A camera's rotation and video reference round-trip; 0 is not written.
+TEST(CaptureManifest, RotationRoundTrips) {
+  CaptureManifest m = SampleManifest();
+  m.cameras[0].video = "../videos/21334181.avi";
+  m.cameras[0].rotate_deg = 90;
+  const Json j = CaptureManifestToJson(m);
+  EXPECT_EQ(j["cameras"][0]["rotate_deg"], 90);
+  EXPECT_FALSE(j["cameras"][1].contains("rotate_deg"));
+  const auto r = ParseCaptureManifest(j.dump(), "capture.json");
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->cameras[0].rotate_deg, 90);
+  EXPECT_EQ(r->cameras[1].rotate_deg, 0);
+  EXPECT_EQ(r->cameras[0].video, "../videos/21334181.avi");
+  EXPECT_EQ(ResolveCapturePath("caps/one", r->cameras[0].video), "caps/one/../videos/21334181.avi");
+}
+
+TEST(DetectionLayoutName, FollowsTheInstrument) {
+  EXPECT_EQ(*DetectionLayoutName("none"), "coco_wholebody_133");
+  EXPECT_EQ(*DetectionLayoutName("cello"), "spd_cello");
+  EXPECT_EQ(*DetectionLayoutName("viola"), "spd_violin");
+  EXPECT_FALSE(DetectionLayoutName("lute").ok());
 }
 
 // JSON has no NaN: a Python-written NaN / Infinity is named as such, not as a missing field.

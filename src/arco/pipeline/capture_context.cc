@@ -16,6 +16,7 @@ StatusOr<CaptureContext> OpenCapture(const std::string& capture_dir) {
   c.capture_dir = capture_dir;
   ARCO_ASSIGN_OR_RETURN(c.manifest, ReadCaptureManifest(capture_dir));
   const std::string where = JoinPath(capture_dir, kCaptureManifestName);
+  ARCO_RETURN_IF_ERROR(CheckCaptureHasKeypoints2d(capture_dir, c.manifest));
   ARCO_ASSIGN_OR_RETURN(c.layout, c.manifest.Layout());
   if (c.manifest.instrument == "none" || c.manifest.instrument.empty()) {
     return Status::Error(where + ": the capture names no instrument; arco run needs one");

@@ -16,23 +16,6 @@
 namespace arco::pipeline {
 namespace {
 
-// A relative `path` (from the working folder) made relative to the folder `base`; an
-// absolute one stays absolute (right from anywhere, as the user gave it).
-std::string PathRelativeTo(const std::string& path, const std::string& base) {
-  namespace fs = std::filesystem;
-  if (fs::path(path).is_absolute()) return NormalizeOutputPath(path);
-  const fs::path from = fs::absolute(base).lexically_normal();
-  const fs::path to = fs::absolute(path).lexically_normal();
-  const fs::path relative = to.lexically_relative(from);
-  std::string out = relative.empty() ? to.string() : relative.string();
-  while (out.size() > 1 && out.back() == '/') out.pop_back();
-  return out;
-}
-
-}  // namespace
-
-namespace {
-
 // File names inside the stage folders.
 constexpr char kPoints3dFile[] = "points3d.npy";
 constexpr char kPoints3dRawFile[] = "points3d_raw.npy";

@@ -33,9 +33,7 @@ StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOpti
   ARCO_ASSIGN_OR_RETURN(CaptureManifest manifest, ReadCaptureManifest(o.capture_dir));
   const std::string manifest_path = JoinPath(o.capture_dir, kCaptureManifestName);
   ARCO_ASSIGN_OR_RETURN(KeypointLayout layout, [&]() -> StatusOr<KeypointLayout> {
-    if (manifest.keypoints2d.empty()) {
-      return Status::Error(manifest_path + ": no \"keypoints2d\" entry to triangulate");
-    }
+    ARCO_RETURN_IF_ERROR(CheckCaptureHasKeypoints2d(o.capture_dir, manifest));
     auto l = manifest.Layout();
     if (!l.ok()) return l.status().WithContext(manifest_path);
     return l;

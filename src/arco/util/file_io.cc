@@ -1,10 +1,12 @@
 #include "arco/util/file_io.h"
 
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 
 #include "arco/util/output_set.h"
 
@@ -63,6 +65,43 @@ bool FileExists(const std::string& path) {
 
 std::string JoinPath(const std::string& a, const std::string& b) {
   return (fs::path(a) / fs::path(b)).string();
+}
+
+std::string PathRelativeTo(const std::string& path, const std::string& base) {
+  if (fs::path(path).is_absolute()) return NormalizeOutputPath(path);
+  const fs::path from = fs::absolute(base).lexically_normal();
+  const fs::path to = fs::absolute(path).lexically_normal();
+  const fs::path relative = to.lexically_relative(from);
+  std::string out = relative.empty() ? to.string() : relative.string();
+  while (out.size() > 1 && out.back() == '/') out.pop_back();
+  return out;
+}
+
+bool NaturalLess(const std::string& a, const std::string& b) {
+  size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    const bool da = std::isdigit(static_cast<unsigned char>(a[i])) != 0;
+    const bool db = std::isdigit(static_cast<unsigned char>(b[j])) != 0;
+    if (da && db) {
+      size_t ie = i, je = j;
+      while (ie < a.size() && std::isdigit(static_cast<unsigned char>(a[ie]))) ++ie;
+      while (je < b.size() && std::isdigit(static_cast<unsigned char>(b[je]))) ++je;
+      size_t is = i, js = j;  // skip leading zeros, then longer is larger
+      while (is + 1 < ie && a[is] == '0') ++is;
+      while (js + 1 < je && b[js] == '0') ++js;
+      const std::string_view na(a.data() + is, ie - is), nb(b.data() + js, je - js);
+      if (na.size() != nb.size()) return na.size() < nb.size();
+      if (na != nb) return na < nb;
+      i = ie;
+      j = je;
+      continue;
+    }
+    if (a[i] != b[j]) return a[i] < b[j];
+    ++i;
+    ++j;
+  }
+  if (a.size() - i != b.size() - j) return a.size() - i < b.size() - j;
+  return a < b;  // equal up to leading zeros: any fixed order
 }
 
 }  // namespace arco

@@ -29,4 +29,15 @@ bool FileExists(const std::string& path);
 // "a/b" + "c.json" -> "a/b/c.json" (std::filesystem based).
 std::string JoinPath(const std::string& a, const std::string& b);
 
+// A path stored in a manifest: a relative `path` (from the working folder) made relative
+// to the folder `base` that holds the manifest, so the two can move together; an absolute
+// one stays absolute (right from anywhere, as the user gave it). The inverse is
+// ResolveCapturePath (mocap/capture.h): JoinPath(base, PathRelativeTo(path, base)) names
+// `path`.
+std::string PathRelativeTo(const std::string& path, const std::string& base);
+
+// Natural order of file names: runs of digits compare as numbers, so frame2.png sorts
+// before frame10.png (image folders, per-frame keypoint files).
+bool NaturalLess(const std::string& a, const std::string& b);
+
 }  // namespace arco

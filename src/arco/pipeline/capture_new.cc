@@ -1,0 +1,305 @@
+#include "arco/pipeline/capture_new.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+#include "arco/audio/audio_reader.h"
+#include "arco/calibration/calibration_file.h"
+#include "arco/media/video_reader.h"
+#include "arco/mocap/capture.h"
+#include "arco/mocap/spd_import.h"
+#include "arco/registry/instruments.h"
+#include "arco/util/file_io.h"
+#include "arco/util/number_range.h"
+#include "arco/util/output_set.h"
+
+namespace arco::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Two frame rates are the same when within 0.1 % (29.97 vs 30000/1001 written rounded).
+bool SameFps(double a, double b) { return std::abs(a - b) <= 1e-3 * std::max(a, b); }
+
+std::string FpsText(double fps) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", fps);
+  return text;
+}
+
+struct OpenedInput {
+  const CaptureNewInput* input = nullptr;
+  int calibration_camera = -1;
+  media::VideoProperties properties;
+  int rotate_deg = 0;
+  std::vector<int64_t> drops;  // sorted global frames
+};
+
+// Opens one input and decodes its first and last frames: an unreadable or truncated
+// file fails here, naming itself.
+StatusOr<media::VideoProperties> ProbeInput(const CaptureNewInput& input) {
+  std::error_code ec;
+  const bool is_folder = fs::is_directory(input.path, ec);
+  if (input.images && !is_folder) {
+    if (!fs::exists(input.path, ec)) return Status::Error(input.path + ": no such folder");
+    return Status::Error(input.path + ": not a folder of images");
+  }
+  if (!input.images && is_folder) {
+    return Status::Error(input.path + ": is a folder; a folder of images is given as images");
+  }
+  ARCO_ASSIGN_OR_RETURN(media::VideoReader reader, media::VideoReader::Open(input.path));
+  media::VideoProperties p = reader.properties();
+  if (p.frame_count <= 0) return Status::Error(input.path + ": holds no frames");
+  ARCO_ASSIGN_OR_RETURN(const media::Image first, reader.ReadFrame(0));
+  (void)first;
+  if (p.frame_count > 1) {
+    StatusOr<media::Image> last = reader.ReadFrame(p.frame_count - 1);
+    if (!last.ok()) {
+      return Status::Error(input.path + ": frame " + std::to_string(p.frame_count - 1) +
+                           " of the " + std::to_string(p.frame_count) +
+                           " it announces cannot be read (truncated?): " + last.status().message());
+    }
+  }
+  return p;
+}
+
+}  // namespace
+
+Status CaptureNewOptions::Validate() const {
+  if (output_dir.empty()) return Status::Error("output_dir is empty");
+  if (calibration.empty()) return Status::Error("calibration is empty");
+  if (inputs.empty()) return Status::Error("inputs: give at least one camera's video or images");
+  std::set<std::string> cameras;
+  for (const CaptureNewInput& input : inputs) {
+    if (input.camera.empty()) return Status::Error("inputs: a camera name is empty");
+    if (input.path.empty()) return Status::Error("inputs: camera " + input.camera + " has no path");
+    if (!cameras.insert(input.camera).second) {
+      return Status::Error("inputs: camera " + input.camera + " is given twice");
+    }
+  }
+  if (instrument != "none") {
+    const auto kind = ParseInstrumentKind(instrument);
+    if (!kind.ok()) return Status::Error("instrument: " + kind.status().message());
+  }
+  if (fps != 0) ARCO_RETURN_IF_ERROR(CheckInRange("fps", fps, AboveZero(kMaxCaptureFps)));
+  for (const auto& [camera, deg] : rotate_deg) {
+    if (!cameras.count(camera)) {
+      return Status::Error("rotate_deg: camera " + camera + " has no video or images");
+    }
+    if (deg != 0 && deg != 90 && deg != 180 && deg != 270) {
+      return Status::Error("rotate_deg: " + camera + "=" + std::to_string(deg) +
+                           "; must be 0, 90, 180 or 270 (clockwise)");
+    }
+  }
+  if (!dropped_frames.empty() && !spd_summary.empty()) {
+    return Status::Error("dropped_frames and spd_summary: give one or the other");
+  }
+  for (const auto& [camera, drops] : dropped_frames) {
+    if (!cameras.count(camera)) {
+      return Status::Error("dropped_frames: camera " + camera + " has no video or images");
+    }
+    std::vector<int64_t> sorted = drops;
+    std::sort(sorted.begin(), sorted.end());
+    if (!sorted.empty() && sorted.front() < 1) {
+      return Status::Error("dropped_frames: " + camera + " lists frame " +
+                           std::to_string(sorted.front()) +
+                           "; global frames number the recording from 1");
+    }
+    const auto twice = std::adjacent_find(sorted.begin(), sorted.end());
+    if (twice != sorted.end()) {
+      return Status::Error("dropped_frames: " + camera + " lists frame " + std::to_string(*twice) +
+                           " twice");
+    }
+  }
+  return Status::Ok();
+}
+
+StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
+  ARCO_RETURN_IF_ERROR(o.Validate());
+  FolderReplace replace;
+  replace.overwrite = o.overwrite;
+  replace.marker = kCaptureManifestName;  // only an arco capture is replaced
+  replace.kind = "capture";
+  ARCO_RETURN_IF_ERROR(CheckOutputFolder(o.output_dir, replace));  // before the work
+  ARCO_ASSIGN_OR_RETURN(const Calibration calibration, LoadCalibration(o.calibration));
+  const Rig& rig = calibration.rig;
+
+  // Cameras first (cheap), then the videos.
+  std::vector<OpenedInput> opened;
+  for (const CaptureNewInput& input : o.inputs) {
+    OpenedInput in;
+    in.input = &input;
+    in.calibration_camera = rig.FindCamera(input.camera);
+    if (in.calibration_camera < 0) {
+      std::string known;
+      for (const Camera& cam : rig.cameras) known += (known.empty() ? "" : ", ") + cam.name;
+      if (known.size() > 200) known = known.substr(0, 197) + "...";
+      return Status::Error(o.calibration + ": no camera \"" + input.camera + "\" (given for " +
+                           input.path + "; cameras: " + known + ")");
+    }
+    opened.push_back(in);
+  }
+  std::set<int> used;
+  for (const OpenedInput& in : opened) {
+    if (!used.insert(in.calibration_camera).second) {
+      return Status::Error(o.calibration + ": camera \"" + in.input->camera +
+                           "\" is the same calibration camera as another input");
+    }
+  }
+  SpdSummary summary;
+  if (!o.spd_summary.empty()) {
+    ARCO_ASSIGN_OR_RETURN(summary, ReadSpdSummary(o.spd_summary));
+  }
+  if (!o.audio.empty()) {
+    auto audio = audio::OpenAudio(o.audio);
+    if (!audio.ok()) return audio.status();
+  }
+
+  double fps = o.fps;
+  const media::VideoProperties* fps_from = nullptr;  // the first container with a rate
+  for (OpenedInput& in : opened) {
+    const CaptureNewInput& input = *in.input;
+    ARCO_ASSIGN_OR_RETURN(in.properties, ProbeInput(input));
+    const media::VideoProperties& p = in.properties;
+    const Camera& cam = rig.cameras[static_cast<size_t>(in.calibration_camera)];
+    const auto rotate = o.rotate_deg.find(input.camera);
+    in.rotate_deg = rotate != o.rotate_deg.end() ? rotate->second : p.rotation_deg;
+    const bool quarter = in.rotate_deg == 90 || in.rotate_deg == 270;
+    const int width = quarter ? p.coded_height : p.coded_width;
+    const int height = quarter ? p.coded_width : p.coded_height;
+    if (width != cam.width || height != cam.height) {
+      return Status::Error(input.path + ": " + std::to_string(p.coded_width) + "x" +
+                           std::to_string(p.coded_height) + " frames" +
+                           (in.rotate_deg ? " rotated " + std::to_string(in.rotate_deg) +
+                                                " deg clockwise are " + std::to_string(width) +
+                                                "x" + std::to_string(height)
+                                          : std::string()) +
+                           ", but camera " + cam.name + " of " + o.calibration + " is " +
+                           std::to_string(cam.width) + "x" + std::to_string(cam.height) +
+                           (!quarter && height == cam.width && width == cam.height
+                                ? " (a camera turned by 90 degrees: give its rotate_deg)"
+                                : std::string()));
+    }
+    // A container's rate is the video's; images carry none.
+    const bool has_rate =
+        p.frame_count_source != media::FrameCountSource::kImageFiles && p.fps_hz > 0;
+    if (has_rate) {
+      if (o.fps > 0 && !SameFps(o.fps, p.fps_hz)) {
+        return Status::Error(input.path + ": " + FpsText(p.fps_hz) +
+                             " fps in the container, but fps = " + FpsText(o.fps) +
+                             " (fps sets the rate of image folders only)");
+      }
+      if (fps_from && !SameFps(fps_from->fps_hz, p.fps_hz)) {
+        return Status::Error(input.path + ": " + FpsText(p.fps_hz) + " fps, but " + fps_from->path +
+                             " has " + FpsText(fps_from->fps_hz) + " fps");
+      }
+      if (!fps_from) fps_from = &p;
+      if (fps <= 0) fps = p.fps_hz;
+    }
+    // Dropped frames: given per camera, or the summary's for the camera's serial/name.
+    if (auto it = o.dropped_frames.find(input.camera); it != o.dropped_frames.end()) {
+      in.drops = it->second;
+    } else if (!o.spd_summary.empty()) {
+      for (const std::string& id : {cam.serial, cam.name}) {
+        if (id.empty()) continue;
+        if (auto s = summary.frame_drops.find(id); s != summary.frame_drops.end()) {
+          in.drops = s->second;
+          break;
+        }
+      }
+    }
+    std::sort(in.drops.begin(), in.drops.end());
+    in.drops.erase(std::unique(in.drops.begin(), in.drops.end()), in.drops.end());
+  }
+  if (fps <= 0) {
+    return Status::Error(opened.front().input->path +
+                         ": images carry no frame rate and no video gives one; give fps");
+  }
+  if (fps_from) fps = fps_from->fps_hz;  // the container's exact rate
+
+  // Every camera's recorded frames plus its drops make the same recording.
+  const auto recording = [](const OpenedInput& in) {
+    return in.properties.frame_count + static_cast<int64_t>(in.drops.size());
+  };
+  const OpenedInput& reference = opened.front();
+  const int64_t total = recording(reference);
+  const bool any_drops = std::any_of(
+      opened.begin(), opened.end(), [](const OpenedInput& in) { return !in.drops.empty(); });
+  for (const OpenedInput& in : opened) {
+    if (recording(in) == total) continue;
+    const auto count = [&](const OpenedInput& x) {
+      std::string text = std::to_string(x.properties.frame_count) + " frames";
+      if (any_drops) {
+        text +=
+            " + " + std::to_string(x.drops.size()) + " dropped = " + std::to_string(recording(x));
+      }
+      return text;
+    };
+    return Status::Error(in.input->path + ": " + count(in) + ", but camera " +
+                         reference.input->camera + "'s " + reference.input->path + " has " +
+                         count(reference) +
+                         (any_drops ? std::string()
+                                    : "; cameras that dropped frames need dropped_frames or an "
+                                      "SPD summary"));
+  }
+  for (const OpenedInput& in : opened) {
+    if (!in.drops.empty() && in.drops.back() > total) {
+      const std::string source = o.spd_summary.empty() ? "dropped_frames" : o.spd_summary;
+      return Status::Error(source + ": camera " + in.input->camera + " drops frame " +
+                           std::to_string(in.drops.back()) + ", after the recording's last (" +
+                           std::to_string(total) + ")");
+    }
+  }
+
+  CaptureManifest m;
+  m.name =
+      o.name.empty() ? fs::path(NormalizeOutputPath(o.output_dir)).filename().string() : o.name;
+  if (o.instrument != "none") {
+    ARCO_ASSIGN_OR_RETURN(const InstrumentKind kind, ParseInstrumentKind(o.instrument));
+    m.instrument = InstrumentKindName(kind);
+  }
+  m.fps = fps;
+  m.frame_first = 1;
+  m.frame_count = total;
+  m.calibration = "calibration" + fs::path(o.calibration).extension().string();
+  if (!o.audio.empty()) m.audio = PathRelativeTo(o.audio, o.output_dir);
+  CaptureNewSummary out;
+  out.fps = fps;
+  out.frames = total;
+  ARCO_ASSIGN_OR_RETURN(out.layout, DetectionLayoutName(m.instrument));
+  for (const OpenedInput& in : opened) {
+    const Camera& cam = rig.cameras[static_cast<size_t>(in.calibration_camera)];
+    CaptureCamera cc;
+    cc.name = cam.name;
+    cc.serial = cam.serial;
+    cc.video = PathRelativeTo(in.input->path, o.output_dir);
+    cc.dropped_frames = in.drops;
+    cc.rotate_deg = in.rotate_deg;
+    m.cameras.push_back(cc);
+    out.cameras.push_back({cc.name,
+                           cc.serial,
+                           cc.video,
+                           in.properties.frame_count,
+                           in.properties.coded_width,
+                           in.properties.coded_height,
+                           in.rotate_deg,
+                           static_cast<int64_t>(in.drops.size())});
+  }
+  // The manifest we write must read back.
+  ARCO_RETURN_IF_ERROR(
+      ParseCaptureManifest(CaptureManifestToJson(m).dump(), kCaptureManifestName).status());
+
+  OutputSet outputs;
+  ARCO_ASSIGN_OR_RETURN(const std::string tmp, outputs.AddFolder(o.output_dir, replace));
+  std::error_code ec;
+  fs::copy_file(o.calibration, JoinPath(tmp, m.calibration), ec);
+  if (ec) return Status::Error(o.calibration + ": cannot copy (" + ec.message() + ")");
+  ARCO_RETURN_IF_ERROR(WriteCaptureManifest(tmp, m));
+  ARCO_RETURN_IF_ERROR(outputs.Commit());
+  return out;
+}
+
+}  // namespace arco::pipeline

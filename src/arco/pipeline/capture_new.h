@@ -1,0 +1,75 @@
+// A capture folder from videos (`arco capture new`): the manifest (docs/formats.md)
+// references each camera's video file, image folder (one image per frame, natural
+// order) or single image (a 1-frame video), and holds a copy of the calibration; it has
+// no 2D keypoints until `arco detect` or `arco capture import-keypoints` writes them.
+//
+// Checks, each one line naming the file: every camera is in the calibration; each
+// video's size after `rotate_deg` equals its camera's image size; the first and the
+// last frame decode (an unreadable or truncated video); frame rates agree; frame counts
+// agree once each camera's dropped frames are added back (below).
+//
+// Frame rate: a video file's comes from its container. `fps` (> 0) is required for
+// image folders and single images when no video file gives one, and must agree with
+// every container that states a rate (within 0.1 %): it never overrides a container.
+//
+// Frames: global frames number the recording from 1 (docs/formats.md); a camera's
+// video holds every frame it recorded, so its frame count plus its dropped frames is the
+// recording's length, which must be the same for every camera. The capture covers the
+// whole recording: frames.first = 1, frames.count = that length.
+//
+// Rotation: a camera's rotate_deg is the one given, else the container's display
+// rotation (a phone's portrait video), else 0.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "arco/util/status.h"
+
+namespace arco::pipeline {
+
+struct CaptureNewInput {
+  std::string camera;   // a calibration camera's name or serial
+  std::string path;     // video file or single image; a folder when `images`
+  bool images = false;  // a folder of images, one per frame
+};
+
+struct CaptureNewOptions {
+  std::string calibration;                // any format arco reads; copied into the capture
+  std::vector<CaptureNewInput> inputs;    // one per camera, in the capture's view order
+  std::string audio;                      // optional; referenced, not copied
+  std::string instrument = "none";        // cello, violin, viola, double_bass or none
+  double fps = 0;                         // 0: from the containers (see above)
+  std::map<std::string, int> rotate_deg;  // camera -> 0, 90, 180 or 270 (clockwise)
+  // camera -> global frames (from 1) it did not record; or all of them from an SPD
+  // SESSION_summary.json's FrameDropIDLog (keyed by serial): one or the other.
+  std::map<std::string, std::vector<int64_t>> dropped_frames;
+  std::string spd_summary;
+  std::string name;        // session name (default: the output folder's name)
+  std::string output_dir;  // the capture folder to create
+  bool overwrite = false;  // replace an existing capture (a folder with capture.json)
+  // Readable message naming the field on a bad value or combination.
+  Status Validate() const;
+};
+
+struct CaptureNewCamera {
+  std::string name, serial;
+  std::string video;  // as stored in capture.json (relative to the capture folder)
+  int64_t frames = 0;
+  int width = 0, height = 0;  // decoded (coded) size, before rotate_deg
+  int rotate_deg = 0;
+  int64_t dropped = 0;
+};
+
+struct CaptureNewSummary {
+  double fps = 0;
+  int64_t frames = 0;  // frames.count: the recording's length
+  std::string layout;  // the layout `arco detect` will write
+  std::vector<CaptureNewCamera> cameras;
+};
+
+StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& options);
+
+}  // namespace arco::pipeline

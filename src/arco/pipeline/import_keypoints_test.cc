@@ -1,0 +1,220 @@
+// `arco capture import-keypoints`: hand-written MMPose and OpenPose output into a capture
+// made by CreateCapture from generated videos.
+#include "arco/pipeline/import_keypoints.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "arco/calibration/calibration_file.h"
+#include "arco/media/test_video.h"
+#include "arco/mocap/capture.h"
+#include "arco/pipeline/capture_new.h"
+#include "arco/registry/keypoint_layout.h"
+#include "arco/util/file_io.h"
+#include "arco/util/npy.h"
+#include "arco/util/test_dir.h"
+
+namespace arco::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+using arco::testing::TempDir;
+
+// Two cameras, 4 recorded frames; cam1 dropped global frame 2, so its video has 3.
+std::string MakeCapture(const TempDir& dir, const std::string& instrument = "none") {
+  Rig rig;
+  for (const char* name : {"cam0", "cam1"}) {
+    Camera c;
+    c.name = name;
+    c.width = 128;
+    c.height = 96;
+    c.fx = c.fy = 100;
+    rig.cameras.push_back(c);
+  }
+  EXPECT_TRUE(SaveCalibration(dir / "rig.json", rig).ok());
+  CaptureNewOptions o;
+  o.calibration = dir / "rig.json";
+  for (int v = 0; v < 2; ++v) {
+    media::testing::IndexVideo video;
+    video.frames = v == 0 ? 4 : 3;
+    const std::string path = dir / ("v" + std::to_string(v) + ".mkv");
+    EXPECT_TRUE(media::testing::WriteIndexVideo(path, video).ok());
+    o.inputs.push_back({"cam" + std::to_string(v), path, false});
+  }
+  o.dropped_frames = {{"cam1", {2}}};
+  o.instrument = instrument;
+  o.output_dir = dir / "capture";
+  const auto r = CreateCapture(o);
+  EXPECT_TRUE(r.ok()) << r.status().message();
+  return o.output_dir;
+}
+
+// An MMPose instance with every point at (x0 + p, y0) and score `score`, its box given.
+std::string Instance(double x0, double y0, double score, double box_size) {
+  std::string kp, sc;
+  for (int p = 0; p < 133; ++p) {
+    kp +=
+        (p ? "," : "") + std::string("[") + std::to_string(x0 + p) + "," + std::to_string(y0) + "]";
+    sc += (p ? "," : "") + std::to_string(score);
+  }
+  return "{\"keypoints\": [" + kp + "], \"keypoint_scores\": [" + sc + "], \"bbox\": [[0, 0, " +
+         std::to_string(box_size) + ", " + std::to_string(box_size) + "]], \"bbox_score\": 0.9}";
+}
+
+void Write(const std::string& path, const std::string& text) {
+  ASSERT_TRUE(AtomicWriteFile(path, text).ok()) << path;
+}
+
+TEST(ImportKeypoints, MmposePerVideoAndPerFrameFolder) {
+  TempDir dir;
+  const std::string capture = MakeCapture(dir);
+  // cam0: MMPoseInferencer's per-video list (frame_id from 0); frame 2 has two people,
+  // the second larger; frame 3 nobody.
+  Write(dir / "cam0.json",
+        "[{\"frame_id\": 0, \"instances\": [" + Instance(10, 20, 0.5, 50) + "]}," +
+            "{\"frame_id\": 1, \"instances\": [" + Instance(11, 20, 0.5, 50) + "]}," +
+            "{\"frame_id\": 2, \"instances\": [" + Instance(1, 1, 0.5, 10) + "," +
+            Instance(12, 20, 1.7, 80) + "]}," + "{\"frame_id\": 3, \"instances\": []}]");
+  // cam1: a folder of per-image files (natural order) of its 3 video frames.
+  ASSERT_TRUE(MakeDirectories(dir / "cam1").ok());
+  for (int k = 0; k < 3; ++k) {
+    Write(dir / ("cam1/img" + std::to_string(k == 2 ? 10 : k + 1) + ".json"),
+          "[" + Instance(100 + k, 30, 0.25, 40) + "]");
+  }
+  ImportKeypointsOptions o;
+  o.capture_dir = capture;
+  o.format = "mmpose";
+  o.sources = {{"cam0", dir / "cam0.json"}, {"cam1", dir / "cam1"}};
+  const auto r = ImportKeypoints(o);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->layout, "coco_wholebody_133");
+  EXPECT_EQ(r->report.people_kept, 6);  // 3 + 3 (cam0's frame 4 empty)
+  EXPECT_EQ(r->report.frames_without_person, 1);
+  EXPECT_EQ(r->report.frames_with_several, 1);
+  EXPECT_EQ(r->report.scores_clamped, 133);
+
+  const auto m = ReadCaptureManifest(capture);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  EXPECT_EQ(m->layout, "coco_wholebody_133");
+  ASSERT_TRUE(CheckCaptureKeypoints2d(capture, *m).ok());
+  const auto header = ReadNpyHeader(dir / "capture/keypoints2d.npy");
+  ASSERT_TRUE(header.ok());
+  EXPECT_EQ(header->dtype, "float32");
+  const auto k = ReadCaptureKeypoints2d(capture, *m);
+  ASSERT_TRUE(k.ok()) << k.status().message();
+  ASSERT_EQ(k->shape, (std::vector<int64_t>{4, 2, 133, 3}));
+  // cam0, global frame 3 = video frame 2: the larger person, score clamped to 1.
+  EXPECT_DOUBLE_EQ(k->at(2, 0, 5, 0), 17);
+  EXPECT_DOUBLE_EQ(k->at(2, 0, 5, 1), 20);
+  EXPECT_DOUBLE_EQ(k->at(2, 0, 5, 2), 1);
+  EXPECT_TRUE(std::isnan(k->at(3, 0, 0, 0)));  // nobody
+  // cam1: global 1 -> img1, global 2 dropped, global 3 -> img2, global 4 -> img10.
+  EXPECT_DOUBLE_EQ(k->at(0, 1, 0, 0), 100);
+  EXPECT_TRUE(std::isnan(k->at(1, 1, 0, 0)));
+  EXPECT_DOUBLE_EQ(k->at(2, 1, 0, 0), 101);
+  EXPECT_DOUBLE_EQ(k->at(3, 1, 0, 0), 102);
+  EXPECT_FLOAT_EQ(static_cast<float>(k->at(3, 1, 0, 2)), 0.25f);
+
+  // A second import needs overwrite.
+  const auto again = ImportKeypoints(o);
+  ASSERT_FALSE(again.ok());
+  EXPECT_NE(again.status().message().find("already"), std::string::npos);
+  o.overwrite = true;
+  EXPECT_TRUE(ImportKeypoints(o).ok());
+}
+
+TEST(ImportKeypoints, OpenPoseFoldersIntoAnInstrumentLayout) {
+  TempDir dir;
+  const std::string capture = MakeCapture(dir, "cello");
+  // BODY_25 with left shoulder (5) at (50, 60) and everything else undetected; the left
+  // hand's wrist at (70, 80).
+  std::string pose, hand;
+  for (int i = 0; i < 25; ++i) pose += (i ? "," : "") + std::string(i == 5 ? "50,60,0.8" : "0,0,0");
+  for (int i = 0; i < 21; ++i) hand += (i ? "," : "") + std::string(i == 0 ? "70,80,0.6" : "0,0,0");
+  const std::string frame = "{\"version\": 1.3, \"people\": [{\"pose_keypoints_2d\": [" + pose +
+                            "], \"hand_left_keypoints_2d\": [" + hand +
+                            "], \"hand_right_keypoints_2d\": [], \"face_keypoints_2d\": []}]}";
+  for (int v = 0; v < 2; ++v) {
+    const std::string folder = dir / ("op" + std::to_string(v));
+    ASSERT_TRUE(MakeDirectories(folder).ok());
+    for (int f = 0; f < 4 - v; ++f) {
+      Write(folder + "/video_" + std::to_string(f) + "_keypoints.json", frame);
+    }
+    Write(folder + "/notes.json", "not a frame");  // not *_keypoints.json: ignored
+  }
+  ImportKeypointsOptions o;
+  o.capture_dir = capture;
+  o.format = "openpose";
+  o.sources = {{"cam1", dir / "op1"}, {"cam0", dir / "op0"}};
+  const auto r = ImportKeypoints(o);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->layout, "spd_cello");
+  const auto m = ReadCaptureManifest(capture);
+  ASSERT_TRUE(m.ok());
+  const auto k = ReadCaptureKeypoints2d(capture, *m);
+  ASSERT_TRUE(k.ok()) << k.status().message();
+  const KeypointLayout* layout = FindKeypointLayout("spd_cello");
+  ASSERT_EQ(k->shape, (std::vector<int64_t>{4, 2, layout->size(), 3}));
+  const int shoulder = layout->Find("left_shoulder");
+  const int wrist = layout->Find("left_hand_wrist");
+  EXPECT_DOUBLE_EQ(k->at(0, 0, shoulder, 0), 50);
+  EXPECT_DOUBLE_EQ(k->at(0, 0, shoulder, 1), 60);
+  EXPECT_FLOAT_EQ(static_cast<float>(k->at(0, 0, shoulder, 2)), 0.8f);
+  EXPECT_DOUBLE_EQ(k->at(3, 1, wrist, 0), 70);
+  EXPECT_TRUE(std::isnan(k->at(0, 0, layout->Find("nose"), 0)));   // confidence 0
+  EXPECT_TRUE(std::isnan(k->at(0, 0, layout->Find("nut_l"), 0)));  // instrument: none
+  EXPECT_TRUE(std::isnan(k->at(1, 1, shoulder, 0)));               // dropped
+}
+
+TEST(ImportKeypoints, BadInputsWriteNothing) {
+  TempDir dir;
+  const std::string capture = MakeCapture(dir);
+  const std::string manifest_before = *ReadFileToString(capture + "/capture.json");
+  ASSERT_TRUE(MakeDirectories(dir / "short").ok());
+  for (int f = 0; f < 3; ++f) {
+    Write(dir / ("short/f" + std::to_string(f) + ".json"), "[" + Instance(1, 1, 0.5, 5) + "]");
+  }
+  Write(dir / "broken.json", "[{\"keypoints\": [[1, 2]]}]");
+  ImportKeypointsOptions o;
+  o.capture_dir = capture;
+  o.format = "mmpose";
+  auto expect_bad = [&](const std::vector<ImportKeypointsSource>& sources,
+                        const std::string& named) {
+    o.sources = sources;
+    const auto r = ImportKeypoints(o);
+    ASSERT_FALSE(r.ok()) << named;
+    EXPECT_EQ(r.status().message().rfind(named + ": ", 0), 0u) << r.status().message();
+    EXPECT_EQ(*ReadFileToString(capture + "/capture.json"), manifest_before);
+    EXPECT_FALSE(fs::exists(capture + "/keypoints2d.npy"));
+    for (const auto& entry : fs::directory_iterator(capture)) {
+      EXPECT_NE(entry.path().filename().string()[0], '.') << "temporary left: " << entry.path();
+    }
+  };
+  const std::string manifest = JoinPath(capture, "capture.json");
+  // cam0 has 4 video frames, the folder 3 files.
+  expect_bad({{"cam0", dir / "short"}, {"cam1", dir / "short"}}, dir / "short");
+  expect_bad({{"cam0", dir / "broken.json"}, {"cam1", dir / "short"}}, dir / "broken.json");
+  expect_bad({{"cam1", dir / "short"}}, manifest);                           // cam0 missing
+  expect_bad({{"cam9", dir / "short"}, {"cam1", dir / "short"}}, manifest);  // unknown
+  expect_bad({{"cam0", dir / "none.json"}, {"cam1", dir / "short"}}, dir / "none.json");
+}
+
+TEST(ImportKeypointsOptions, ValidateNamesTheField) {
+  ImportKeypointsOptions o;
+  o.capture_dir = "c";
+  o.format = "mmpose";
+  o.sources = {{"cam0", "a.json"}};
+  EXPECT_TRUE(o.Validate().ok());
+  o.format = "yolo";
+  EXPECT_NE(o.Validate().message().find("format"), std::string::npos);
+  o.format = "openpose";
+  o.sources.push_back({"cam0", "b.json"});
+  EXPECT_NE(o.Validate().message().find("sources"), std::string::npos);
+  o.sources.clear();
+  EXPECT_NE(o.Validate().message().find("sources"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace arco::pipeline
