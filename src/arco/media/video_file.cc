@@ -9,6 +9,8 @@ extern "C" {
 }
 
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 namespace arco::media {
 namespace {
@@ -95,8 +97,8 @@ class VideoFile : public FrameSource {
     VideoProperties& p = properties_;
     p.path = path_;
     p.codec = codec_->codec->name;
-    const AVRational rate = av_guess_frame_rate(format_.get(), format_->streams[stream_index_],
-                                                nullptr);
+    const AVRational rate =
+        av_guess_frame_rate(format_.get(), format_->streams[stream_index_], nullptr);
     if (rate.num > 0 && rate.den > 0) p.fps = Rational{rate.num, rate.den};
     p.fps_hz = p.fps.ToDouble();
     p.rotation_deg = RotationDegrees(stream);
@@ -229,8 +231,8 @@ class VideoFile : public FrameSource {
       ARCO_ASSIGN_OR_RETURN(const bool more, Advance(nullptr));
       if (!more) {
         return Status::Error(path_ + ": frame " + std::to_string(index) +
-                             " not found (the video ends after " +
-                             std::to_string(next_frame_) + " frames)");
+                             " not found (the video ends after " + std::to_string(next_frame_) +
+                             " frames)");
       }
     }
     return Status::Ok();
@@ -243,7 +245,9 @@ class VideoFile : public FrameSource {
         frame_rate_.den <= 0) {
       return -1;
     }
-    return av_rescale_q_rnd(pts - first_pts_, time_base_, av_inv_q(frame_rate_),
+    return av_rescale_q_rnd(pts - first_pts_,
+                            time_base_,
+                            av_inv_q(frame_rate_),
                             static_cast<AVRounding>(AV_ROUND_NEAR_INF | AV_ROUND_PASS_MINMAX));
   }
 
@@ -310,9 +314,18 @@ class VideoFile : public FrameSource {
             static_cast<size_t>(p.width) * p.height * ChannelCount(options_.format)) {
       *image = MakeImage(p.width, p.height, options_.format);
     }
-    uint8_t* planes[1] = {image->pixels.data()};
-    int strides[1] = {static_cast<int>(image->row_bytes())};
+    // swscale's SIMD paths may write a few bytes past the end of a tightly packed
+    // row (seen with 2300 px wide JPEGs: 4 bytes past the last row), so convert into a
+    // padded buffer and copy the rows out.
+    const size_t row_bytes = image->row_bytes();
+    const size_t stride = (row_bytes + 63) / 64 * 64;
+    converted_.resize(stride * (p.height + 1));
+    uint8_t* planes[1] = {converted_.data()};
+    int strides[1] = {static_cast<int>(stride)};
     sws_scale(sws_.get(), frame.data, frame.linesize, 0, frame.height, planes, strides);
+    for (int y = 0; y < p.height; ++y) {
+      std::memcpy(image->row(y), converted_.data() + y * stride, row_bytes);
+    }
     return Status::Ok();
   }
 
@@ -324,6 +337,7 @@ class VideoFile : public FrameSource {
   std::unique_ptr<AVFrame, FrameFreer> frame_;  // decoded, not yet shown (have_frame_)
   std::unique_ptr<AVFrame, FrameFreer> shown_;  // the picture of frame next_frame_ - 1
   std::unique_ptr<SwsContext, SwsFreer> sws_;
+  std::vector<uint8_t> converted_;  // swscale's output, padded rows (see Convert)
   int stream_index_ = -1;
   AVRational time_base_{1, 1};
   AVRational frame_rate_{0, 1};
