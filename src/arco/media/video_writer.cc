@@ -9,7 +9,9 @@ extern "C" {
 #include <libswscale/swscale.h>
 }
 
+#include <cstring>
 #include <utility>
+#include <vector>
 
 namespace arco::media {
 namespace {
@@ -56,6 +58,7 @@ struct VideoWriter::State {
   AVPacket* packet = nullptr;
   AVFrame* frame = nullptr;
   SwsContext* sws = nullptr;
+  std::vector<uint8_t> padded;  // the frame being converted, padded rows (see Write)
   PixelFormat sws_source = PixelFormat::kRgb8;
   bool header_written = false;
   bool closed = false;
@@ -272,8 +275,16 @@ Status VideoWriter::Write(const Image& image) {
   }
   int rc = av_frame_make_writable(s.frame);
   if (rc < 0) return s.Fail("cannot allocate a frame", rc);
-  const uint8_t* planes[1] = {image.pixels.data()};
-  const int strides[1] = {static_cast<int>(image.row_bytes())};
+  // swscale's SIMD paths read up to 16 bytes past a tightly packed row (valgrind):
+  // hand it padded rows.
+  const size_t row_bytes = image.row_bytes();
+  const size_t stride = (row_bytes + 63) / 64 * 64;
+  s.padded.resize(stride * (image.height + 1));
+  for (int y = 0; y < image.height; ++y) {
+    std::memcpy(s.padded.data() + y * stride, image.row(y), row_bytes);
+  }
+  const uint8_t* planes[1] = {s.padded.data()};
+  const int strides[1] = {static_cast<int>(stride)};
   sws_scale(s.sws, planes, strides, 0, image.height, s.frame->data, s.frame->linesize);
   s.frame->pts = s.frames;
   ARCO_RETURN_IF_ERROR(s.Send(s.frame));
