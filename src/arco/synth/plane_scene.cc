@@ -37,9 +37,10 @@ Eigen::Matrix3d PlaneToTextureMatrix(const PlaneTexture& texture) {
   return m;
 }
 
-// Bilinear sample of `texture` at (u, v) (inside [-0.5, W - 0.5] x [-0.5, H - 0.5]; edge
-// pixels clamped), converted to `out_channels` channels, added to acc.
-void AddBilinear(const media::Image& texture, double u, double v, int out_channels, float* acc) {
+// Bilinear sample of `texture` at (u, v) (edge pixels clamped), converted to
+// `out_channels` channels, times `weight`, added to acc.
+void AddBilinear(
+    const media::Image& texture, double u, double v, float weight, int out_channels, float* acc) {
   const int w = texture.width, h = texture.height, tc = texture.channels();
   u = std::clamp(u, 0.0, double(w - 1));
   v = std::clamp(v, 0.0, double(h - 1));
@@ -52,7 +53,7 @@ void AddBilinear(const media::Image& texture, double u, double v, int out_channe
   for (int c = 0; c < tc; ++c) {
     const float top = r0[u0 * tc + c] + fu * (r0[u1 * tc + c] - r0[u0 * tc + c]);
     const float bottom = r1[u0 * tc + c] + fu * (r1[u1 * tc + c] - r1[u0 * tc + c]);
-    value[c] = top + fv * (bottom - top);
+    value[c] = weight * (top + fv * (bottom - top));
   }
   if (tc == out_channels) {
     for (int c = 0; c < tc; ++c) acc[c] += value[c];
@@ -63,12 +64,48 @@ void AddBilinear(const media::Image& texture, double u, double v, int out_channe
   }
 }
 
+// Half-size level of `image`: texel i averages texels 2i and 2i + 1 (the last one
+// clamped on odd sides) in both directions, so level texel centres sit at
+// (i + 0.5) * 2 - 0.5 of the finer level.
+media::Image HalveImage(const media::Image& image) {
+  const int w = std::max(1, (image.width + 1) / 2), h = std::max(1, (image.height + 1) / 2);
+  const int c = image.channels();
+  media::Image half = media::MakeImage(w, h, image.format);
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* r0 = image.row(std::min(2 * y, image.height - 1));
+    const uint8_t* r1 = image.row(std::min(2 * y + 1, image.height - 1));
+    uint8_t* out = half.row(y);
+    for (int x = 0; x < w; ++x) {
+      const int x0 = std::min(2 * x, image.width - 1), x1 = std::min(2 * x + 1, image.width - 1);
+      for (int k = 0; k < c; ++k) {
+        out[x * c + k] = static_cast<uint8_t>(
+            (r0[x0 * c + k] + r0[x1 * c + k] + r1[x0 * c + k] + r1[x1 * c + k] + 2) / 4);
+      }
+    }
+  }
+  return half;
+}
+
 }  // namespace
+
+void BuildMipmaps(PlaneTexture* texture) {
+  texture->mipmaps.clear();
+  const media::Image* level = &texture->image;
+  while (level->width > 1 || level->height > 1) {
+    texture->mipmaps.push_back(HalveImage(*level));
+    level = &texture->mipmaps.back();
+  }
+}
 
 void PlaneTexture::Check() const {
   if (image.empty() || image.width < 1 || image.height < 1 ||
       image.pixels.size() != image.row_bytes() * static_cast<size_t>(image.height)) {
     throw std::invalid_argument("PlaneTexture: empty or malformed image");
+  }
+  if (!mipmaps.empty() && (mipmaps[0].width != std::max(1, (image.width + 1) / 2) ||
+                           mipmaps[0].height != std::max(1, (image.height + 1) / 2) ||
+                           mipmaps[0].format != image.format)) {
+    throw std::invalid_argument("PlaneTexture: mipmaps do not match the image (call BuildMipmaps)");
   }
   if (!(width_mm > 0) || !(height_mm > 0) || !std::isfinite(width_mm) ||
       !std::isfinite(height_mm)) {
@@ -221,6 +258,21 @@ void PlaneRenderer::Render(const Rigid3d& world_from_plane,
   const int channels = out->channels();
   const double u_max = texture.image.width - 0.5, v_max = texture.image.height - 0.5;
   const float inv_samples = 1.0f / (s * s);
+  // Level k of the pyramid (texel = 2^k texture pixels); level 0 only without mipmaps.
+  std::vector<media::Image> built;
+  std::vector<const media::Image*> levels = {&texture.image};
+  if (options_.mipmap) {
+    const std::vector<media::Image>* mipmaps = &texture.mipmaps;
+    if (mipmaps->empty()) {
+      PlaneTexture copy;
+      copy.image = texture.image;
+      BuildMipmaps(&copy);
+      built = std::move(copy.mipmaps);
+      mipmaps = &built;
+    }
+    for (const media::Image& level : *mipmaps) levels.push_back(&level);
+  }
+  const double inv_fx = 1.0 / camera_.fx, inv_fy = 1.0 / camera_.fy;
   ParallelFor(
       camera_.height,
       options_.threads,
@@ -238,8 +290,44 @@ void PlaneRenderer::Render(const Rigid3d& world_from_plane,
               if (!(q.z() > 0)) continue;
               const double u = q.x() / q.z(), v = q.y() / q.z();
               if (!(u >= -0.5 && u <= u_max && v >= -0.5 && v <= v_max)) continue;
-              AddBilinear(texture.image, u, v, channels, acc);
               ++plane_samples;
+              if (levels.size() == 1) {
+                AddBilinear(texture.image, u, v, 1.0f, channels, acc);
+                continue;
+              }
+              // Texels per sample from the homography's Jacobian (the lens's own
+              // Jacobian, a few per cent, is ignored for the choice of level).
+              const double du_dx = (to_texture(0, 0) - u * to_texture(2, 0)) / q.z();
+              const double dv_dx = (to_texture(1, 0) - v * to_texture(2, 0)) / q.z();
+              const double du_dy = (to_texture(0, 1) - u * to_texture(2, 1)) / q.z();
+              const double dv_dy = (to_texture(1, 1) - v * to_texture(2, 1)) / q.z();
+              const double texels =
+                  std::max(std::hypot(du_dx, dv_dx) * inv_fx, std::hypot(du_dy, dv_dy) * inv_fy) /
+                  s;
+              if (!(texels > 1)) {
+                AddBilinear(texture.image, u, v, 1.0f, channels, acc);
+                continue;
+              }
+              // Trilinear: the two levels around log2(texels), blended.
+              const double lambda = std::min(std::log2(texels), double(levels.size() - 1));
+              const int l0 = std::min(static_cast<int>(lambda), int(levels.size()) - 1);
+              const int l1 = std::min(l0 + 1, int(levels.size()) - 1);
+              const float t = static_cast<float>(lambda - l0);
+              const double scale0 = 1.0 / (1 << l0), scale1 = 1.0 / (1 << l1);
+              AddBilinear(*levels[l0],
+                          (u + 0.5) * scale0 - 0.5,
+                          (v + 0.5) * scale0 - 0.5,
+                          1.0f - t,
+                          channels,
+                          acc);
+              if (t > 0) {
+                AddBilinear(*levels[l1],
+                            (u + 0.5) * scale1 - 0.5,
+                            (v + 0.5) * scale1 - 0.5,
+                            t,
+                            channels,
+                            acc);
+              }
             }
           }
           if (plane_samples == 0) continue;  // background as copied
@@ -414,6 +502,8 @@ Status WritePlaneScene(const PlaneScene& scene,
     }
   }
   ARCO_ASSIGN_OR_RETURN(const std::string calibration_json, WriteArcoJson(scene.rig));
+  PlaneTexture texture = scene.texture;  // with its mipmaps, built once
+  if (options.render.mipmap && texture.mipmaps.empty()) BuildMipmaps(&texture);
 
   OutputSet outputs;
   FolderReplace replace;
@@ -445,7 +535,7 @@ Status WritePlaneScene(const PlaneScene& scene,
         MakeSolidImage(cam.width, cam.height, media::PixelFormat::kRgb8, scene.background_rgb);
     media::Image frame;
     for (int f = 0; f < frames; ++f) {
-      renderer.Render(scene.world_from_plane[f], scene.texture, background, &frame);
+      renderer.Render(scene.world_from_plane[f], texture, background, &frame);
       ARCO_RETURN_IF_ERROR(writer.Write(frame));
       progress.Advance(1);
     }

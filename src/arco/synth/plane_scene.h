@@ -23,6 +23,11 @@
 // bilinearly (edge pixels clamped; outside the rectangle: background). Anti-aliasing:
 // `supersampling` x `supersampling` samples per pixel on a regular grid, averaged (a box
 // filter over the pixel's area, as a sensor integrates); 1 renders the pixel centres.
+// A photo shrunk several times (a 2300 px photo into a 400 px wide view) would still
+// alias, so with `mipmap` each sample reads a box-filtered pyramid of the texture
+// (trilinear: the two levels around log2(texels per sample), from the homography's
+// Jacobian), as GPUs do. Texels are never finer than a sample, at the cost of some
+// blur where the plane is seen obliquely (the larger axis picks the level).
 #pragma once
 
 #include <Eigen/Core>
@@ -46,9 +51,16 @@ namespace arco::synth {
 struct PlaneTexture {
   media::Image image;  // RGB8 or Gray8
   double width_mm = 0, height_mm = 0;
-  // Throws std::invalid_argument on an empty image or a non-positive size.
+  // Levels 1, 2, ... of the box-filtered pyramid of `image` (level k's texel covers
+  // 2^k x 2^k pixels), for anti-aliased minification: filled by BuildMipmaps; empty,
+  // PlaneRenderer::Render builds them on every call.
+  std::vector<media::Image> mipmaps;
+  // Throws std::invalid_argument on an empty image, a non-positive size or mipmaps of
+  // another image's size.
   void Check() const;
 };
+// Fills texture->mipmaps from texture->image (call again after changing the image).
+void BuildMipmaps(PlaneTexture* texture);
 
 // Texture pixel -> plane point (mm, z = 0) and back; linear.
 Eigen::Vector2d TexturePixelToPlane(const PlaneTexture& texture, const Eigen::Vector2d& texture_px);
@@ -74,6 +86,7 @@ bool InImage(const Camera& camera, const Eigen::Vector2d& pixel);
 
 struct PlaneRenderOptions {
   int supersampling = 2;  // samples per pixel side (1..8)
+  bool mipmap = true;     // sample a texture pyramid where texels are finer than samples
   // Undistortion is checked per sample by distorting back: a larger round-trip error
   // marks the sample invalid (background) and counts it (invalid_samples()).
   double max_undistortion_error_px = 1e-6;

@@ -247,6 +247,49 @@ TEST(PlaneRenderer, ThreadsDoNotChangeTheImageAndBadInputThrows) {
   EXPECT_THROW(RenderView(camera, pose, no_size, background), std::invalid_argument);
 }
 
+// One-texel black/white stripes shrunk about 5x: without the pyramid the samples
+// alias into strong moire; with it the plane is an even gray.
+TEST(PlaneRenderer, MipmapsRemoveAliasingOfFineTextures) {
+  PlaneTexture stripes;
+  stripes.image = media::MakeImage(2000, 1400, PixelFormat::kGray8);
+  for (int v = 0; v < 1400; ++v) {
+    for (int u = 0; u < 2000; ++u) stripes.image.row(v)[u] = (u % 2 == 0) ? 0 : 255;
+  }
+  stripes.width_mm = 1000;
+  stripes.height_mm = 700;
+  const Camera camera = SmallRig(1).cameras[0];
+  const Image background = MakeSolidImage(camera.width, camera.height, PixelFormat::kGray8, {0});
+  // Spread of the plane's pixels in the middle of the view, where the plane surely is.
+  auto spread = [&](const Image& view) {
+    double sum = 0, sum2 = 0;
+    int n = 0;
+    for (int y = camera.height / 2 - 60; y < camera.height / 2 + 60; ++y) {
+      for (int x = camera.width / 2 - 100; x < camera.width / 2 + 100; ++x) {
+        sum += view.at(x, y);
+        sum2 += double(view.at(x, y)) * view.at(x, y);
+        ++n;
+      }
+    }
+    const double mean = sum / n;
+    EXPECT_NEAR(mean, 127.5, 12);
+    return std::sqrt(std::max(0.0, sum2 / n - mean * mean));
+  };
+  PlaneRenderOptions plain;
+  plain.mipmap = false;
+  const double with_mipmaps = spread(RenderView(camera, PlaneRestPose(), stripes, background));
+  const double without = spread(RenderView(camera, PlaneRestPose(), stripes, background, plain));
+  EXPECT_LT(with_mipmaps, 6.0);
+  EXPECT_GT(without, 4 * with_mipmaps);
+  std::printf("stripes: spread %.2f with mipmaps, %.2f without\n", with_mipmaps, without);
+
+  BuildMipmaps(&stripes);
+  EXPECT_EQ(stripes.mipmaps[0].width, 1000);
+  EXPECT_EQ(stripes.mipmaps.back().width, 1);
+  EXPECT_EQ(stripes.mipmaps.back().height, 1);
+  stripes.image = media::MakeImage(30, 30, PixelFormat::kGray8);  // stale mipmaps
+  EXPECT_THROW(stripes.Check(), std::invalid_argument);
+}
+
 TEST(MakePlaneMotion, SmoothSeededAndWithinItsBounds) {
   PlaneMotionOptions options;
   options.frames = 300;
