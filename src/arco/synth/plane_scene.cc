@@ -488,6 +488,9 @@ Status WritePlaneScene(const PlaneScene& scene,
                        Progress& progress) {
   auto fail = [&](const std::string& what) { return Status::Error(folder + ": " + what); };
   ARCO_RETURN_IF_ERROR(options.render.Validate());
+  if (options.threads < 0 || options.threads > 256) {
+    return Status::Error("PlaneSceneWriteOptions: threads must be in [0, 256]");
+  }
   if (scene.rig.cameras.empty()) return fail("the scene has no cameras");
   if (scene.world_from_plane.empty()) return fail("the scene has no frames");
   try {
@@ -520,16 +523,21 @@ Status WritePlaneScene(const PlaneScene& scene,
   progress.SetTotal(int64_t(frames) * scene.rig.cameras.size());
   Json videos = Json::array();  // in the rig's order
   for (const Camera& cam : scene.rig.cameras) {
-    const std::string relative = "videos/" + cam.name + options.extension;
-    videos.push_back({{"camera", cam.name}, {"path", relative}});
+    videos.push_back({{"camera", cam.name}, {"path", "videos/" + cam.name + options.extension}});
+  }
+  // One camera per work item: its renderer, its video; the first failing camera (in
+  // the rig's order) is reported.
+  auto write_camera = [&](const Camera& cam) -> Status {
     media::VideoWriterOptions writer_options;
     writer_options.container = options.container;
     writer_options.codec = options.codec;
     writer_options.width = cam.width;
     writer_options.height = cam.height;
     writer_options.fps = scene.fps;
-    ARCO_ASSIGN_OR_RETURN(media::VideoWriter writer,
-                          media::VideoWriter::Open(JoinPath(tmp, relative), writer_options));
+    ARCO_ASSIGN_OR_RETURN(
+        media::VideoWriter writer,
+        media::VideoWriter::Open(JoinPath(tmp, "videos/" + cam.name + options.extension),
+                                 writer_options));
     const PlaneRenderer renderer(cam, options.render);
     const media::Image background =
         MakeSolidImage(cam.width, cam.height, media::PixelFormat::kRgb8, scene.background_rgb);
@@ -539,8 +547,15 @@ Status WritePlaneScene(const PlaneScene& scene,
       ARCO_RETURN_IF_ERROR(writer.Write(frame));
       progress.Advance(1);
     }
-    ARCO_RETURN_IF_ERROR(writer.Close());
-  }
+    return writer.Close();
+  };
+  std::vector<Status> results(scene.rig.cameras.size(), Status::Ok());
+  ParallelFor(
+      static_cast<int64_t>(scene.rig.cameras.size()),
+      options.threads,
+      [&](int64_t c, int) { results[c] = write_camera(scene.rig.cameras[c]); },
+      /*chunk=*/1);
+  for (const Status& result : results) ARCO_RETURN_IF_ERROR(result);
 
   Json truth;
   truth["format"] = "arco-plane-scene";

@@ -191,6 +191,9 @@ struct PlaneSceneWriteOptions {
   std::string codec = "ffv1";          // lossless
   std::string extension = ".mkv";
   bool overwrite = false;  // replace an existing scene folder (one holding truth.json)
+  // Cameras rendered and encoded in parallel (0 = all cores); each camera's video is
+  // the same for any count. render.threads splits each camera's rows on top.
+  int threads = 0;
 };
 
 // Writes a scene folder atomically (util/output_set.h):
