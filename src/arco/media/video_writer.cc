@@ -188,6 +188,10 @@ StatusOr<VideoWriter> VideoWriter::Open(const std::string& path,
     av_opt_set(c->priv_data, "crf", "16", 0);
   }
   if (s->format->oformat->flags & AVFMT_GLOBALHEADER) c->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
+  if (options.bitexact) {
+    c->flags |= AV_CODEC_FLAG_BITEXACT;
+    s->format->flags |= AVFMT_FLAG_BITEXACT;
+  }
   rc = avcodec_open2(c, encoder, nullptr);
   if (rc < 0) return s->Fail("cannot open the " + options.codec + " encoder", rc);
 

@@ -55,6 +55,9 @@ struct VideoWriterOptions {
   // qscale 2, libx264 crf 16).
   int64_t bit_rate = 0;
   int threads = 1;  // encoder threads; 1 encodes on the calling thread
+  // Reproducible files: no random ids (Matroska's segment UID) or version strings, so
+  // the same frames give the same bytes (libavformat/libavcodec's bitexact flags).
+  bool bitexact = true;
 
   // Sizes, fps, rotation, gop and threads in range; the names are checked at Open.
   Status Validate() const;

@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <vector>
 
 #include "arco/media/video_reader.h"
@@ -109,6 +111,31 @@ TEST_F(VideoWriterTest, Ffv1RoundTripIsBitExactWithPropertiesReadBack) {
     for (size_t k = 0; k < written.size(); ++k) {
       EXPECT_TRUE(back.frames[k].pixels == written[k].pixels) << "frame " << k << " differs";
     }
+  }
+}
+
+TEST_F(VideoWriterTest, SameFramesGiveTheSameBytes) {
+  for (const char* container : {"matroska", "mp4"}) {
+    SCOPED_TRACE(container);
+    std::string bytes[2];
+    for (int run = 0; run < 2; ++run) {
+      const std::string path = Path("same" + std::to_string(run) + "." + container);
+      VideoWriterOptions options;
+      options.container = container;
+      options.codec = std::string(container) == "mp4" ? "mpeg4" : "ffv1";
+      options.width = 64;
+      options.height = 48;
+      auto writer = VideoWriter::Open(path, options);
+      ASSERT_TRUE(writer.ok()) << writer.status().message();
+      for (int k = 0; k < 4; ++k) {
+        ASSERT_TRUE(writer->Write(TestFrame(64, 48, PixelFormat::kRgb8, k, true)).ok());
+      }
+      ASSERT_TRUE(writer->Close().ok());
+      std::ifstream in(path, std::ios::binary);
+      bytes[run].assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    EXPECT_GT(bytes[0].size(), 1000u);
+    EXPECT_TRUE(bytes[0] == bytes[1]) << "the two files differ";
   }
 }
 
