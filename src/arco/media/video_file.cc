@@ -314,18 +314,17 @@ class VideoFile : public FrameSource {
             static_cast<size_t>(p.width) * p.height * ChannelCount(options_.format)) {
       *image = MakeImage(p.width, p.height, options_.format);
     }
-    // swscale's SIMD output writes whole blocks and may run a few bytes past the end of
-    // a row (valgrind: 4 bytes past a 2300-pixel RGB24 image's last row), so it writes
-    // into a scratch buffer with 64-byte aligned rows and a padded end, copied row by
-    // row into the tightly packed image.
+    // swscale's SIMD paths may write a few bytes past the end of a tightly packed
+    // row (seen with 2300 px wide JPEGs: 4 bytes past the last row), so convert into a
+    // padded buffer and copy the rows out.
     const size_t row_bytes = image->row_bytes();
     const size_t stride = (row_bytes + 63) / 64 * 64;
-    scratch_.resize(stride * static_cast<size_t>(p.height) + 64);
-    uint8_t* planes[1] = {scratch_.data()};
+    converted_.resize(stride * (p.height + 1));
+    uint8_t* planes[1] = {converted_.data()};
     int strides[1] = {static_cast<int>(stride)};
     sws_scale(sws_.get(), frame.data, frame.linesize, 0, frame.height, planes, strides);
     for (int y = 0; y < p.height; ++y) {
-      std::memcpy(image->row(y), scratch_.data() + stride * static_cast<size_t>(y), row_bytes);
+      std::memcpy(image->row(y), converted_.data() + y * stride, row_bytes);
     }
     return Status::Ok();
   }
@@ -338,7 +337,7 @@ class VideoFile : public FrameSource {
   std::unique_ptr<AVFrame, FrameFreer> frame_;  // decoded, not yet shown (have_frame_)
   std::unique_ptr<AVFrame, FrameFreer> shown_;  // the picture of frame next_frame_ - 1
   std::unique_ptr<SwsContext, SwsFreer> sws_;
-  std::vector<uint8_t> scratch_;  // swscale's padded output (Convert)
+  std::vector<uint8_t> converted_;  // swscale's output, padded rows (see Convert)
   int stream_index_ = -1;
   AVRational time_base_{1, 1};
   AVRational frame_rate_{0, 1};
