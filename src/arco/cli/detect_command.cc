@@ -73,15 +73,16 @@ int RunDetect(const DetectArgs& a) {
               s.cameras.size(),
               s.layout.c_str());
   for (const auto& c : s.cameras) {
-    std::printf("  %-12s %6lld frames  person %5.1f%%  left hand %5.1f%%  right hand %5.1f%%  "
-                "re-detections %lld%s\n",
-                c.camera.c_str(),
-                static_cast<long long>(c.frames),
-                percent(c.tracker.frames_with_person, c.tracker.frames),
-                percent(c.tracker.frames_with_left_hand, c.tracker.frames),
-                percent(c.tracker.frames_with_right_hand, c.tracker.frames),
-                static_cast<long long>(c.tracker.redetections),
-                c.dropped > 0 ? (", " + std::to_string(c.dropped) + " dropped").c_str() : "");
+    std::printf(
+        "  %-12s %6lld frames  person %5.1f%%  left hand %5.1f%%  right hand %5.1f%%  "
+        "re-detections %lld%s\n",
+        c.camera.c_str(),
+        static_cast<long long>(c.frames),
+        percent(c.tracker.frames_with_person, c.tracker.frames),
+        percent(c.tracker.frames_with_left_hand, c.tracker.frames),
+        percent(c.tracker.frames_with_right_hand, c.tracker.frames),
+        static_cast<long long>(c.tracker.redetections),
+        c.dropped > 0 ? (", " + std::to_string(c.dropped) + " dropped").c_str() : "");
   }
   const int64_t frames = s.total.frames;
   std::printf("time %.1f s: inference %.1f ms, decoding %.1f ms per view-frame (all workers)\n",

@@ -31,9 +31,8 @@ Image RotateClockwise(const Image& image, int degrees) {
   }
   if (degrees == 0) return image;
   const bool swap = degrees != 180;
-  Image out = MakeImage(swap ? image.height : image.width,
-                        swap ? image.width : image.height,
-                        image.format);
+  Image out =
+      MakeImage(swap ? image.height : image.width, swap ? image.width : image.height, image.format);
   const int c = image.channels();
   const int w = image.width, h = image.height;
   for (int y = 0; y < h; ++y) {

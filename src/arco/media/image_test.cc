@@ -1,8 +1,8 @@
 #include "arco/media/image.h"
 
-#include <stdexcept>
-
 #include <gtest/gtest.h>
+
+#include <stdexcept>
 
 namespace arco::media {
 namespace {

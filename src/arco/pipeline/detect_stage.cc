@@ -142,8 +142,7 @@ Json ToJson(const DetectStageSummary& s) {
               {"wall_s", s.wall_s}};
 }
 
-StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options,
-                                            Progress& progress) {
+StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
   ARCO_RETURN_IF_ERROR(options.Validate());
   const std::string& dir = options.capture_dir;
@@ -193,11 +192,10 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options,
     const bool swap = in.rotate_deg == 90 || in.rotate_deg == 270;
     const int w = swap ? p.height : p.width, h = swap ? p.width : p.height;
     if (w != in.width || h != in.height) {
-      return Status::Error(in.video + ": frames are " + std::to_string(w) + "x" +
-                           std::to_string(h) + " after rotate_deg " +
-                           std::to_string(in.rotate_deg) + ", camera " + cam.name + " of " +
-                           calibration_path + " is " + std::to_string(in.width) + "x" +
-                           std::to_string(in.height));
+      return Status::Error(
+          in.video + ": frames are " + std::to_string(w) + "x" + std::to_string(h) +
+          " after rotate_deg " + std::to_string(in.rotate_deg) + ", camera " + cam.name + " of " +
+          calibration_path + " is " + std::to_string(in.width) + "x" + std::to_string(in.height));
     }
     in.video_frames = p.frame_count;
     // The last global frame this camera recorded must be in its video.
