@@ -359,6 +359,18 @@ TEST_F(PlaneSceneFolder, WritesVideosCalibrationAndTruthThatReadBack) {
   motion.frames = 6;
   scene.world_from_plane = MakePlaneMotion(motion);
   scene.fps = {30, 1};
+  for (int c = 0; c < 3; ++c) {  // static backgrounds: a gradient per camera
+    Image background = media::MakeImage(320, 180, PixelFormat::kRgb8);
+    for (int y = 0; y < 180; ++y) {
+      for (int x = 0; x < 320; ++x) {
+        uint8_t* p = background.row(y) + 3 * x;
+        p[0] = static_cast<uint8_t>(x * 255 / 319);
+        p[1] = static_cast<uint8_t>(y * 255 / 179);
+        p[2] = static_cast<uint8_t>(80 * c);
+      }
+    }
+    scene.backgrounds.push_back(background);
+  }
   const std::string folder = (dir_ / "scene").string();
   const Status written = WritePlaneScene(scene, folder);
   ASSERT_TRUE(written.ok()) << written.message();
@@ -394,11 +406,8 @@ TEST_F(PlaneSceneFolder, WritesVideosCalibrationAndTruthThatReadBack) {
     // Lossless: frame 4 is the render, bit for bit.
     auto frame = reader->ReadFrame(4);
     ASSERT_TRUE(frame.ok()) << frame.status().message();
-    const Image expected =
-        RenderView(scene.rig.cameras[c],
-                   scene.world_from_plane[4],
-                   scene.texture,
-                   MakeSolidImage(320, 180, PixelFormat::kRgb8, scene.background_rgb));
+    const Image expected = RenderView(
+        scene.rig.cameras[c], scene.world_from_plane[4], scene.texture, scene.backgrounds[c]);
     EXPECT_TRUE(frame->pixels == expected.pixels) << camera.name;
   }
 
@@ -407,6 +416,12 @@ TEST_F(PlaneSceneFolder, WritesVideosCalibrationAndTruthThatReadBack) {
   PlaneSceneWriteOptions overwrite;
   overwrite.overwrite = true;
   EXPECT_TRUE(WritePlaneScene(scene, folder, overwrite).ok());
+  PlaneScene wrong_background = scene;
+  wrong_background.backgrounds.assign(3, MakeSolidImage(32, 18, PixelFormat::kRgb8, {0, 0, 0}));
+  const Status bad_background = WritePlaneScene(wrong_background, (dir_ / "bg").string());
+  ASSERT_FALSE(bad_background.ok());
+  EXPECT_NE(bad_background.message().find("background of camera cam0"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir_ / "bg"));
   PlaneScene empty = scene;
   empty.world_from_plane.clear();
   const Status no_frames = WritePlaneScene(empty, (dir_ / "empty").string());
