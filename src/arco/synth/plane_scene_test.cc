@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "arco/camera/calibration_io.h"
+#include "arco/geometry/triangulation.h"
 #include "arco/media/video_reader.h"
 #include "arco/media/video_writer.h"
 #include "arco/util/file_io.h"
@@ -409,6 +410,34 @@ TEST_F(PlaneSceneFolder, WritesVideosCalibrationAndTruthThatReadBack) {
     const Image expected = RenderView(
         scene.rig.cameras[c], scene.world_from_plane[4], scene.texture, scene.backgrounds[c]);
     EXPECT_TRUE(frame->pixels == expected.pixels) << camera.name;
+  }
+
+  // The files alone are consistent: texture points projected with the stored cameras
+  // and poses triangulate back onto their place on the plane.
+  std::vector<Eigen::Vector3d> centers;
+  for (const Camera& camera : calibration->rig.cameras) centers.push_back(camera.CenterInWorld());
+  const WorldConditioning conditioning = ConditioningFromCameraCenters(centers);
+  PlaneTexture stored;
+  stored.image =
+      media::MakeImage(truth->texture_width_px, truth->texture_height_px, PixelFormat::kGray8);
+  stored.width_mm = truth->width_mm;
+  stored.height_mm = truth->height_mm;
+  for (size_t f = 0; f < truth->world_from_plane.size(); ++f) {
+    for (const Eigen::Vector2d& texture_px :
+         {Eigen::Vector2d(0, 0), Eigen::Vector2d(350, 250), Eigen::Vector2d(699, 120)}) {
+      std::vector<DltObservation> observations;
+      for (const Camera& camera : calibration->rig.cameras) {
+        const auto pixel =
+            ProjectPlanePoint(camera, truth->world_from_plane[f], stored, texture_px);
+        ASSERT_TRUE(pixel.has_value());
+        observations.push_back({camera.ProjectionMatrix(), camera.UndistortPixel(*pixel), 1.0});
+      }
+      const auto point = TriangulateDlt(observations, conditioning);
+      ASSERT_TRUE(point.has_value());
+      const Eigen::Vector3d expected =
+          PlaneToWorld(scene.world_from_plane[f], TexturePixelToPlane(scene.texture, texture_px));
+      EXPECT_LT((*point - expected).norm(), 1e-6) << "frame " << f;
+    }
   }
 
   // An existing scene is replaced only with overwrite; bad scenes write nothing.
