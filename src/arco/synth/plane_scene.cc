@@ -498,6 +498,21 @@ Status WritePlaneScene(const PlaneScene& scene,
   } catch (const std::invalid_argument& e) {
     return fail(e.what());
   }
+  if (!scene.backgrounds.empty()) {
+    if (scene.backgrounds.size() != scene.rig.cameras.size()) {
+      return fail("backgrounds: " + std::to_string(scene.backgrounds.size()) + " images for " +
+                  std::to_string(scene.rig.cameras.size()) + " cameras");
+    }
+    for (size_t c = 0; c < scene.backgrounds.size(); ++c) {
+      const media::Image& b = scene.backgrounds[c];
+      const Camera& cam = scene.rig.cameras[c];
+      if (b.format != media::PixelFormat::kRgb8 || b.width != cam.width || b.height != cam.height ||
+          b.pixels.size() != b.row_bytes() * size_t(b.height)) {
+        return fail("the background of camera " + cam.name + " must be an RGB8 image of " +
+                    std::to_string(cam.width) + "x" + std::to_string(cam.height));
+      }
+    }
+  }
   for (const Camera& cam : scene.rig.cameras) {
     if (cam.name.empty() || cam.name.find_first_of("/\\") != std::string::npos ||
         cam.name[0] == '.') {
@@ -527,7 +542,8 @@ Status WritePlaneScene(const PlaneScene& scene,
   }
   // One camera per work item: its renderer, its video; the first failing camera (in
   // the rig's order) is reported.
-  auto write_camera = [&](const Camera& cam) -> Status {
+  auto write_camera = [&](size_t index) -> Status {
+    const Camera& cam = scene.rig.cameras[index];
     media::VideoWriterOptions writer_options;
     writer_options.container = options.container;
     writer_options.codec = options.codec;
@@ -540,7 +556,9 @@ Status WritePlaneScene(const PlaneScene& scene,
                                  writer_options));
     const PlaneRenderer renderer(cam, options.render);
     const media::Image background =
-        MakeSolidImage(cam.width, cam.height, media::PixelFormat::kRgb8, scene.background_rgb);
+        scene.backgrounds.empty()
+            ? MakeSolidImage(cam.width, cam.height, media::PixelFormat::kRgb8, scene.background_rgb)
+            : scene.backgrounds[index];
     media::Image frame;
     for (int f = 0; f < frames; ++f) {
       renderer.Render(scene.world_from_plane[f], texture, background, &frame);
@@ -553,7 +571,7 @@ Status WritePlaneScene(const PlaneScene& scene,
   ParallelFor(
       static_cast<int64_t>(scene.rig.cameras.size()),
       options.threads,
-      [&](int64_t c, int) { results[c] = write_camera(scene.rig.cameras[c]); },
+      [&](int64_t c, int) { results[c] = write_camera(static_cast<size_t>(c)); },
       /*chunk=*/1);
   for (const Status& result : results) ARCO_RETURN_IF_ERROR(result);
 

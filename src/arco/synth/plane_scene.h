@@ -183,6 +183,9 @@ struct PlaneScene {
   std::vector<Rigid3d> world_from_plane;  // one per frame
   media::Rational fps{30, 1};
   std::array<uint8_t, 3> background_rgb{90, 90, 90};
+  // Optional static backgrounds, one per camera (RGB8, the camera's size), e.g. a room
+  // for a tracker to ignore; empty: background_rgb everywhere.
+  std::vector<media::Image> backgrounds;
 };
 
 struct PlaneSceneWriteOptions {

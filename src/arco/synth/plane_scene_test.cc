@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "arco/camera/calibration_io.h"
+#include "arco/geometry/triangulation.h"
 #include "arco/media/video_reader.h"
 #include "arco/media/video_writer.h"
 #include "arco/util/file_io.h"
@@ -359,6 +360,18 @@ TEST_F(PlaneSceneFolder, WritesVideosCalibrationAndTruthThatReadBack) {
   motion.frames = 6;
   scene.world_from_plane = MakePlaneMotion(motion);
   scene.fps = {30, 1};
+  for (int c = 0; c < 3; ++c) {  // static backgrounds: a gradient per camera
+    Image background = media::MakeImage(320, 180, PixelFormat::kRgb8);
+    for (int y = 0; y < 180; ++y) {
+      for (int x = 0; x < 320; ++x) {
+        uint8_t* p = background.row(y) + 3 * x;
+        p[0] = static_cast<uint8_t>(x * 255 / 319);
+        p[1] = static_cast<uint8_t>(y * 255 / 179);
+        p[2] = static_cast<uint8_t>(80 * c);
+      }
+    }
+    scene.backgrounds.push_back(background);
+  }
   const std::string folder = (dir_ / "scene").string();
   const Status written = WritePlaneScene(scene, folder);
   ASSERT_TRUE(written.ok()) << written.message();
@@ -394,12 +407,37 @@ TEST_F(PlaneSceneFolder, WritesVideosCalibrationAndTruthThatReadBack) {
     // Lossless: frame 4 is the render, bit for bit.
     auto frame = reader->ReadFrame(4);
     ASSERT_TRUE(frame.ok()) << frame.status().message();
-    const Image expected =
-        RenderView(scene.rig.cameras[c],
-                   scene.world_from_plane[4],
-                   scene.texture,
-                   MakeSolidImage(320, 180, PixelFormat::kRgb8, scene.background_rgb));
+    const Image expected = RenderView(
+        scene.rig.cameras[c], scene.world_from_plane[4], scene.texture, scene.backgrounds[c]);
     EXPECT_TRUE(frame->pixels == expected.pixels) << camera.name;
+  }
+
+  // The files alone are consistent: texture points projected with the stored cameras
+  // and poses triangulate back onto their place on the plane.
+  std::vector<Eigen::Vector3d> centers;
+  for (const Camera& camera : calibration->rig.cameras) centers.push_back(camera.CenterInWorld());
+  const WorldConditioning conditioning = ConditioningFromCameraCenters(centers);
+  PlaneTexture stored;
+  stored.image =
+      media::MakeImage(truth->texture_width_px, truth->texture_height_px, PixelFormat::kGray8);
+  stored.width_mm = truth->width_mm;
+  stored.height_mm = truth->height_mm;
+  for (size_t f = 0; f < truth->world_from_plane.size(); ++f) {
+    for (const Eigen::Vector2d& texture_px :
+         {Eigen::Vector2d(0, 0), Eigen::Vector2d(350, 250), Eigen::Vector2d(699, 120)}) {
+      std::vector<DltObservation> observations;
+      for (const Camera& camera : calibration->rig.cameras) {
+        const auto pixel =
+            ProjectPlanePoint(camera, truth->world_from_plane[f], stored, texture_px);
+        ASSERT_TRUE(pixel.has_value());
+        observations.push_back({camera.ProjectionMatrix(), camera.UndistortPixel(*pixel), 1.0});
+      }
+      const auto point = TriangulateDlt(observations, conditioning);
+      ASSERT_TRUE(point.has_value());
+      const Eigen::Vector3d expected =
+          PlaneToWorld(scene.world_from_plane[f], TexturePixelToPlane(scene.texture, texture_px));
+      EXPECT_LT((*point - expected).norm(), 1e-6) << "frame " << f;
+    }
   }
 
   // An existing scene is replaced only with overwrite; bad scenes write nothing.
@@ -407,6 +445,12 @@ TEST_F(PlaneSceneFolder, WritesVideosCalibrationAndTruthThatReadBack) {
   PlaneSceneWriteOptions overwrite;
   overwrite.overwrite = true;
   EXPECT_TRUE(WritePlaneScene(scene, folder, overwrite).ok());
+  PlaneScene wrong_background = scene;
+  wrong_background.backgrounds.assign(3, MakeSolidImage(32, 18, PixelFormat::kRgb8, {0, 0, 0}));
+  const Status bad_background = WritePlaneScene(wrong_background, (dir_ / "bg").string());
+  ASSERT_FALSE(bad_background.ok());
+  EXPECT_NE(bad_background.message().find("background of camera cam0"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir_ / "bg"));
   PlaneScene empty = scene;
   empty.world_from_plane.clear();
   const Status no_frames = WritePlaneScene(empty, (dir_ / "empty").string());
