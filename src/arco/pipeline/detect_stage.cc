@@ -302,9 +302,10 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
             return fail(Status::Error(in.video + ": frame " + std::to_string(n - 1) +
                                       " could not be read (the video ends early)"));
           }
-          const media::Image turned = media::RotateClockwise(frame, in.rotate_deg);
+          media::Image turned;
+          if (in.rotate_deg != 0) turned = media::RotateClockwise(frame, in.rotate_deg);
           w.decode_s += SecondsSince(decode_start);
-          auto found = w.tracker->Track(turned);
+          auto found = w.tracker->Track(in.rotate_deg != 0 ? turned : frame);
           if (!found.ok()) return fail(found.status());
           ++chunk_read[i];
           for (int p = 0; p < wholebody::kNumPoints; ++p) {
