@@ -208,6 +208,27 @@ TEST(WholeBodyTracker, CellistLeftHandOnTheFingerboard) {
   EXPECT_GT(summary.preprocess_s, 0.0);
 }
 
+// Any one missing model stops Create with the line naming that file and scripts/setup
+// (here the hand model, the last one loaded).
+TEST(WholeBodyTracker, MissingHandModelNamesIt) {
+  ARCO_REQUIRE_MODELS();
+  const std::string dir = ::testing::TempDir() + "/arco_wholebody_models";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  for (ModelId id : {ModelId::kPoseDetection, ModelId::kPoseLandmarkFull, ModelId::kHandRecrop}) {
+    std::filesystem::create_symlink(ModelPath(id), ModelPath(id, dir));
+  }
+  WholeBodyOptions options = TestOptions(1);
+  options.models_dir = dir;
+  StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(options);
+  ASSERT_FALSE(tracker.ok());
+  EXPECT_EQ(tracker.status().message(),
+            dir +
+                "/hand_landmark_full.onnx: model file not found; run scripts/setup to fetch "
+                "and convert the models (docs/detect.md)");
+  std::filesystem::remove_all(dir);
+}
+
 TEST(WholeBodyTracker, RejectsAGrayFrame) {
   ARCO_REQUIRE_MODELS();
   StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(TestOptions(1));
