@@ -88,6 +88,9 @@ struct ScoredPoint {
   float y_px = std::numeric_limits<float>::quiet_NaN();
   float score = std::numeric_limits<float>::quiet_NaN();
 };
+// WholeBodyFrame::points is laid out as float[kNumPoints][3] (x, y, score): one row of
+// keypoints2d.npy (docs/formats.md), copyable as is.
+static_assert(sizeof(ScoredPoint) == 3 * sizeof(float), "ScoredPoint must be 3 packed floats");
 
 struct WholeBodyFrame {
   std::array<ScoredPoint, wholebody::kNumPoints> points;  // COCO-WholeBody order
