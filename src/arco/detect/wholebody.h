@@ -62,6 +62,7 @@ ModelId PoseLandmarkModel(PoseModel model);
 // Declared ranges of WholeBodyOptions' numbers (util/number_range.h).
 inline constexpr NumberRange kWholeBodyScoreRange = Closed(0, 1);  // thresholds on scores
 inline constexpr NumberRange kWholeBodyThreadsRange = Closed(1, 1024);
+inline constexpr NumberRange kWholeBodyTileLevelsRange = Closed(0, 2);
 
 struct WholeBodyOptions {
   PoseModel pose_model = PoseModel::kFull;
@@ -70,6 +71,13 @@ struct WholeBodyOptions {
   double min_detection_score = 0.5;
   // Weighted NMS merges detections overlapping the best one by more than this IoU.
   double nms_min_iou = 0.3;
+  // The detector sees the frame letterboxed into 224 x 224 and misses a person smaller
+  // than about a quarter of the frame's longer side. When it finds nobody, level k
+  // (1..detection_tile_levels) searches squares of side longer_side / 2^k overlapping by
+  // half (level 1: 6 squares of a 4:3 frame; level 2: 35), finest last; the best
+  // detection of the first level that finds one wins. 0: whole frame only (MediaPipe).
+  // Costs only frames where nobody is tracked and the whole frame finds nobody.
+  int detection_tile_levels = 1;
   // Tracking is lost (and the detector runs) when the pose presence is below this.
   double min_pose_presence = 0.5;
   // A hand whose presence is below this is NaN.
