@@ -13,11 +13,11 @@
 //
 // Per frame: the pose landmarker runs in the ROI carried from the previous frame's
 // landmarks; on the first frame, after Reset(), and when the pose presence falls below
-// min_pose_presence, the person detector runs on the whole frame first (the same frame
-// is then tracked from the detection). Hand ROIs come from the pose's wrist, index and
-// little-finger points, refined by hand_recrop, and the hand landmarker runs on both.
-// Left and right come from the pose (the person's left is COCO's left), never from the
-// hand model's handedness output.
+// min_pose_presence, the person detector runs first (the whole frame, then squares of
+// it when that finds nobody; the same frame is then tracked from the detection). Hand ROIs come
+// from the pose's wrist, index and little-finger points, refined by hand_recrop, and the hand
+// landmarker runs on both. Left and right come from the pose (the person's left is COCO's left),
+// never from the hand model's handedness output.
 //
 // Output: pixels of the given image in OpenCV's convention (origin at the centre of the
 // top-left pixel); NaN x, y and score where nothing was found: every point of a frame

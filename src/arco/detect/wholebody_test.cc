@@ -14,6 +14,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "arco/detect/models_for_test.h"
@@ -341,12 +342,25 @@ TEST(WholeBodyTracker, VtestWalkerTrackedAcrossFrames) {
   StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(TestOptions());
   ASSERT_TRUE(tracker.ok()) << tracker.status().message();
   std::vector<WholeBodyFrame> outs;
+  int hands_below_threshold = 0;
   for (const media::Image& frame : frames) {
     StatusOr<WholeBodyFrame> out = tracker->Track(frame);
     ASSERT_TRUE(out.ok());
     ExpectWellFormed(*out);
+    // A hand below min_hand_presence (0.5; these hands are a few pixels wide) is NaN.
+    for (const auto& [found, presence, first] :
+         {std::tuple{out->left_hand, out->left_hand_presence, wholebody::kLeftHandFirst},
+          std::tuple{out->right_hand, out->right_hand_presence, wholebody::kRightHandFirst}}) {
+      EXPECT_EQ(found, presence >= 0.5f);
+      if (found) continue;
+      hands_below_threshold += presence < 0.5f ? 1 : 0;
+      for (int i = 0; i < wholebody::kNumHandPoints; ++i) {
+        EXPECT_TRUE(std::isnan(out->points[first + i].x_px));
+      }
+    }
     outs.push_back(*out);
   }
+  EXPECT_GT(hands_below_threshold, 10);
   MaybeWriteOverlay(frames[0], outs[0], "vtest_0");
   MaybeWriteOverlay(frames[29], outs[29], "vtest_29");
   const WholeBodySummary& summary = tracker->summary();
