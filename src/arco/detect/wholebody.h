@@ -117,9 +117,11 @@ struct WholeBodySummary {
   int64_t frames_with_person = 0;
   int64_t frames_with_left_hand = 0;
   int64_t frames_with_right_hand = 0;
-  int64_t detector_runs = 0;  // pose_detection runs
-  // Detector runs after a person had been found since creation or the last Reset:
-  // tracking was lost.
+  // Frames on which the person detector ran (models[0].runs counts its passes: the
+  // whole frame and any squares searched).
+  int64_t detector_runs = 0;
+  // Of those, the ones after a person had been found since creation or the last
+  // Reset: tracking was lost.
   int64_t redetections = 0;
   // Wall time of the forward passes (Network::Run) per model kind, and of the rest:
   // cutting and converting crops (preprocess), decoding outputs and ROI geometry
