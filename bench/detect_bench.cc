@@ -1,16 +1,27 @@
-// Detector inference latency (docs/performance.md, section "Detect"): one forward pass
-// of each converted MediaPipe model with cv::dnn on 2 threads (detect::Network::Run:
-// NHWC -> NCHW copy, forward, outputs copied out) on a fixed pseudo-random input of
-// the model's size (the time does not depend on the content). Wall time is what counts
-// (OpenCV's pool threads do the work, not the calling thread), so the benchmarks
-// report real time.
+// Detector latency (docs/performance.md, section "Detect"), 2 OpenCV threads, wall
+// time (OpenCV's pool threads do the work, not the calling thread: real time):
+// - BM_Inference: one forward pass of each converted MediaPipe model
+//   (detect::Network::Run: NHWC -> NCHW copy, forward, outputs copied out) on a fixed
+//   pseudo-random input of the model's size (the time does not depend on the content);
+// - BM_WholeBodyTracked / BM_WholeBodyDetected: detect::WholeBodyTracker::Track per
+//   view-frame on the real SPD cellist (2300 x 2656): a tracked frame (pose landmarks in
+//   the carried ROI, hand_recrop and hand landmarks for both hands) and a frame that
+//   starts with the person detector (after Reset). Counters split the time per frame:
+//   inference_ms (forward passes only, the 45 ms target), per model, and
+//   preprocess_ms (cutting and converting crops) and postprocess_ms (decoding), which
+//   the tracker times separately;
+// - BM_DecodeFrame: reading frames with media::VideoReader (decoding is not part of
+//   the tracker's time): opencv-doc's vtest.avi (768 x 576 MPEG-4) and the cellist JPEG.
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "arco/detect/network.h"
+#include "arco/detect/wholebody.h"
+#include "arco/media/video_reader.h"
 
 namespace arco::detect {
 namespace {
@@ -39,6 +50,95 @@ void BM_Inference(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_Inference)->DenseRange(0, 7)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+const char* const kCellist = ARCO_SHARED_DATA_DIR "/spd/example.jpg";
+const char* const kVtest = "/usr/share/doc/opencv-doc/examples/data/vtest.avi";
+
+// Per-frame counters from the tracker's summary between two points.
+void ReportPerFrame(benchmark::State& state,
+                    const WholeBodySummary& before,
+                    const WholeBodySummary& after) {
+  const double frames = static_cast<double>(after.frames - before.frames);
+  if (frames <= 0) return;
+  auto per_frame_ms = [&](double seconds) { return 1e3 * seconds / frames; };
+  state.counters["inference_ms"] = per_frame_ms(after.inference_s - before.inference_s);
+  state.counters["preprocess_ms"] = per_frame_ms(after.preprocess_s - before.preprocess_s);
+  state.counters["postprocess_ms"] = per_frame_ms(after.postprocess_s - before.postprocess_s);
+  const char* names[] = {"detector_ms", "pose_ms", "recrop_ms", "hands_ms"};
+  for (size_t k = 0; k < after.models.size(); ++k) {
+    state.counters[names[k]] =
+        per_frame_ms(after.models[k].inference_s - before.models[k].inference_s);
+  }
+}
+
+// range(0): pose model 0 lite, 1 full, 2 heavy; range(1): 1 with a detection per frame.
+void WholeBody(benchmark::State& state, bool detect_every_frame) {
+  const PoseModel model = static_cast<PoseModel>(state.range(0));
+  state.SetLabel(std::string("pose ") + PoseModelName(model) + ", hands full, recrop");
+  StatusOr<media::VideoReader> reader = media::VideoReader::Open(kCellist);
+  if (!reader.ok()) {
+    state.SkipWithError(reader.status().message().c_str());
+    return;
+  }
+  StatusOr<media::Image> image = reader->ReadFrame(0);
+  WholeBodyOptions options;
+  options.pose_model = model;
+  options.num_threads = 2;
+  StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(options);
+  if (!image.ok() || !tracker.ok()) {
+    state.SkipWithError(tracker.ok() ? "cannot read the image"
+                                     : tracker.status().message().c_str());
+    return;
+  }
+  // Warm-up (first passes allocate) and, for tracked frames, the first detection.
+  for (int i = 0; i < 2; ++i) {
+    if (!tracker->Track(*image).ok()) {
+      state.SkipWithError("inference failed");
+      return;
+    }
+  }
+  const WholeBodySummary before = tracker->summary();
+  for (auto _ : state) {
+    if (detect_every_frame) tracker->Reset();
+    StatusOr<WholeBodyFrame> out = tracker->Track(*image);
+    benchmark::DoNotOptimize(out);
+  }
+  ReportPerFrame(state, before, tracker->summary());
+}
+void BM_WholeBodyTracked(benchmark::State& state) { WholeBody(state, false); }
+void BM_WholeBodyDetected(benchmark::State& state) { WholeBody(state, true); }
+BENCHMARK(BM_WholeBodyTracked)->DenseRange(0, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WholeBodyDetected)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// range(0): 0 vtest.avi read sequentially (rewinding at the end), 1 the cellist JPEG.
+void BM_DecodeFrame(benchmark::State& state) {
+  const char* path = state.range(0) == 0 ? kVtest : kCellist;
+  state.SetLabel(state.range(0) == 0 ? "vtest.avi 768x576 mpeg4" : "example.jpg 2300x2656");
+  StatusOr<media::VideoReader> reader = media::VideoReader::Open(path);
+  if (!reader.ok()) {
+    state.SkipWithError(reader.status().message().c_str());
+    return;
+  }
+  media::Image frame;
+  const int64_t frame_count = reader->properties().frame_count;
+  for (auto _ : state) {
+    if (reader->next_frame() >= frame_count) {  // rewind, untimed
+      state.PauseTiming();
+      const Status seek = reader->Seek(0);
+      state.ResumeTiming();
+      if (!seek.ok()) {
+        state.SkipWithError(seek.message().c_str());
+        return;
+      }
+    }
+    StatusOr<bool> more = reader->Read(&frame);
+    if (!more.ok() || !*more) {
+      state.SkipWithError("read failed");
+      return;
+    }
+  }
+}
+BENCHMARK(BM_DecodeFrame)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace arco::detect

@@ -226,6 +226,12 @@ TEST(WholeBodyOptions, ValidateNamesTheField) {
     options.num_threads = threads;
     EXPECT_NE(options.Validate().message().find("WholeBodyOptions.num_threads"), std::string::npos);
   }
+  for (int levels : {-1, 3}) {
+    WholeBodyOptions options;
+    options.detection_tile_levels = levels;
+    EXPECT_NE(options.Validate().message().find("WholeBodyOptions.detection_tile_levels"),
+              std::string::npos);
+  }
   WholeBodyOptions bad_model;
   bad_model.pose_model = static_cast<PoseModel>(7);
   EXPECT_FALSE(bad_model.Validate().ok());

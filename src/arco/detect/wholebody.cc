@@ -1,5 +1,6 @@
 #include "arco/detect/wholebody.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <opencv2/core.hpp>
@@ -98,6 +99,8 @@ Status WholeBodyOptions::Validate() const {
       CheckInRange("WholeBodyOptions.min_hand_presence", min_hand_presence, kWholeBodyScoreRange));
   ARCO_RETURN_IF_ERROR(
       CheckInRange("WholeBodyOptions.num_threads", num_threads, kWholeBodyThreadsRange));
+  ARCO_RETURN_IF_ERROR(CheckInRange(
+      "WholeBodyOptions.detection_tile_levels", detection_tile_levels, kWholeBodyTileLevelsRange));
   return Status::Ok();
 }
 
@@ -168,11 +171,11 @@ struct WholeBodyTracker::Impl {
     return Status::Ok();
   }
 
-  // The best person on the whole frame, as the ROI of its keypoints 0 (hip centre) and
-  // 1 (full-body circle); false when no detection reaches min_detection_score.
-  StatusOr<bool> Detect(const cv::Mat& image, Roi* roi) {
-    const Roi whole = WholeImageRoi(image.cols, image.rows);
-    CutCrop(image, whole, kDetectorSlot);
+  // The best detection in `region` (a square of the image, upright) whose score beats
+  // *best_score: its keypoints 0 (hip centre) and 1 (full-body circle) in the image.
+  Status DetectIn(
+      const cv::Mat& image, const Roi& region, double* best_score, Point2* hip, Point2* circle) {
+    CutCrop(image, region, kDetectorSlot);
     ARCO_RETURN_IF_ERROR(Run(kDetectorSlot));
     const auto start = Clock::now();
     const Network& net = *networks[kDetectorSlot];
@@ -183,16 +186,48 @@ struct WholeBodyTracker::Impl {
                            kPoseDetectionInputSize,
                            options.min_detection_score);
     detections = WeightedNonMaxSuppression(std::move(detections), options.nms_min_iou);
-    bool found = false;
-    if (!detections.empty()) {
+    if (!detections.empty() && detections.front().score > *best_score) {
       const SsdDetection& best = detections.front();
-      const Point2 hip = whole.ToImage(best.keypoints[0].x, best.keypoints[0].y);
-      const Point2 circle = whole.ToImage(best.keypoints[1].x, best.keypoints[1].y);
-      *roi = RoiFromAlignmentPoints(hip, circle, kPi / 2, kPoseRoiScale);
-      found = roi->IsFinite() && roi->side_px >= kMinRoiSidePx;
+      *best_score = best.score;
+      *hip = region.ToImage(best.keypoints[0].x, best.keypoints[0].y);
+      *circle = region.ToImage(best.keypoints[1].x, best.keypoints[1].y);
     }
     summary.postprocess_s += Seconds(start);
-    return found;
+    return Status::Ok();
+  }
+
+  // The best person, as the pose ROI of its keypoints; false when no detection reaches
+  // min_detection_score. The whole frame first, then the tile levels (see
+  // WholeBodyOptions::detection_tile_levels), in a fixed order.
+  StatusOr<bool> Detect(const cv::Mat& image, Roi* roi) {
+    double best_score = -1;
+    Point2 hip, circle;
+    ARCO_RETURN_IF_ERROR(
+        DetectIn(image, WholeImageRoi(image.cols, image.rows), &best_score, &hip, &circle));
+    const int longer = std::max(image.cols, image.rows);
+    for (int level = 1; level <= options.detection_tile_levels && best_score < 0; ++level) {
+      const int side = longer >> level;
+      if (side < kPoseDetectionInputSize / 2) break;  // tiles this small upscale too much
+      // Tile origins every side / 2, the last one flush with the image's far edge.
+      auto origins = [&](int extent) {
+        std::vector<int> starts;
+        if (extent <= side) return std::vector<int>{(extent - side) / 2};
+        for (int o = 0; o + side < extent; o += side / 2) starts.push_back(o);
+        starts.push_back(extent - side);
+        return starts;
+      };
+      for (int y0 : origins(image.rows)) {
+        for (int x0 : origins(image.cols)) {
+          Roi tile;
+          tile.centre = {x0 + (side - 1) / 2.0, y0 + (side - 1) / 2.0};
+          tile.side_px = side;
+          ARCO_RETURN_IF_ERROR(DetectIn(image, tile, &best_score, &hip, &circle));
+        }
+      }
+    }
+    if (best_score < 0) return false;
+    *roi = RoiFromAlignmentPoints(hip, circle, kPi / 2, kPoseRoiScale);
+    return roi->IsFinite() && roi->side_px >= kMinRoiSidePx;
   }
 
   // Pose landmarks in `roi` into pose_points / pose_scores; returns the presence.

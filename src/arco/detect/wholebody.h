@@ -13,11 +13,11 @@
 //
 // Per frame: the pose landmarker runs in the ROI carried from the previous frame's
 // landmarks; on the first frame, after Reset(), and when the pose presence falls below
-// min_pose_presence, the person detector runs on the whole frame first (the same frame
-// is then tracked from the detection). Hand ROIs come from the pose's wrist, index and
-// little-finger points, refined by hand_recrop, and the hand landmarker runs on both.
-// Left and right come from the pose (the person's left is COCO's left), never from the
-// hand model's handedness output.
+// min_pose_presence, the person detector runs first (the whole frame, then squares of
+// it when that finds nobody; the same frame is then tracked from the detection). Hand ROIs come
+// from the pose's wrist, index and little-finger points, refined by hand_recrop, and the hand
+// landmarker runs on both. Left and right come from the pose (the person's left is COCO's left),
+// never from the hand model's handedness output.
 //
 // Output: pixels of the given image in OpenCV's convention (origin at the centre of the
 // top-left pixel); NaN x, y and score where nothing was found: every point of a frame
@@ -62,6 +62,7 @@ ModelId PoseLandmarkModel(PoseModel model);
 // Declared ranges of WholeBodyOptions' numbers (util/number_range.h).
 inline constexpr NumberRange kWholeBodyScoreRange = Closed(0, 1);  // thresholds on scores
 inline constexpr NumberRange kWholeBodyThreadsRange = Closed(1, 1024);
+inline constexpr NumberRange kWholeBodyTileLevelsRange = Closed(0, 2);
 
 struct WholeBodyOptions {
   PoseModel pose_model = PoseModel::kFull;
@@ -70,6 +71,13 @@ struct WholeBodyOptions {
   double min_detection_score = 0.5;
   // Weighted NMS merges detections overlapping the best one by more than this IoU.
   double nms_min_iou = 0.3;
+  // The detector sees the frame letterboxed into 224 x 224 and misses a person smaller
+  // than about a quarter of the frame's longer side. When it finds nobody, level k
+  // (1..detection_tile_levels) searches squares of side longer_side / 2^k overlapping by
+  // half (level 1: 6 squares of a 4:3 frame; level 2: 35), finest last; the best
+  // detection of the first level that finds one wins. 0: whole frame only (MediaPipe).
+  // Costs only frames where nobody is tracked and the whole frame finds nobody.
+  int detection_tile_levels = 1;
   // Tracking is lost (and the detector runs) when the pose presence is below this.
   double min_pose_presence = 0.5;
   // A hand whose presence is below this is NaN.
@@ -88,6 +96,9 @@ struct ScoredPoint {
   float y_px = std::numeric_limits<float>::quiet_NaN();
   float score = std::numeric_limits<float>::quiet_NaN();
 };
+// WholeBodyFrame::points is laid out as float[kNumPoints][3] (x, y, score): one row of
+// keypoints2d.npy (docs/formats.md), copyable as is.
+static_assert(sizeof(ScoredPoint) == 3 * sizeof(float), "ScoredPoint must be 3 packed floats");
 
 struct WholeBodyFrame {
   std::array<ScoredPoint, wholebody::kNumPoints> points;  // COCO-WholeBody order
@@ -106,9 +117,11 @@ struct WholeBodySummary {
   int64_t frames_with_person = 0;
   int64_t frames_with_left_hand = 0;
   int64_t frames_with_right_hand = 0;
-  int64_t detector_runs = 0;  // pose_detection runs
-  // Detector runs after a person had been found since creation or the last Reset:
-  // tracking was lost.
+  // Frames on which the person detector ran (models[0].runs counts its passes: the
+  // whole frame and any squares searched).
+  int64_t detector_runs = 0;
+  // Of those, the ones after a person had been found since creation or the last
+  // Reset: tracking was lost.
   int64_t redetections = 0;
   // Wall time of the forward passes (Network::Run) per model kind, and of the rest:
   // cutting and converting crops (preprocess), decoding outputs and ROI geometry
