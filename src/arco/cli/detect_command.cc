@@ -140,6 +140,13 @@ std::function<int()> SetupDetect(CLI::App& app) {
             "A hand below this presence is left empty (NaN)",
             detect::kWholeBodyScoreRange)
       ->capture_default_str();
+  AddNumber(sub,
+            "--tile-levels",
+            d.detection_tile_levels,
+            "When the whole frame finds nobody, search overlapping squares of 1/2 (1) and 1/4 "
+            "(2) of the frame for a small person; 0 = whole frame only",
+            detect::kWholeBodyTileLevelsRange)
+      ->capture_default_str();
   sub->add_flag("--no-hand-recrop",
                 a->no_hand_recrop,
                 "Hand crops straight from the pose, without hand_recrop's refinement");

@@ -116,6 +116,7 @@ Json ToJson(const DetectStageOptions& o) {
               {"min_pose_presence", o.detector.min_pose_presence},
               {"min_hand_presence", o.detector.min_hand_presence},
               {"hand_recrop", o.detector.hand_recrop},
+              {"detection_tile_levels", o.detector.detection_tile_levels},
               {"chunk_frames", o.chunk_frames},
               {"first_frame", o.first_frame},
               {"last_frame", o.last_frame}};
