@@ -24,6 +24,7 @@ namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr char kKeypointsFile[] = "keypoints2d.npy";
+constexpr char kReportFile[] = "detect.json";
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -239,6 +240,7 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
   OutputSet outputs;
   ARCO_ASSIGN_OR_RETURN(const std::string npy_tmp, outputs.AddFile(JoinPath(dir, kKeypointsFile)));
   ARCO_ASSIGN_OR_RETURN(const std::string manifest_tmp, outputs.AddFile(manifest_path));
+  ARCO_ASSIGN_OR_RETURN(const std::string report_tmp, outputs.AddFile(JoinPath(dir, kReportFile)));
 
   // The models load here (a missing file is one line naming it).
   const int threads = ResolveThreadCount(options.num_threads);
@@ -351,8 +353,29 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
   manifest.layout = layout_name;
   manifest.keypoint_names.clear();
   ARCO_RETURN_IF_ERROR(WriteJsonFile(manifest_tmp, CaptureManifestToJson(manifest)));
-  ARCO_RETURN_IF_ERROR(outputs.Commit());
   summary.wall_s = SecondsSince(start);
+  // The options as applied and what they found; times are not deterministic and are
+  // left out, so the report is the same bit for bit for any thread count.
+  Json report_summary = ToJson(summary);
+  report_summary.erase("decode_s");
+  report_summary.erase("wall_s");
+  for (Json* j : {&report_summary["total"]}) {
+    j->erase("models");
+    j->erase("inference_s");
+    j->erase("preprocess_s");
+    j->erase("postprocess_s");
+  }
+  for (Json& j : report_summary["cameras"]) {
+    j.erase("models");
+    j.erase("inference_s");
+    j.erase("preprocess_s");
+    j.erase("postprocess_s");
+  }
+  ARCO_RETURN_IF_ERROR(WriteJsonFile(report_tmp,
+                                     Json{{"format", "arco-detect-report"},
+                                          {"options", ToJson(options)},
+                                          {"summary", report_summary}}));
+  ARCO_RETURN_IF_ERROR(outputs.Commit());
   return summary;
 }
 

@@ -62,8 +62,9 @@ Json ToJson(const DetectStageSummary& summary);
 
 // Checks the capture (manifest, every camera's video present, readable and of its
 // calibration camera's size after rotate_deg, the models) before any frame is decoded,
-// then detects and replaces CAPTURE/keypoints2d.npy and capture.json together
-// (util/output_set.h): on any error neither changes. Progress: total = frames x cameras.
+// then detects and replaces CAPTURE/keypoints2d.npy, capture.json and detect.json (the
+// options as applied and the counts of the summary, without times) together
+// (util/output_set.h): on any error none changes. Progress: total = frames x cameras.
 StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options,
                                             Progress& progress = NoProgress());
 

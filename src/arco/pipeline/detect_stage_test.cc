@@ -19,6 +19,7 @@
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/capture_new.h"
 #include "arco/registry/keypoint_layout.h"
+#include "arco/util/json_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/test_dir.h"
 
@@ -139,6 +140,11 @@ TEST_F(DetectStageTest, FindsThePlayerInEveryCameraAfterRotation) {
   EXPECT_EQ(manifest->keypoints2d, "keypoints2d.npy");
   EXPECT_EQ(manifest->layout, "coco_wholebody_133");
   EXPECT_EQ(manifest->cameras[1].rotate_deg, 90);
+  // detect.json: the options as applied and the counts.
+  auto report = ReadJsonFile(capture + "/detect.json");
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  EXPECT_EQ((*report)["options"]["pose_model"], "full");
+  EXPECT_EQ((*report)["summary"]["cameras"][1]["frames_with_person"], 3);
 }
 
 TEST_F(DetectStageTest, SameBytesForAnyThreadCount) {
@@ -153,7 +159,8 @@ TEST_F(DetectStageTest, SameBytesForAnyThreadCount) {
     auto summary = RunDetectStage(o);
     ASSERT_TRUE(summary.ok()) << summary.status().message();
     EXPECT_EQ(summary->total.detector_runs, 4);  // 2 chunks x 2 cameras
-    bytes[threads - 1] = ReadBytes(capture + "/keypoints2d.npy");
+    bytes[threads - 1] =
+        ReadBytes(capture + "/keypoints2d.npy") + ReadBytes(capture + "/detect.json");
   }
   ASSERT_FALSE(bytes[0].empty());
   EXPECT_EQ(bytes[0], bytes[1]);
@@ -244,6 +251,7 @@ TEST_F(DetectStageTest, BadInputChangesNothing) {
 
   // Nothing was written by any of them.
   EXPECT_FALSE(fs::exists(capture + "/keypoints2d.npy"));
+  EXPECT_FALSE(fs::exists(capture + "/detect.json"));
   EXPECT_EQ(ReadBytes(capture + "/capture.json"), manifest_before);
   for (const auto& entry : fs::directory_iterator(capture)) {
     EXPECT_NE(entry.path().filename().string()[0], '.') << entry.path();
