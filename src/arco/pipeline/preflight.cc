@@ -1,6 +1,7 @@
 #include "arco/pipeline/preflight.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <vector>
@@ -135,6 +136,37 @@ Status CheckTriangulationFilters(const TriangulateStageOptions& options,
   return Status::Ok();
 }
 
+Status CheckCaptureInstrumentPoints(const CaptureContext& capture) {
+  const CaptureManifest& m = capture.manifest;
+  ARCO_ASSIGN_OR_RETURN(const NpyArray<double> k, ReadCaptureKeypoints2d(capture.capture_dir, m));
+  const InstrumentModel& model = *capture.instrument;
+  std::vector<int> ends;
+  for (const int i : {model.nut_l(), model.nut_r(), model.bridge_l(), model.bridge_r()}) {
+    ends.push_back(capture.layout.Find(model.keypoint_names()[i]));
+  }
+  const int64_t frames = k.shape[0], views = k.shape[1], points = k.shape[2];
+  for (int64_t f = 0; f < frames; ++f) {
+    bool all = true;
+    for (const int p : ends) {
+      int seen = 0;
+      for (int64_t v = 0; v < views && seen < 2; ++v) {
+        const double* q = &k.data[static_cast<size_t>(((f * views + v) * points + p) * 3)];
+        if (std::isfinite(q[0]) && std::isfinite(q[1]) && q[2] > 0) ++seen;
+      }
+      if (seen < 2) {
+        all = false;
+        break;
+      }
+    }
+    if (all) return Status::Ok();
+  }
+  return Status::Error(ResolveCapturePath(capture.capture_dir, m.keypoints2d) +
+                       ": no frame shows the " + m.instrument +
+                       "'s nut_l, nut_r, bridge_l and bridge_r in two views each (the strings "
+                       "cannot be placed); a capture made from videos gets them from `arco "
+                       "track` after `arco detect`");
+}
+
 StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
   ARCO_RETURN_IF_ERROR(options.Validate());
   ARCO_RETURN_IF_ERROR(CheckOutputFolder(options.result_dir, options.Replace()));
@@ -142,6 +174,7 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
   const CaptureManifest& m = capture.manifest;
   ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(options.capture_dir, m));
   ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(options.capture_dir, m));
+  ARCO_RETURN_IF_ERROR(CheckCaptureInstrumentPoints(capture));
   ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(
       options.ForTriangulate(), capture.layout, m.fps, ManifestPath(options.capture_dir)));
   ARCO_RETURN_IF_ERROR(CheckCaptureAudio(options.capture_dir, m).status());

@@ -50,10 +50,17 @@ Status CheckTriangulationFilters(const TriangulateStageOptions& options,
                                  double fps,
                                  const std::string& manifest_path);
 
+// The instrument's string ends (nut_l, nut_r, bridge_l, bridge_r) are seen, each in at
+// least two views, in at least one frame: the instrument stage needs them to place the
+// strings. A capture made from videos has them only after `arco track` (or an importer);
+// without them this is one line naming keypoints2d.npy, before any work. Reads the 2D
+// keypoints (their header was checked by CheckCaptureKeypoints2d).
+Status CheckCaptureInstrumentPoints(const CaptureContext& capture);
+
 // Every check of `arco run`, in the order a user fixes them: options, the result folder
 // (writable; replaceable only with --overwrite), capture.json and its instrument and
 // layout (OpenCapture), the calibration and cameras, keypoints2d.npy (dtype and shape,
-// from its header), the filters, the audio and its offset. Returns the opened capture.
+// from its header; the instrument's string ends present), the filters, the audio and its offset. Returns the opened capture.
 StatusOr<CaptureContext> PreflightRun(const RunOptions& options);
 
 }  // namespace arco::pipeline

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "arco/audio/test_signals.h"
@@ -145,6 +146,32 @@ TEST(PreflightRun, TheInstrumentsPointsAndTheOutputAreChecked) {
                                                "point ",
                                 0),
             0u);
+  // The string ends missing (a capture from videos before `arco track`): NaN in every
+  // frame, then present in one view only, then in two views of one frame.
+  TestCapture e;
+  const int kNut = 133 + 1;  // spd_cello: scroll_top, nut_l, nut_r, bridge_l, bridge_r, ...
+  NpyArray<float> k;
+  k.shape = {kFrames, 2, 142, 3};
+  k.data.assign(static_cast<size_t>(kFrames * 2 * 142 * 3), 100.0f);
+  const auto point = [&](int f, int v, int p) { return &k.data[((f * 2 + v) * 142 + p) * 3]; };
+  for (int f = 0; f < kFrames; ++f)
+    for (int v = 0; v < 2; ++v)
+      for (int p = kNut; p < kNut + 4; ++p) point(f, v, p)[0] = NAN;
+  ASSERT_TRUE(WriteNpy(e.dir / "keypoints2d.npy", k).ok());
+  const std::string missing = e.Preflight();
+  EXPECT_EQ(missing.rfind((e.dir / "keypoints2d.npy") + ": no frame shows the cello's nut_l, "
+                                                        "nut_r, bridge_l and bridge_r in two "
+                                                        "views each",
+                          0),
+            0u)
+      << missing;
+  for (int p = kNut; p < kNut + 4; ++p) point(7, 0, p)[0] = 100.0f;
+  ASSERT_TRUE(WriteNpy(e.dir / "keypoints2d.npy", k).ok());
+  EXPECT_NE(e.Preflight(), "ok");
+  for (int p = kNut; p < kNut + 4; ++p) point(7, 1, p)[0] = 100.0f;
+  ASSERT_TRUE(WriteNpy(e.dir / "keypoints2d.npy", k).ok());
+  EXPECT_EQ(e.Preflight(), "ok");
+
   TestCapture d;
   ASSERT_TRUE(AtomicWriteFile(d.dir / "file", "x").ok());
   RunOptions o = d.Options();
