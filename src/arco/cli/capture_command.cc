@@ -27,6 +27,8 @@ inline constexpr FieldFlag kCaptureFlags[] = {{"inputs", "--video/--images"},
                                               {"output_dir", "-o"},
                                               {"format", "--format"},
                                               {"sources", "--camera"},
+                                              {"pixels = decoded", "--pixels decoded"},
+                                              {"pixels = calibration", "--pixels calibration"},
                                               {"an input with images set", "given with --images"}};
 
 // "CAMERA=VALUE" -> {CAMERA, VALUE}; throws CLI::ValidationError naming the flag and the
@@ -229,6 +231,14 @@ std::function<int()> SetupCapture(CLI::App& app) {
                    k->cameras,
                    "CAMERA=PATH: a camera's keypoint file or folder; one for every camera")
       ->required();
+  import
+      ->add_option("--pixels",
+                   k->options.pixels,
+                   "Needed when a camera has a rotation: decoded (the detector saw the video's "
+                   "frames as stored; arco turns the points by the camera's rotate_deg) or "
+                   "calibration (it saw them turned, e.g. SPD's images or OpenCV's "
+                   "auto-rotated phone video)")
+      ->check(CLI::IsMember({"decoded", "calibration"}));
   import->add_flag(
       "--overwrite", k->options.overwrite, "Replace the 2D keypoints the capture already has");
   import->parse_complete_callback([k] {

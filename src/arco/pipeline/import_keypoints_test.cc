@@ -168,6 +168,59 @@ TEST(ImportKeypoints, OpenPoseFoldersIntoAnInstrumentLayout) {
   EXPECT_TRUE(std::isnan(k->at(1, 1, shoulder, 0)));               // dropped
 }
 
+TEST(RotateDecodedPixel, TurnsPixelCentresLikeTheFrame) {
+  // A 4 x 2 frame turned clockwise is 2 x 4: its top-left pixel goes to the top right.
+  const Eigen::Vector2i turned(2, 4);
+  EXPECT_EQ(RotateDecodedPixel({0, 0}, 90, turned), Eigen::Vector2d(1, 0));
+  EXPECT_EQ(RotateDecodedPixel({3, 0}, 90, turned), Eigen::Vector2d(1, 3));
+  EXPECT_EQ(RotateDecodedPixel({3, 1}, 90, turned), Eigen::Vector2d(0, 3));
+  EXPECT_EQ(RotateDecodedPixel({0, 0}, 270, turned), Eigen::Vector2d(0, 3));
+  EXPECT_EQ(RotateDecodedPixel({1, 0}, 180, Eigen::Vector2i(4, 2)), Eigen::Vector2d(2, 1));
+  EXPECT_EQ(RotateDecodedPixel({1.5, 0.25}, 0, Eigen::Vector2i(4, 2)), Eigen::Vector2d(1.5, 0.25));
+  // 90 then 270 (in the turned frame) is where it started.
+  const Eigen::Vector2d p(2.5, 1.25);
+  EXPECT_TRUE(RotateDecodedPixel(RotateDecodedPixel(p, 90, {2, 4}), 270, {4, 2}).isApprox(p));
+}
+
+// A rotated camera: the pixels' frame must be said, and decoded pixels are turned.
+TEST(ImportKeypoints, RotatedCameraNeedsPixelsAndTurnsDecodedOnes) {
+  TempDir dir;
+  const std::string capture = MakeCapture(dir);
+  auto m = ReadCaptureManifest(capture);
+  ASSERT_TRUE(m.ok());
+  m->cameras[1].rotate_deg = 180;  // 128 x 96 either way
+  ASSERT_TRUE(WriteCaptureManifest(capture, *m).ok());
+  ASSERT_TRUE(MakeDirectories(dir / "frames").ok());
+  for (int f = 0; f < 4; ++f) {
+    Write(dir / ("frames/" + std::to_string(f) + ".json"), "[" + Instance(10, 20, 0.5, 5) + "]");
+  }
+  ImportKeypointsOptions o;
+  o.capture_dir = capture;
+  o.format = "mmpose";
+  o.sources = {{"cam0", dir / "frames"}, {"cam1", dir / "frames"}};
+  // cam1 has 3 video frames: a per-video file instead.
+  Write(dir / "cam1.json",
+        "[{\"frame_id\": 0, \"instances\": [" + Instance(10, 20, 0.5, 5) + "]}]");
+  o.sources[1].path = dir / "cam1.json";
+  const auto unsaid = ImportKeypoints(o);
+  ASSERT_FALSE(unsaid.ok());
+  EXPECT_NE(unsaid.status().message().find("rotate_deg 180"), std::string::npos)
+      << unsaid.status().message();
+  o.pixels = "calibration";
+  ASSERT_TRUE(ImportKeypoints(o).ok());
+  auto k = ReadCaptureKeypoints2d(capture, *ReadCaptureManifest(capture));
+  ASSERT_TRUE(k.ok());
+  EXPECT_DOUBLE_EQ(k->at(0, 1, 0, 0), 10);
+  o.pixels = "decoded";
+  o.overwrite = true;
+  ASSERT_TRUE(ImportKeypoints(o).ok());
+  k = ReadCaptureKeypoints2d(capture, *ReadCaptureManifest(capture));
+  ASSERT_TRUE(k.ok());
+  EXPECT_DOUBLE_EQ(k->at(0, 1, 0, 0), 127 - 10);  // turned by 180 in 128 x 96
+  EXPECT_DOUBLE_EQ(k->at(0, 1, 0, 1), 95 - 20);
+  EXPECT_DOUBLE_EQ(k->at(0, 0, 0, 0), 10);  // cam0 is not rotated
+}
+
 TEST(ImportKeypoints, BadInputsWriteNothing) {
   TempDir dir;
   const std::string capture = MakeCapture(dir);
@@ -214,6 +267,9 @@ TEST(ImportKeypointsOptions, ValidateNamesTheField) {
   EXPECT_NE(o.Validate().message().find("sources"), std::string::npos);
   o.sources.clear();
   EXPECT_NE(o.Validate().message().find("sources"), std::string::npos);
+  o.sources = {{"cam0", "a.json"}};
+  o.pixels = "sideways";
+  EXPECT_NE(o.Validate().message().find("pixels"), std::string::npos);
 }
 
 }  // namespace
