@@ -171,9 +171,11 @@ std::function<int()> SetupCapture(CLI::App& app) {
                      n->videos,
                      "CAMERA=FILE: a camera's video file (or single image); CAMERA is a "
                      "calibration camera's name or serial; repeat for each camera");
-  create->add_option("--images",
-                     n->images,
-                     "CAMERA=DIR: a camera's folder of images, one per frame (natural order)");
+  create->add_option(
+      "--images",
+      n->images,
+      "CAMERA=DIR: a camera's folder of images, one per frame (natural order); views: "
+      "the --video cameras first, then these");
   create->add_option("--audio", n->options.audio, "Audio file of the performance (referenced)");
   create
       ->add_option("--instrument",
