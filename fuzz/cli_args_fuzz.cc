@@ -23,6 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (args.size() > kMaxArgs) args.resize(kMaxArgs);
   arco::cli::App app = arco::cli::BuildApp();
   (void)arco::cli::CheckCommandName(app, args.front());  // a Status, never throws
+  (void)arco::cli::CheckCommandNames(app, args);
   try {
     app.Parse(args);
   } catch (const CLI::ParseError&) {

@@ -26,14 +26,19 @@ inline constexpr FieldFlag kCaptureFlags[] = {{"inputs", "--video/--images"},
                                               {"fps", "--fps"},
                                               {"output_dir", "-o"},
                                               {"format", "--format"},
-                                              {"sources", "--camera"}};
+                                              {"sources", "--camera"},
+                                              {"pixels = decoded", "--pixels decoded"},
+                                              {"pixels = calibration", "--pixels calibration"},
+                                              {"an input with images set", "given with --images"}};
 
-// "CAMERA=VALUE" -> {CAMERA, VALUE}; throws CLI::ValidationError naming the flag.
+// "CAMERA=VALUE" -> {CAMERA, VALUE}; throws CLI::ValidationError naming the flag and the
+// expected `form`.
 std::pair<std::string, std::string> SplitAssignment(const std::string& flag,
-                                                    const std::string& text) {
+                                                    const std::string& text,
+                                                    const std::string& form) {
   const size_t eq = text.find('=');
   if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) {
-    throw CLI::ValidationError(flag + ": " + text + " is not CAMERA=VALUE");
+    throw CLI::ValidationError(flag + ": " + text + " is not " + form);
   }
   return {text.substr(0, eq), text.substr(eq + 1)};
 }
@@ -58,16 +63,16 @@ struct CaptureNewArgs {
     auto& o = options;
     o.inputs.clear();
     for (const std::string& v : videos) {
-      const auto [camera, path] = SplitAssignment("--video", v);
+      const auto [camera, path] = SplitAssignment("--video", v, "CAMERA=FILE");
       o.inputs.push_back({camera, path, false});
     }
     for (const std::string& v : images) {
-      const auto [camera, path] = SplitAssignment("--images", v);
+      const auto [camera, path] = SplitAssignment("--images", v, "CAMERA=DIR");
       o.inputs.push_back({camera, path, true});
     }
     o.rotate_deg.clear();
     for (const std::string& r : rotate) {
-      const auto [camera, deg] = SplitAssignment("--rotate", r);
+      const auto [camera, deg] = SplitAssignment("--rotate", r, "CAMERA=DEGREES");
       const int64_t value = ParseWhole("--rotate", deg, 0, 270);
       if (value % 90 != 0) {
         throw CLI::ValidationError("--rotate: " + r + ": the rotation must be 0, 90, 180 or 270");
@@ -78,7 +83,7 @@ struct CaptureNewArgs {
     }
     o.dropped_frames.clear();
     for (const std::string& d : drops) {
-      const auto [camera, list] = SplitAssignment("--dropped-frames", d);
+      const auto [camera, list] = SplitAssignment("--dropped-frames", d, "CAMERA=FRAME,FRAME,...");
       std::vector<int64_t> frames;
       for (size_t at = 0; at <= list.size();) {
         const size_t comma = std::min(list.find(',', at), list.size());
@@ -125,7 +130,7 @@ struct ImportArgs {
   void Convert() {
     options.sources.clear();
     for (const std::string& c : cameras) {
-      const auto [camera, path] = SplitAssignment("--camera", c);
+      const auto [camera, path] = SplitAssignment("--camera", c, "CAMERA=PATH");
       options.sources.push_back({camera, path});
     }
   }
@@ -166,9 +171,11 @@ std::function<int()> SetupCapture(CLI::App& app) {
                      n->videos,
                      "CAMERA=FILE: a camera's video file (or single image); CAMERA is a "
                      "calibration camera's name or serial; repeat for each camera");
-  create->add_option("--images",
-                     n->images,
-                     "CAMERA=DIR: a camera's folder of images, one per frame (natural order)");
+  create->add_option(
+      "--images",
+      n->images,
+      "CAMERA=DIR: a camera's folder of images, one per frame (natural order); views: "
+      "the --video cameras first, then these");
   create->add_option("--audio", n->options.audio, "Audio file of the performance (referenced)");
   create
       ->add_option("--instrument",
@@ -226,6 +233,14 @@ std::function<int()> SetupCapture(CLI::App& app) {
                    k->cameras,
                    "CAMERA=PATH: a camera's keypoint file or folder; one for every camera")
       ->required();
+  import
+      ->add_option("--pixels",
+                   k->options.pixels,
+                   "Needed when a camera has a rotation: decoded (the detector saw the video's "
+                   "frames as stored; arco turns the points by the camera's rotate_deg) or "
+                   "calibration (it saw them turned, e.g. SPD's images or OpenCV's "
+                   "auto-rotated phone video)")
+      ->check(CLI::IsMember({"decoded", "calibration"}));
   import->add_flag(
       "--overwrite", k->options.overwrite, "Replace the 2D keypoints the capture already has");
   import->parse_complete_callback([k] {

@@ -48,7 +48,9 @@ StatusOr<media::VideoProperties> ProbeInput(const CaptureNewInput& input) {
     return Status::Error(input.path + ": not a folder of images");
   }
   if (!input.images && is_folder) {
-    return Status::Error(input.path + ": is a folder; a folder of images is given as images");
+    return Status::Error(input.path +
+                         ": is a folder, not a video file (a folder of images is an input with "
+                         "images set)");
   }
   ARCO_ASSIGN_OR_RETURN(media::VideoReader reader, media::VideoReader::Open(input.path));
   media::VideoProperties p = reader.properties();
@@ -58,9 +60,10 @@ StatusOr<media::VideoProperties> ProbeInput(const CaptureNewInput& input) {
   if (p.frame_count > 1) {
     StatusOr<media::Image> last = reader.ReadFrame(p.frame_count - 1);
     if (!last.ok()) {
-      return Status::Error(input.path + ": frame " + std::to_string(p.frame_count - 1) +
-                           " of the " + std::to_string(p.frame_count) +
-                           " it announces cannot be read (truncated?): " + last.status().message());
+      std::string why = last.status().message();
+      if (why.rfind(input.path + ": ", 0) == 0) why = why.substr(input.path.size() + 2);
+      return Status::Error(input.path + ": announces " + std::to_string(p.frame_count) +
+                           " frames but the last cannot be read (truncated?): " + why);
     }
   }
   return p;

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 
+#include "arco/audio/test_signals.h"
 #include "arco/calibration/calibration_file.h"
 #include "arco/media/test_video.h"
 #include "arco/mocap/capture.h"
@@ -115,6 +116,8 @@ TEST(CreateCapture, RelativePathsResolveFromTheCapture) {
   o.inputs[0].path = "a.mkv";
   o.inputs[1].path = "./b.mkv";
   o.output_dir = "captures/session/";
+  ASSERT_TRUE(audio::testing::WriteWav("take.wav", std::vector<float>(4410, 0.1f), 44100).ok());
+  o.audio = "take.wav";
   const auto r = CreateCapture(o);
   const auto m = ReadCaptureManifest("captures/session");
   fs::current_path(before);
@@ -122,6 +125,8 @@ TEST(CreateCapture, RelativePathsResolveFromTheCapture) {
   ASSERT_TRUE(m.ok()) << m.status().message();
   EXPECT_EQ(m->cameras[0].video, "../../a.mkv");
   EXPECT_EQ(m->cameras[1].video, "../../b.mkv");
+  EXPECT_EQ(m->audio, "../../take.wav");
+  EXPECT_EQ(m->audio_offset_s, 0);
   EXPECT_EQ(m->name, "session");
   EXPECT_TRUE(fs::exists(ResolveCapturePath(dir / "captures/session", m->cameras[0].video)));
 }

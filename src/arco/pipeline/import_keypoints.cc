@@ -5,9 +5,11 @@
 #include <filesystem>
 #include <set>
 
+#include "arco/calibration/calibration_file.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/mmpose_json.h"
 #include "arco/mocap/openpose_json.h"
+#include "arco/pipeline/preflight.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/check.h"
 #include "arco/util/file_io.h"
@@ -22,10 +24,31 @@ constexpr char kKeypointsFile[] = "keypoints2d.npy";
 
 }  // namespace
 
+Eigen::Vector2d RotateDecodedPixel(const Eigen::Vector2d& pixel,
+                                   int rotate_deg,
+                                   const Eigen::Vector2i& rotated_size) {
+  // Pixel centres at integers: turning a W x H image clockwise by 90 degrees sends the
+  // centre (x, y) to (H - 1 - y, x), and H is the turned image's width.
+  const double w = rotated_size.x() - 1.0, h = rotated_size.y() - 1.0;
+  switch (rotate_deg) {
+    case 90:
+      return {w - pixel.y(), pixel.x()};
+    case 180:
+      return {w - pixel.x(), h - pixel.y()};
+    case 270:
+      return {pixel.y(), h - pixel.x()};
+    default:
+      return pixel;
+  }
+}
+
 Status ImportKeypointsOptions::Validate() const {
   if (capture_dir.empty()) return Status::Error("capture_dir is empty");
   if (format != "mmpose" && format != "openpose") {
     return Status::Error("format is \"" + format + "\"; must be mmpose or openpose");
+  }
+  if (!pixels.empty() && pixels != "decoded" && pixels != "calibration") {
+    return Status::Error("pixels is \"" + pixels + "\"; must be decoded or calibration");
   }
   if (sources.empty()) return Status::Error("sources: give every camera's keypoints");
   std::set<std::string> cameras;
@@ -70,6 +93,33 @@ StatusOr<ImportKeypointsSummary> ImportKeypoints(const ImportKeypointsOptions& o
     if (!by_view[v]) {
       return Status::Error(manifest_path + ": camera \"" + m.cameras[v].name +
                            "\" has no keypoints; give every camera's");
+    }
+  }
+  // A rotated camera's decoded pixels are turned into the calibration's image, whose size
+  // the calibration gives.
+  std::vector<Eigen::Vector2i> image_size(m.cameras.size(), Eigen::Vector2i::Zero());
+  bool rotated = false;
+  for (const CaptureCamera& c : m.cameras) rotated = rotated || c.rotate_deg != 0;
+  if (rotated && o.pixels.empty()) {
+    for (const CaptureCamera& c : m.cameras) {
+      if (c.rotate_deg == 0) continue;
+      return Status::Error(manifest_path + ": camera \"" + c.name + "\" has rotate_deg " +
+                           std::to_string(c.rotate_deg) +
+                           "; say whether the keypoints' pixels are in the decoded frames "
+                           "(pixels = decoded: they are turned the same way) or already in "
+                           "the calibration's image (pixels = calibration)");
+    }
+  }
+  if (rotated && o.pixels == "decoded") {
+    const std::string calibration_path = ResolveCapturePath(o.capture_dir, m.calibration);
+    StatusOr<Calibration> calibration = LoadCalibration(calibration_path);
+    if (!calibration.ok()) return calibration.status().WithContext(manifest_path + ": calibration");
+    ARCO_ASSIGN_OR_RETURN(
+        const std::vector<int> cameras,
+        MatchCaptureCameras(o.capture_dir, m, calibration->rig, calibration_path));
+    for (size_t v = 0; v < m.cameras.size(); ++v) {
+      const Camera& cam = calibration->rig.cameras[static_cast<size_t>(cameras[v])];
+      image_size[v] = {cam.width, cam.height};
     }
   }
   // Declared before the work: both or neither.
@@ -123,8 +173,12 @@ StatusOr<ImportKeypointsSummary> ImportKeypoints(const ImportKeypointsOptions& o
         const Eigen::Vector3d& row = person.keypoints[static_cast<size_t>(p)];
         if (!row.allFinite()) continue;
         float* at = &k.data[static_cast<size_t>(((f * views + v) * points + p) * 3)];
-        at[0] = static_cast<float>(row.x());
-        at[1] = static_cast<float>(row.y());
+        const Eigen::Vector2d pixel =
+            o.pixels == "decoded"
+                ? RotateDecodedPixel(row.head<2>(), m.cameras[v].rotate_deg, image_size[v])
+                : Eigen::Vector2d(row.head<2>());
+        at[0] = static_cast<float>(pixel.x());
+        at[1] = static_cast<float>(pixel.y());
         at[2] = static_cast<float>(row.z());
       }
     }

@@ -11,8 +11,17 @@
 // NaN. A folder of per-frame files must hold one file per video frame up to the
 // capture's last frame; a per-video file may stop early (the rest NaN) but not go past
 // it. One person per frame: the largest box (mocap/detections.h SelectPerson).
+//
+// Pixels: the capture's are in the calibration's image, a camera's video frames turned by
+// its rotate_deg. A detector run on the decoded frames as stored (arco's VideoReader,
+// ffmpeg) gives pixels that must be turned the same way (pixels = "decoded"); one run on
+// frames already turned (SPD's rotated images; OpenCV, which applies a phone video's
+// display rotation, the default rotate_deg) gives the calibration's pixels (pixels =
+// "calibration"). With a rotated camera, pixels must be said: a guess would be a silently
+// wrong capture.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -31,6 +40,8 @@ struct ImportKeypointsOptions {
   std::string format;                          // "mmpose" or "openpose"
   std::vector<ImportKeypointsSource> sources;  // one per camera of the capture
   bool overwrite = false;                      // replace the 2D keypoints the capture already names
+  // "decoded" or "calibration" (above); may stay empty when no camera is rotated.
+  std::string pixels;
   Status Validate() const;
 };
 
@@ -49,5 +60,12 @@ struct ImportKeypointsSummary {
 };
 
 StatusOr<ImportKeypointsSummary> ImportKeypoints(const ImportKeypointsOptions& options);
+
+// A pixel of a decoded video frame in the frame turned clockwise by `rotate_deg` (0, 90,
+// 180, 270), whose size is `rotated_size` (the calibration's image); OpenCV's pixel
+// convention (centre of the top-left pixel at 0, 0).
+Eigen::Vector2d RotateDecodedPixel(const Eigen::Vector2d& pixel,
+                                   int rotate_deg,
+                                   const Eigen::Vector2i& rotated_size);
 
 }  // namespace arco::pipeline

@@ -10,7 +10,10 @@
 #include "arco/calibration/calibration_file.h"
 #include "arco/media/test_video.h"
 #include "arco/mocap/capture.h"
+#include "arco/mocap/synthetic_views.h"
 #include "arco/pipeline/capture_new.h"
+#include "arco/pipeline/result_folder.h"
+#include "arco/pipeline/triangulate_stage.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
@@ -168,6 +171,157 @@ TEST(ImportKeypoints, OpenPoseFoldersIntoAnInstrumentLayout) {
   EXPECT_TRUE(std::isnan(k->at(1, 1, shoulder, 0)));               // dropped
 }
 
+TEST(RotateDecodedPixel, TurnsPixelCentresLikeTheFrame) {
+  // A 4 x 2 frame turned clockwise is 2 x 4: its top-left pixel goes to the top right.
+  const Eigen::Vector2i turned(2, 4);
+  EXPECT_EQ(RotateDecodedPixel({0, 0}, 90, turned), Eigen::Vector2d(1, 0));
+  EXPECT_EQ(RotateDecodedPixel({3, 0}, 90, turned), Eigen::Vector2d(1, 3));
+  EXPECT_EQ(RotateDecodedPixel({3, 1}, 90, turned), Eigen::Vector2d(0, 3));
+  EXPECT_EQ(RotateDecodedPixel({0, 0}, 270, turned), Eigen::Vector2d(0, 3));
+  EXPECT_EQ(RotateDecodedPixel({1, 0}, 180, Eigen::Vector2i(4, 2)), Eigen::Vector2d(2, 1));
+  EXPECT_EQ(RotateDecodedPixel({1.5, 0.25}, 0, Eigen::Vector2i(4, 2)), Eigen::Vector2d(1.5, 0.25));
+  // 90 then 270 (in the turned frame) is where it started.
+  const Eigen::Vector2d p(2.5, 1.25);
+  EXPECT_TRUE(RotateDecodedPixel(RotateDecodedPixel(p, 90, {2, 4}), 270, {4, 2}).isApprox(p));
+}
+
+// A rotated camera: the pixels' frame must be said, and decoded pixels are turned.
+TEST(ImportKeypoints, RotatedCameraNeedsPixelsAndTurnsDecodedOnes) {
+  TempDir dir;
+  const std::string capture = MakeCapture(dir);
+  auto m = ReadCaptureManifest(capture);
+  ASSERT_TRUE(m.ok());
+  m->cameras[1].rotate_deg = 180;  // 128 x 96 either way
+  ASSERT_TRUE(WriteCaptureManifest(capture, *m).ok());
+  ASSERT_TRUE(MakeDirectories(dir / "frames").ok());
+  for (int f = 0; f < 4; ++f) {
+    Write(dir / ("frames/" + std::to_string(f) + ".json"), "[" + Instance(10, 20, 0.5, 5) + "]");
+  }
+  ImportKeypointsOptions o;
+  o.capture_dir = capture;
+  o.format = "mmpose";
+  o.sources = {{"cam0", dir / "frames"}, {"cam1", dir / "frames"}};
+  // cam1 has 3 video frames: a per-video file instead.
+  Write(dir / "cam1.json",
+        "[{\"frame_id\": 0, \"instances\": [" + Instance(10, 20, 0.5, 5) + "]}]");
+  o.sources[1].path = dir / "cam1.json";
+  const auto unsaid = ImportKeypoints(o);
+  ASSERT_FALSE(unsaid.ok());
+  EXPECT_NE(unsaid.status().message().find("rotate_deg 180"), std::string::npos)
+      << unsaid.status().message();
+  o.pixels = "calibration";
+  ASSERT_TRUE(ImportKeypoints(o).ok());
+  auto k = ReadCaptureKeypoints2d(capture, *ReadCaptureManifest(capture));
+  ASSERT_TRUE(k.ok());
+  EXPECT_DOUBLE_EQ(k->at(0, 1, 0, 0), 10);
+  o.pixels = "decoded";
+  o.overwrite = true;
+  ASSERT_TRUE(ImportKeypoints(o).ok());
+  k = ReadCaptureKeypoints2d(capture, *ReadCaptureManifest(capture));
+  ASSERT_TRUE(k.ok());
+  EXPECT_DOUBLE_EQ(k->at(0, 1, 0, 0), 127 - 10);  // turned by 180 in 128 x 96
+  EXPECT_DOUBLE_EQ(k->at(0, 1, 0, 1), 95 - 20);
+  EXPECT_DOUBLE_EQ(k->at(0, 0, 0, 0), 10);  // cam0 is not rotated
+}
+
+// The whole path from videos: capture new (one camera's video stored landscape and turned
+// 90 degrees, one camera that dropped a frame) -> MMPose files of exact projections in
+// the decoded frames -> import -> triangulate: every point back where it was.
+TEST(ImportKeypoints, VideosToCaptureToTriangulation) {
+  TempDir dir;
+  SyntheticRigOptions ro;
+  ro.num_cameras = 4;
+  ro.distortion = false;
+  Rig rig = MakeSyntheticRig(ro);
+  for (Camera& c : rig.cameras) {  // 2300 x 2656 scaled to 128 x 160 (about 1/18)
+    const double s = 128.0 / 2300.0;
+    c.width = 128;
+    c.height = 160;
+    c.fx *= s;
+    c.fy *= s;
+    c.cx = c.cx * s;
+    c.cy = c.cy * s;
+  }
+  ASSERT_TRUE(SaveCalibration(dir / "rig.json", rig).ok());
+  constexpr int kFrames = 5;
+  const NpyArray<double> truth = MakeSyntheticPoints(kFrames, 133, 3);
+  SyntheticDetectionOptions d;
+  d.noise_px = 0;
+  const NpyArray<double> k = MakeSyntheticDetections(rig, truth, d);
+
+  CaptureNewOptions c;
+  c.calibration = dir / "rig.json";
+  c.output_dir = dir / "capture";
+  c.rotate_deg = {{rig.cameras[1].name, 90}};
+  c.dropped_frames = {{rig.cameras[2].name, {3}}};
+  ImportKeypointsOptions o;
+  o.capture_dir = c.output_dir;
+  o.format = "mmpose";
+  o.pixels = "decoded";
+  for (int v = 0; v < 4; ++v) {
+    const std::string name = rig.cameras[static_cast<size_t>(v)].name;
+    media::testing::IndexVideo video;
+    video.width = v == 1 ? 160 : 128;  // stored landscape, turned 90 degrees
+    video.height = v == 1 ? 128 : 160;
+    video.frames = v == 2 ? kFrames - 1 : kFrames;
+    const std::string path = dir / (name + ".mkv");
+    ASSERT_TRUE(media::testing::WriteIndexVideo(path, video).ok());
+    c.inputs.push_back({name, path, false});
+    // Detections in the decoded frames: the calibration's pixels turned back.
+    std::string json = "[";
+    int frame_id = 0;
+    for (int f = 0; f < kFrames; ++f) {
+      if (v == 2 && f == 2) continue;  // global frame 3 was dropped
+      std::string kp, sc;
+      for (int p = 0; p < 133; ++p) {
+        Eigen::Vector2d px(k.at(f, v, p, 0), k.at(f, v, p, 1));
+        if (v == 1) px = RotateDecodedPixel(px, 270, {160, 128});  // the decoded size
+        char text[64];
+        std::snprintf(text, sizeof text, "[%.9g, %.9g]", px.x(), px.y());
+        kp += (p ? "," : "") + std::string(text);
+        sc += (p ? "," : "") + std::to_string(k.at(f, v, p, 2));
+      }
+      json += std::string(frame_id > 0 ? "," : "") + "{\"frame_id\": " + std::to_string(frame_id) +
+              ", \"instances\": [{\"keypoints\": [" + kp + "], \"keypoint_scores\": [" + sc +
+              "]}]}";
+      ++frame_id;
+    }
+    Write(dir / (name + ".json"), json + "]");
+    o.sources.push_back({name, dir / (name + ".json")});
+  }
+  const auto created = CreateCapture(c);
+  ASSERT_TRUE(created.ok()) << created.status().message();
+  EXPECT_EQ(created->frames, kFrames);
+  const auto imported = ImportKeypoints(o);
+  ASSERT_TRUE(imported.ok()) << imported.status().message();
+  TriangulateStageOptions t;
+  t.capture_dir = c.output_dir;
+  t.result_dir = dir / "result";
+  t.triangulation.point.max_reprojection_px = 1;  // exact data in 128 px images
+  const auto triangulated = RunTriangulateStage(t);
+  ASSERT_TRUE(triangulated.ok()) << triangulated.status().message();
+  const auto points = ReadNpy<double>(dir / "result/triangulation/points3d_raw.npy");
+  ASSERT_TRUE(points.ok()) << points.status().message();
+  ASSERT_EQ(points->shape, (std::vector<int64_t>{kFrames, 133, 3}));
+  double worst_m = 0;
+  for (int f = 0; f < kFrames; ++f) {
+    for (int p = 0; p < 133; ++p) {
+      for (int a = 0; a < 3; ++a) {
+        worst_m = std::max(worst_m, std::abs(points->at(f, p, a) - truth.at(f, p, a)));
+      }
+    }
+  }
+  EXPECT_LT(worst_m, 1e-3) << "a point moved by " << worst_m << " m";
+  // Every view agrees (the turned camera included); the dropped frame has one view fewer.
+  const auto inliers = ReadNpy<int32_t>(dir / "result/triangulation/inlier_count.npy");
+  ASSERT_TRUE(inliers.ok()) << inliers.status().message();
+  for (int f = 0; f < kFrames; ++f) {
+    for (int p = 0; p < 133; ++p) {
+      ASSERT_EQ(inliers->at(f, p), f == 2 ? 3 : 4) << "frame " << f << " point " << p;
+    }
+  }
+}
+
 TEST(ImportKeypoints, BadInputsWriteNothing) {
   TempDir dir;
   const std::string capture = MakeCapture(dir);
@@ -214,6 +368,9 @@ TEST(ImportKeypointsOptions, ValidateNamesTheField) {
   EXPECT_NE(o.Validate().message().find("sources"), std::string::npos);
   o.sources.clear();
   EXPECT_NE(o.Validate().message().find("sources"), std::string::npos);
+  o.sources = {{"cam0", "a.json"}};
+  o.pixels = "sideways";
+  EXPECT_NE(o.Validate().message().find("pixels"), std::string::npos);
 }
 
 }  // namespace

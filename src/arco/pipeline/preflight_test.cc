@@ -138,6 +138,17 @@ TEST(PreflightRun, KeypointsDtypeAndShapeComeFromTheHeader) {
                 "3) (frames.count, cameras, spd_cello points, 3)");
 }
 
+// A capture made from videos has no 2D keypoints until arco detect writes them.
+TEST(PreflightRun, ACaptureWithoutKeypointsSaysToRunDetect) {
+  TestCapture c;
+  c.manifest.keypoints2d.clear();
+  c.manifest.layout.clear();
+  c.Write();
+  EXPECT_EQ(c.Preflight(),
+            c.Manifest() + ": no 2D keypoints yet (no \"keypoints2d\" entry); run `arco detect " +
+                c.dir.path() + "` (or `arco capture import-keypoints`) first");
+}
+
 TEST(PreflightRun, TheInstrumentsPointsAndTheOutputAreChecked) {
   TestCapture c;
   c.manifest.layout = "coco_wholebody_133";
