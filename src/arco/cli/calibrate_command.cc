@@ -1,0 +1,201 @@
+// `arco calibrate --board SPEC --video CAM=FILE | --images CAM=DIR ... -o CALIBRATION`: a
+// rig's intrinsics and extrinsics from board videos or image folders
+// (calibration/calibrate.h; docs/calibration.md "Calibrating a rig"). Coexists with
+// `arco calibration show|convert`, which inspects and converts existing files.
+#include <cstdio>
+#include <memory>
+
+#include "arco/calibration/calibrate.h"
+#include "arco/cli/command.h"
+#include "arco/cli/flag_names.h"
+#include "arco/cli/number_option.h"
+#include "arco/cli/progress.h"
+
+namespace arco::cli {
+namespace {
+
+inline constexpr FieldFlag kCalibrateFlags[] = {{"frame_step", "--frame-step"},
+                                                {"max_frames", "--max-frames"},
+                                                {"max_intrinsic_views", "--intrinsic-views"},
+                                                {"loss_scale_px", "--loss-px"},
+                                                {"max_iterations", "--max-iterations"},
+                                                {"num_threads", "--threads"},
+                                                {"high_residual_px", "--high-residual-px"},
+                                                {"min_views", "--min-views"}};
+
+struct CalibrateArgs {
+  calibration::CalibrateOptions options;
+  std::vector<std::string> videos, images;
+  bool fix_intrinsics = false;
+};
+
+std::string FormatReport(const calibration::CalibrateResult& result, const std::string& output) {
+  const calibration::RigCalibrationReport& r = result.calibration.report;
+  std::string text;
+  char line[512];
+  std::snprintf(line,
+                sizeof(line),
+                "calibrated %zu cameras from %s boards; world: %s, mm\n",
+                r.cameras.size(),
+                r.board.c_str(),
+                r.origin.c_str());
+  text += line;
+  std::snprintf(line,
+                sizeof(line),
+                "%-16s %6s %6s %9s %9s %10s %10s %10s\n",
+                "camera",
+                "views",
+                "used",
+                "rms px",
+                "p95 px",
+                "fx",
+                "cx",
+                "cy");
+  text += line;
+  for (size_t c = 0; c < r.cameras.size(); ++c) {
+    const auto& cam = r.cameras[c];
+    const Camera& k = result.calibration.rig.cameras[c];
+    std::snprintf(line,
+                  sizeof(line),
+                  "%-16s %6d %6d %9.3f %9.3f %10.2f %10.2f %10.2f\n",
+                  cam.name.c_str(),
+                  cam.views,
+                  cam.views_used,
+                  cam.rms_px,
+                  cam.p95_px,
+                  k.fx,
+                  k.cx,
+                  k.cy);
+    text += line;
+  }
+  text += "shared frames:";
+  for (const auto& p : r.pairs)
+    text += " " + p.camera_a + "-" + p.camera_b + " " + std::to_string(p.shared_frames);
+  text += "\n";
+  std::snprintf(line,
+                sizeof(line),
+                "reprojection rms %.3f px; board triangulated: %.3f mm rms, %.3f mm p95 (%d "
+                "points); bundle adjustment %s after %d iterations, %.2f s\n",
+                r.rms_px,
+                r.board_rms_mm,
+                r.board_p95_mm,
+                r.board_points,
+                r.bundle_adjustment.termination.c_str(),
+                r.bundle_adjustment.iterations,
+                r.bundle_adjustment.time_s);
+  text += line;
+  for (const auto& w : r.warnings) text += "warning: " + w.code + ": " + w.message + "\n";
+  text += "wrote " + output + " and " + result.report_path + "\n";
+  return text;
+}
+
+void ApplyAndValidate(CalibrateArgs& a) {
+  a.options.inputs.clear();
+  for (const auto* list : {&a.videos, &a.images})
+    for (const std::string& text : *list) {
+      auto input = calibration::ParseCalibrateInput(text);
+      if (!input.ok())
+        ThrowIfInvalid(Status::Error((list == &a.videos ? "--video: " : "--images: ") +
+                                     input.status().message()));
+      a.options.inputs.push_back(*input);
+    }
+  a.options.calibration.refine_intrinsics = !a.fix_intrinsics;
+  a.options.calibration.num_threads = a.options.num_threads;
+  const Status valid = a.options.Validate();
+  if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kCalibrateFlags)));
+}
+
+std::function<int()> SetupCalibrate(CLI::App& app) {
+  auto a = std::make_shared<CalibrateArgs>();
+  calibration::CalibrateOptions& o = a->options;
+  auto* cmd = app.add_subcommand(
+      "calibrate",
+      "Calibrate a camera rig from videos or image folders of a board (intrinsics, "
+      "extrinsics by bundle adjustment, a report in px and mm)");
+  cmd->add_option("--board",
+                  o.board,
+                  "chessboard:COLSxROWS:SQUARE_MM (inner corners, e.g. chessboard:9x6:25) or "
+                  "charuco:COLSxROWS:SQUARE_MM:MARKER_MM[:DICT] (squares; DICT default "
+                  "DICT_4X4_50)")
+      ->required();
+  cmd->add_option("--video",
+                  a->videos,
+                  "CAMERA=FILE: a camera's video of the board (repeat per camera; all "
+                  "synchronised: frame n of every video is the same instant)");
+  cmd->add_option("--images",
+                  a->images,
+                  "CAMERA=DIR: a camera's folder of images (natural order; image n of every "
+                  "folder is the same instant), or one image");
+  cmd->add_option("--intrinsics",
+                  o.intrinsics,
+                  "Calibration file whose cameras (by name) give intrinsics to start from");
+  cmd->add_flag("--fix-intrinsics",
+                a->fix_intrinsics,
+                "Keep the intrinsics (given or initial) fixed in the bundle adjustment");
+  cmd->add_option("--origin",
+                  o.calibration.origin,
+                  "World frame: a camera's name (default: the first camera) or 'board' (the "
+                  "board in the first frame two cameras see)");
+  AddNumber(cmd,
+            "--max-frames",
+            o.detection.max_frames,
+            "Look at most at this many frames per camera (0 = all)",
+            calibration::kMaxFramesRange)
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--frame-step",
+            o.detection.frame_step,
+            "Look at every n-th frame",
+            calibration::kFrameStepRange)
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--intrinsic-views",
+            o.calibration.max_intrinsic_views,
+            "Views per camera (chosen to cover the image) for the initial intrinsics",
+            calibration::kIntrinsicViewsRange)
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--loss-px",
+            o.calibration.loss_scale_px,
+            "Huber loss scale of the bundle adjustment (px)",
+            calibration::kLossScaleRangePx)
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--max-iterations",
+            o.calibration.max_iterations,
+            "Bundle adjustment iterations at most",
+            calibration::kIterationsRange)
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--high-residual-px",
+            o.calibration.high_residual_px,
+            "Warn about a camera whose reprojection RMS is above this (px)",
+            calibration::kHighResidualRangePx)
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--min-views",
+            o.calibration.min_views,
+            "Warn about a camera with fewer board views",
+            calibration::kMinViewsRange)
+      ->capture_default_str();
+  AddNumber(cmd, "--threads", o.num_threads, "Threads (0 = all cores)", kThreadsRange)
+      ->capture_default_str();
+  cmd->add_option("-o,--output",
+                  o.output,
+                  "Calibration to write: .json arco JSON, .yaml/.yml OpenCV YAML, .xml OpenCV "
+                  "XML; the report goes beside it as NAME.report.json")
+      ->required();
+  cmd->parse_complete_callback([a] { ApplyAndValidate(*a); });
+  return [a] {
+    ProgressBar bar("calibrate");
+    auto result = calibration::RunCalibrate(a->options, bar);
+    bar.Finish();
+    if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kCalibrateFlags));
+    std::fputs(FormatReport(*result, a->options.output).c_str(), stdout);
+    return 0;
+  };
+}
+
+}  // namespace
+ARCO_REGISTER_COMMAND(calibrate, 21, SetupCalibrate);
+}  // namespace arco::cli
