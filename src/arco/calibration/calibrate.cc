@@ -65,7 +65,8 @@ StatusOr<CalibrateResult> RunCalibrate(const CalibrateOptions& options, Progress
   }
 
   const int n = static_cast<int>(options.inputs.size());
-  progress.StartStage(1, 2, "board detection");
+  // Progress counts cameras whose detection is done (no stage lines: an error is then the
+  // command's only line on stderr).
   std::vector<StatusOr<CameraBoardViews>> detected(n, Status::Error("not run"));
   progress.SetTotal(n);
   ParallelFor(
@@ -84,7 +85,6 @@ StatusOr<CalibrateResult> RunCalibrate(const CalibrateOptions& options, Progress
     if (!d.ok()) return d.status();
     result.detections.push_back(std::move(*d));
   }
-  progress.StartStage(2, 2, "calibration");
   ARCO_ASSIGN_OR_RETURN(
       result.calibration,
       CalibrateRig(

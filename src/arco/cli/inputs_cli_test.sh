@@ -161,6 +161,53 @@ check 'grep -q "^arco: error: $tmp/out_file/result: cannot create folder" "$tmp/
   "run under a file names the output: $(cat "$tmp/err")"
 check '! grep -q triangulate "$tmp/stdout" "$tmp/err"' "run under a file: a stage started"
 
+# arco calibrate: the board videos/images, the board spec, the camera graph and the given
+# intrinsics; one line, nothing written (OpenCV's stereo pairs from opencv-doc).
+data=/usr/share/doc/opencv-doc/examples/data
+blank=$tmp/blank.pgm  # a 640x480 frame without a board
+{ printf 'P5\n640 480\n255\n'; head -c 307200 /dev/zero | tr '\0' '\200'; } >"$blank"
+mkdir -p "$tmp/cal/L" "$tmp/cal/R" "$tmp/cal/A" "$tmp/cal/B"
+for n in 01 02 03 04 05 06; do
+  ln -s "$data/left$n.jpg" "$tmp/cal/L/$n.jpg"; ln -s "$data/right$n.jpg" "$tmp/cal/R/$n.jpg"
+  # A sees the board in frames 1-3 only, B in frames 4-6 only: no shared frame.
+  if [ "$n" -le 03 ]; then ln -s "$data/left$n.jpg" "$tmp/cal/A/$n.jpg"; ln -s "$blank" "$tmp/cal/B/$n.pgm"
+  else ln -s "$blank" "$tmp/cal/A/$n.pgm"; ln -s "$data/right$n.jpg" "$tmp/cal/B/$n.jpg"; fi
+done
+echo '{"cameras": 3}' >"$tmp/cal/bad_intrinsics.json"
+C=(calibrate --board chessboard:9x6:25)
+bad "calibrate: no board found" "$blank" "no board (chessboard:9x6:25) found in 1 frames" \
+  "${C[@]}" --images left="$tmp/cal/L" --images blank="$blank" -o "$tmp/out/rig.json"
+bad "calibrate: missing video" "$tmp/cal/missing.mp4" "" \
+  "${C[@]}" --images left="$tmp/cal/L" --video right="$tmp/cal/missing.mp4" -o "$tmp/out/rig.json"
+bad "calibrate: bad intrinsics" "$tmp/cal/bad_intrinsics.json" "" \
+  "${C[@]}" --images left="$tmp/cal/L" --images right="$tmp/cal/R" \
+  --intrinsics "$tmp/cal/bad_intrinsics.json" -o "$tmp/out/rig.json"
+# cal_bad NAME WORDS ARGS...: one line "arco: error: " holding WORDS, nothing written.
+cal_bad() {
+  local name=$1 words=$2; shift 2
+  rm -rf "$tmp/out"; mkdir -p "$tmp/out"
+  "$arco" "$@" >"$tmp/stdout" 2>"$tmp/err"
+  local rc=$?
+  local line; line=$(cat "$tmp/err")
+  check '[ $rc -ne 0 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ]' "$name: exit $rc, not one line: $line"
+  check '[[ "$line" == "arco: error: "*"$words"* ]]' "$name: does not say '$words': $line"
+  check '[ -z "$(ls -A "$tmp/out")" ]' "$name: left $(ls -A "$tmp/out" | head -3)"
+}
+cal_bad "calibrate: one camera" "at least two cameras, got 1 (left)" \
+  "${C[@]}" --images left="$tmp/cal/L" -o "$tmp/out/rig.json"
+cal_bad "calibrate: disconnected" "disconnected camera graph: b shares no board frame with a's group" \
+  "${C[@]}" --images a="$tmp/cal/A" --images b="$tmp/cal/B" -o "$tmp/out/rig.json"
+cal_bad "calibrate: wrong board spec" "board 'chessboard:9x6': expected chessboard:COLSxROWS:SQUARE_MM" \
+  calibrate --board chessboard:9x6 --images left="$tmp/cal/L" --images right="$tmp/cal/R" -o "$tmp/out/rig.json"
+cal_bad "calibrate: wrong board size" "no board (chessboard:7x7:25) found" \
+  calibrate --board chessboard:7x7:25 --images left="$tmp/cal/L" --images right="$tmp/cal/R" -o "$tmp/out/rig.json"
+cal_bad "calibrate: not CAMERA=PATH" "--images: 'left' is not CAMERA=PATH" \
+  "${C[@]}" --images left --images right="$tmp/cal/R" -o "$tmp/out/rig.json"
+cal_bad "calibrate: a camera twice" "camera 'left' is given twice" \
+  "${C[@]}" --images left="$tmp/cal/L" --images left="$tmp/cal/R" -o "$tmp/out/rig.json"
+cal_bad "calibrate: unknown origin" "origin 'cam9' is neither 'board' nor one of the cameras" \
+  "${C[@]}" --images left="$tmp/cal/L" --images right="$tmp/cal/R" --origin cam9 -o "$tmp/out/rig.json"
+
 # No temporaries next to any output after all of the above.
 check '[ -z "$(find "$tmp" -name ".tmp-*" -o -name ".old-*")" ]' "temporaries left behind"
 
