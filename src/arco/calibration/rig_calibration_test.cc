@@ -4,8 +4,10 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <set>
 
@@ -302,6 +304,92 @@ TEST(CalibrateRig, InvalidOptionsAndInputsThrow) {
   synthetic.views[0].views[0].point_ids.pop_back();
   EXPECT_THROW((void)CalibrateRig(RigCalibrationOptions(), board, synthetic.views),
                std::invalid_argument);
+}
+
+// ---- Detection on rendered frames. ----
+
+TEST(DetectBoard, FindsRenderedChessboardCornersToASmallFractionOfAPixel) {
+  const BoardSpec board = Chessboard(80);
+  SyntheticBoardRigOptions options;
+  options.num_cameras = 3;
+  options.num_frames = 30;
+  options.width = 1280;
+  options.height = 720;
+  options.noise_px = 0;
+  const SyntheticBoardRig exact = MakeSyntheticBoardRig(board, options);
+  const Camera& camera = exact.truth.cameras[0];
+  const BoardRenderer renderer(board, camera, 4);
+  double worst = 0;
+  int found = 0;
+  ASSERT_GE(exact.views[0].views.size(), 5u);
+  for (const BoardView& truth : exact.views[0].views) {
+    const media::Image image = renderer.Render(exact.world_from_board[truth.frame]);
+    const auto view = DetectBoard(board, image);
+    if (!view) continue;
+    ++found;
+    ASSERT_EQ(view->corners_px.size(), truth.corners_px.size());
+    // The corners come in the board's order or backwards (a chessboard's 180-degree
+    // ambiguity, which CalibrateRig resolves).
+    double forward = 0, backward = 0;
+    const size_t n = truth.corners_px.size();
+    for (size_t i = 0; i < n; ++i) {
+      forward = std::max(forward, (view->corners_px[i] - truth.corners_px[i]).norm());
+      backward = std::max(backward, (view->corners_px[i] - truth.corners_px[n - 1 - i]).norm());
+    }
+    worst = std::max(worst, std::min(forward, backward));
+  }
+  std::printf("rendered chessboard: %d of %zu views found, worst corner %.3f px\n",
+              found,
+              exact.views[0].views.size(),
+              worst);
+  EXPECT_GE(found, static_cast<int>(exact.views[0].views.size()) - 1);
+  EXPECT_LT(worst, 0.3);
+  // A frame without the board.
+  media::Image blank = renderer.Render(Eigen::Isometry3d(Eigen::Translation3d(0, 0, -1e5)));
+  EXPECT_FALSE(DetectBoard(board, blank).has_value());
+}
+
+TEST(DetectBoard, FindsAChArUcoBoardDrawnByOpenCvWithItsIds) {
+  auto spec = ParseBoardSpec("charuco:7x5:40:30:DICT_5X5_100");
+  ASSERT_TRUE(spec.ok());
+  const cv::Ptr<cv::aruco::CharucoBoard> board = cv::aruco::CharucoBoard::create(
+      7, 5, 40.f, 30.f, cv::aruco::getPredefinedDictionary(cv::aruco::DICT_5X5_100));
+  cv::Mat drawn;
+  board->draw(cv::Size(1400, 1000), drawn, 40, 1);
+  // Seen obliquely: the drawing warped by a homography onto a grey 1280 x 720 frame.
+  const std::vector<cv::Point2f> from = {{0, 0}, {1400, 0}, {1400, 1000}, {0, 1000}};
+  const std::vector<cv::Point2f> to = {{250, 90}, {1050, 140}, {980, 650}, {300, 600}};
+  const cv::Mat H = cv::getPerspectiveTransform(from, to);
+  cv::Mat frame(720, 1280, CV_8UC1, cv::Scalar(128));
+  cv::warpPerspective(drawn, frame, H, frame.size(), cv::INTER_AREA, cv::BORDER_TRANSPARENT);
+  media::Image image;
+  image.width = frame.cols;
+  image.height = frame.rows;
+  image.format = media::PixelFormat::kGray8;
+  image.pixels.assign(frame.data, frame.data + frame.total());
+  const auto view = DetectBoard(*spec, image);
+  ASSERT_TRUE(view.has_value());
+  EXPECT_GE(view->point_ids.size(), 20u);  // 6 x 4 inner corners
+  // The ids agree with the board's geometry: one homography maps the board's points to the
+  // corners found.
+  const auto points = spec->PointsInBoard();
+  std::vector<cv::Point2f> board_points, corners;
+  for (size_t i = 0; i < view->point_ids.size(); ++i) {
+    board_points.emplace_back(points[view->point_ids[i]].x(), points[view->point_ids[i]].y());
+    corners.emplace_back(view->corners_px[i].x(), view->corners_px[i].y());
+  }
+  const cv::Mat fit = cv::findHomography(board_points, corners, 0);
+  std::vector<cv::Point2f> mapped;
+  cv::perspectiveTransform(board_points, mapped, fit);
+  double worst = 0;
+  for (size_t i = 0; i < mapped.size(); ++i)
+    worst = std::max(worst, static_cast<double>(cv::norm(mapped[i] - corners[i])));
+  std::printf("charuco: %zu corners, worst homography residual %.3f px\n", corners.size(), worst);
+  EXPECT_LT(worst, 0.5);
+  // Another dictionary finds nothing.
+  auto other = ParseBoardSpec("charuco:7x5:40:30:DICT_4X4_50");
+  ASSERT_TRUE(other.ok());
+  EXPECT_FALSE(DetectBoard(*other, image).has_value());
 }
 
 // ---- Real images: OpenCV's stereo pairs (opencv-doc), against cv::stereoCalibrate. ----

@@ -1,5 +1,6 @@
 #include "arco/calibration/synthetic_board_rig.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -104,20 +105,32 @@ SyntheticBoardRig MakeSyntheticBoardRig(const BoardSpec& board,
   return rig;
 }
 
-media::Image RenderBoardImage(const BoardSpec& board,
-                              const Camera& camera,
-                              const Eigen::Isometry3d& world_from_board) {
+BoardRenderer::BoardRenderer(const BoardSpec& board, const Camera& camera, int supersample)
+    : board_(board), camera_(camera), supersample_(supersample) {
+  const int w = camera.width * supersample, h = camera.height * supersample;
+  rays_.resize(static_cast<size_t>(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const Eigen::Vector2d pixel((x + 0.5) / supersample - 0.5, (y + 0.5) / supersample - 0.5);
+      rays_[static_cast<size_t>(y) * w + x] = camera.PixelToNormalized(pixel).cast<float>();
+    }
+}
+
+media::Image BoardRenderer::Render(const Eigen::Isometry3d& world_from_board) const {
+  const Camera& camera = camera_;
+  const BoardSpec& board = board_;
   media::Image image;
   image.width = camera.width;
   image.height = camera.height;
   image.format = media::PixelFormat::kGray8;
   image.pixels.assign(static_cast<size_t>(image.width) * image.height, 128);
   const Eigen::Isometry3d board_from_world = world_from_board.inverse();
-  const Eigen::Matrix3d world_from_cam = camera.cam_from_world_rotation.transpose();
-  const Eigen::Vector3d centre = camera.CenterInWorld();
+  const Eigen::Matrix3d board_from_cam =
+      board_from_world.linear() * camera.cam_from_world_rotation.transpose();
+  const Eigen::Vector3d origin = board_from_world * camera.CenterInWorld();
   const double s = board.square_mm;
-  // The board's squares span [-s, inner_cols * s] x [-s, inner_rows * s]; white margin of
-  // one square around them.
+  // The squares span [-s, inner_cols * s] x [-s, inner_rows * s] (corner ids at multiples
+  // of s); a white margin of one square around them.
   const double x_min = -2 * s, x_max = (board.inner_cols + 1) * s;
   const double y_min = -2 * s, y_max = (board.inner_rows + 1) * s;
   // Bounding box of the board in the image, to skip the background.
@@ -129,42 +142,37 @@ media::Image RenderBoardImage(const BoardSpec& board,
       u0 = std::min(u0, p->x()), u1 = std::max(u1, p->x());
       v0 = std::min(v0, p->y()), v1 = std::max(v1, p->y());
     }
-  const int x_begin = std::max(0, static_cast<int>(u0) - 20);
-  const int x_end = std::min(camera.width, static_cast<int>(u1) + 20);
-  const int y_begin = std::max(0, static_cast<int>(v0) - 20);
-  const int y_end = std::min(camera.height, static_cast<int>(v1) + 20);
-  constexpr int kSub = 4;
+  const int x_begin = std::clamp(static_cast<int>(u0) - 20, 0, camera.width);
+  const int x_end = std::clamp(static_cast<int>(u1) + 20, 0, camera.width);
+  const int y_begin = std::clamp(static_cast<int>(v0) - 20, 0, camera.height);
+  const int y_end = std::clamp(static_cast<int>(v1) + 20, 0, camera.height);
+  const int sub = supersample_;
+  const int row = camera.width * sub;
   for (int v = y_begin; v < y_end; ++v)
     for (int u = x_begin; u < x_end; ++u) {
       int sum = 0;
-      for (int sy = 0; sy < kSub; ++sy)
-        for (int sx = 0; sx < kSub; ++sx) {
-          const Eigen::Vector2d pixel(u + (sx + 0.5) / kSub - 0.5, v + (sy + 0.5) / kSub - 0.5);
-          const Eigen::Vector2d n = camera.PixelToNormalized(pixel);
-          const Eigen::Vector3d ray =
-              board_from_world.linear() * (world_from_cam * Eigen::Vector3d(n.x(), n.y(), 1));
-          const Eigen::Vector3d origin = board_from_world * centre;
-          if (std::abs(ray.z()) < 1e-12) {
-            sum += 128;
-            continue;
-          }
-          const double t = -origin.z() / ray.z();
-          const Eigen::Vector3d hit = origin + t * ray;
+      for (int sy = 0; sy < sub; ++sy)
+        for (int sx = 0; sx < sub; ++sx) {
+          const Eigen::Vector2f& n = rays_[static_cast<size_t>(v * sub + sy) * row + u * sub + sx];
+          const Eigen::Vector3d ray = board_from_cam * Eigen::Vector3d(n.x(), n.y(), 1);
           int value = 128;
-          if (t > 0 && hit.x() >= x_min && hit.x() <= x_max && hit.y() >= y_min &&
-              hit.y() <= y_max) {
-            value = 255;
-            if (hit.x() >= -s && hit.x() <= board.inner_cols * s && hit.y() >= -s &&
-                hit.y() <= board.inner_rows * s) {
-              const int i = static_cast<int>(std::floor(hit.x() / s)) + 1;
-              const int j = static_cast<int>(std::floor(hit.y() / s)) + 1;
-              value = (i + j) % 2 == 0 ? 20 : 235;
+          if (std::abs(ray.z()) > 1e-12) {
+            const double t = -origin.z() / ray.z();
+            const double hx = origin.x() + t * ray.x(), hy = origin.y() + t * ray.y();
+            if (t > 0 && hx >= x_min && hx <= x_max && hy >= y_min && hy <= y_max) {
+              value = 255;
+              if (hx >= -s && hx <= board.inner_cols * s && hy >= -s &&
+                  hy <= board.inner_rows * s) {
+                const int i = static_cast<int>(std::floor(hx / s)) + 1;
+                const int j = static_cast<int>(std::floor(hy / s)) + 1;
+                value = (i + j) % 2 == 0 ? 20 : 235;
+              }
             }
           }
           sum += value;
         }
       image.pixels[static_cast<size_t>(v) * image.width + u] =
-          static_cast<uint8_t>(sum / (kSub * kSub));
+          static_cast<uint8_t>(sum / (sub * sub));
     }
   return image;
 }

@@ -35,10 +35,19 @@ struct SyntheticBoardRig {
 SyntheticBoardRig MakeSyntheticBoardRig(const BoardSpec& board,
                                         const SyntheticBoardRigOptions& options);
 
-// The board (white margin of one square around the squares) as `camera` sees it, grey
-// background, 4x4 supersampled; chessboard only.
-media::Image RenderBoardImage(const BoardSpec& board,
-                              const Camera& camera,
-                              const Eigen::Isometry3d& world_from_board);
+// Draws the board (white margin of one square around the squares) as `camera` sees it, with
+// its distortion, on a grey background, supersampled; chessboard only. The rays of every
+// sample are computed once, at construction.
+class BoardRenderer {
+ public:
+  BoardRenderer(const BoardSpec& board, const Camera& camera, int supersample = 2);
+  media::Image Render(const Eigen::Isometry3d& world_from_board) const;
+
+ private:
+  BoardSpec board_;
+  Camera camera_;
+  int supersample_;
+  std::vector<Eigen::Vector2f> rays_;  // normalised coordinates per sample, row-major
+};
 
 }  // namespace arco::calibration
