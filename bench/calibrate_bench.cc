@@ -83,7 +83,7 @@ void BM_CalibrateRig(benchmark::State& state) {
   state.counters["ba_iterations"] = iterations;
   state.counters["rms_px"] = rms;
 }
-BENCHMARK(BM_CalibrateRig)->Unit(benchmark::kSecond)->Iterations(2);
+BENCHMARK(BM_CalibrateRig)->Unit(benchmark::kSecond)->Iterations(2)->MeasureProcessCPUTime();
 
 }  // namespace
 }  // namespace arco::calibration

@@ -21,6 +21,7 @@
 #include "arco/geometry/rotation.h"
 #include "arco/geometry/triangulation.h"
 #include "arco/util/check.h"
+#include "arco/util/parallel.h"
 #include "arco/util/stats.h"
 
 namespace arco::calibration {
@@ -368,24 +369,37 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   progress.StartStage(1, 3, "initial poses");
   progress.SetTotal(num_cameras);
   std::vector<std::array<double, kNumIntrinsics>> intrinsics(num_cameras);
-  std::vector<bool> given(num_cameras, false);
-  for (int c = 0; c < num_cameras; ++c) {
-    const int index = initial != nullptr ? initial->FindCamera(cameras[c].camera) : -1;
-    if (index >= 0) {
-      const Camera& known = initial->cameras[index];
-      if (known.width != cameras[c].width || known.height != cameras[c].height)
-        return Status::Error("camera " + cameras[c].camera + ": the given intrinsics are for " +
-                             std::to_string(known.width) + "x" + std::to_string(known.height) +
-                             " images, its frames are " + std::to_string(cameras[c].width) + "x" +
-                             std::to_string(cameras[c].height));
-      intrinsics[c] = known.Intrinsics();
-      given[c] = true;
-    } else {
-      ARCO_ASSIGN_OR_RETURN(intrinsics[c],
-                            CalibrateIntrinsics(cameras[c], points, options.max_intrinsic_views));
-    }
-    progress.Advance(1);
-  }
+  std::vector<char> given(num_cameras, 0);  // not vector<bool>: written by threads
+  std::vector<Status> intrinsics_status(num_cameras, Status::Ok());
+  // Cameras in parallel; each writes only its own slots.
+  ParallelFor(
+      num_cameras,
+      options.num_threads,
+      [&](int64_t c, int) {
+        const int index = initial != nullptr ? initial->FindCamera(cameras[c].camera) : -1;
+        if (index >= 0) {
+          const Camera& known = initial->cameras[index];
+          if (known.width != cameras[c].width || known.height != cameras[c].height) {
+            intrinsics_status[c] =
+                Status::Error("camera " + cameras[c].camera + ": the given intrinsics are for " +
+                              std::to_string(known.width) + "x" + std::to_string(known.height) +
+                              " images, its frames are " + std::to_string(cameras[c].width) + "x" +
+                              std::to_string(cameras[c].height));
+            return;
+          }
+          intrinsics[c] = known.Intrinsics();
+          given[c] = 1;
+        } else {
+          auto estimated = CalibrateIntrinsics(cameras[c], points, options.max_intrinsic_views);
+          if (estimated.ok())
+            intrinsics[c] = *estimated;
+          else
+            intrinsics_status[c] = estimated.status();
+        }
+        progress.Advance(1);
+      },
+      1);
+  for (const Status& status : intrinsics_status) ARCO_RETURN_IF_ERROR(status);
 
   // 2. Board pose in every view; frames -> views.
   std::vector<std::vector<std::optional<Pose>>> cam_from_board(num_cameras);
@@ -622,7 +636,7 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
     r.observations = static_cast<int>(errors[c].size());
     r.rms_px = Rms(errors[c]);
     r.p95_px = errors[c].empty() ? 0 : InterpolatedQuantile(errors[c], 0.95);
-    r.intrinsics_given = given[c];
+    r.intrinsics_given = given[c] != 0;
     report.cameras.push_back(r);
     all_errors.insert(all_errors.end(), errors[c].begin(), errors[c].end());
   }
