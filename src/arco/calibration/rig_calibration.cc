@@ -369,37 +369,27 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   progress.StartStage(1, 3, "initial poses");
   progress.SetTotal(num_cameras);
   std::vector<std::array<double, kNumIntrinsics>> intrinsics(num_cameras);
-  std::vector<char> given(num_cameras, 0);  // not vector<bool>: written by threads
-  std::vector<Status> intrinsics_status(num_cameras, Status::Ok());
-  // Cameras in parallel; each writes only its own slots.
-  ParallelFor(
-      num_cameras,
-      options.num_threads,
-      [&](int64_t c, int) {
-        const int index = initial != nullptr ? initial->FindCamera(cameras[c].camera) : -1;
-        if (index >= 0) {
-          const Camera& known = initial->cameras[index];
-          if (known.width != cameras[c].width || known.height != cameras[c].height) {
-            intrinsics_status[c] =
-                Status::Error("camera " + cameras[c].camera + ": the given intrinsics are for " +
-                              std::to_string(known.width) + "x" + std::to_string(known.height) +
-                              " images, its frames are " + std::to_string(cameras[c].width) + "x" +
-                              std::to_string(cameras[c].height));
-            return;
-          }
-          intrinsics[c] = known.Intrinsics();
-          given[c] = 1;
-        } else {
-          auto estimated = CalibrateIntrinsics(cameras[c], points, options.max_intrinsic_views);
-          if (estimated.ok())
-            intrinsics[c] = *estimated;
-          else
-            intrinsics_status[c] = estimated.status();
-        }
-        progress.Advance(1);
-      },
-      1);
-  for (const Status& status : intrinsics_status) ARCO_RETURN_IF_ERROR(status);
+  std::vector<char> given(num_cameras, 0);
+  // One camera after the other: cv::calibrateCamera's own parallel loops are disabled on a
+  // worker thread, which changes its sums in the last bits (results must not depend on the
+  // thread count).
+  for (int c = 0; c < num_cameras; ++c) {
+    const int index = initial != nullptr ? initial->FindCamera(cameras[c].camera) : -1;
+    if (index >= 0) {
+      const Camera& known = initial->cameras[index];
+      if (known.width != cameras[c].width || known.height != cameras[c].height)
+        return Status::Error("camera " + cameras[c].camera + ": the given intrinsics are for " +
+                             std::to_string(known.width) + "x" + std::to_string(known.height) +
+                             " images, its frames are " + std::to_string(cameras[c].width) + "x" +
+                             std::to_string(cameras[c].height));
+      intrinsics[c] = known.Intrinsics();
+      given[c] = 1;
+    } else {
+      ARCO_ASSIGN_OR_RETURN(intrinsics[c],
+                            CalibrateIntrinsics(cameras[c], points, options.max_intrinsic_views));
+    }
+    progress.Advance(1);
+  }
 
   // 2. Board pose in every view; frames -> views.
   std::vector<std::vector<std::optional<Pose>>> cam_from_board(num_cameras);
@@ -571,9 +561,9 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   solver_options.function_tolerance = 1e-10;
   solver_options.gradient_tolerance = 1e-12;
   solver_options.parameter_tolerance = 1e-10;
-  solver_options.num_threads =
-      options.num_threads > 0 ? options.num_threads
-                              : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  // One thread: Ceres's multi-threaded Schur elimination sums in a varying order, and the
+  // result must not depend on the thread count (the adjustment takes about a second).
+  solver_options.num_threads = 1;
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
   if (summary.termination_type == ceres::FAILURE)
