@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # End-to-end checks of `arco calibration show/convert` on the real SPD files:
 # JSON shape and conventions, conversions, and bad input (one error line, exit 1,
-# no output file). usage: calibration_cli_test.sh ARCO_BINARY SHARED_DATA_DIR
+# no output file); and `arco calibrate` on OpenCV's stereo pairs (opencv-doc): the
+# calibration reads back, the report's figures, --origin board, --intrinsics with
+# --fix-intrinsics. usage: calibration_cli_test.sh ARCO_BINARY SHARED_DATA_DIR
 set -uo pipefail
 arco=$1
 spd=$2/spd
@@ -66,6 +68,45 @@ done
 check '[ $? -eq 1 ] && grep -q "out.txt" "$tmp/err" && [ ! -e "$tmp/out.txt" ]' "unknown extension"
 "$arco" calibration show "$tmp/truncated.xml" >/dev/null 2>"$tmp/err"
 check '[ $? -eq 1 ] && grep -q "malformed XML" "$tmp/err"' "show on malformed XML"
+
+# arco calibrate on OpenCV's stereo pairs.
+data=/usr/share/doc/opencv-doc/examples/data
+mkdir -p "$tmp/L" "$tmp/R"
+for f in "$data"/left[0-9][0-9].jpg; do ln -s "$f" "$tmp/L/"; done
+for f in "$data"/right[0-9][0-9].jpg; do ln -s "$f" "$tmp/R/"; done
+K=(calibrate --board chessboard:9x6:25 --images left="$tmp/L" --images right="$tmp/R")
+"$arco" "${K[@]}" -o "$tmp/rig.json" >"$tmp/cal.out" 2>"$tmp/err"
+check '[ $? -eq 0 ]' "calibrate: $(tail -1 "$tmp/err")"
+check 'grep -q "calibrated 2 cameras from chessboard:9x6:25 boards; world: left, mm" "$tmp/cal.out"' \
+  "calibrate prints its summary: $(head -1 "$tmp/cal.out")"
+"$arco" calibration show "$tmp/rig.json" --json >"$tmp/rig.show"
+check 'python3 - "$tmp/rig.show" "$tmp/rig.report.json" <<EOF
+import json, sys
+rig = json.load(open(sys.argv[1])); rep = json.load(open(sys.argv[2]))
+cams = rig["cameras"]
+assert [c["name"] for c in cams] == ["left", "right"], cams
+assert cams[0]["R"] == [1, 0, 0, 0, 1, 0, 0, 0, 1] and cams[0]["t"] == [0, 0, 0], cams[0]
+baseline = sum(x * x for x in cams[1]["t"]) ** 0.5
+assert 80 < baseline < 87, baseline            # about 3.3 squares of 25 mm
+assert rep["rms_px"] < 0.3 and rep["warnings"] == [], rep
+assert rep["pairs"] == [{"cameras": ["left", "right"], "shared_frames": 13}], rep["pairs"]
+assert rep["board_triangulation"]["rms_mm"] < 0.6, rep["board_triangulation"]
+assert rep["bundle_adjustment"]["termination"] == "CONVERGENCE", rep["bundle_adjustment"]
+EOF' "calibrate: the calibration and the report"
+"$arco" "${K[@]}" --origin board --intrinsics "$tmp/rig.json" --fix-intrinsics -o "$tmp/rig2.yaml" >/dev/null 2>"$tmp/err"
+check '[ $? -eq 0 ]' "calibrate --origin board --intrinsics --fix-intrinsics: $(tail -1 "$tmp/err")"
+"$arco" calibration show "$tmp/rig2.yaml" --json >"$tmp/rig2.show"
+check 'python3 - "$tmp/rig.show" "$tmp/rig2.show" "$tmp/rig2.report.json" <<EOF
+import json, sys
+a = json.load(open(sys.argv[1]))["cameras"]; b = json.load(open(sys.argv[2]))["cameras"]
+rep = json.load(open(sys.argv[3]))
+assert rep["origin"].startswith("board@"), rep["origin"]
+assert all(c["intrinsics_given"] for c in rep["cameras"]), rep["cameras"]
+for x, y in zip(a, b):
+    assert all(abs(p - q) < 1e-9 * max(1, abs(p)) for p, q in zip(x["K"], y["K"])), (x["K"], y["K"])
+    assert x["distortion"] == y["distortion"] or all(abs(x["distortion"][k] - y["distortion"][k]) < 1e-12 for k in x["distortion"])
+assert b[0]["t"] != [0, 0, 0]                  # the world is the board now
+EOF' "calibrate --origin board --fix-intrinsics keeps the given intrinsics"
 
 [ $fail -eq 0 ] && echo "calibration CLI: all checks passed"
 exit $fail
