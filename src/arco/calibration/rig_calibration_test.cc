@@ -238,6 +238,44 @@ TEST(CalibrateRig, SurvivesBackwardChessboardViewsAndABadDetection) {
   EXPECT_LT(worst_mm, 1e-4);
 }
 
+TEST(CalibrateRig, UsesPartialChArUcoViews) {
+  auto board = ParseBoardSpec("charuco:10x7:80:60");
+  ASSERT_TRUE(board.ok());
+  SyntheticBoardRigOptions options;
+  options.num_cameras = 6;
+  options.num_frames = 120;
+  SyntheticBoardRig synthetic = MakeSyntheticBoardRig(*board, options);
+  // A ChArUco detection misses corners (occluded or unreadable markers): drop a third.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  int dropped = 0;
+  for (auto& camera : synthetic.views)
+    for (BoardView& v : camera.views) {
+      BoardView kept;
+      kept.frame = v.frame;
+      for (size_t i = 0; i < v.point_ids.size(); ++i) {
+        if (u(rng) < 0.33) {
+          ++dropped;
+          continue;
+        }
+        kept.point_ids.push_back(v.point_ids[i]);
+        kept.corners_px.push_back(v.corners_px[i]);
+      }
+      v = kept;
+    }
+  ASSERT_GT(dropped, 1000);
+  auto result = CalibrateRig(RigCalibrationOptions(), *board, synthetic.views);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_EQ(result->report.board, "charuco:10x7:80:60:DICT_4X4_50");
+  for (int c = 0; c < options.num_cameras; ++c) {
+    const Relative truth = RelativeToFirst(synthetic.truth, c);
+    const Relative estimate = RelativeToFirst(result->rig, c);
+    EXPECT_LT(RotationAngleBetween(truth.R, estimate.R) * 180 / M_PI, 0.1) << c;
+    EXPECT_LT((truth.centre_in_cam0 - estimate.centre_in_cam0).norm(), 2.0) << c;
+    EXPECT_EQ(result->report.cameras[c].views_used, result->report.cameras[c].views) << c;
+  }
+}
+
 TEST(CalibrateRig, OriginAtTheBoardOfTheFirstSharedFrame) {
   const BoardSpec board = Chessboard(80);
   SyntheticBoardRigOptions options;
