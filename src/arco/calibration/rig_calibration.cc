@@ -200,12 +200,14 @@ std::optional<Pose> BoardPose(const std::array<double, kNumIntrinsics>& in,
 }
 
 // The relative pose b_from_a from per-frame estimates: the estimate most others agree with
-// (within 2 degrees and 2 % of the baseline + 1 mm), then the mean of those that agree.
-Pose ConsensusPose(const std::vector<Pose>& candidates) {
+// (within 5 degrees and 10 % of the baseline + 10 mm: loose, as one view's PnP of a small or
+// distant board is; a backward chessboard or another instant is far off), then the mean of
+// those that agree; *support = how many agree.
+Pose ConsensusPose(const std::vector<Pose>& candidates, int* support) {
   ARCO_CHECK(!candidates.empty());
   auto agree = [](const Pose& a, const Pose& b) {
-    return RotationAngleBetween(a.R, b.R) < 2.0 * M_PI / 180 &&
-           (a.t - b.t).norm() < 0.02 * a.t.norm() + 1.0;
+    return RotationAngleBetween(a.R, b.R) < 5.0 * M_PI / 180 &&
+           (a.t - b.t).norm() < 0.1 * a.t.norm() + 10.0;
   };
   size_t best = 0;
   int best_count = -1;
@@ -223,6 +225,7 @@ Pose ConsensusPose(const std::vector<Pose>& candidates) {
       translation_sum += other.t;
       ++n;
     }
+  *support = n;
   return {NearestRotation(rotation_sum / n), translation_sum / n};
 }
 
@@ -457,6 +460,7 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
 
   // 4. cam_from_world along the tree.
   std::vector<Pose> cam_from_world(num_cameras);
+  std::vector<CalibrationWarning> weak_links;
   for (size_t k = 1; k < order.size(); ++k) {
     const int c = order[k], p = parent[c];
     std::vector<Pose> candidates;
@@ -469,7 +473,23 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
       if (vp >= 0 && vc >= 0)
         candidates.push_back(*cam_from_board[c][vc] * cam_from_board[p][vp]->Inverse());
     }
-    cam_from_world[c] = ConsensusPose(candidates) * cam_from_world[p];
+    int support = 0;
+    cam_from_world[c] = ConsensusPose(candidates, &support) * cam_from_world[p];
+    // Frames that disagree on the relative pose (most of them) mean unsynchronised videos
+    // or wrong detections: a rig built on one of them would look consistent and be wrong.
+    const int n = static_cast<int>(candidates.size());
+    if (n >= 3 && 2 * support < n)
+      return Status::Error("cameras " + cameras[p].camera + " and " + cameras[c].camera +
+                           ": their " + std::to_string(n) +
+                           " shared frames disagree on the relative pose (at most " +
+                           std::to_string(support) + " agree): are the videos synchronised?");
+    if (n < 3)
+      weak_links.push_back({"weak_link",
+                            cameras[c].camera,
+                            cameras[c].camera + " is joined to the rig through " +
+                                std::to_string(n) + " frame" + (n == 1 ? "" : "s") +
+                                " shared with " + cameras[p].camera +
+                                ", too few to check: film the board in view of both longer"});
   }
 
   // 5. Board pose per frame: the view estimate that best explains the frame's other views;
@@ -512,6 +532,18 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
     ba_views.push_back(std::move(used));
   }
   progress.Advance(0);
+
+  // Every camera must keep a view in a frame that another camera's view agrees with, else
+  // nothing ties it to the rig.
+  std::vector<int> shared_used(num_cameras, 0);
+  for (const auto& used : ba_views)
+    if (used.size() >= 2)
+      for (const UsedView& u : used) ++shared_used[u.camera];
+  for (int c = 0; c < num_cameras; ++c)
+    if (shared_used[c] == 0)
+      return Status::Error("camera " + cameras[c].camera + " (" + cameras[c].source +
+                           "): none of its board views agrees with the other cameras' views of "
+                           "the same frames (are the videos synchronised?)");
 
   // 6. Bundle adjustment.
   progress.StartStage(2, 3, "bundle adjustment");
@@ -673,6 +705,7 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   report.board_p95_mm = board_errors.empty() ? 0 : InterpolatedQuantile(board_errors, 0.95);
 
   // Warnings.
+  report.warnings = weak_links;
   std::vector<double> rms;
   for (const CameraReport& r : report.cameras) rms.push_back(r.rms_px);
   const double median_rms = Median(rms);

@@ -379,6 +379,18 @@ TEST(CalibrateRig, ExpectedFailuresAreOneLine) {
   EXPECT_NE(message.find("{cam0"), std::string::npos) << message;
   EXPECT_EQ(message.find('\n'), std::string::npos);
 
+  // cam3's frames numbered one off (unsynchronised videos): its views disagree with the
+  // others' in every frame.
+  auto unsynchronised = synthetic.views;
+  for (BoardView& v : unsynchronised[3].views) v.frame += 1;
+  auto desync = CalibrateRig(RigCalibrationOptions(), board, unsynchronised);
+  ASSERT_FALSE(desync.ok());
+  EXPECT_NE(desync.status().message().find(
+                "shared frames disagree on the relative pose (at most 1 agree): are the "
+                "videos synchronised?"),
+            std::string::npos)
+      << desync.status().message();
+
   RigCalibrationOptions bad_origin;
   bad_origin.origin = "cam9";
   auto origin = CalibrateRig(bad_origin, board, synthetic.views);
@@ -614,6 +626,24 @@ TEST(CalibrateRig, AgreesWithOpenCvStereoCalibrateOnItsStereoPairs) {
   EXPECT_LT(baseline_rel, 0.005);
   EXPECT_LT(rotation_deg, 0.1);
   EXPECT_NEAR(result->rig.cameras[0].fx, K1.at<double>(0, 0), 0.01 * K1.at<double>(0, 0));
+
+  // Only two frames seen by both: calibrated, with a named warning.
+  CameraBoardViews left2 = left, right2 = right;
+  auto keep = [](CameraBoardViews& cam, const std::set<int64_t>& frames) {
+    auto& v = cam.views;
+    v.erase(std::remove_if(
+                v.begin(), v.end(), [&](const BoardView& b) { return !frames.count(b.frame); }),
+            v.end());
+  };
+  keep(left2, {1, 2, 8, 9, 11, 12, 13, 14});
+  keep(right2, {1, 2, 3, 4, 5, 6, 7});
+  auto weak = CalibrateRig(RigCalibrationOptions(), board, {left2, right2});
+  ASSERT_TRUE(weak.ok()) << weak.status().message();
+  ASSERT_FALSE(weak->report.warnings.empty());
+  EXPECT_EQ(weak->report.warnings[0].code, "weak_link");
+  EXPECT_EQ(weak->report.warnings[0].message,
+            "right is joined to the rig through 2 frames shared with left, too few to check: "
+            "film the board in view of both longer");
 }
 
 // ---- The files: RunCalibrate writes nothing on an error. ----
