@@ -4,7 +4,8 @@
 //   BM_DetectBoardFrame/board and /empty: one frame's detection (findChessboardCorners on
 //     the frame scaled to 1280 px, cornerSubPix at full size), on rendered frames.
 //   BM_CalibrateRig: intrinsics, initial poses and the bundle adjustment over the 8 x 300
-//     frames' detections (exact corners + 0.1 px noise), 2 Ceres threads.
+//     frames' detections (exact corners + 0.1 px noise); one thread (OpenCV's own loops
+//     aside).
 // Detection of the whole rig = views x board + (2400 - views) x empty, over the threads.
 #include <benchmark/benchmark.h>
 
@@ -63,7 +64,6 @@ BENCHMARK(BM_DetectBoardFrame_empty)->Unit(benchmark::kMillisecond);
 void BM_CalibrateRig(benchmark::State& state) {
   const Scene& s = GetScene();
   RigCalibrationOptions options;
-  options.num_threads = 2;
   int views = 0;
   for (const auto& c : s.rig.views) views += static_cast<int>(c.views.size());
   double ba_s = 0, rms = 0;

@@ -15,13 +15,11 @@
 #include <optional>
 #include <set>
 #include <stdexcept>
-#include <thread>
 
 #include "arco/geometry/alignment.h"
 #include "arco/geometry/rotation.h"
 #include "arco/geometry/triangulation.h"
 #include "arco/util/check.h"
-#include "arco/util/parallel.h"
 #include "arco/util/stats.h"
 
 namespace arco::calibration {
@@ -284,7 +282,6 @@ Status RigCalibrationOptions::Validate() const {
       CheckInRange("max_intrinsic_views", max_intrinsic_views, kIntrinsicViewsRange));
   ARCO_RETURN_IF_ERROR(CheckInRange("loss_scale_px", loss_scale_px, kLossScaleRangePx));
   ARCO_RETURN_IF_ERROR(CheckInRange("max_iterations", max_iterations, kIterationsRange));
-  ARCO_RETURN_IF_ERROR(CheckInRange("num_threads", num_threads, Closed(0, 1024)));
   ARCO_RETURN_IF_ERROR(CheckInRange("high_residual_px", high_residual_px, kHighResidualRangePx));
   ARCO_RETURN_IF_ERROR(CheckInRange("min_views", min_views, kMinViewsRange));
   return Status::Ok();
@@ -373,9 +370,7 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   progress.SetTotal(num_cameras);
   std::vector<std::array<double, kNumIntrinsics>> intrinsics(num_cameras);
   std::vector<char> given(num_cameras, 0);
-  // One camera after the other: cv::calibrateCamera's own parallel loops are disabled on a
-  // worker thread, which changes its sums in the last bits (results must not depend on the
-  // thread count).
+  // One camera after the other: OpenCV parallelises calibrateCamera itself.
   for (int c = 0; c < num_cameras; ++c) {
     const int index = initial != nullptr ? initial->FindCamera(cameras[c].camera) : -1;
     if (index >= 0) {
@@ -531,7 +526,6 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
     world_from_board.push_back(best);
     ba_views.push_back(std::move(used));
   }
-  progress.Advance(0);
 
   // Every camera must keep a view in a frame that another camera's view agrees with, else
   // nothing ties it to the rig.

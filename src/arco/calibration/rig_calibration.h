@@ -57,9 +57,6 @@ struct RigCalibrationOptions {
   int max_intrinsic_views = 40;   // views per camera for calibrateCamera, covering the image
   double loss_scale_px = 2.0;     // Huber loss: quadratic up to this residual
   int max_iterations = 200;       // bundle adjustment iterations
-  // Reserved (0 = all cores): the intrinsics and the bundle adjustment run on one thread,
-  // so that results do not depend on the thread count.
-  int num_threads = 1;
   double high_residual_px = 1.0;  // warning "high_residual" above this RMS
   int min_views = 10;             // warning "few_views" below this many views of a camera
   Status Validate() const;        // messages name the fields

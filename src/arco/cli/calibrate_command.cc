@@ -100,7 +100,6 @@ void ApplyAndValidate(CalibrateArgs& a) {
       a.options.inputs.push_back(*input);
     }
   a.options.calibration.refine_intrinsics = !a.fix_intrinsics;
-  a.options.calibration.num_threads = a.options.num_threads;
   const Status valid = a.options.Validate();
   if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kCalibrateFlags)));
 }
@@ -178,7 +177,12 @@ std::function<int()> SetupCalibrate(CLI::App& app) {
             "Warn about a camera with fewer board views",
             calibration::kMinViewsRange)
       ->capture_default_str();
-  AddNumber(cmd, "--threads", o.num_threads, "Threads (0 = all cores)", kThreadsRange)
+  AddNumber(
+      cmd,
+      "--threads",
+      o.num_threads,
+      "Cameras whose board detection runs at once (0 = all cores; results do not depend on it)",
+      kThreadsRange)
       ->capture_default_str();
   cmd->add_option("-o,--output",
                   o.output,
