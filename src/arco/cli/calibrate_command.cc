@@ -89,16 +89,25 @@ std::string FormatReport(const calibration::CalibrateResult& result, const std::
   return text;
 }
 
-void ApplyAndValidate(CalibrateArgs& a) {
+// The cameras in the order --video and --images were given (the first is the default
+// origin).
+void ApplyAndValidate(CalibrateArgs& a, const CLI::App& cmd) {
   a.options.inputs.clear();
-  for (const auto* list : {&a.videos, &a.images})
-    for (const std::string& text : *list) {
-      auto input = calibration::ParseCalibrateInput(text);
-      if (!input.ok())
-        ThrowIfInvalid(Status::Error((list == &a.videos ? "--video: " : "--images: ") +
-                                     input.status().message()));
-      a.options.inputs.push_back(*input);
-    }
+  std::vector<std::pair<const std::string*, const char*>> given;
+  size_t video = 0, image = 0;
+  for (const CLI::Option* option : cmd.parse_order()) {
+    if (option->get_name() == "--video" && video < a.videos.size())
+      given.emplace_back(&a.videos[video++], "--video: ");
+    if (option->get_name() == "--images" && image < a.images.size())
+      given.emplace_back(&a.images[image++], "--images: ");
+  }
+  for (; video < a.videos.size(); ++video) given.emplace_back(&a.videos[video], "--video: ");
+  for (; image < a.images.size(); ++image) given.emplace_back(&a.images[image], "--images: ");
+  for (const auto& [text, flag] : given) {
+    auto input = calibration::ParseCalibrateInput(*text);
+    if (!input.ok()) ThrowIfInvalid(Status::Error(flag + input.status().message()));
+    a.options.inputs.push_back(*input);
+  }
   a.options.calibration.refine_intrinsics = !a.fix_intrinsics;
   const Status valid = a.options.Validate();
   if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kCalibrateFlags)));
@@ -133,8 +142,8 @@ std::function<int()> SetupCalibrate(CLI::App& app) {
                 "Keep the intrinsics (given or initial) fixed in the bundle adjustment");
   cmd->add_option("--origin",
                   o.calibration.origin,
-                  "World frame: a camera's name (default: the first camera) or 'board' (the "
-                  "board in the first frame two cameras see)");
+                  "World frame: a camera's name (default: the first camera given) or 'board' "
+                  "(the board in the first frame two cameras see)");
   AddNumber(cmd,
             "--max-frames",
             o.detection.max_frames,
@@ -189,7 +198,7 @@ std::function<int()> SetupCalibrate(CLI::App& app) {
                   "Calibration to write: .json arco JSON, .yaml/.yml OpenCV YAML, .xml OpenCV "
                   "XML; the report goes beside it as NAME.report.json")
       ->required();
-  cmd->parse_complete_callback([a] { ApplyAndValidate(*a); });
+  cmd->parse_complete_callback([a, cmd] { ApplyAndValidate(*a, *cmd); });
   return [a] {
     ProgressBar bar("calibrate");
     auto result = calibration::RunCalibrate(a->options, bar);

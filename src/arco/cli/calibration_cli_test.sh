@@ -93,6 +93,10 @@ assert rep["pairs"] == [{"cameras": ["left", "right"], "shared_frames": 13}], re
 assert rep["board_triangulation"]["rms_mm"] < 0.6, rep["board_triangulation"]
 assert rep["bundle_adjustment"]["termination"] == "CONVERGENCE", rep["bundle_adjustment"]
 EOF' "calibrate: the calibration and the report"
+# The first camera given is the world, whichever flag gives it.
+"$arco" calibrate --board chessboard:9x6:25 --images right="$tmp/R" --video left="$tmp/L" \
+  -o "$tmp/order.json" >"$tmp/order.out" 2>"$tmp/err"
+check 'grep -q "world: right, mm" "$tmp/order.out"' "calibrate: the first camera given is the origin: $(head -1 "$tmp/order.out") $(cat "$tmp/err")"
 "$arco" "${K[@]}" --origin board --intrinsics "$tmp/rig.json" --fix-intrinsics -o "$tmp/rig2.yaml" >/dev/null 2>"$tmp/err"
 check '[ $? -eq 0 ]' "calibrate --origin board --intrinsics --fix-intrinsics: $(tail -1 "$tmp/err")"
 "$arco" calibration show "$tmp/rig2.yaml" --json >"$tmp/rig2.show"
