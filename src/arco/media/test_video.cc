@@ -82,6 +82,12 @@ int ReadIndex(const Image& frame) {
 bool HasEncoder(const std::string& name) { return avcodec_find_encoder_by_name(name.c_str()); }
 
 Status WriteIndexVideo(const std::string& path, const IndexVideo& v) {
+  return WriteGrayVideo(path, v, [&](int k) { return IndexFrame(v, k); });
+}
+
+Status WriteGrayVideo(const std::string& path,
+                      const IndexVideo& v,
+                      const std::function<Image(int)>& make_frame) {
   auto fail = [&](const std::string& what) { return Status::Error(path + ": " + what); };
   Encoder e;
   if (avformat_alloc_output_context2(&e.format, nullptr, v.container.c_str(), path.c_str()) < 0) {
@@ -106,7 +112,8 @@ Status WriteIndexVideo(const std::string& path, const IndexVideo& v) {
   e.stream->time_base = e.codec->time_base;
   e.stream->avg_frame_rate = e.codec->framerate;
   if (v.rotation_deg != 0) {
-    uint8_t* matrix = av_stream_new_side_data(e.stream, AV_PKT_DATA_DISPLAYMATRIX, 9 * sizeof(int32_t));
+    uint8_t* matrix =
+        av_stream_new_side_data(e.stream, AV_PKT_DATA_DISPLAYMATRIX, 9 * sizeof(int32_t));
     if (matrix == nullptr) return fail("cannot add a display matrix");
     // av_display_rotation_set takes the clockwise angle (av_display_rotation_get
     // returns the counter-clockwise one).
@@ -123,7 +130,11 @@ Status WriteIndexVideo(const std::string& path, const IndexVideo& v) {
   bool ok = true;
   for (int k = 0; k < v.frames && ok; ++k) {
     av_frame_make_writable(frame);
-    const Image luma = IndexFrame(v, k);
+    const Image luma = make_frame(k);
+    if (luma.width != v.width || luma.height != v.height || luma.format != PixelFormat::kGray8) {
+      ok = false;
+      break;
+    }
     for (int y = 0; y < v.height; ++y) {
       std::memcpy(frame->data[0] + y * frame->linesize[0], luma.row(y), v.width);
     }
