@@ -10,6 +10,7 @@
 #include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
+#include "arco/pipeline/calibration_check.h"
 
 namespace arco::cli {
 namespace {
@@ -22,6 +23,51 @@ inline constexpr FieldFlag kCalibrateFlags[] = {{"frame_step", "--frame-step"},
                                                 {"num_threads", "--threads"},
                                                 {"high_residual_px", "--high-residual-px"},
                                                 {"min_views", "--min-views"}};
+
+inline constexpr FieldFlag kCheckFlags[] = {{"min_score", "--min-score"},
+                                            {"min_views", "--min-views"},
+                                            {"flag_ratio", "--flag-ratio"},
+                                            {"min_flag_px", "--min-flag-px"},
+                                            {"frame_step", "--frame-step"}};
+
+int RunCheck(const pipeline::CalibrationCheckOptions& options, bool json) {
+  ProgressBar bar("check");
+  auto result = pipeline::CheckCalibration(options, bar);
+  bar.Finish();
+  if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kCheckFlags));
+  if (json) {
+    std::printf("%s\n", result->ToJson().dump(2).c_str());
+    return 0;
+  }
+  std::printf("%s against %s: %lld frames; rig median %.2f px, flag above %.2f px\n",
+              result->calibration.c_str(),
+              options.capture_dir.c_str(),
+              static_cast<long long>(result->frames),
+              result->rig_median_px,
+              result->threshold_px);
+  std::printf("%-20s %10s %10s %10s  %s\n", "camera", "residuals", "median px", "p90 px", "");
+  for (const auto& c : result->cameras) {
+    std::string frames;
+    for (const auto& [first, last] : c.off_frames)
+      frames += (frames.empty() ? " frames " : ", ") + std::to_string(first) +
+                (last != first ? "-" + std::to_string(last) : "");
+    std::printf("%-20s %10lld %10.2f %10.2f  %s%s\n",
+                c.name.c_str(),
+                static_cast<long long>(c.residuals),
+                c.median_px,
+                c.p90_px,
+                c.flagged ? "FLAGGED" : "",
+                frames.c_str());
+  }
+  if (result->flagged.empty()) {
+    std::printf("no camera flagged\n");
+  } else {
+    for (const auto& name : result->flagged)
+      std::printf("warning: %s: residuals stand out from the rig's: moved or mis-calibrated?\n",
+                  name.c_str());
+  }
+  return 0;
+}
 
 struct CalibrateArgs {
   calibration::CalibrateOptions options;
@@ -90,8 +136,11 @@ std::string FormatReport(const calibration::CalibrateResult& result, const std::
 }
 
 // The cameras in the order --video and --images were given (the first is the default
-// origin).
-void ApplyAndValidate(CalibrateArgs& a, const CLI::App& cmd) {
+// origin). Nothing to check when `arco calibrate check` is what runs.
+void ApplyAndValidate(CalibrateArgs& a, const CLI::App& cmd, const CLI::App& check) {
+  if (check.parsed()) return;
+  if (a.options.board.empty()) ThrowIfInvalid(Status::Error("--board is required"));
+  if (a.options.output.empty()) ThrowIfInvalid(Status::Error("--output is required"));
   a.options.inputs.clear();
   std::vector<std::pair<const std::string*, const char*>> given;
   size_t video = 0, image = 0;
@@ -124,8 +173,7 @@ std::function<int()> SetupCalibrate(CLI::App& app) {
                   o.board,
                   "chessboard:COLSxROWS:SQUARE_MM (inner corners, e.g. chessboard:9x6:25) or "
                   "charuco:COLSxROWS:SQUARE_MM:MARKER_MM[:DICT] (squares; DICT default "
-                  "DICT_4X4_50)")
-      ->required();
+                  "DICT_4X4_50); required");
   cmd->add_option("--video",
                   a->videos,
                   "CAMERA=FILE: a camera's video of the board (repeat per camera; all "
@@ -196,10 +244,51 @@ std::function<int()> SetupCalibrate(CLI::App& app) {
   cmd->add_option("-o,--output",
                   o.output,
                   "Calibration to write: .json arco JSON, .yaml/.yml OpenCV YAML, .xml OpenCV "
-                  "XML; the report goes beside it as NAME.report.json")
+                  "XML; the report goes beside it as NAME.report.json; required");
+  auto c = std::make_shared<pipeline::CalibrationCheckOptions>();
+  auto json = std::make_shared<bool>(false);
+  auto* check = cmd->add_subcommand(
+      "check",
+      "Check a calibration against a capture's 2D keypoints: per camera the reprojection "
+      "residuals of the triangulated keypoints; a camera that stands out (moved or "
+      "mis-calibrated) is flagged with its frames");
+  check->add_option("capture", c->capture_dir, "Capture folder (capture.json, keypoints2d)")
       ->required();
-  cmd->parse_complete_callback([a, cmd] { ApplyAndValidate(*a, *cmd); });
-  return [a] {
+  check->add_option("--calibration",
+                    c->calibration,
+                    "Calibration to check instead of the capture's own (any format arco reads)");
+  AddNumber(
+      check, "--min-score", c->min_score, "Ignore detections below this confidence", kFractionRange)
+      ->capture_default_str();
+  AddNumber(check,
+            "--min-views",
+            c->min_views,
+            "Use keypoints triangulated from at least this many cameras",
+            Closed(2, 1000))
+      ->capture_default_str();
+  AddNumber(check,
+            "--flag-ratio",
+            c->flag_ratio,
+            "Flag a camera whose median residual exceeds this times the rig's median",
+            pipeline::kCheckRatioRange)
+      ->capture_default_str();
+  AddNumber(check,
+            "--min-flag-px",
+            c->min_flag_px,
+            "... and this many pixels (px)",
+            pipeline::kCheckMinFlagRangePx)
+      ->capture_default_str();
+  AddNumber(
+      check, "--frame-step", c->frame_step, "Check every n-th frame", calibration::kFrameStepRange)
+      ->capture_default_str();
+  check->add_flag("--json", *json, "Print the summary as JSON");
+  check->parse_complete_callback([c] {
+    const Status valid = c->Validate();
+    if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kCheckFlags)));
+  });
+  cmd->parse_complete_callback([a, cmd, check] { ApplyAndValidate(*a, *cmd, *check); });
+  return [a, c, json, check] {
+    if (check->parsed()) return RunCheck(*c, *json);
     ProgressBar bar("calibrate");
     auto result = calibration::RunCalibrate(a->options, bar);
     bar.Finish();

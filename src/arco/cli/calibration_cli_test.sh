@@ -76,7 +76,8 @@ for f in "$data"/left[0-9][0-9].jpg; do ln -s "$f" "$tmp/L/"; done
 for f in "$data"/right[0-9][0-9].jpg; do ln -s "$f" "$tmp/R/"; done
 K=(calibrate --board chessboard:9x6:25 --images left="$tmp/L" --images right="$tmp/R")
 "$arco" "${K[@]}" -o "$tmp/rig.json" >"$tmp/cal.out" 2>"$tmp/err"
-check '[ $? -eq 0 ]' "calibrate: $(tail -1 "$tmp/err")"
+rc=$?
+check '[ $rc -eq 0 ]' "calibrate: $(tail -1 "$tmp/err")"
 check 'grep -q "calibrated 2 cameras from chessboard:9x6:25 boards; world: left, mm" "$tmp/cal.out"' \
   "calibrate prints its summary: $(head -1 "$tmp/cal.out")"
 "$arco" calibration show "$tmp/rig.json" --json >"$tmp/rig.show"
@@ -98,7 +99,8 @@ EOF' "calibrate: the calibration and the report"
   -o "$tmp/order.json" >"$tmp/order.out" 2>"$tmp/err"
 check 'grep -q "world: right, mm" "$tmp/order.out"' "calibrate: the first camera given is the origin: $(head -1 "$tmp/order.out") $(cat "$tmp/err")"
 "$arco" "${K[@]}" --origin board --intrinsics "$tmp/rig.json" --fix-intrinsics -o "$tmp/rig2.yaml" >/dev/null 2>"$tmp/err"
-check '[ $? -eq 0 ]' "calibrate --origin board --intrinsics --fix-intrinsics: $(tail -1 "$tmp/err")"
+rc=$?
+check '[ $rc -eq 0 ]' "calibrate --origin board --intrinsics --fix-intrinsics: $(tail -1 "$tmp/err")"
 "$arco" calibration show "$tmp/rig2.yaml" --json >"$tmp/rig2.show"
 check 'python3 - "$tmp/rig.show" "$tmp/rig2.show" "$tmp/rig2.report.json" <<EOF
 import json, sys
@@ -111,6 +113,34 @@ for x, y in zip(a, b):
     assert x["distortion"] == y["distortion"] or all(abs(x["distortion"][k] - y["distortion"][k]) < 1e-12 for k in x["distortion"])
 assert b[0]["t"] != [0, 0, 0]                  # the world is the board now
 EOF' "calibrate --origin board --fix-intrinsics keeps the given intrinsics"
+
+# arco calibrate check: a synthetic capture against its own calibration (nothing flagged)
+# and against a copy with one camera turned by 1 degree about its centre (flagged).
+"$arco" synth --duration-s 1 --no-audio -o "$tmp/cap" >/dev/null 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ]' "synth for check: $(tail -1 "$tmp/err")"
+"$arco" calibrate check "$tmp/cap" >"$tmp/check.out" 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ] && grep -q "no camera flagged" "$tmp/check.out"' "check: $(tail -2 "$tmp/check.out") $(cat "$tmp/err")"
+python3 - "$tmp/cap/calibration.json" "$tmp/turned.json" <<EOF
+import json, math, sys
+d = json.load(open(sys.argv[1]))
+a = math.radians(1)
+ry = [[math.cos(a), 0, math.sin(a)], [0, 1, 0], [-math.sin(a), 0, math.cos(a)]]
+cam = d["cameras"][3]
+R = [cam["R"][0:3], cam["R"][3:6], cam["R"][6:9]]
+cam["R"] = [sum(ry[i][k] * R[k][j] for k in range(3)) for i in range(3) for j in range(3)]
+cam["t"] = [sum(ry[i][k] * cam["t"][k] for k in range(3)) for i in range(3)]
+json.dump(d, open(sys.argv[2], "w"))
+EOF
+name=$(python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['cameras'][3]['name'])" "$tmp/cap/calibration.json")
+"$arco" calibrate check "$tmp/cap" --calibration "$tmp/turned.json" --json >"$tmp/check.json" 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ] && python3 -c "import json, sys; d = json.load(open(sys.argv[1])); assert d[\"flagged\"] == [sys.argv[2]], d[\"flagged\"]" "$tmp/check.json" "$name"' \
+  "check flags the turned camera $name: $(cat "$tmp/err")"
+"$arco" calibrate check "$tmp/cap" --calibration "$tmp/missing.json" >/dev/null 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 1 ] && [ $(wc -l <"$tmp/err") -eq 1 ] && grep -q "^arco: error: $tmp/missing.json" "$tmp/err"' "check: missing calibration: $(cat "$tmp/err")"
 
 [ $fail -eq 0 ] && echo "calibration CLI: all checks passed"
 exit $fail
