@@ -3,6 +3,7 @@
 # inputs is one line "arco: error: FILE: ..." naming the file and the field, a non-zero
 # exit, no output (and no temporary) left behind, on every command that reads that input:
 # arco run (before its first stage: no stage progress line), arco triangulate,
+# arco calibrate check,
 # arco pitch --capture and arco sync --capture. Also: a truncated WAV is a warning naming
 # the file; a capture whose audio starts late is still run.
 # usage: inputs_cli_test.sh ARCO_BINARY SHARED_DATA_DIR
@@ -85,8 +86,9 @@ sync_bad() {
   bad "sync: $1" "$2" "$3" sync "$tmp/good/audio.wav" --video "$tmp/good/audio.wav" \
     --capture "$tmp/$1"
 }
+check_bad() { bad "calibrate check: $1" "$2" "$3" calibrate check "$tmp/$1"; }
 # every NAME FILE WORDS: the manifest defect on every command reading capture.json.
-every() { run_bad "$@"; tri_bad "$@"; pitch_bad "$@"; sync_bad "$@"; }
+every() { run_bad "$@"; tri_bad "$@"; pitch_bad "$@"; sync_bad "$@"; check_bad "$@"; }
 
 M=capture.json
 # capture.json fields: the file and the field, never a flag.
@@ -128,23 +130,29 @@ pitch_bad bad_audio "$tmp/bad_audio/$M" "audio.file: $tmp/bad_audio/audio.wav: c
 # The calibration: run and triangulate.
 defect no_calib; rm "$tmp/no_calib/calibration.json"
 run_bad no_calib "$tmp/no_calib/$M" "calibration \"calibration.json\": $tmp/no_calib/calibration.json not found"
+check_bad no_calib "$tmp/no_calib/$M" "calibration \"calibration.json\": $tmp/no_calib/calibration.json not found"
 tri_bad no_calib "$tmp/no_calib/$M" "calibration: $tmp/no_calib/calibration.json"
 defect bad_calib; echo '{"cameras": 3}' >"$tmp/bad_calib/calibration.json"
 run_bad bad_calib "$tmp/bad_calib/$M" "calibration: $tmp/bad_calib/calibration.json"
+check_bad bad_calib "$tmp/bad_calib/$M" "calibration: $tmp/bad_calib/calibration.json"
 tri_bad bad_calib "$tmp/bad_calib/$M" "calibration: $tmp/bad_calib/calibration.json"
 defect no_camera; json no_camera 'j["cameras"][1]["name"] = "cam_x"; j["cameras"][1]["serial"] = "x"'
 run_bad no_camera "$tmp/no_camera/$M" "camera \"cam_x\" is not in $tmp/no_camera/calibration.json"
+check_bad no_camera "$tmp/no_camera/$M" "camera \"cam_x\" is not in $tmp/no_camera/calibration.json"
 tri_bad no_camera "$tmp/no_camera/$M" "camera \"cam_x\" is not in $tmp/no_camera/calibration.json"
 
 # keypoints2d.npy: dtype and shape, from its header.
 defect int32; npy int32 '<i4' 0
 run_bad int32 "$tmp/int32/keypoints2d.npy" "dtype int32; keypoints2d must be float32 or float64"
+check_bad int32 "$tmp/int32/keypoints2d.npy" "dtype int32; keypoints2d must be float32 or float64"
 tri_bad int32 "$tmp/int32/keypoints2d.npy" "dtype int32; keypoints2d must be float32 or float64"
 defect short; npy short '<f4' 30
 run_bad short "$tmp/short/keypoints2d.npy" "shape (30, 20, 142, 3) does not match capture.json ("
+check_bad short "$tmp/short/keypoints2d.npy" "shape (30, 20, 142, 3) does not match capture.json ("
 tri_bad short "$tmp/short/keypoints2d.npy" "shape (30, 20, 142, 3) does not match capture.json ("
 defect no_npy; rm "$tmp/no_npy/keypoints2d.npy"
 run_bad no_npy "$tmp/no_npy/keypoints2d.npy" "not found"
+check_bad no_npy "$tmp/no_npy/keypoints2d.npy" "not found"
 tri_bad no_npy "$tmp/no_npy/keypoints2d.npy" "not found"
 
 # The instrument's points: run (the instrument stage needs them).

@@ -52,6 +52,10 @@ StatusOr<CalibrationCheckSummary> CheckCalibration(const CalibrationCheckOptions
   summary.calibration = options.calibration.empty()
                             ? ResolveCapturePath(options.capture_dir, manifest.calibration)
                             : options.calibration;
+  // The capture's own calibration is checked as `arco run` checks it (messages name
+  // capture.json's field); another one by its path.
+  if (options.calibration.empty())
+    ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(options.capture_dir, manifest));
   ARCO_ASSIGN_OR_RETURN(const Calibration calibration, LoadCalibration(summary.calibration));
   const Rig& rig = calibration.rig;
   ARCO_ASSIGN_OR_RETURN(
