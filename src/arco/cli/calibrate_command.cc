@@ -41,7 +41,7 @@ int RunCheck(const pipeline::CalibrationCheckOptions& options, bool json) {
   }
   std::printf("%s against %s: %lld frames; rig median %.2f px, flag above %.2f px\n",
               result->calibration.c_str(),
-              options.capture_dir.c_str(),
+              options.label_views.empty() ? options.capture_dir.c_str() : "the labelled views",
               static_cast<long long>(result->frames),
               result->rig_median_px,
               result->threshold_px);
@@ -252,8 +252,12 @@ std::function<int()> SetupCalibrate(CLI::App& app) {
       "Check a calibration against a capture's 2D keypoints: per camera the reprojection "
       "residuals of the triangulated keypoints; a camera that stands out (moved or "
       "mis-calibrated) is flagged with its frames");
-  check->add_option("capture", c->capture_dir, "Capture folder (capture.json, keypoints2d)")
-      ->required();
+  check->add_option("capture", c->capture_dir, "Capture folder (capture.json, keypoints2d)");
+  auto views = std::make_shared<std::vector<std::string>>();
+  check->add_option("--view",
+                    *views,
+                    "CAMERA=LABELME.json: check labelled views instead of a capture (CAMERA a "
+                    "camera name or serial; repeat per view; needs --calibration)");
   check->add_option("--calibration",
                     c->calibration,
                     "Calibration to check instead of the capture's own (any format arco reads)");
@@ -282,7 +286,19 @@ std::function<int()> SetupCalibrate(CLI::App& app) {
       check, "--frame-step", c->frame_step, "Check every n-th frame", calibration::kFrameStepRange)
       ->capture_default_str();
   check->add_flag("--json", *json, "Print the summary as JSON");
-  check->parse_complete_callback([c] {
+  check->parse_complete_callback([c, views] {
+    c->label_views.clear();
+    for (const std::string& text : *views) {
+      auto view = calibration::ParseCalibrateInput(text);
+      if (!view.ok()) ThrowIfInvalid(Status::Error("--view: " + view.status().message()));
+      c->label_views.emplace_back(view->camera, view->path);
+    }
+    if (!c->label_views.empty() && !c->capture_dir.empty())
+      ThrowIfInvalid(Status::Error("give a capture or --view labels, not both"));
+    if (c->label_views.empty() && c->capture_dir.empty())
+      ThrowIfInvalid(Status::Error("give a capture folder or --view labels"));
+    if (!c->label_views.empty() && c->calibration.empty())
+      ThrowIfInvalid(Status::Error("--view needs --calibration"));
     const Status valid = c->Validate();
     if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kCheckFlags)));
   });

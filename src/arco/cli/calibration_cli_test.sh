@@ -142,5 +142,18 @@ check '[ $rc -eq 0 ] && python3 -c "import json, sys; d = json.load(open(sys.arg
 rc=$?
 check '[ $rc -eq 1 ] && [ $(wc -l <"$tmp/err") -eq 1 ] && grep -q "^arco: error: $tmp/missing.json" "$tmp/err"' "check: missing calibration: $(cat "$tmp/err")"
 
+# calibrate check on the real SPD labelled views of frame 128: nothing flagged with the
+# session's calibration.
+V=()
+for s in 21334181 21334190 21334211 21334237; do
+  V+=(--view "$s=$spd/labels_frame128/cello_1113_scale_${s}_128.json")
+done
+"$arco" calibrate check --calibration "$spd/cello_1113_scale_camera.xml" "${V[@]}" >"$tmp/spd.out" 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ] && grep -q "no camera flagged" "$tmp/spd.out"' "check on the SPD labels: $(cat "$tmp/spd.out" "$tmp/err")"
+"$arco" calibrate check "${V[@]}" >/dev/null 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 1 ] && grep -q "^arco: error: --view needs --calibration" "$tmp/err"' "check --view without --calibration: $(cat "$tmp/err")"
+
 [ $fail -eq 0 ] && echo "calibration CLI: all checks passed"
 exit $fail

@@ -7,12 +7,17 @@
 #include "arco/calibration/calibration_file.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/triangulate_point.h"
+#include "arco/pipeline/label_views.h"
 #include "arco/pipeline/preflight.h"
 #include "arco/util/stats.h"
 
 namespace arco::pipeline {
 
 Status CalibrationCheckOptions::Validate() const {
+  if (!label_views.empty() && calibration.empty())
+    return Status::Error("calibration: needed with labelled views");
+  if (label_views.empty() && capture_dir.empty())
+    return Status::Error("capture_dir: give a capture folder or labelled views");
   ARCO_RETURN_IF_ERROR(CheckInRange("min_score", min_score, Closed(0, 1)));
   ARCO_RETURN_IF_ERROR(CheckInRange("min_views", min_views, Closed(2, 1000)));
   ARCO_RETURN_IF_ERROR(CheckInRange("flag_ratio", flag_ratio, kCheckRatioRange));
@@ -42,9 +47,66 @@ Json CalibrationCheckSummary::ToJson() const {
   return j;
 }
 
+namespace {
+
+// The medians, the threshold and the flags, from each camera's residuals.
+Status Flag(const CalibrationCheckOptions& options,
+            const std::vector<std::vector<double>>& residuals,
+            CalibrationCheckSummary* summary) {
+  std::vector<double> medians;
+  for (size_t v = 0; v < residuals.size(); ++v) {
+    CameraCheck& c = summary->cameras[v];
+    c.residuals = static_cast<int64_t>(residuals[v].size());
+    if (residuals[v].empty()) continue;
+    c.median_px = Median(residuals[v]);
+    c.p90_px = InterpolatedQuantile(residuals[v], 0.9);
+    medians.push_back(c.median_px);
+  }
+  if (medians.empty())
+    return Status::Error(
+        (options.label_views.empty() ? options.capture_dir : options.label_views[0].second) +
+        ": no keypoint is seen by " + std::to_string(options.min_views) +
+        " cameras with a score of at least " + NumberText(options.min_score) +
+        "; nothing to check");
+  summary->rig_median_px = Median(medians);
+  summary->threshold_px =
+      std::max(options.min_flag_px, options.flag_ratio * summary->rig_median_px);
+  for (CameraCheck& c : summary->cameras) {
+    if (c.residuals == 0 || c.median_px <= summary->threshold_px) continue;
+    c.flagged = true;
+    summary->flagged.push_back(c.name);
+  }
+  return Status::Ok();
+}
+
+StatusOr<CalibrationCheckSummary> CheckLabelViews(const CalibrationCheckOptions& options) {
+  LabelViewsOptions labels;
+  labels.calibration = options.calibration;
+  labels.views = options.label_views;
+  ARCO_ASSIGN_OR_RETURN(const Json triangulated, TriangulateLabelViews(labels));
+  CalibrationCheckSummary summary;
+  summary.calibration = options.calibration;
+  summary.frames = 1;
+  std::vector<std::vector<double>> residuals(options.label_views.size());
+  for (const auto& view : options.label_views) summary.cameras.emplace_back(view.first);
+  for (const Json& point : triangulated["points"]) {
+    if (static_cast<int>(point["inlier_views"].size()) < options.min_views) continue;
+    for (size_t v = 0; v < options.label_views.size(); ++v) {
+      const auto it = point["reprojection_px"].find(options.label_views[v].first);
+      if (it != point["reprojection_px"].end() && it->is_number())
+        residuals[v].push_back(it->template get<double>());
+    }
+  }
+  ARCO_RETURN_IF_ERROR(Flag(options, residuals, &summary));
+  return summary;
+}
+
+}  // namespace
+
 StatusOr<CalibrationCheckSummary> CheckCalibration(const CalibrationCheckOptions& options,
                                                    Progress& progress) {
   ARCO_RETURN_IF_ERROR(options.Validate());
+  if (!options.label_views.empty()) return CheckLabelViews(options);
   ARCO_ASSIGN_OR_RETURN(const CaptureManifest manifest, ReadCaptureManifest(options.capture_dir));
   if (manifest.keypoints2d.empty())
     return Status::Error(options.capture_dir + "/capture.json: no keypoints2d to check against");
@@ -103,29 +165,11 @@ StatusOr<CalibrationCheckSummary> CheckCalibration(const CalibrationCheckOptions
     }
     progress.Advance(1);
   }
-  std::vector<double> medians;
-  for (int64_t v = 0; v < views; ++v) {
-    CameraCheck c;
-    c.name = manifest.cameras[v].name;
-    c.residuals = static_cast<int64_t>(residuals[v].size());
-    if (!residuals[v].empty()) {
-      c.median_px = Median(residuals[v]);
-      c.p90_px = InterpolatedQuantile(residuals[v], 0.9);
-      medians.push_back(c.median_px);
-    }
-    summary.cameras.push_back(c);
-  }
-  if (medians.empty())
-    return Status::Error(options.capture_dir + ": no keypoint is seen by " +
-                         std::to_string(options.min_views) + " cameras with a score of at least " +
-                         NumberText(options.min_score) + "; nothing to check");
-  summary.rig_median_px = Median(medians);
-  summary.threshold_px = std::max(options.min_flag_px, options.flag_ratio * summary.rig_median_px);
+  for (int64_t v = 0; v < views; ++v) summary.cameras.emplace_back(manifest.cameras[v].name);
+  ARCO_RETURN_IF_ERROR(Flag(options, residuals, &summary));
   for (int64_t v = 0; v < views; ++v) {
     CameraCheck& c = summary.cameras[v];
-    if (c.residuals == 0 || c.median_px <= summary.threshold_px) continue;
-    c.flagged = true;
-    summary.flagged.push_back(c.name);
+    if (!c.flagged) continue;
     for (const auto& [frame, r] : per_frame[v]) {
       if (Median(r) <= summary.threshold_px) continue;
       if (!c.off_frames.empty() && c.off_frames.back().second + options.frame_step >= frame)

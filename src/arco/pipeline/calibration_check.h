@@ -21,7 +21,10 @@ inline constexpr NumberRange kCheckRatioRange = Closed(1, 1000);
 inline constexpr NumberRange kCheckMinFlagRangePx = AboveZero(10000);
 
 struct CalibrationCheckOptions {
-  std::string capture_dir;
+  std::string capture_dir;  // a capture folder, or
+  // labelled views instead (labelme files, corner pixel origin as labelme writes them):
+  // (camera name or serial, file) per view; `calibration` is then required.
+  std::vector<std::pair<std::string, std::string>> label_views;
   std::string calibration;   // "" = the capture's own; else this file is checked
   double min_score = 0.5;    // detections below this confidence are ignored
   int min_views = 3;         // a point must be triangulated from this many cameras
@@ -32,6 +35,7 @@ struct CalibrationCheckOptions {
 };
 
 struct CameraCheck {
+  explicit CameraCheck(std::string name = "") : name(std::move(name)) {}
   std::string name;
   int64_t residuals = 0;  // reprojections measured
   double median_px = 0, p90_px = 0;
@@ -51,8 +55,9 @@ struct CalibrationCheckSummary {
   Json ToJson() const;
 };
 
-// Errors: the capture or calibration cannot be read (messages name the file), a camera
-// of the capture is not in the calibration, no keypoint is seen by enough cameras.
+// Errors: the capture, labels or calibration cannot be read (messages name the file), a
+// camera is not in the calibration, no keypoint is seen by enough cameras. With label
+// views, "frames" is 1 and off_frames stays empty.
 StatusOr<CalibrationCheckSummary> CheckCalibration(const CalibrationCheckOptions& options,
                                                    Progress& progress = NoProgress());
 

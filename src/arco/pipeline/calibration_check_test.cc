@@ -80,6 +80,44 @@ TEST(CheckCalibration, FlagsOnlyACameraTurnedByOneDegree) {
   EXPECT_EQ(bad->ToJson()["flagged"][0], rig.cameras[3].name);
 }
 
+// The real SPD rig: the four labelled views of frame 128 with the session's Metashape
+// calibration, and a copy with one of the four cameras turned by 1 degree.
+TEST(CheckCalibration, RealSpdLabelledViews) {
+  TempDir dir;
+  const std::string spd = std::string(ARCO_SHARED_DATA_DIR) + "/spd/";
+  const std::string calibration = spd + "cello_1113_scale_camera.xml";
+  CalibrationCheckOptions options;
+  options.calibration = calibration;
+  const char* serials[] = {"21334181", "21334190", "21334211", "21334237"};
+  for (const char* s : serials)
+    options.label_views.emplace_back(s,
+                                     spd + "labels_frame128/cello_1113_scale_" + s + "_128.json");
+  auto good = CheckCalibration(options);
+  ASSERT_TRUE(good.ok()) << good.status().message();
+  EXPECT_TRUE(good->flagged.empty()) << good->ToJson().dump();
+  for (const CameraCheck& c : good->cameras) EXPECT_GE(c.residuals, 5) << c.name;
+
+  auto loaded = LoadCalibration(calibration);
+  ASSERT_TRUE(loaded.ok());
+  Rig moved = loaded->rig;
+  Camera& turned = moved.cameras[moved.FindCamera("21334211")];
+  const Eigen::Vector3d centre = turned.CenterInWorld();
+  turned.cam_from_world_rotation =
+      RotationFromAxisAngle(Eigen::Vector3d(M_PI / 180, 0, 0)) * turned.cam_from_world_rotation;
+  turned.cam_from_world_translation = -turned.cam_from_world_rotation * centre;
+  ASSERT_TRUE(SaveCalibration(dir / "moved.json", moved).ok());
+  options.calibration = dir / "moved.json";
+  auto bad = CheckCalibration(options);
+  ASSERT_TRUE(bad.ok()) << bad.status().message();
+  std::printf("SPD frame 128: medians %.2f %.2f %.2f %.2f px; 21334211 turned 1 deg: %.1f px\n",
+              good->cameras[0].median_px,
+              good->cameras[1].median_px,
+              good->cameras[2].median_px,
+              good->cameras[3].median_px,
+              bad->cameras[2].median_px);
+  EXPECT_EQ(bad->flagged, std::vector<std::string>{"21334211"});
+}
+
 TEST(CheckCalibration, ErrorsNameTheFile) {
   TempDir dir;
   Rig rig;
