@@ -8,6 +8,34 @@ Eigen::Matrix3d Camera::K() const {
   return k;
 }
 
+std::array<double, kNumIntrinsics> Camera::Intrinsics() const {
+  std::array<double, kNumIntrinsics> i{};
+  i[kFx] = fx;
+  i[kFy] = fy;
+  i[kCx] = cx;
+  i[kCy] = cy;
+  i[kSkew] = skew;
+  i[kK1] = distortion.k1;
+  i[kK2] = distortion.k2;
+  i[kK3] = distortion.k3;
+  i[kP1] = distortion.p1;
+  i[kP2] = distortion.p2;
+  return i;
+}
+
+void Camera::SetIntrinsics(const std::array<double, kNumIntrinsics>& i) {
+  fx = i[kFx];
+  fy = i[kFy];
+  cx = i[kCx];
+  cy = i[kCy];
+  skew = i[kSkew];
+  distortion.k1 = i[kK1];
+  distortion.k2 = i[kK2];
+  distortion.k3 = i[kK3];
+  distortion.p1 = i[kP1];
+  distortion.p2 = i[kP2];
+}
+
 Eigen::Matrix<double, 3, 4> Camera::ProjectionMatrix() const {
   Eigen::Matrix<double, 3, 4> rt;
   rt.leftCols<3>() = cam_from_world_rotation;

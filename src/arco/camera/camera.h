@@ -12,12 +12,45 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace arco {
+
+// The intrinsics as one parameter block, for solvers that refine them (arco calibrate's
+// bundle adjustment): the model below is written once, in PixelFromPointInCamera.
+enum IntrinsicIndex : int { kFx, kFy, kCx, kCy, kSkew, kK1, kK2, kK3, kP1, kP2, kNumIntrinsics };
+
+// Brown-Conrady distortion of normalised coordinates (x, y) -> (x', y') with the
+// distortion entries of an intrinsics block (kK1..kP2); templated for autodiff.
+template <typename T>
+void DistortNormalized(const T* intrinsics, const T& x, const T& y, T* xd, T* yd) {
+  const T& k1 = intrinsics[kK1];
+  const T& k2 = intrinsics[kK2];
+  const T& k3 = intrinsics[kK3];
+  const T& p1 = intrinsics[kP1];
+  const T& p2 = intrinsics[kP2];
+  const T r2 = x * x + y * y;
+  const T radial = T(1) + r2 * (k1 + r2 * (k2 + r2 * k3));
+  *xd = x * radial + T(2) * p1 * x * y + p2 * (r2 + T(2) * x * x);
+  *yd = y * radial + p1 * (r2 + T(2) * y * y) + T(2) * p2 * x * y;
+}
+
+// Pixel of a point in the camera frame; false when it is not in front (z <= 0).
+template <typename T>
+bool PixelFromPointInCamera(const T* intrinsics, const T* point_in_camera, T* pixel) {
+  if (!(point_in_camera[2] > T(0))) return false;
+  const T x = point_in_camera[0] / point_in_camera[2];
+  const T y = point_in_camera[1] / point_in_camera[2];
+  T xd, yd;
+  DistortNormalized(intrinsics, x, y, &xd, &yd);
+  pixel[0] = intrinsics[kFx] * xd + intrinsics[kSkew] * yd + intrinsics[kCx];
+  pixel[1] = intrinsics[kFy] * yd + intrinsics[kCy];
+  return true;
+}
 
 struct Distortion {
   double k1 = 0, k2 = 0, k3 = 0;  // radial
@@ -35,6 +68,9 @@ struct Camera {
   Eigen::Vector3d cam_from_world_translation = Eigen::Vector3d::Zero();
 
   Eigen::Matrix3d K() const;
+  // fx fy cx cy skew k1 k2 k3 p1 p2 (IntrinsicIndex order), and back.
+  std::array<double, kNumIntrinsics> Intrinsics() const;
+  void SetIntrinsics(const std::array<double, kNumIntrinsics>& intrinsics);
   // 3x4 P = K [R | t] (no distortion): for DLT on undistorted pixels.
   Eigen::Matrix<double, 3, 4> ProjectionMatrix() const;
   Eigen::Vector3d CenterInWorld() const;
@@ -63,10 +99,10 @@ struct Camera {
 
 template <typename T>
 void Camera::Distort(const T& x, const T& y, T* xd, T* yd) const {
-  const T r2 = x * x + y * y;
-  const T radial = T(1) + r2 * (T(distortion.k1) + r2 * (T(distortion.k2) + r2 * T(distortion.k3)));
-  *xd = x * radial + T(2 * distortion.p1) * x * y + T(distortion.p2) * (r2 + T(2) * x * x);
-  *yd = y * radial + T(distortion.p1) * (r2 + T(2) * y * y) + T(2 * distortion.p2) * x * y;
+  const std::array<double, kNumIntrinsics> d = Intrinsics();
+  T intrinsics[kNumIntrinsics];
+  for (int i = 0; i < kNumIntrinsics; ++i) intrinsics[i] = T(d[i]);
+  DistortNormalized(intrinsics, x, y, xd, yd);
 }
 
 template <typename T>
@@ -76,14 +112,10 @@ bool Camera::ProjectToPixel(const T* point_in_world, T* pixel) const {
     p[r] = T(cam_from_world_translation[r]);
     for (int c = 0; c < 3; ++c) p[r] += T(cam_from_world_rotation(r, c)) * point_in_world[c];
   }
-  if (!(p[2] > T(0))) return false;
-  const T x = p[0] / p[2];
-  const T y = p[1] / p[2];
-  T xd, yd;
-  Distort(x, y, &xd, &yd);
-  pixel[0] = T(fx) * xd + T(skew) * yd + T(cx);
-  pixel[1] = T(fy) * yd + T(cy);
-  return true;
+  const std::array<double, kNumIntrinsics> d = Intrinsics();
+  T intrinsics[kNumIntrinsics];
+  for (int i = 0; i < kNumIntrinsics; ++i) intrinsics[i] = T(d[i]);
+  return PixelFromPointInCamera(intrinsics, p, pixel);
 }
 
 }  // namespace arco

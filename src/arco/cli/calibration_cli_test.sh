@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # End-to-end checks of `arco calibration show/convert` on the real SPD files:
 # JSON shape and conventions, conversions, and bad input (one error line, exit 1,
-# no output file). usage: calibration_cli_test.sh ARCO_BINARY SHARED_DATA_DIR
+# no output file); and `arco calibrate` on OpenCV's stereo pairs (opencv-doc): the
+# calibration reads back, the report's figures, --origin board, --intrinsics with
+# --fix-intrinsics. usage: calibration_cli_test.sh ARCO_BINARY SHARED_DATA_DIR
 set -uo pipefail
 arco=$1
 spd=$2/spd
@@ -66,6 +68,92 @@ done
 check '[ $? -eq 1 ] && grep -q "out.txt" "$tmp/err" && [ ! -e "$tmp/out.txt" ]' "unknown extension"
 "$arco" calibration show "$tmp/truncated.xml" >/dev/null 2>"$tmp/err"
 check '[ $? -eq 1 ] && grep -q "malformed XML" "$tmp/err"' "show on malformed XML"
+
+# arco calibrate on OpenCV's stereo pairs.
+data=/usr/share/doc/opencv-doc/examples/data
+mkdir -p "$tmp/L" "$tmp/R"
+for f in "$data"/left[0-9][0-9].jpg; do ln -s "$f" "$tmp/L/"; done
+for f in "$data"/right[0-9][0-9].jpg; do ln -s "$f" "$tmp/R/"; done
+K=(calibrate --board chessboard:9x6:25 --images left="$tmp/L" --images right="$tmp/R")
+"$arco" "${K[@]}" -o "$tmp/rig.json" >"$tmp/cal.out" 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ]' "calibrate: $(tail -1 "$tmp/err")"
+check 'grep -q "calibrated 2 cameras from chessboard:9x6:25 boards; world: left, mm" "$tmp/cal.out"' \
+  "calibrate prints its summary: $(head -1 "$tmp/cal.out")"
+"$arco" calibration show "$tmp/rig.json" --json >"$tmp/rig.show"
+check 'python3 - "$tmp/rig.show" "$tmp/rig.report.json" <<EOF
+import json, sys
+rig = json.load(open(sys.argv[1])); rep = json.load(open(sys.argv[2]))
+cams = rig["cameras"]
+assert [c["name"] for c in cams] == ["left", "right"], cams
+assert cams[0]["R"] == [1, 0, 0, 0, 1, 0, 0, 0, 1] and cams[0]["t"] == [0, 0, 0], cams[0]
+baseline = sum(x * x for x in cams[1]["t"]) ** 0.5
+assert 80 < baseline < 87, baseline            # about 3.3 squares of 25 mm
+assert rep["rms_px"] < 0.3 and rep["warnings"] == [], rep
+assert rep["pairs"] == [{"cameras": ["left", "right"], "shared_frames": 13}], rep["pairs"]
+assert rep["board_triangulation"]["rms_mm"] < 0.6, rep["board_triangulation"]
+assert rep["bundle_adjustment"]["termination"] == "CONVERGENCE", rep["bundle_adjustment"]
+EOF' "calibrate: the calibration and the report"
+# The first camera given is the world, whichever flag gives it.
+"$arco" calibrate --board chessboard:9x6:25 --images right="$tmp/R" --video left="$tmp/L" \
+  -o "$tmp/order.json" >"$tmp/order.out" 2>"$tmp/err"
+check 'grep -q "world: right, mm" "$tmp/order.out"' "calibrate: the first camera given is the origin: $(head -1 "$tmp/order.out") $(cat "$tmp/err")"
+"$arco" "${K[@]}" --origin board --intrinsics "$tmp/rig.json" --fix-intrinsics -o "$tmp/rig2.yaml" >/dev/null 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ]' "calibrate --origin board --intrinsics --fix-intrinsics: $(tail -1 "$tmp/err")"
+"$arco" calibration show "$tmp/rig2.yaml" --json >"$tmp/rig2.show"
+check 'python3 - "$tmp/rig.show" "$tmp/rig2.show" "$tmp/rig2.report.json" <<EOF
+import json, sys
+a = json.load(open(sys.argv[1]))["cameras"]; b = json.load(open(sys.argv[2]))["cameras"]
+rep = json.load(open(sys.argv[3]))
+assert rep["origin"].startswith("board@"), rep["origin"]
+assert all(c["intrinsics_given"] for c in rep["cameras"]), rep["cameras"]
+for x, y in zip(a, b):
+    assert all(abs(p - q) < 1e-9 * max(1, abs(p)) for p, q in zip(x["K"], y["K"])), (x["K"], y["K"])
+    assert x["distortion"] == y["distortion"] or all(abs(x["distortion"][k] - y["distortion"][k]) < 1e-12 for k in x["distortion"])
+assert b[0]["t"] != [0, 0, 0]                  # the world is the board now
+EOF' "calibrate --origin board --fix-intrinsics keeps the given intrinsics"
+
+# arco calibrate check: a synthetic capture against its own calibration (nothing flagged)
+# and against a copy with one camera turned by 1 degree about its centre (flagged).
+"$arco" synth --duration-s 1 --no-audio -o "$tmp/cap" >/dev/null 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ]' "synth for check: $(tail -1 "$tmp/err")"
+"$arco" calibrate check "$tmp/cap" >"$tmp/check.out" 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ] && grep -q "no camera flagged" "$tmp/check.out"' "check: $(tail -2 "$tmp/check.out") $(cat "$tmp/err")"
+python3 - "$tmp/cap/calibration.json" "$tmp/turned.json" <<EOF
+import json, math, sys
+d = json.load(open(sys.argv[1]))
+a = math.radians(1)
+ry = [[math.cos(a), 0, math.sin(a)], [0, 1, 0], [-math.sin(a), 0, math.cos(a)]]
+cam = d["cameras"][3]
+R = [cam["R"][0:3], cam["R"][3:6], cam["R"][6:9]]
+cam["R"] = [sum(ry[i][k] * R[k][j] for k in range(3)) for i in range(3) for j in range(3)]
+cam["t"] = [sum(ry[i][k] * cam["t"][k] for k in range(3)) for i in range(3)]
+json.dump(d, open(sys.argv[2], "w"))
+EOF
+name=$(python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['cameras'][3]['name'])" "$tmp/cap/calibration.json")
+"$arco" calibrate check "$tmp/cap" --calibration "$tmp/turned.json" --json >"$tmp/check.json" 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ] && python3 -c "import json, sys; d = json.load(open(sys.argv[1])); assert d[\"flagged\"] == [sys.argv[2]], d[\"flagged\"]" "$tmp/check.json" "$name"' \
+  "check flags the turned camera $name: $(cat "$tmp/err")"
+"$arco" calibrate check "$tmp/cap" --calibration "$tmp/missing.json" >/dev/null 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 1 ] && [ $(wc -l <"$tmp/err") -eq 1 ] && grep -q "^arco: error: $tmp/missing.json" "$tmp/err"' "check: missing calibration: $(cat "$tmp/err")"
+
+# calibrate check on the real SPD labelled views of frame 128: nothing flagged with the
+# session's calibration.
+V=()
+for s in 21334181 21334190 21334211 21334237; do
+  V+=(--view "$s=$spd/labels_frame128/cello_1113_scale_${s}_128.json")
+done
+"$arco" calibrate check --calibration "$spd/cello_1113_scale_camera.xml" "${V[@]}" >"$tmp/spd.out" 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ] && grep -q "no camera flagged" "$tmp/spd.out"' "check on the SPD labels: $(cat "$tmp/spd.out" "$tmp/err")"
+"$arco" calibrate check "${V[@]}" >/dev/null 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 1 ] && grep -q "^arco: error: --view needs --calibration" "$tmp/err"' "check --view without --calibration: $(cat "$tmp/err")"
 
 [ $fail -eq 0 ] && echo "calibration CLI: all checks passed"
 exit $fail

@@ -3,6 +3,7 @@
 # inputs is one line "arco: error: FILE: ..." naming the file and the field, a non-zero
 # exit, no output (and no temporary) left behind, on every command that reads that input:
 # arco run (before its first stage: no stage progress line), arco triangulate,
+# arco calibrate check,
 # arco pitch --capture and arco sync --capture. Also: a truncated WAV is a warning naming
 # the file; a capture whose audio starts late is still run.
 # usage: inputs_cli_test.sh ARCO_BINARY SHARED_DATA_DIR
@@ -85,8 +86,9 @@ sync_bad() {
   bad "sync: $1" "$2" "$3" sync "$tmp/good/audio.wav" --video "$tmp/good/audio.wav" \
     --capture "$tmp/$1"
 }
+check_bad() { bad "calibrate check: $1" "$2" "$3" calibrate check "$tmp/$1"; }
 # every NAME FILE WORDS: the manifest defect on every command reading capture.json.
-every() { run_bad "$@"; tri_bad "$@"; pitch_bad "$@"; sync_bad "$@"; }
+every() { run_bad "$@"; tri_bad "$@"; pitch_bad "$@"; sync_bad "$@"; check_bad "$@"; }
 
 M=capture.json
 # capture.json fields: the file and the field, never a flag.
@@ -128,23 +130,29 @@ pitch_bad bad_audio "$tmp/bad_audio/$M" "audio.file: $tmp/bad_audio/audio.wav: c
 # The calibration: run and triangulate.
 defect no_calib; rm "$tmp/no_calib/calibration.json"
 run_bad no_calib "$tmp/no_calib/$M" "calibration \"calibration.json\": $tmp/no_calib/calibration.json not found"
+check_bad no_calib "$tmp/no_calib/$M" "calibration \"calibration.json\": $tmp/no_calib/calibration.json not found"
 tri_bad no_calib "$tmp/no_calib/$M" "calibration: $tmp/no_calib/calibration.json"
 defect bad_calib; echo '{"cameras": 3}' >"$tmp/bad_calib/calibration.json"
 run_bad bad_calib "$tmp/bad_calib/$M" "calibration: $tmp/bad_calib/calibration.json"
+check_bad bad_calib "$tmp/bad_calib/$M" "calibration: $tmp/bad_calib/calibration.json"
 tri_bad bad_calib "$tmp/bad_calib/$M" "calibration: $tmp/bad_calib/calibration.json"
 defect no_camera; json no_camera 'j["cameras"][1]["name"] = "cam_x"; j["cameras"][1]["serial"] = "x"'
 run_bad no_camera "$tmp/no_camera/$M" "camera \"cam_x\" is not in $tmp/no_camera/calibration.json"
+check_bad no_camera "$tmp/no_camera/$M" "camera \"cam_x\" is not in $tmp/no_camera/calibration.json"
 tri_bad no_camera "$tmp/no_camera/$M" "camera \"cam_x\" is not in $tmp/no_camera/calibration.json"
 
 # keypoints2d.npy: dtype and shape, from its header.
 defect int32; npy int32 '<i4' 0
 run_bad int32 "$tmp/int32/keypoints2d.npy" "dtype int32; keypoints2d must be float32 or float64"
+check_bad int32 "$tmp/int32/keypoints2d.npy" "dtype int32; keypoints2d must be float32 or float64"
 tri_bad int32 "$tmp/int32/keypoints2d.npy" "dtype int32; keypoints2d must be float32 or float64"
 defect short; npy short '<f4' 30
 run_bad short "$tmp/short/keypoints2d.npy" "shape (30, 20, 142, 3) does not match capture.json ("
+check_bad short "$tmp/short/keypoints2d.npy" "shape (30, 20, 142, 3) does not match capture.json ("
 tri_bad short "$tmp/short/keypoints2d.npy" "shape (30, 20, 142, 3) does not match capture.json ("
 defect no_npy; rm "$tmp/no_npy/keypoints2d.npy"
 run_bad no_npy "$tmp/no_npy/keypoints2d.npy" "not found"
+check_bad no_npy "$tmp/no_npy/keypoints2d.npy" "not found"
 tri_bad no_npy "$tmp/no_npy/keypoints2d.npy" "not found"
 
 # The instrument's points: run (the instrument stage needs them).
@@ -160,6 +168,53 @@ check '[ $rc -ne 0 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ]' "run under a file: one
 check 'grep -q "^arco: error: $tmp/out_file/result: cannot create folder" "$tmp/err"' \
   "run under a file names the output: $(cat "$tmp/err")"
 check '! grep -q triangulate "$tmp/stdout" "$tmp/err"' "run under a file: a stage started"
+
+# arco calibrate: the board videos/images, the board spec, the camera graph and the given
+# intrinsics; one line, nothing written (OpenCV's stereo pairs from opencv-doc).
+data=/usr/share/doc/opencv-doc/examples/data
+blank=$tmp/blank.pgm  # a 640x480 frame without a board
+{ printf 'P5\n640 480\n255\n'; head -c 307200 /dev/zero | tr '\0' '\200'; } >"$blank"
+mkdir -p "$tmp/cal/L" "$tmp/cal/R" "$tmp/cal/A" "$tmp/cal/B"
+for n in 01 02 03 04 05 06; do
+  ln -s "$data/left$n.jpg" "$tmp/cal/L/$n.jpg"; ln -s "$data/right$n.jpg" "$tmp/cal/R/$n.jpg"
+  # A sees the board in frames 1-3 only, B in frames 4-6 only: no shared frame.
+  if [ "$n" -le 03 ]; then ln -s "$data/left$n.jpg" "$tmp/cal/A/$n.jpg"; ln -s "$blank" "$tmp/cal/B/$n.pgm"
+  else ln -s "$blank" "$tmp/cal/A/$n.pgm"; ln -s "$data/right$n.jpg" "$tmp/cal/B/$n.jpg"; fi
+done
+echo '{"cameras": 3}' >"$tmp/cal/bad_intrinsics.json"
+C=(calibrate --board chessboard:9x6:25)
+bad "calibrate: no board found" "$blank" "no board (chessboard:9x6:25) found in 1 frames" \
+  "${C[@]}" --images left="$tmp/cal/L" --images blank="$blank" -o "$tmp/out/rig.json"
+bad "calibrate: missing video" "$tmp/cal/missing.mp4" "" \
+  "${C[@]}" --images left="$tmp/cal/L" --video right="$tmp/cal/missing.mp4" -o "$tmp/out/rig.json"
+bad "calibrate: bad intrinsics" "$tmp/cal/bad_intrinsics.json" "" \
+  "${C[@]}" --images left="$tmp/cal/L" --images right="$tmp/cal/R" \
+  --intrinsics "$tmp/cal/bad_intrinsics.json" -o "$tmp/out/rig.json"
+# cal_bad NAME WORDS ARGS...: one line "arco: error: " holding WORDS, nothing written.
+cal_bad() {
+  local name=$1 words=$2; shift 2
+  rm -rf "$tmp/out"; mkdir -p "$tmp/out"
+  "$arco" "$@" >"$tmp/stdout" 2>"$tmp/err"
+  local rc=$?
+  local line; line=$(cat "$tmp/err")
+  check '[ $rc -ne 0 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ]' "$name: exit $rc, not one line: $line"
+  check '[[ "$line" == "arco: error: "*"$words"* ]]' "$name: does not say '$words': $line"
+  check '[ -z "$(ls -A "$tmp/out")" ]' "$name: left $(ls -A "$tmp/out" | head -3)"
+}
+cal_bad "calibrate: one camera" "at least two cameras, got 1 (left)" \
+  "${C[@]}" --images left="$tmp/cal/L" -o "$tmp/out/rig.json"
+cal_bad "calibrate: disconnected" "disconnected camera graph: b shares no board frame with a's group" \
+  "${C[@]}" --images a="$tmp/cal/A" --images b="$tmp/cal/B" -o "$tmp/out/rig.json"
+cal_bad "calibrate: wrong board spec" "board 'chessboard:9x6': expected chessboard:COLSxROWS:SQUARE_MM" \
+  calibrate --board chessboard:9x6 --images left="$tmp/cal/L" --images right="$tmp/cal/R" -o "$tmp/out/rig.json"
+cal_bad "calibrate: wrong board size" "no board (chessboard:7x7:25) found" \
+  calibrate --board chessboard:7x7:25 --images left="$tmp/cal/L" --images right="$tmp/cal/R" -o "$tmp/out/rig.json"
+cal_bad "calibrate: not CAMERA=PATH" "--images: 'left' is not CAMERA=PATH" \
+  "${C[@]}" --images left --images right="$tmp/cal/R" -o "$tmp/out/rig.json"
+cal_bad "calibrate: a camera twice" "camera 'left' is given twice" \
+  "${C[@]}" --images left="$tmp/cal/L" --images left="$tmp/cal/R" -o "$tmp/out/rig.json"
+cal_bad "calibrate: unknown origin" "origin 'cam9' is neither 'board' nor one of the cameras" \
+  "${C[@]}" --images left="$tmp/cal/L" --images right="$tmp/cal/R" --origin cam9 -o "$tmp/out/rig.json"
 
 # No temporaries next to any output after all of the above.
 check '[ -z "$(find "$tmp" -name ".tmp-*" -o -name ".old-*")" ]' "temporaries left behind"

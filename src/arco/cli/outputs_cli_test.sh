@@ -145,5 +145,25 @@ ok "calibration convert" calibration convert "$calib" "$w/c.json"
 bad "calibration convert into a folder" "$w/dir" calibration convert "$calib" "$w/dir"
 bad "calibration convert into a missing folder" "$w/nodir/c.json" calibration convert "$calib" "$w/nodir/c.json"
 
+# calibrate: the calibration and its report, both or neither.
+data=/usr/share/doc/opencv-doc/examples/data
+mkdir -p "$tmp/in/L" "$tmp/in/R"
+for n in 01 02 03 04 05 06 07 08; do
+  ln -s "$data/left$n.jpg" "$tmp/in/L/"; ln -s "$data/right$n.jpg" "$tmp/in/R/"
+done
+K=(calibrate --board chessboard:9x6:25 --images left="$tmp/in/L" --images right="$tmp/in/R")
+ok "calibrate -o rig.json" "${K[@]}" -o "$w/rig.json"
+check '[ -f "$w/rig.json" ] && [ -f "$w/rig.report.json" ]' "calibrate writes rig.json and rig.report.json"
+ok "calibrate -o rig.yaml over an old report" "${K[@]}" -o "$w/rig.yaml"
+check 'grep -q "%YAML" "$w/rig.yaml"' "calibrate -o rig.yaml writes OpenCV YAML"
+rm "$w/rig.yaml" "$w/rig.json"
+bad "calibrate into a folder" "$w/dir" "${K[@]}" -o "$w/dir"
+bad "calibrate into a missing folder" "$w/nodir/rig.json" "${K[@]}" -o "$w/nodir/rig.json"
+bad "calibrate under a file" "$w/file/rig.json" "${K[@]}" -o "$w/file/rig.json"
+mkdir "$w/r2.report.json"
+bad "calibrate: the report's path is a folder" "$w/r2.report.json" "${K[@]}" -o "$w/r2.json"
+rmdir "$w/r2.report.json"
+rm "$w/rig.report.json"
+
 check '[ -z "$(find "$w" -name ".tmp-*" -o -name ".old-*")" ]' "no temporaries left"
 exit $fail

@@ -1,5 +1,7 @@
 #include "arco/media/test_video.h"
 
+#include <string>
+
 #include "arco/media/video_writer.h"
 
 namespace arco::media::testing {
@@ -48,6 +50,12 @@ int ReadIndex(const Image& frame) {
 bool HasEncoder(const std::string& name) { return HasVideoEncoder(name); }
 
 Status WriteIndexVideo(const std::string& path, const IndexVideo& v) {
+  return WriteGrayVideo(path, v, [&](int k) { return IndexFrame(v, k); });
+}
+
+Status WriteGrayVideo(const std::string& path,
+                      const IndexVideo& v,
+                      const std::function<Image(int)>& make_frame) {
   VideoWriterOptions options;
   options.container = v.container;
   options.codec = v.codec;
@@ -61,7 +69,15 @@ Status WriteIndexVideo(const std::string& path, const IndexVideo& v) {
   options.pixel_format = "yuv420p";
   options.bit_rate = 4000000;
   ARCO_ASSIGN_OR_RETURN(VideoWriter writer, VideoWriter::Open(path, options));
-  for (int k = 0; k < v.frames; ++k) ARCO_RETURN_IF_ERROR(writer.Write(IndexFrame(v, k)));
+  for (int k = 0; k < v.frames; ++k) {
+    const Image frame = make_frame(k);
+    if (frame.width != v.width || frame.height != v.height || frame.format != PixelFormat::kGray8) {
+      return Status::Error(path + ": frame " + std::to_string(k) + " is not a " +
+                           std::to_string(v.width) + "x" + std::to_string(v.height) +
+                           " gray image");
+    }
+    ARCO_RETURN_IF_ERROR(writer.Write(frame));
+  }
   return writer.Close();
 }
 

@@ -3,6 +3,7 @@
 // large enough to survive lossy codecs, so a test can check which frame it got.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "arco/media/image.h"
@@ -17,8 +18,8 @@ struct IndexVideo {
   int width = 128, height = 96;        // multiples of the 32 px blocks
   Rational fps{30, 1};
   int frames = 60;
-  int gop = 12;       // key frame interval
-  int b_frames = 0;   // B-frames between references (reordered pts)
+  int gop = 12;          // key frame interval
+  int b_frames = 0;      // B-frames between references (reordered pts)
   int rotation_deg = 0;  // clockwise display rotation, written as a display matrix
 };
 
@@ -28,6 +29,11 @@ Image IndexFrame(const IndexVideo& video, int k);
 int ReadIndex(const Image& frame);
 
 Status WriteIndexVideo(const std::string& path, const IndexVideo& video);
+// The same container, codec and timing with the frames `frame(k)` (gray, video.width x
+// video.height) instead of index frames: e.g. rendered calibration-board views.
+Status WriteGrayVideo(const std::string& path,
+                      const IndexVideo& video,
+                      const std::function<Image(int)>& frame);
 // Frame k of `video` alone as a grayscale PNG file.
 Status WriteIndexPng(const std::string& path, const IndexVideo& video, int k);
 

@@ -1,0 +1,319 @@
+// `arco calibrate --board SPEC --video CAM=FILE | --images CAM=DIR ... -o CALIBRATION`: a
+// rig's intrinsics and extrinsics from board videos or image folders
+// (calibration/calibrate.h; docs/calibration.md "Calibrating a rig"). Coexists with
+// `arco calibration show|convert`, which inspects and converts existing files.
+#include <cstdio>
+#include <memory>
+
+#include "arco/calibration/calibrate.h"
+#include "arco/cli/command.h"
+#include "arco/cli/flag_names.h"
+#include "arco/cli/number_option.h"
+#include "arco/cli/progress.h"
+#include "arco/pipeline/calibration_check.h"
+
+namespace arco::cli {
+namespace {
+
+inline constexpr FieldFlag kCalibrateFlags[] = {{"frame_step", "--frame-step"},
+                                                {"max_frames", "--max-frames"},
+                                                {"max_intrinsic_views", "--intrinsic-views"},
+                                                {"loss_scale_px", "--loss-px"},
+                                                {"max_iterations", "--max-iterations"},
+                                                {"num_threads", "--threads"},
+                                                {"high_residual_px", "--high-residual-px"},
+                                                {"min_views", "--min-views"}};
+
+inline constexpr FieldFlag kCheckFlags[] = {{"min_score", "--min-score"},
+                                            {"min_views", "--min-views"},
+                                            {"flag_ratio", "--flag-ratio"},
+                                            {"min_flag_px", "--min-flag-px"},
+                                            {"frame_step", "--frame-step"}};
+
+int RunCheck(const pipeline::CalibrationCheckOptions& options, bool json) {
+  ProgressBar bar("check");
+  auto result = pipeline::CheckCalibration(options, bar);
+  bar.Finish();
+  if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kCheckFlags));
+  if (json) {
+    std::printf("%s\n", result->ToJson().dump(2).c_str());
+    return 0;
+  }
+  std::printf("%s against %s: %lld frames; rig median %.2f px, flag above %.2f px\n",
+              result->calibration.c_str(),
+              options.label_views.empty() ? options.capture_dir.c_str() : "the labelled views",
+              static_cast<long long>(result->frames),
+              result->rig_median_px,
+              result->threshold_px);
+  std::printf("%-20s %10s %10s %10s  %s\n", "camera", "residuals", "median px", "p90 px", "");
+  for (const auto& c : result->cameras) {
+    std::string frames;
+    for (const auto& [first, last] : c.off_frames)
+      frames += (frames.empty() ? " frames " : ", ") + std::to_string(first) +
+                (last != first ? "-" + std::to_string(last) : "");
+    std::printf("%-20s %10lld %10.2f %10.2f  %s%s\n",
+                c.name.c_str(),
+                static_cast<long long>(c.residuals),
+                c.median_px,
+                c.p90_px,
+                c.flagged ? "FLAGGED" : "",
+                frames.c_str());
+  }
+  if (result->flagged.empty()) {
+    std::printf("no camera flagged\n");
+  } else {
+    for (const auto& name : result->flagged)
+      std::printf("warning: %s: residuals stand out from the rig's: moved or mis-calibrated?\n",
+                  name.c_str());
+  }
+  return 0;
+}
+
+struct CalibrateArgs {
+  calibration::CalibrateOptions options;
+  std::vector<std::string> videos, images;
+  bool fix_intrinsics = false;
+};
+
+std::string FormatReport(const calibration::CalibrateResult& result, const std::string& output) {
+  const calibration::RigCalibrationReport& r = result.calibration.report;
+  std::string text;
+  char line[512];
+  std::snprintf(line,
+                sizeof(line),
+                "calibrated %zu cameras from %s boards; world: %s, mm\n",
+                r.cameras.size(),
+                r.board.c_str(),
+                r.origin.c_str());
+  text += line;
+  std::snprintf(line,
+                sizeof(line),
+                "%-16s %6s %6s %9s %9s %10s %10s %10s\n",
+                "camera",
+                "views",
+                "used",
+                "rms px",
+                "p95 px",
+                "fx",
+                "cx",
+                "cy");
+  text += line;
+  for (size_t c = 0; c < r.cameras.size(); ++c) {
+    const auto& cam = r.cameras[c];
+    const Camera& k = result.calibration.rig.cameras[c];
+    std::snprintf(line,
+                  sizeof(line),
+                  "%-16s %6d %6d %9.3f %9.3f %10.2f %10.2f %10.2f\n",
+                  cam.name.c_str(),
+                  cam.views,
+                  cam.views_used,
+                  cam.rms_px,
+                  cam.p95_px,
+                  k.fx,
+                  k.cx,
+                  k.cy);
+    text += line;
+  }
+  text += "shared frames:";
+  for (const auto& p : r.pairs)
+    text += " " + p.camera_a + "-" + p.camera_b + " " + std::to_string(p.shared_frames);
+  text += "\n";
+  std::snprintf(line,
+                sizeof(line),
+                "reprojection rms %.3f px; board triangulated: %.3f mm rms, %.3f mm p95 (%d "
+                "points); bundle adjustment %s after %d iterations, %.2f s\n",
+                r.rms_px,
+                r.board_rms_mm,
+                r.board_p95_mm,
+                r.board_points,
+                r.bundle_adjustment.termination.c_str(),
+                r.bundle_adjustment.iterations,
+                r.bundle_adjustment.time_s);
+  text += line;
+  for (const auto& w : r.warnings) text += "warning: " + w.code + ": " + w.message + "\n";
+  text += "wrote " + output + " and " + result.report_path + "\n";
+  return text;
+}
+
+// The cameras in the order --video and --images were given (the first is the default
+// origin). Nothing to check when `arco calibrate check` is what runs.
+void ApplyAndValidate(CalibrateArgs& a, const CLI::App& cmd, const CLI::App& check) {
+  if (check.parsed()) return;
+  if (a.options.board.empty()) ThrowIfInvalid(Status::Error("--board is required"));
+  if (a.options.output.empty()) ThrowIfInvalid(Status::Error("--output is required"));
+  a.options.inputs.clear();
+  std::vector<std::pair<const std::string*, const char*>> given;
+  size_t video = 0, image = 0;
+  for (const CLI::Option* option : cmd.parse_order()) {
+    if (option->get_name() == "--video" && video < a.videos.size())
+      given.emplace_back(&a.videos[video++], "--video: ");
+    if (option->get_name() == "--images" && image < a.images.size())
+      given.emplace_back(&a.images[image++], "--images: ");
+  }
+  for (; video < a.videos.size(); ++video) given.emplace_back(&a.videos[video], "--video: ");
+  for (; image < a.images.size(); ++image) given.emplace_back(&a.images[image], "--images: ");
+  for (const auto& [text, flag] : given) {
+    auto input = calibration::ParseCalibrateInput(*text);
+    if (!input.ok()) ThrowIfInvalid(Status::Error(flag + input.status().message()));
+    a.options.inputs.push_back(*input);
+  }
+  a.options.calibration.refine_intrinsics = !a.fix_intrinsics;
+  const Status valid = a.options.Validate();
+  if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kCalibrateFlags)));
+}
+
+std::function<int()> SetupCalibrate(CLI::App& app) {
+  auto a = std::make_shared<CalibrateArgs>();
+  calibration::CalibrateOptions& o = a->options;
+  auto* cmd = app.add_subcommand(
+      "calibrate",
+      "Calibrate a camera rig from videos or image folders of a board (intrinsics, "
+      "extrinsics by bundle adjustment, a report in px and mm)");
+  cmd->add_option("--board",
+                  o.board,
+                  "chessboard:COLSxROWS:SQUARE_MM (inner corners, e.g. chessboard:9x6:25) or "
+                  "charuco:COLSxROWS:SQUARE_MM:MARKER_MM[:DICT] (squares; DICT default "
+                  "DICT_4X4_50); required");
+  cmd->add_option("--video",
+                  a->videos,
+                  "CAMERA=FILE: a camera's video of the board (repeat per camera; all "
+                  "synchronised: frame n of every video is the same instant)");
+  cmd->add_option("--images",
+                  a->images,
+                  "CAMERA=DIR: a camera's folder of images (natural order; image n of every "
+                  "folder is the same instant), or one image");
+  cmd->add_option("--intrinsics",
+                  o.intrinsics,
+                  "Calibration file whose cameras (by name) give intrinsics to start from");
+  cmd->add_flag("--fix-intrinsics",
+                a->fix_intrinsics,
+                "Keep the intrinsics (given or initial) fixed in the bundle adjustment");
+  cmd->add_option("--origin",
+                  o.calibration.origin,
+                  "World frame: a camera's name (default: the first camera given) or 'board' "
+                  "(the board in the first frame two cameras see)");
+  AddNumber(cmd,
+            "--max-frames",
+            o.detection.max_frames,
+            "Look at most at this many frames per camera (0 = all)",
+            calibration::kMaxFramesRange)
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--frame-step",
+            o.detection.frame_step,
+            "Look at every n-th frame",
+            calibration::kFrameStepRange)
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--intrinsic-views",
+            o.calibration.max_intrinsic_views,
+            "Views per camera (chosen to cover the image) for the initial intrinsics",
+            calibration::kIntrinsicViewsRange)
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--loss-px",
+            o.calibration.loss_scale_px,
+            "Huber loss scale of the bundle adjustment (px)",
+            calibration::kLossScaleRangePx)
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--max-iterations",
+            o.calibration.max_iterations,
+            "Bundle adjustment iterations at most",
+            calibration::kIterationsRange)
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--high-residual-px",
+            o.calibration.high_residual_px,
+            "Warn about a camera whose reprojection RMS is above this (px)",
+            calibration::kHighResidualRangePx)
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--min-views",
+            o.calibration.min_views,
+            "Warn about a camera with fewer board views",
+            calibration::kMinViewsRange)
+      ->capture_default_str();
+  AddNumber(
+      cmd,
+      "--threads",
+      o.num_threads,
+      "Cameras whose board detection runs at once (0 = all cores; results do not depend on it)",
+      kThreadsRange)
+      ->capture_default_str();
+  cmd->add_option("-o,--output",
+                  o.output,
+                  "Calibration to write: .json arco JSON, .yaml/.yml OpenCV YAML, .xml OpenCV "
+                  "XML; the report goes beside it as NAME.report.json; required");
+  auto c = std::make_shared<pipeline::CalibrationCheckOptions>();
+  auto json = std::make_shared<bool>(false);
+  auto* check = cmd->add_subcommand(
+      "check",
+      "Check a calibration against a capture's 2D keypoints: per camera the reprojection "
+      "residuals of the triangulated keypoints; a camera that stands out (moved or "
+      "mis-calibrated) is flagged with its frames");
+  check->add_option("capture", c->capture_dir, "Capture folder (capture.json, keypoints2d)");
+  auto views = std::make_shared<std::vector<std::string>>();
+  check->add_option("--view",
+                    *views,
+                    "CAMERA=LABELME.json: check labelled views instead of a capture (CAMERA a "
+                    "camera name or serial; repeat per view; needs --calibration)");
+  check->add_option("--calibration",
+                    c->calibration,
+                    "Calibration to check instead of the capture's own (any format arco reads)");
+  AddNumber(
+      check, "--min-score", c->min_score, "Ignore detections below this confidence", kFractionRange)
+      ->capture_default_str();
+  AddNumber(check,
+            "--min-views",
+            c->min_views,
+            "Use keypoints triangulated from at least this many cameras",
+            Closed(2, 1000))
+      ->capture_default_str();
+  AddNumber(check,
+            "--flag-ratio",
+            c->flag_ratio,
+            "Flag a camera whose median residual exceeds this times the rig's median",
+            pipeline::kCheckRatioRange)
+      ->capture_default_str();
+  AddNumber(check,
+            "--min-flag-px",
+            c->min_flag_px,
+            "... and this many pixels (px)",
+            pipeline::kCheckMinFlagRangePx)
+      ->capture_default_str();
+  AddNumber(
+      check, "--frame-step", c->frame_step, "Check every n-th frame", calibration::kFrameStepRange)
+      ->capture_default_str();
+  check->add_flag("--json", *json, "Print the summary as JSON");
+  check->parse_complete_callback([c, views] {
+    c->label_views.clear();
+    for (const std::string& text : *views) {
+      auto view = calibration::ParseCalibrateInput(text);
+      if (!view.ok()) ThrowIfInvalid(Status::Error("--view: " + view.status().message()));
+      c->label_views.emplace_back(view->camera, view->path);
+    }
+    if (!c->label_views.empty() && !c->capture_dir.empty())
+      ThrowIfInvalid(Status::Error("give a capture or --view labels, not both"));
+    if (c->label_views.empty() && c->capture_dir.empty())
+      ThrowIfInvalid(Status::Error("give a capture folder or --view labels"));
+    if (!c->label_views.empty() && c->calibration.empty())
+      ThrowIfInvalid(Status::Error("--view needs --calibration"));
+    const Status valid = c->Validate();
+    if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kCheckFlags)));
+  });
+  cmd->parse_complete_callback([a, cmd, check] { ApplyAndValidate(*a, *cmd, *check); });
+  return [a, c, json, check] {
+    if (check->parsed()) return RunCheck(*c, *json);
+    ProgressBar bar("calibrate");
+    auto result = calibration::RunCalibrate(a->options, bar);
+    bar.Finish();
+    if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kCalibrateFlags));
+    std::fputs(FormatReport(*result, a->options.output).c_str(), stdout);
+    return 0;
+  };
+}
+
+}  // namespace
+ARCO_REGISTER_COMMAND(calibrate, 21, SetupCalibrate);
+}  // namespace arco::cli
