@@ -283,6 +283,10 @@ py::dict TrackPitch(const py::array_t<float, py::array::c_style | py::array::for
                     std::to_string(audio::kMinRateHz) + ".." + std::to_string(audio::kMaxRateHz) +
                     " Hz");
   }
+  // PitchRunOptions reads NaN as "the default"; here a NaN is the caller's value.
+  CheckValid(CheckInRange("fps", fps, audio::kTrackerFpsRange));
+  CheckValid(CheckInRange("start_s", start_s, audio::kTrackerStartRangeS));
+  CheckValid(CheckInRange("a4_hz", a4_hz, kA4RangeHz));
   pipeline::PitchRunOptions o;
   o.instrument = instrument;
   o.fps = fps;
