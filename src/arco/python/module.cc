@@ -9,6 +9,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <algorithm>
 #include <cmath>
@@ -112,7 +113,7 @@ PyCalibration CalibrationFrom(const py::object& calibration) {
   if (py::isinstance<PyCalibration>(calibration)) return calibration.cast<PyCalibration>();
   if (py::isinstance<py::str>(calibration) ||
       py::isinstance(calibration, py::module_::import("os").attr("PathLike"))) {
-    return LoadCalibrationOrRaise(py::str(calibration).cast<std::string>());
+    return LoadCalibrationOrRaise(calibration.cast<std::filesystem::path>().string());
   }
   RaiseValueError("calibration must be an arco.Calibration or a path");
 }
@@ -432,7 +433,8 @@ T ValueOrRaise(StatusOr<T> value, const std::string& path) {
   return std::move(*value);
 }
 
-py::dict ReadResult(const std::string& dir) {
+py::dict ReadResult(const std::filesystem::path& dir_path) {
+  const std::string dir = dir_path.string();
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) RaiseOsError(dir + ": no such result folder");
   const pipeline::ResultFolder folder(dir);
@@ -443,9 +445,12 @@ py::dict ReadResult(const std::string& dir) {
   py::dict out;
   out["dir"] = dir;
   out["result"] = py::module_::import("json").attr("loads")(manifest.dump());
-  py::dict points3d, contacts;
+  const pipeline::ResultHeader header = ValueOrRaise(folder.ReadHeader(), folder.ManifestPath());
+  py::dict points3d, keypoint_names, contacts;
   for (const pipeline::PointStage& stage :
        ValueOrRaise(folder.PointStages(), folder.ManifestPath())) {
+    keypoint_names[py::str(stage.name)] =
+        stage.keypoint_names.empty() ? header.keypoint_names : stage.keypoint_names;
     points3d[py::str(stage.name)] =
         ToArray(ValueOrRaise(ReadNpy<double>(stage.points3d_path), stage.points3d_path));
     if (!stage.contacts_path.empty() && std::filesystem::exists(stage.contacts_path, ec)) {
@@ -454,10 +459,24 @@ py::dict ReadResult(const std::string& dir) {
     }
   }
   out["points3d"] = points3d;
+  out["keypoint_names"] = keypoint_names;
   out["contacts"] = contacts;
   out["pitch"] = py::none();
   if (std::filesystem::exists(folder.PitchPath(), ec)) {
     out["pitch"] = PitchColumns(ValueOrRaise(folder.ReadPitch(), folder.PitchPath()));
+  }
+  out["instrument"] = py::none();
+  if (ValueOrRaise(folder.HasStage(pipeline::kInstrumentStage), folder.ManifestPath())) {
+    pipeline::InstrumentRecord record =
+        ValueOrRaise(folder.ReadInstrument(), folder.InstrumentStringsPath());
+    py::dict instrument;
+    instrument["name"] = record.instrument;
+    instrument["a4_hz"] = record.a4_hz;
+    instrument["world_units_per_mm"] = record.world_units_per_mm;
+    instrument["keypoint_names"] = record.keypoint_names;
+    instrument["strings_mm"] = ToArray(std::move(record.strings_mm));
+    instrument["keypoints_mm"] = ToArray(std::move(record.keypoints_mm));
+    out["instrument"] = instrument;
   }
   out["hand_params"] = py::none();
   if (std::filesystem::exists(folder.HandParamsPath(), ec)) {
@@ -537,14 +556,14 @@ PYBIND11_MODULE(arco, m) {
           "The camera with this name or serial")
       .def(
           "save",
-          [](const PyCalibration& c, const std::string& path, const std::string& format) {
+          [](const PyCalibration& c, const std::filesystem::path& path, const std::string& format) {
             CalibrationFormat f = CalibrationFormat::kUnknown;
             if (!format.empty()) {
               StatusOr<CalibrationFormat> parsed = CalibrationFormatFromFlag(format);
               CheckValid(parsed.status());
               f = *parsed;
             }
-            const Status saved = SaveCalibration(path, c.calibration.rig, f);
+            const Status saved = SaveCalibration(path.string(), c.calibration.rig, f);
             if (!saved.ok()) throw std::runtime_error(saved.message());
           },
           "path"_a,
@@ -558,9 +577,7 @@ PYBIND11_MODULE(arco, m) {
 
   m.def(
       "load_calibration",
-      [](const py::object& path) {
-        return LoadCalibrationOrRaise(py::str(path).cast<std::string>());
-      },
+      [](const std::filesystem::path& path) { return LoadCalibrationOrRaise(path.string()); },
       "path"_a,
       "Reads a calibration (Metashape XML, OpenCV YAML/XML, SPD or arco JSON)");
 
@@ -643,6 +660,8 @@ cents_from_open, stop_from_bridge_mm, contact_from_bridge_mm, fraction_from_brid
         "dir"_a,
         R"(Reads an `arco run` result folder.
 
-Returns a dict: result (result.json), points3d {stage: (F, P, 3)}, contacts {method: columns},
-pitch (columns of pitch.csv or None), hand_params ((F, 26) or None).)");
+Returns a dict: result (result.json), points3d {stage: (F, P, 3)}, keypoint_names {stage: the
+P names}, contacts {method: columns},
+pitch (columns of pitch.csv or None), instrument (strings_mm (F, S, 2, 3), keypoints_mm,
+name, a4_hz, world_units_per_mm; or None), hand_params ((F, 26) or None).)");
 }
