@@ -143,20 +143,37 @@ py::array_t<double> ProjectPoints(
 
 // ---- triangulation ------------------------------------------------------------------
 
-py::dict Triangulate(
-    const py::array_t<double, py::array::c_style | py::array::forcecast>& keypoints2d,
-    const py::object& calibration_arg,
-    const py::object& cameras,
-    double min_score,
-    double max_reprojection_px,
-    int max_ransac_trials,
-    double ransac_confidence,
-    uint64_t seed,
-    bool weight_by_score,
-    bool refine,
-    double robust_loss_scale_px,
-    int max_refine_iterations,
-    int num_threads) {
+// Copies `array` (any real dtype, any layout) into the library's float64 array: one pass,
+// float32 keypoints (keypoints2d.npy) converted as they are copied.
+NpyArray<double> ToNpyArray(const py::array& array) {
+  NpyArray<double> out;
+  out.shape.assign(array.shape(), array.shape() + array.ndim());
+  if (py::isinstance<py::array_t<float>>(array)) {
+    const auto f = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(array);
+    out.data.assign(f.data(), f.data() + f.size());
+  } else {
+    const auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(array);
+    if (!d) throw py::error_already_set();
+    out.data.assign(d.data(), d.data() + d.size());
+  }
+  return out;
+}
+
+py::dict Triangulate(const py::object& keypoints2d_arg,
+                     const py::object& calibration_arg,
+                     const py::object& cameras,
+                     double min_score,
+                     double max_reprojection_px,
+                     int max_ransac_trials,
+                     double ransac_confidence,
+                     uint64_t seed,
+                     bool weight_by_score,
+                     bool refine,
+                     double robust_loss_scale_px,
+                     int max_refine_iterations,
+                     int num_threads) {
+  const py::array keypoints2d = py::array::ensure(keypoints2d_arg);
+  if (!keypoints2d) RaiseValueError("keypoints2d must be a numpy array (or convertible to one)");
   if (keypoints2d.ndim() != 4 || keypoints2d.shape(3) != 3) {
     RaiseValueError("keypoints2d must be (frames, views, points, 3) [x, y, score], got " +
                     ShapeString(keypoints2d));
@@ -206,9 +223,7 @@ py::dict Triangulate(
   options.num_threads = num_threads;
   CheckValid(options.Validate());
 
-  NpyArray<double> input;
-  input.shape.assign(keypoints2d.shape(), keypoints2d.shape() + 4);
-  input.data.assign(keypoints2d.data(), keypoints2d.data() + keypoints2d.size());
+  const NpyArray<double> input = ToNpyArray(keypoints2d);
   StatusOr<SequenceTriangulation> result = [&] {
     py::gil_scoped_release release;
     return TriangulateSequence(rig, view_to_camera, input, options);
@@ -305,12 +320,10 @@ py::dict TrackPitch(const py::array_t<float, py::array::c_style | py::array::for
   const StatusOr<audio::PitchTrackerOptions> tracker = pipeline::PitchTrackerOptionsFor(o);
   CheckValid(tracker.status());
   audio::PitchSummary summary;
+  auto reader = std::make_unique<SamplesReader>(samples.data(), samples.shape(0), sample_rate);
   StatusOr<audio::PitchTrack> track = [&] {
     py::gil_scoped_release release;
-    return audio::TrackPitch(
-        std::make_unique<SamplesReader>(samples.data(), samples.shape(0), sample_rate),
-        *tracker,
-        &summary);
+    return audio::TrackPitch(std::move(reader), *tracker, &summary);
   }();
   if (!track.ok()) throw std::runtime_error(track.status().message());
   return PitchColumns(track->frames);

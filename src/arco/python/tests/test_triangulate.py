@@ -109,3 +109,17 @@ def test_bad_inputs(spd_rig):
         arco.triangulate(views, "/nonexistent/rig.xml")
     with pytest.raises(TypeError):
         arco.triangulate(views, spd_rig, 0.5)  # options are keyword-only
+
+
+def test_any_dtype_and_layout(spd_rig):
+    centre = np.mean([c.center for c in spd_rig.cameras], axis=0)
+    truth = centre + np.random.default_rng(5).uniform(-0.1, 0.1, (2, 6, 3))
+    views = synthetic_views(spd_rig, truth)
+    ref = arco.triangulate(views, spd_rig)["points3d"]
+    fortran = np.asfortranarray(views)
+    np.testing.assert_array_equal(arco.triangulate(fortran, spd_rig)["points3d"], ref)
+    np.testing.assert_array_equal(arco.triangulate(views.tolist(), spd_rig)["points3d"], ref)
+    f32 = arco.triangulate(views.astype(np.float32), spd_rig)["points3d"]
+    np.testing.assert_allclose(f32, ref, atol=1e-5)
+    # Results own their memory, writable, C-contiguous.
+    assert ref.flags.c_contiguous and ref.flags.writeable
