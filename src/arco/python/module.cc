@@ -24,6 +24,7 @@
 #include "arco/audio/pitch_tracker.h"
 #include "arco/calibration/calibration_file.h"
 #include "arco/camera/calibration_io.h"
+#include "arco/eval/evaluate.h"
 #include "arco/eval/metrics.h"
 #include "arco/hand/hand_model.h"
 #include "arco/hand/hand_params.h"
@@ -577,6 +578,44 @@ py::dict EvaluatePitchPy(const py::array_t<double, py::array::forcecast>& truth_
   return out;
 }
 
+// `arco eval`: a result folder against a synthetic truth folder or labelled frames; the dict
+// of `arco eval -o eval.json`.
+py::object EvaluatePy(const std::filesystem::path& result_dir,
+                      const py::object& truth,
+                      const std::vector<int64_t>& truth_frames,
+                      const std::string& pitch,
+                      const std::vector<double>& pck_thresholds_mm,
+                      double joint_limit_tolerance_deg) {
+  eval::EvalRequest r;
+  r.result_dir = result_dir.string();
+  // One truth without truth_frames: a synthetic truth folder; else labelled frames.
+  if (py::isinstance<py::str>(truth) ||
+      py::isinstance(truth, py::module_::import("os").attr("PathLike"))) {
+    r.truth = truth.cast<std::filesystem::path>().string();
+    if (!truth_frames.empty()) {  // one labelled frame
+      r.labels = {r.truth};
+      r.truth.clear();
+    }
+  } else {
+    for (const std::filesystem::path& label : truth.cast<std::vector<std::filesystem::path>>()) {
+      r.labels.push_back(label.string());
+    }
+  }
+  r.truth_frames = truth_frames;
+  r.pitch_csv = pitch;
+  r.metrics.pck_thresholds_mm = pck_thresholds_mm;
+  r.joint_limit_tolerance_deg = joint_limit_tolerance_deg;
+  CheckValid(r.Validate());
+  StatusOr<eval::EvalReport> report = [&] {
+    py::gil_scoped_release release;
+    return eval::Evaluate(r);
+  }();
+  if (!report.ok()) RaiseStatus(report.status(), r.result_dir);
+  Json json = report->ToJson(r.metrics);
+  json["options"] = eval::ToJson(r);
+  return py::module_::import("json").attr("loads")(json.dump());
+}
+
 // ---- result folder ------------------------------------------------------------------
 
 py::dict ContactColumns(const std::vector<refine::ContactRow>& rows) {
@@ -925,6 +964,21 @@ active_limit_dofs, step_limited, termination.)");
         R"(Pitch metrics of `arco eval` (docs/evaluation.md) on per-frame f0 arrays (<= 0 or NaN:
 unvoiced); `scored` (bool) leaves frames out. Returns rpa50, rpa25, voicing_recall,
 voicing_false_alarm, median_abs_cents, frames, truth_voiced_frames.)");
+
+  const eval::EvalRequest e;
+  m.def("evaluate",
+        &EvaluatePy,
+        "result_dir"_a,
+        "truth"_a,
+        py::kw_only(),
+        "truth_frames"_a = std::vector<int64_t>{},
+        "pitch"_a = "",
+        "pck_thresholds_mm"_a = e.metrics.pck_thresholds_mm,
+        "joint_limit_tolerance_deg"_a = e.joint_limit_tolerance_deg,
+        R"(`arco eval`: every method of a result folder scored against truth (docs/evaluation.md).
+
+truth: an `arco synth` truth folder, or points JSONs of labelled views (a list) with
+truth_frames. Returns the dict `arco eval -o eval.json` writes.)");
 
   m.def("read_result",
         &ReadResult,

@@ -1,4 +1,6 @@
-"""arco.HandModel (forward kinematics, bounded fingertip IK) and arco.evaluate_pitch."""
+"""arco.HandModel (forward kinematics, bounded fingertip IK), arco.evaluate_pitch and arco.evaluate."""
+import json
+
 import numpy as np
 import pytest
 
@@ -77,3 +79,20 @@ def test_evaluate_pitch():
     assert m2["frames"] == 3 and m2["rpa50"] == pytest.approx(1.0)
     with pytest.raises(ValueError, match="one length"):
         arco.evaluate_pitch(truth, est[:3])
+
+
+def test_evaluate_matches_arco_eval(arco_bin, capture, result, tmp_path):
+    from conftest import cli_error, run_arco
+    p = run_arco(arco_bin, "eval", result, "--truth", capture / "truth", "--pck-mm", 5, 15,
+                 "-o", tmp_path / "eval.json")
+    assert p.returncode == 0, p.stderr
+    expected = json.loads((tmp_path / "eval.json").read_text())
+    got = arco.evaluate(result, capture / "truth", pck_thresholds_mm=[5, 15])
+    assert got == expected
+    assert set(got["methods"]) >= {"vision", "paper", "arco"}
+    with pytest.raises(ValueError, match="pck_thresholds_mm"):
+        arco.evaluate(result, capture / "truth", pck_thresholds_mm=[np.nan])
+    with pytest.raises(OSError) as e:
+        arco.evaluate(tmp_path / "missing", capture / "truth")
+    assert str(e.value) == cli_error(run_arco(arco_bin, "eval", tmp_path / "missing",
+                                              "--truth", capture / "truth"))
