@@ -242,27 +242,39 @@ py::dict Triangulate(const py::object& keypoints2d_arg,
 
 // ---- pitch --------------------------------------------------------------------------
 
-// Mono float samples held by the caller (the numpy array outlives the reader).
+// Float samples held by the caller (the numpy array outlives the reader), (frames,) or
+// interleaved (frames, channels). Mixed down as the file readers do (audio/audio_reader.h:
+// the channels' float sum times 1 / channels; a non-finite or absurd sample reads as 0), so
+// a WAV's samples give `arco pitch`'s rows.
 class SamplesReader : public audio::AudioReader {
  public:
-  SamplesReader(const float* samples, int64_t count, int rate_hz)
-      : samples_(samples), count_(count) {
+  SamplesReader(const float* samples, int64_t frames, int channels, int rate_hz)
+      : samples_(samples), frames_(frames), channels_(channels) {
     info_.sample_rate_hz = rate_hz;
-    info_.channels = 1;
-    info_.frames = count;
+    info_.channels = channels;
+    info_.frames = frames;
     info_.format = "float32 samples";
     info_.source = "samples";
   }
   StatusOr<int64_t> ReadMono(float* out, int64_t max_frames) override {
-    const int64_t n = std::min(max_frames, count_ - position_);
-    std::memcpy(out, samples_ + position_, static_cast<size_t>(n) * sizeof(float));
+    const int64_t n = std::min(max_frames, frames_ - position_);
+    const float scale = 1.0f / static_cast<float>(channels_);
+    for (int64_t i = 0; i < n; ++i) {
+      const float* frame = samples_ + (position_ + i) * channels_;
+      float sum = 0.0f;
+      for (int c = 0; c < channels_; ++c) sum += frame[c];
+      float v = sum * scale;
+      if (!(v == v) || v > 1e6f || v < -1e6f) v = 0.0f;
+      out[i] = v;
+    }
     position_ += n;
     return n;
   }
 
  private:
   const float* samples_;
-  int64_t count_;
+  int64_t frames_;
+  int channels_;
   int64_t position_ = 0;
 };
 
@@ -297,8 +309,12 @@ py::dict TrackPitch(const py::array_t<float, py::array::c_style | py::array::for
                     double a4_hz,
                     double min_f0_hz,
                     double max_f0_hz) {
-  if (samples.ndim() != 1) {
-    RaiseValueError("samples must be 1-D (mono), got " + ShapeString(samples));
+  if (samples.ndim() != 1 && samples.ndim() != 2) {
+    RaiseValueError("samples must be (frames,) or (frames, channels), got " + ShapeString(samples));
+  }
+  const int channels = samples.ndim() == 2 ? static_cast<int>(samples.shape(1)) : 1;
+  if (channels < 1 || channels > 1024) {
+    RaiseValueError("samples have " + std::to_string(channels) + " channels (1..1024)");
   }
   if (sample_rate < audio::kMinRateHz || sample_rate > audio::kMaxRateHz) {
     RaiseValueError("sample_rate " + std::to_string(sample_rate) + " outside " +
@@ -321,7 +337,8 @@ py::dict TrackPitch(const py::array_t<float, py::array::c_style | py::array::for
   const StatusOr<audio::PitchTrackerOptions> tracker = pipeline::PitchTrackerOptionsFor(o);
   CheckValid(tracker.status());
   audio::PitchSummary summary;
-  auto reader = std::make_unique<SamplesReader>(samples.data(), samples.shape(0), sample_rate);
+  auto reader =
+      std::make_unique<SamplesReader>(samples.data(), samples.shape(0), channels, sample_rate);
   StatusOr<audio::PitchTrack> track = [&] {
     py::gil_scoped_release release;
     return audio::TrackPitch(std::move(reader), *tracker, &summary);
@@ -851,7 +868,8 @@ rms_reprojection_px (F, P); num_inliers (F, P); num_views (F, P); inlier_mask (F
         "a4_hz"_a = 440.0,
         "min_f0_hz"_a = 0.0,
         "max_f0_hz"_a = 0.0,
-        R"(Pitch of mono float samples at video-frame times: the rows of `arco pitch`.
+        R"(Pitch of float samples ((frames,) or (frames, channels), mixed down as `arco pitch` does)
+at video-frame times: the rows of `arco pitch`.
 
 Returns a dict of columns frame, time_s, f0_hz (0 unvoiced), confidence, voiced.)");
 

@@ -52,6 +52,27 @@ def test_rows_match_arco_pitch(arco_bin, tmp_path, fps, instrument, extra, kwarg
     assert got["voiced"].dtype == bool and got["voiced"].any()
 
 
+def test_real_stereo_recording_matches_arco_pitch(arco_bin, spd_dir, tmp_path):
+    """SPD's cello scale (48 kHz 16-bit stereo): (frames, channels) samples are mixed down
+    as the WAV reader does."""
+    wav = spd_dir / "background.wav"
+    p = run_arco(arco_bin, "pitch", wav, "-o", tmp_path / "pitch.csv")
+    assert p.returncode == 0, p.stderr
+    rows = read_pitch_csv(tmp_path / "pitch.csv")
+    with wave.open(str(wav)) as w:
+        rate = w.getframerate()
+        pcm = np.frombuffer(w.readframes(w.getnframes()), "<i2").reshape(-1, w.getnchannels())
+    assert pcm.shape[1] == 2
+    got = arco.track_pitch(pcm.astype(np.float32) / 32768, rate)
+    assert len(got["frame"]) == len(rows) == 612
+    np.testing.assert_allclose(got["f0_hz"], rows["f0_hz"], atol=5e-5)
+    np.testing.assert_allclose(got["confidence"], rows["confidence"], atol=5e-5)
+    np.testing.assert_array_equal(got["voiced"], rows["voiced"].astype(bool))
+    # The scale starts on the open C string (C2, 65.4 Hz; within 50 cents: attack, tuning).
+    first = got["f0_hz"][got["voiced"]][:10]
+    np.testing.assert_allclose(np.median(first), 65.41, rtol=0.03)
+
+
 def test_pitch_values(tmp_path):
     pcm = write_tone(tmp_path / "tone.wav", 48000)
     got = arco.track_pitch(pcm / 32768.0, 48000, 30)  # float64 input is converted
@@ -65,8 +86,10 @@ def test_pitch_values(tmp_path):
 
 def test_bad_inputs(arco_bin, tmp_path):
     x = np.zeros(8000, np.float32)
-    with pytest.raises(ValueError, match=r"samples must be 1-D \(mono\), got \(4000, 2\)"):
-        arco.track_pitch(x.reshape(-1, 2), 8000, 30)
+    with pytest.raises(ValueError, match=r"samples must be \(frames,\) or \(frames, channels\), got \(2, 2, 2000\)"):
+        arco.track_pitch(x.reshape(2, 2, -1), 8000, 30)
+    with pytest.raises(ValueError, match="samples have 0 channels"):
+        arco.track_pitch(np.zeros((10, 0)), 8000, 30)
     with pytest.raises(ValueError, match="fps must be a finite number"):
         arco.track_pitch(x, 8000, float("nan"))
     with pytest.raises(ValueError, match="fps"):
