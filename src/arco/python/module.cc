@@ -124,6 +124,55 @@ PyCalibration CalibrationFrom(const py::object& calibration) {
   RaiseValueError("calibration must be an arco.Calibration or a path");
 }
 
+using MatrixArg = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+const double* CheckedShape(const MatrixArg& a, const char* field, std::vector<py::ssize_t> shape) {
+  if (a.ndim() != static_cast<py::ssize_t>(shape.size()) ||
+      !std::equal(shape.begin(), shape.end(), a.shape())) {
+    std::string want = "(";
+    for (size_t i = 0; i < shape.size(); ++i) want += (i ? ", " : "") + std::to_string(shape[i]);
+    RaiseValueError(std::string(field) + " must be " + want + (shape.size() == 1 ? ",)" : ")") +
+                    ", got " + ShapeString(a));
+  }
+  return a.data();
+}
+
+// A camera from numpy arrays (OpenCV conventions), checked as every calibration reader's.
+Camera MakeCamera(const std::string& name,
+                  const MatrixArg& K,
+                  const MatrixArg& distortion,
+                  const MatrixArg& R,
+                  const MatrixArg& t,
+                  const std::pair<int, int>& size,
+                  const std::string& serial) {
+  Camera c;
+  c.name = name;
+  c.serial = serial;
+  c.width = size.first;
+  c.height = size.second;
+  const double* k = CheckedShape(K, "K", {3, 3});
+  c.fx = k[0];
+  c.skew = k[1];
+  c.cx = k[2];
+  c.fy = k[4];
+  c.cy = k[5];
+  if (k[3] != 0 || k[6] != 0 || k[7] != 0 || k[8] != 1) {
+    RaiseValueError("camera '" + name + "': K's last row must be [0, 0, 1] and K[1, 0] 0");
+  }
+  const double* d = CheckedShape(distortion, "distortion", {5});
+  c.distortion.k1 = d[0];
+  c.distortion.k2 = d[1];
+  c.distortion.p1 = d[2];
+  c.distortion.p2 = d[3];
+  c.distortion.k3 = d[4];
+  const double* r = CheckedShape(R, "R", {3, 3});
+  for (int i = 0; i < 9; ++i) c.cam_from_world_rotation(i / 3, i % 3) = r[i];
+  const double* tt = CheckedShape(t, "t", {3});
+  c.cam_from_world_translation = Eigen::Vector3d(tt[0], tt[1], tt[2]);
+  CheckValid(ValidateCamera(c));
+  return c;
+}
+
 // Projects (N, 3) world points: (N, 2) distorted pixels, NaN behind the camera.
 py::array_t<double> ProjectPoints(
     const Camera& camera,
@@ -747,6 +796,16 @@ PYBIND11_MODULE(arco, m) {
   m.attr("__version__") = ARCO_VERSION_STRING;
 
   py::class_<Camera>(m, "Camera", "One calibrated camera (OpenCV pinhole + distortion)")
+      .def(py::init(&MakeCamera),
+           "name"_a,
+           "K"_a,
+           "distortion"_a,
+           "R"_a,
+           "t"_a,
+           "size"_a,
+           "serial"_a = "",
+           "From arrays: K (3, 3), distortion (5,) k1 k2 p1 p2 k3, R (3, 3) and t (3,) "
+           "cam_from_world, size (width, height)")
       .def_readonly("name", &Camera::name)
       .def_readonly("serial", &Camera::serial)
       .def_readonly("width", &Camera::width)
@@ -787,6 +846,16 @@ PYBIND11_MODULE(arco, m) {
       });
 
   py::class_<PyCalibration>(m, "Calibration", "A camera rig as read by arco.load_calibration")
+      .def(py::init([](const std::vector<Camera>& cameras, const std::string& units) {
+             PyCalibration c;
+             c.calibration.rig.cameras = cameras;
+             c.calibration.rig.units = units;
+             CheckValid(ValidateRig(c.calibration.rig));
+             return c;
+           }),
+           "cameras"_a,
+           "units"_a = "unknown",
+           "A rig of arco.Camera objects; units of world coordinates: mm, m, ...")
       .def_property_readonly("cameras",
                              [](const PyCalibration& c) { return c.calibration.rig.cameras; })
       .def_property_readonly("units",

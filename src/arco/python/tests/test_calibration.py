@@ -69,3 +69,34 @@ def test_malformed_file_is_runtimeerror(arco_bin, tmp_path):
     with pytest.raises(RuntimeError) as e:
         arco.load_calibration(bad)
     assert str(e.value) == cli_error(run_arco(arco_bin, "calibration", "show", bad))
+
+
+def test_calibration_from_arrays(spd_dir, tmp_path):
+    cal = arco.load_calibration(spd_dir / "cello_1113_scale_camera.xml")
+    cameras = [arco.Camera(c.name, c.K, c.distortion, c.R, c.t, c.size, serial=c.serial)
+               for c in cal.cameras]
+    rebuilt = arco.Calibration(cameras, units=cal.units)
+    assert len(rebuilt) == 20 and rebuilt.units == "metashape"
+    points = np.mean([c.center for c in cal.cameras], axis=0) + np.zeros((4, 3))
+    for a, b in zip(cal.cameras, rebuilt.cameras):
+        np.testing.assert_array_equal(a.project(points), b.project(points))
+    rebuilt.save(tmp_path / "rig.json", format="arco")
+    again = arco.load_calibration(tmp_path / "rig.json")
+    assert again.format == "arco-json"
+    np.testing.assert_allclose(again.cameras[3].K, cal.cameras[3].K)
+
+
+def test_camera_bad_arrays(spd_dir):
+    c = arco.load_calibration(spd_dir / "cello_1113_scale_camera.xml").cameras[0]
+    with pytest.raises(ValueError, match=r"K must be \(3, 3\), got \(3, 4\)"):
+        arco.Camera("a", np.zeros((3, 4)), c.distortion, c.R, c.t, c.size)
+    with pytest.raises(ValueError, match=r"distortion must be \(5,\), got \(4,\)"):
+        arco.Camera("a", c.K, np.zeros(4), c.R, c.t, c.size)
+    with pytest.raises(ValueError, match="camera 'a': rotation is not a proper rotation matrix"):
+        arco.Camera("a", c.K, c.distortion, 2 * c.R, c.t, c.size)
+    with pytest.raises(ValueError, match="camera 'a': focal lengths must be positive"):
+        arco.Camera("a", c.K * [[-1], [1], [1]], c.distortion, c.R, c.t, c.size)
+    with pytest.raises(ValueError, match="camera 'a': pose is not finite"):
+        arco.Camera("a", c.K, c.distortion, c.R, [np.nan, 0, 0], c.size)
+    with pytest.raises(ValueError):
+        arco.Calibration([c, c])  # duplicate names
