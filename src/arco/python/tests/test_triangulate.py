@@ -123,3 +123,24 @@ def test_any_dtype_and_layout(spd_rig):
     np.testing.assert_allclose(f32, ref, atol=1e-5)
     # Results own their memory, writable, C-contiguous.
     assert ref.flags.c_contiguous and ref.flags.writeable
+
+
+def test_concurrent_calls_from_threads(capture):
+    """The GIL is released during the work: calls from several Python threads run at once
+    and give the same results as one call."""
+    from concurrent.futures import ThreadPoolExecutor
+    manifest = json.loads((capture / "capture.json").read_text())
+    cal = arco.load_calibration(capture / manifest["calibration"])
+    keypoints = np.load(capture / "keypoints2d.npy")[:20]
+    cameras = [c["name"] for c in manifest["cameras"]]
+    ref = arco.triangulate(keypoints, cal, cameras=cameras, num_threads=1)["points3d"]
+    signal = np.sin(2 * np.pi * 220 * np.arange(44100) / 44100).astype(np.float32)
+    pitch_ref = arco.track_pitch(signal, 44100)["f0_hz"]
+    with ThreadPoolExecutor(4) as pool:
+        tri = [pool.submit(arco.triangulate, keypoints, cal, cameras=cameras, num_threads=1)
+               for _ in range(4)]
+        pitch = [pool.submit(arco.track_pitch, signal, 44100) for _ in range(4)]
+        for f in tri:
+            np.testing.assert_array_equal(f.result()["points3d"], ref)
+        for f in pitch:
+            np.testing.assert_array_equal(f.result()["f0_hz"], pitch_ref)
