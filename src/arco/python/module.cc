@@ -285,7 +285,7 @@ py::dict Triangulate(const py::object& keypoints2d_arg,
   out["num_inliers"] = ToArray(std::move(result->num_inliers));
   out["num_views"] = ToArray(std::move(result->num_views));
   out["inlier_mask"] =
-      ToArray(std::move(result->inlier_mask)).attr("astype")("bool", "copy"_a = false);
+      ToArray(std::move(result->inlier_mask)).attr("view")("bool");  // 0 or 1: no copy
   return out;
 }
 
@@ -344,7 +344,7 @@ py::dict PitchColumns(const std::vector<audio::PitchFrame>& frames) {
   out["time_s"] = VectorToArray(std::move(time_s));
   out["f0_hz"] = VectorToArray(std::move(f0_hz));
   out["confidence"] = VectorToArray(std::move(confidence));
-  out["voiced"] = VectorToArray(std::move(voiced)).attr("astype")("bool");
+  out["voiced"] = VectorToArray(std::move(voiced)).attr("view")("bool");
   return out;
 }
 
@@ -417,12 +417,13 @@ PyInstrument InstrumentFrom(const py::object& instrument) {
   return instrument.cast<PyInstrument>();
 }
 
-py::object ContactPointPy(const py::object& instrument_arg,
-                          int string,
-                          const py::array_t<double, py::array::forcecast>& f0_hz,
-                          double open_tolerance_cents,
-                          double range_tolerance_cents,
-                          bool physical_correction) {
+py::object ContactPointPy(
+    const py::object& instrument_arg,
+    int string,
+    const py::array_t<double, py::array::c_style | py::array::forcecast>& f0_hz,
+    double open_tolerance_cents,
+    double range_tolerance_cents,
+    bool physical_correction) {
   const PyInstrument instrument = InstrumentFrom(instrument_arg);
   ContactOptions options;
   options.open_tolerance_cents = open_tolerance_cents;
@@ -460,7 +461,7 @@ py::object ContactPointPy(const py::object& instrument_arg,
   }
   out["kind"] =
       py::module_::import("numpy").attr("array")(kinds).attr("reshape")(f0_hz.attr("shape"));
-  out["stopped"] = ToArray(std::move(stopped), shape).attr("astype")("bool");
+  out["stopped"] = ToArray(std::move(stopped), shape).attr("view")("bool");
   out["string"] = string;
   out["f0_hz"] = ToArray(fill(&Contact::f0_hz), shape);
   out["cents_from_open"] = ToArray(fill(&Contact::cents_from_open), shape);
@@ -614,9 +615,10 @@ py::dict FingertipIkPy(const hand::HandModel& model,
 
 // ---- eval ---------------------------------------------------------------------------
 
-py::dict EvaluatePitchPy(const py::array_t<double, py::array::forcecast>& truth_f0_hz,
-                         const py::array_t<double, py::array::forcecast>& f0_hz,
-                         const py::object& scored) {
+py::dict EvaluatePitchPy(
+    const py::array_t<double, py::array::c_style | py::array::forcecast>& truth_f0_hz,
+    const py::array_t<double, py::array::c_style | py::array::forcecast>& f0_hz,
+    const py::object& scored) {
   if (truth_f0_hz.ndim() != 1 || f0_hz.ndim() != 1 || truth_f0_hz.size() != f0_hz.size()) {
     RaiseValueError("truth_f0_hz and f0_hz must be 1-D of one length, got " +
                     ShapeString(truth_f0_hz) + " and " + ShapeString(f0_hz));
@@ -625,7 +627,7 @@ py::dict EvaluatePitchPy(const py::array_t<double, py::array::forcecast>& truth_
   const std::vector<double> estimate(f0_hz.data(), f0_hz.data() + f0_hz.size());
   std::vector<bool> mask;
   if (!scored.is_none()) {
-    const auto m = scored.cast<py::array_t<bool, py::array::forcecast>>();
+    const auto m = scored.cast<py::array_t<bool, py::array::c_style | py::array::forcecast>>();
     if (m.ndim() != 1 || m.size() != f0_hz.size()) {
       RaiseValueError("scored must be 1-D like f0_hz, got " + ShapeString(m));
     }

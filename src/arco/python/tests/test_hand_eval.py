@@ -96,3 +96,9 @@ def test_evaluate_matches_arco_eval(arco_bin, capture, result, tmp_path):
         arco.evaluate(tmp_path / "missing", capture / "truth")
     assert str(e.value) == cli_error(run_arco(arco_bin, "eval", tmp_path / "missing",
                                               "--truth", capture / "truth"))
+
+
+def test_evaluate_pitch_strided():
+    both = np.array([[220.0, 221.0], [330.0, 0.0], [440.0, 440.0]])
+    m = arco.evaluate_pitch(both[:, 0], both[:, 1])
+    assert m["frames"] == 3 and m["rpa50"] == pytest.approx(2 / 3)

@@ -61,3 +61,11 @@ def test_bad_inputs():
         arco.contact_point("cello", 1, 220.0, open_tolerance_cents=150)
     with pytest.raises(ValueError, match="a4_hz"):
         arco.Instrument("cello", a4_hz=float("nan"))
+
+
+def test_strided_and_integer_inputs():
+    f0 = np.array([220.0, 0.0, 440.0, 0.0, 880.0, 0.0])
+    strided = arco.contact_point("cello", 1, f0[::2])
+    np.testing.assert_allclose(strided["contact_from_bridge_mm"][1:],
+                               arco.contact_point("cello", 1, [440, 880])["contact_from_bridge_mm"])
+    assert arco.contact_point("cello", 1, 440)["fraction_from_bridge"] == pytest.approx(0.5)
