@@ -13,4 +13,6 @@ if [ "${ARCO_PYTHON_MODULE:-ON}" != ON ]; then
   if [ -n "${CI:-}" ]; then exit 1; fi
   exit 77
 fi
+# No __pycache__ or .pytest_cache in the source tree.
+export PYTHONDONTWRITEBYTECODE=1
 exec /usr/bin/python3 -m pytest -q -p no:cacheprovider "$1"
