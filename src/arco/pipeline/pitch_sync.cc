@@ -30,6 +30,23 @@ Status PitchRunOptions::Validate() const {
   return Status::Ok();
 }
 
+StatusOr<audio::PitchTrackerOptions> PitchTrackerOptionsFor(const PitchRunOptions& o) {
+  ARCO_RETURN_IF_ERROR(o.Validate());
+  ARCO_ASSIGN_OR_RETURN(
+      auto range, audio::InstrumentRangeByName(o.instrument.empty() ? "cello" : o.instrument));
+  audio::PitchTrackerOptions t;
+  t.range = range;
+  if (o.min_f0_hz > 0) t.range.min_f0_hz = o.min_f0_hz;
+  if (o.max_f0_hz > 0) t.range.max_f0_hz = o.max_f0_hz;
+  t.fps = std::isnan(o.fps) ? 30.0 : o.fps;
+  t.start_s = std::isnan(o.start_s) ? 0.0 : o.start_s;
+  t.a4_hz = std::isnan(o.a4_hz) ? 440.0 : o.a4_hz;
+  t.max_frames = o.frames;
+  t.hops_per_frame = o.hops_per_frame;
+  ARCO_RETURN_IF_ERROR(t.Validate());
+  return t;
+}
+
 StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, Progress& progress) {
   ARCO_RETURN_IF_ERROR(o.Validate());
   PitchRunResult result;
@@ -58,18 +75,14 @@ StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, Progress& progress) 
     }
   }
   if (result.input.empty()) return Status::Error("no input: give an audio file or --capture");
-  ARCO_ASSIGN_OR_RETURN(auto range,
-                        audio::InstrumentRangeByName(instrument.empty() ? "cello" : instrument));
-  auto& t = result.tracker;
-  t.range = range;
-  if (o.min_f0_hz > 0) t.range.min_f0_hz = o.min_f0_hz;
-  if (o.max_f0_hz > 0) t.range.max_f0_hz = o.max_f0_hz;
-  t.fps = std::isnan(fps) ? 30.0 : fps;
-  t.start_s = std::isnan(start_s) ? 0.0 : start_s;
-  t.a4_hz = std::isnan(a4_hz) ? 440.0 : a4_hz;
-  t.max_frames = frames;
-  t.hops_per_frame = o.hops_per_frame;
-  ARCO_RETURN_IF_ERROR(t.Validate());
+  PitchRunOptions resolved = o;
+  resolved.instrument = instrument;
+  resolved.fps = fps;
+  resolved.start_s = start_s;
+  resolved.a4_hz = a4_hz;
+  resolved.frames = frames;
+  ARCO_ASSIGN_OR_RETURN(result.tracker, PitchTrackerOptionsFor(resolved));
+  const audio::PitchTrackerOptions& t = result.tracker;
   // Every output declared and checked before the work, written together at the end.
   OutputSet outputs;
   ARCO_ASSIGN_OR_RETURN(const std::string pitch_tmp, outputs.AddFile(o.output));

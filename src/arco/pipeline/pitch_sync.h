@@ -42,6 +42,11 @@ struct PitchRunResult {
   int notes = 0, notes_with_vibrato = 0, glides = 0;
 };
 
+// The tracker's options for `o` without a capture folder (its manifest already applied):
+// the instrument's range with the f0 overrides, the defaults for NaN fields, validated.
+// RunPitch and the Python bindings' track_pitch share it.
+StatusOr<audio::PitchTrackerOptions> PitchTrackerOptionsFor(const PitchRunOptions& o);
+
 // Tracks, writes pitch.csv (and the optional outputs). Errors are one line that
 // names the file.
 StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& options,

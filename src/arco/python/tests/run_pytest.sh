@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# ctest's python_test: pytest on the module with Debian's python3 (/usr/bin/python3 sees
+# Debian's numpy and pytest). Exit 77 (skipped) when the module was not built because
+# pybind11 was absent at configure time (unless CI is set), or in a sanitizer build.
+#   run_pytest.sh TESTS_DIR   (PYTHONPATH, ARCO_BIN, ARCO_PYTHON_MODULE from ctest)
+set -euo pipefail
+if [ "${ARCO_PYTHON_MODULE:-ON}" = SANITIZED ]; then
+  echo "python_test: sanitizer build, no Python module" >&2
+  exit 77
+fi
+if [ "${ARCO_PYTHON_MODULE:-ON}" != ON ]; then
+  echo "python_test: the module was not built (pybind11 absent at configure time)" >&2
+  if [ -n "${CI:-}" ]; then exit 1; fi
+  exit 77
+fi
+# No __pycache__ or .pytest_cache in the source tree.
+export PYTHONDONTWRITEBYTECODE=1
+exec /usr/bin/python3 -m pytest -q -p no:cacheprovider "$1"
