@@ -50,7 +50,8 @@ done
 
 # End to end.
 wf out --keep-going > run1.txt 2>&1
-check '[ $? -eq 0 ]' "first run failed: $(tail -20 run1.txt)"
+rc=$?
+check '[ $rc -eq 0 ]' "first run failed: $(tail -20 run1.txt)"
 for k in 1 2 3; do
   check '[ -f out/take$k/result/result.json ] && [ -f out/take$k/eval.json ]' \
     "take$k: no result.json or eval.json"
@@ -67,11 +68,25 @@ check 'grep -q "threads: 2" run1.txt' "run jobs were not given 2 threads"
 wf out -n > rerun.txt 2>&1
 check 'grep -q "Nothing to be done" rerun.txt' "re-run is not empty: $(tail -20 rerun.txt)"
 
+# `arco batch` runs the same workflow: nothing to do either; a clear line without snakemake.
+"$arco" batch takes -o out --cores 2 --workflow "$here" -n > batch.txt 2>&1
+rc=$?
+check '[ $rc -eq 0 ] && grep -q "Nothing to be done" batch.txt' "arco batch -n: $(tail -5 batch.txt)"
+line=$("$arco" batch takes -o out --cores 2 --keep-going --workflow "$here" --print-command)
+check '[ "$line" = "snakemake -s $here/Snakefile --cores 2 --keep-going --config takes=$tmp/takes out=$tmp/out arco=$arco" ]' \
+  "arco batch --print-command: $line"
+mkdir empty
+PATH="$tmp/empty" "$arco" batch takes -o out --workflow "$here" > batch2.txt 2>&1
+rc=$?
+check '[ $rc -eq 1 ] && grep -q "^arco: error: snakemake: not found; .*apt-get install snakemake" batch2.txt' \
+  "arco batch without snakemake: $(cat batch2.txt)"
+
 # A changed input redoes only its take (Snakemake compares contents: a touch alone is no change).
 before1=$(stat -c %Y out/take1/eval.json)
 echo " " >> takes/take2/capture.json
 wf out > run2.txt 2>&1
-check '[ $? -eq 0 ]' "run after a change failed: $(tail -20 run2.txt)"
+rc=$?
+check '[ $rc -eq 0 ]' "run after a change failed: $(tail -20 run2.txt)"
 check '[ "$(grep -c "wildcards: take=take2" run2.txt)" -eq 2 ] && ! grep -q "take=take[13]" run2.txt' \
   "a change of take2 ran: $(grep wildcards run2.txt)"
 check '[ "$(stat -c %Y out/take1/eval.json)" = "$before1" ]' "take1 was redone"
@@ -80,7 +95,8 @@ check '[ "$(stat -c %Y out/take1/eval.json)" = "$before1" ]' "take1 was redone"
 echo '{"format": "arco-capture", "version": 1, "fps": ' > takes/take3/capture.json
 echo " " >> takes/take1/capture.json
 wf out --keep-going > run3.txt 2>&1
-check '[ $? -ne 0 ]' "a broken take did not fail the workflow"
+rc=$?
+check '[ $rc -ne 0 ]' "a broken take did not fail the workflow"
 check 'grep -q "arco workflow: take take3 failed at stage run: arco: error: .*take3/capture.json: malformed JSON" run3.txt' \
   "no line naming take3 and its stage: $(grep "arco workflow" run3.txt)"
 check 'grep -q "arco workflow: 2 of 3 takes done" run3.txt' "count of takes done"
@@ -116,7 +132,8 @@ echo '{"StartFrame": 1, "EndFrame": 10}' > sessions/spd1/spd1_summary.json
 echo '{"instrument": "violin"}' > sessions/spd1/take.json
 "${snakemake[@]}" -s "$snakefile" --cores 2 -n -p --config takes=sessions out=out-s \
   arco="$arco" > sessions.txt 2>&1
-check '[ $? -eq 0 ]' "dry run of the sessions: $(tail -20 sessions.txt)"
+rc=$?
+check '[ $rc -eq 0 ]' "dry run of the sessions: $(tail -20 sessions.txt)"
 check 'grep -q "capture new --calibration .*video1/calibration.json --instrument cello --video cam0=.*videos/cam0.mp4 --video cam1=.*--rotate cam1=90 --audio .*audio.wav --name video1 -o .*out-s/video1/capture" sessions.txt' \
   "video1: capture new: $(grep "capture new" sessions.txt)"
 check 'grep -q "detect .*out-s/video1/detect --threads" sessions.txt' "video1: detect"
@@ -164,14 +181,17 @@ cp -r takes/take1 takes-slurm
 mkdir takes-one && mv takes-slurm takes-one/take1
 "${snakemake[@]}" -s "$snakefile" -n --profile "$here/profiles/slurm" \
   --config takes=takes-one out=out-slurm arco="$arco" > slurm-n.txt 2>&1
-check '[ $? -eq 0 ] && grep -q "^rule run:" slurm-n.txt && grep -q "mem_mb=4000" slurm-n.txt' \
+rc=$?
+check '[ $rc -eq 0 ] && grep -q "^rule run:" slurm-n.txt && grep -q "mem_mb=4000" slurm-n.txt' \
   "slurm dry run: $(tail -20 slurm-n.txt)"
 "${snakemake[@]}" -s "$snakefile" -n --profile "$here/profiles/cluster" \
   --config takes=takes-one out=out-slurm arco="$arco" > cluster-n.txt 2>&1
-check '[ $? -eq 0 ] && grep -q "^rule eval:" cluster-n.txt' "cluster dry run: $(tail -20 cluster-n.txt)"
+rc=$?
+check '[ $rc -eq 0 ] && grep -q "^rule eval:" cluster-n.txt' "cluster dry run: $(tail -20 cluster-n.txt)"
 CI=true PATH="$tmp/mock:$PATH" "${snakemake[@]}" -s "$snakefile" --profile "$here/profiles/slurm" \
   --config takes=takes-one out=out-slurm arco="$arco" > slurm.txt 2>&1
-check '[ $? -eq 0 ] && [ -f out-slurm/take1/eval.json ] && [ -f out-slurm/summary.md ]' \
+rc=$?
+check '[ $rc -eq 0 ] && [ -f out-slurm/take1/eval.json ] && [ -f out-slurm/summary.md ]' \
   "slurm run with a mock sbatch: $(tail -20 slurm.txt)"
 check 'grep -q "^sbatch --parsable --job-name=arco-run-take1 --cpus-per-task=2 --mem=4000 --time=120 --output=logs/slurm/arco-run-take1-%j.out .*snakejob.run" sbatch.log &&
        grep -q "^sbatch --parsable --job-name=arco-eval-take1 --cpus-per-task=1 --mem=2000 " sbatch.log &&
