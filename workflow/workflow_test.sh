@@ -49,7 +49,7 @@ for k in 1 2 3; do
 done
 
 # End to end.
-wf out --keep-going > run1.txt 2>&1
+wf out --keep-going --printshellcmds > run1.txt 2>&1
 rc=$?
 check '[ $rc -eq 0 ]' "first run failed: $(tail -20 run1.txt)"
 for k in 1 2 3; do
@@ -62,7 +62,8 @@ for k in 1 2 3; do
 done
 check '[ "$(wc -l < out/summary.tsv)" -eq 4 ] && [ "$(grep -c "^| take" out/summary.md)" -eq 4 ]' \
   "summary: $(cat out/summary.md)"
-check 'grep -q "threads: 2" run1.txt' "run jobs were not given 2 threads"
+check '[ "$(grep -c "arco run .*/takes/take[123] -o .*/out/take[123]/result --threads 2" run1.txt)" -eq 3 ]' \
+  "run jobs were not given 2 threads: $(grep "arco run" run1.txt)"
 
 # A re-run executes nothing.
 wf out -n > rerun.txt 2>&1
