@@ -30,8 +30,8 @@ struct BatchOptions {
   bool keep_going = false;
   bool dry_run = false;
   bool print_command = false;
-  std::string profile;    // a Snakemake profile folder (cluster); replaces --cores
-  std::string workflow;   // folder holding the Snakefile
+  std::string profile;                  // a Snakemake profile folder (cluster); replaces --cores
+  std::string workflow;                 // folder holding the Snakefile
   std::string snakemake = "snakemake";  // executable, found on PATH
 };
 
@@ -98,7 +98,8 @@ int RunBatch(const BatchOptions& o) {
                       "--workflow or $ARCO_WORKFLOW_DIR");
   }
   if (!o.profile.empty() && !fs::is_regular_file(o.profile + "/config.yaml", ec)) {
-    return PrintError(o.profile + "/config.yaml: not found; --profile takes a Snakemake "
+    return PrintError(o.profile +
+                      "/config.yaml: not found; --profile takes a Snakemake "
                       "profile folder such as workflow/profiles/slurm");
   }
   const std::vector<std::string> args = SnakemakeArgs(o, workflow_dir);
@@ -128,8 +129,7 @@ std::function<int()> SetupBatch(CLI::App& app) {
       "batch",
       "Run every take of a folder (capture folders, video sessions with take.yaml, SPD "
       "sessions) through the Snakemake workflow, with a summary table (docs/workflow.md)");
-  cmd->add_option("takes", o->takes_dir, "Folder of takes, one sub-folder per take")
-      ->required();
+  cmd->add_option("takes", o->takes_dir, "Folder of takes, one sub-folder per take")->required();
   cmd->add_option("-o,--output", o->output_dir, "Folder for every take's outputs and the summary")
       ->required();
   AddNumber(cmd, "--cores", o->cores, "Cores to use at once (0 = all)", kThreadsRange)
