@@ -30,7 +30,7 @@ struct BatchOptions {
   bool keep_going = false;
   bool dry_run = false;
   bool print_command = false;
-  std::string profile;                  // a Snakemake profile folder (cluster); replaces --cores
+  std::string profile;                  // Snakemake profile (cluster); --cores only when given
   std::string workflow;                 // folder holding the Snakefile
   std::string snakemake = "snakemake";  // executable, found on PATH
 };
