@@ -2,8 +2,9 @@
 # The Snakemake workflow (workflow/Snakefile, docs/workflow.md) on three synthetic takes
 # with 2 cores: results, eval and the summary of each; a re-run does nothing; a changed
 # input redoes only its take; a broken take fails alone, named with its stage, while the
-# others complete (--keep-going); the command lines rendered for a video session and an
-# SPD session; the Slurm profile's submissions (a mock sbatch that runs the job itself).
+# others complete (--keep-going); `arco batch`; the command lines rendered for a video
+# session and an SPD session, and an SPD session made from a synthetic take run for real;
+# the Slurm profile's submissions (a mock sbatch that runs the job itself).
 # Without snakemake it skips (exit 77) unless CI is set.
 # With the detector models (MODELS_DIR/pose_detection.onnx) a video take of a real photo
 # runs capture new -> detect -> run for real (run stops: the take names no instrument).
@@ -148,6 +149,38 @@ fi
 check 'grep -q "import-spd --calibration .*spd1_camera.json --human .*spd1/human --instrument violin --instrument-points .*spd1/instrument --summary .*spd1_summary.json --name spd1 -o .*out-s/spd1/capture" sessions.txt' \
   "spd1: import-spd: $(grep "import-spd" sessions.txt)"
 check 'grep -q "notatake: not a take" sessions.txt' "notatake was not skipped with a message"
+
+# An SPD session for real: take1's capture written out in SPD's layout (per camera and
+# frame JSON, a summary, the calibration, the audio), then import-spd -> run.
+if /usr/bin/python3 -c 'import numpy' 2>/dev/null; then
+  mkdir -p spdtakes/spd1
+  /usr/bin/python3 - takes/take1 spdtakes/spd1 <<'PY'
+import json, os, shutil, sys
+import numpy as np
+capture, session = sys.argv[1], sys.argv[2]
+m = json.load(open(os.path.join(capture, "capture.json")))
+k = np.load(os.path.join(capture, "keypoints2d.npy"))
+for v, cam in enumerate(m["cameras"]):
+    for sub, points in (("human", k[:, v, :133]), ("instrument", k[:, v, 133:])):
+        os.makedirs(os.path.join(session, sub, cam["serial"]))
+        for f in range(k.shape[0]):
+            with open(os.path.join(session, sub, cam["serial"], f"{f + 1}.json"), "w") as out:
+                json.dump(points[f].tolist(), out)  # NaN as bare NaN, as SPD writes it
+first, count = m["frames"]["first"], m["frames"]["count"]
+with open(os.path.join(session, "session_summary.json"), "w") as out:
+    json.dump({"StartFrame": first, "EndFrame": first + count - 1, "FrameDropIDLog": {}}, out)
+shutil.copy(os.path.join(capture, m["calibration"]), os.path.join(session, "session_camera.json"))
+shutil.copy(os.path.join(capture, "audio.wav"), os.path.join(session, "audio.wav"))
+PY
+  "${snakemake[@]}" -s "$snakefile" --cores 2 --config takes=spdtakes out=out-spd \
+    arco="$arco" > spd.txt 2>&1
+  rc=$?
+  check '[ $rc -eq 0 ] && grep -q "imported 75 frames x 20 views x 142 points" out-spd/spd1/logs/capture.log &&
+         [ "$(tail -1 out-spd/summary.tsv | cut -f1-5)" = "$(printf "spd1\tok\t\t75\t20")" ]' \
+    "SPD session: $(tail -5 spd.txt) $(cat out-spd/summary.tsv)"
+else
+  echo "no numpy for Debian's python3: the SPD session is only dry-run"
+fi
 
 # A video take for real: a photo as a 1-frame video in two cameras.
 photo=/usr/share/doc/opencv-doc/examples/data/messi5.jpg
