@@ -172,10 +172,15 @@ with open(os.path.join(session, "session_summary.json"), "w") as out:
 shutil.copy(os.path.join(capture, m["calibration"]), os.path.join(session, "session_camera.json"))
 shutil.copy(os.path.join(capture, "audio.wav"), os.path.join(session, "audio.wav"))
 PY
-  "${snakemake[@]}" -s "$snakefile" --cores 2 --config takes=spdtakes out=out-spd \
-    arco="$arco" > spd.txt 2>&1
+  # Beside it a video session whose take file names a missing calibration: it fails alone.
+  mkdir -p spdtakes/missing
+  printf 'calibration: cal.json\ncameras:\n  cam0: cam0.mp4\n' > spdtakes/missing/take.yaml
+  "${snakemake[@]}" -s "$snakefile" --cores 2 --keep-going --config takes=spdtakes \
+    out=out-spd arco="$arco" > spd.txt 2>&1
   rc=$?
-  check '[ $rc -eq 0 ] && grep -q "imported 75 frames x 20 views x 142 points" out-spd/spd1/logs/capture.log &&
+  check '[ $rc -ne 0 ] && grep -q "arco workflow: take missing failed at stage capture: arco: error: .*spdtakes/missing/cal.json: not found" spd.txt' \
+    "missing calibration: $(grep "arco workflow" spd.txt)"
+  check 'grep -q "imported 75 frames x 20 views x 142 points" out-spd/spd1/logs/capture.log &&
          [ "$(tail -1 out-spd/summary.tsv | cut -f1-5)" = "$(printf "spd1\tok\t\t75\t20")" ]' \
     "SPD session: $(tail -5 spd.txt) $(cat out-spd/summary.tsv)"
 else
