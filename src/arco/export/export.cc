@@ -50,12 +50,13 @@ const std::vector<std::string>& ExportMethodNames() {
 
 Status ExportOptions::Validate() const {
   if (result_dir.empty()) return Status::Error("result_dir is empty");
-  auto parsed = ParseExportFormat(format);
-  if (!parsed.ok()) return Status::Error("format: " + parsed.status().message());
+  if (!ParseExportFormat(format).ok()) {
+    return Status::Error("format: '" + format + "' is not csv, trc, c3d, gltf (glb) or bvh");
+  }
   bool known = false;
   for (const auto& m : ExportMethodNames()) known = known || m == method;
   if (!known) {
-    return Status::Error("method: unknown method '" + method + "' (arco, paper, vision)");
+    return Status::Error("method: '" + method + "' is not arco, paper or vision");
   }
   return Status::Ok();
 }
@@ -81,8 +82,8 @@ StatusOr<ExportData> LoadExportData(const ExportOptions& options) {
       if (s.name == "triangulation") continue;
       have += (have.empty() ? "" : ", ") + s.name;
     }
-    return Status::Error(folder.ManifestPath() + ": no method '" + options.method +
-                         "' with 3D points (methods: " + (have.empty() ? "none" : have) +
+    return Status::Error(folder.ManifestPath() + ": the result has no '" + options.method +
+                         "' points (stages with points: " + (have.empty() ? "none" : have) +
                          "; arco refine writes them)");
   }
   ExportData data;
