@@ -38,10 +38,11 @@ int Run(const Args& a) {
               a.output.c_str());
   if (summary->format == exporter::ExportFormat::kBvh) {
     std::printf(
-        "BVH fit residual, median: body %.3f mm, hands %.3f mm (per joint in the file's "
-        "header%s)\n",
+        "BVH fit residual, median: body %.3f mm, left hand %.3f mm, right hand %.3f mm (per "
+        "joint in the file's header%s)\n",
         summary->bvh_body_median_mm,
-        summary->bvh_hands_median_mm,
+        summary->bvh_left_hand_median_mm,
+        summary->bvh_right_hand_median_mm,
         a.residuals ? ", and below" : "; --residuals prints them");
     if (a.residuals) {
       std::printf("%-24s %10s %10s %7s\n", "joint", "median_mm", "max_mm", "frames");

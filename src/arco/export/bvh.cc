@@ -43,7 +43,7 @@ struct Joint {
   int keypoint = -1;           // index in the data; -1 for a midpoint joint
   int mid_a = -1, mid_b = -1;  // midpoint joints: the two keypoints
   Eigen::Vector3d offset_mm = Eigen::Vector3d::Zero();  // rest offset from the parent
-  bool body = true;                                     // for the residual summary: body or hands
+  int group = 0;            // for the residual summary: 0 body, 1 left hand, 2 right hand
   bool positioned = false;  // has position channels: placed at its point
 };
 
@@ -51,12 +51,12 @@ class Skeleton {
  public:
   std::vector<Joint> joints;
 
-  int Add(const std::string& name, int parent, int keypoint, bool body = true) {
+  int Add(const std::string& name, int parent, int keypoint, int group = 0) {
     Joint j;
     j.name = name;
     j.parent = parent;
     j.keypoint = keypoint;
-    j.body = body;
+    j.group = group;
     joints.push_back(j);
     const int id = static_cast<int>(joints.size()) - 1;
     if (parent >= 0) joints[parent].children.push_back(id);
@@ -95,15 +95,16 @@ StatusOr<Skeleton> BuildSkeleton(const ExportData& data) {
     j = s.Add(side + "_elbow", j, kp(side + "_elbow"));
     j = s.Add(side + "_wrist", j, kp(side + "_wrist"));
     const std::string h = side + "_hand_";
-    const int wrist = s.Add(h + "wrist", j, kp(h + "wrist"), false);
+    const int hand = side == "left" ? 1 : 2;
+    const int wrist = s.Add(h + "wrist", j, kp(h + "wrist"), hand);
     s.joints[wrist].positioned = true;
     int t = wrist;
     for (const char* joint : {"thumb_cmc", "thumb_mcp", "thumb_ip", "thumb_tip"})
-      t = s.Add(h + joint, t, kp(h + joint), false);
+      t = s.Add(h + joint, t, kp(h + joint), hand);
     for (const std::string finger : {"index", "middle", "ring", "little"}) {
       int f = wrist;
       for (const char* joint : {"_mcp", "_pip", "_dip", "_tip"})
-        f = s.Add(h + finger + joint, f, kp(h + finger + joint), false);
+        f = s.Add(h + finger + joint, f, kp(h + finger + joint), hand);
     }
   }
   if (!missing.empty()) {
@@ -246,7 +247,7 @@ StatusOr<BvhExport> ExportBvh(const ExportData& data) {
   }
 
   BvhExport out;
-  std::vector<double> body, hands;
+  std::vector<double> pooled[3];
   for (int i = 0; i < n; ++i) {
     if (joints[i].keypoint < 0) continue;
     BvhJointResidual r;
@@ -256,12 +257,12 @@ StatusOr<BvhExport> ExportBvh(const ExportData& data) {
       r.median_mm = Median(errors[i]);
       r.max_mm = *std::max_element(errors[i].begin(), errors[i].end());
     }
-    auto& group = joints[i].body ? body : hands;
+    auto& group = pooled[joints[i].group];
     group.insert(group.end(), errors[i].begin(), errors[i].end());
     out.residuals.push_back(r);
   }
-  out.body_median_mm = body.empty() ? 0 : Median(body);
-  out.hands_median_mm = hands.empty() ? 0 : Median(hands);
+  double* medians[3] = {&out.body_median_mm, &out.left_hand_median_mm, &out.right_hand_median_mm};
+  for (int g = 0; g < 3; ++g) *medians[g] = pooled[g].empty() ? 0 : Median(pooled[g]);
 
   std::string& text = out.text;
   text = "HIERARCHY\n";
@@ -271,9 +272,10 @@ StatusOr<BvhExport> ExportBvh(const ExportData& data) {
   char line[256];
   std::snprintf(line,
                 sizeof(line),
-                "# fit residual median mm: body %.4f hands %.4f\n",
+                "# fit residual median mm: body %.4f left hand %.4f right hand %.4f\n",
                 out.body_median_mm,
-                out.hands_median_mm);
+                out.left_hand_median_mm,
+                out.right_hand_median_mm);
   text += line;
   for (const auto& r : out.residuals) {
     std::snprintf(line,

@@ -207,7 +207,8 @@ StatusOr<ExportSummary> ExportResult(const ExportOptions& options,
       bytes = std::move(bvh.text);
       summary.bvh_residuals = std::move(bvh.residuals);
       summary.bvh_body_median_mm = bvh.body_median_mm;
-      summary.bvh_hands_median_mm = bvh.hands_median_mm;
+      summary.bvh_left_hand_median_mm = bvh.left_hand_median_mm;
+      summary.bvh_right_hand_median_mm = bvh.right_hand_median_mm;
       break;
     }
   }

@@ -82,8 +82,8 @@ struct BvhJointResidual {
 struct BvhExport {
   std::string text;
   std::vector<BvhJointResidual> residuals;  // the joints that are keypoints
-  double body_median_mm = 0;                // over all body joint-frames
-  double hands_median_mm = 0;               // over all hand joint-frames
+  // Medians over all joint-frames of the body, the left hand and the right hand.
+  double body_median_mm = 0, left_hand_median_mm = 0, right_hand_median_mm = 0;
 };
 StatusOr<BvhExport> ExportBvh(const ExportData& data);
 
@@ -93,7 +93,7 @@ struct ExportSummary {
   int keypoints = 0;
   int64_t bytes = 0;
   std::vector<BvhJointResidual> bvh_residuals;  // BVH only
-  double bvh_body_median_mm = 0, bvh_hands_median_mm = 0;
+  double bvh_body_median_mm = 0, bvh_left_hand_median_mm = 0, bvh_right_hand_median_mm = 0;
 };
 
 // Loads the result and writes the export to `path` (a caller wanting an atomic output

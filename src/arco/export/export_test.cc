@@ -111,7 +111,8 @@ TEST(ExportBvh, RigidMotionFitsExactly) {
   auto bvh = ExportBvh(d);
   ASSERT_TRUE(bvh.ok()) << bvh.status().message();
   EXPECT_LT(bvh->body_median_mm, 1e-6);
-  EXPECT_LT(bvh->hands_median_mm, 1e-6);
+  EXPECT_LT(bvh->left_hand_median_mm, 1e-6);
+  EXPECT_LT(bvh->right_hand_median_mm, 1e-6);
   for (const auto& r : bvh->residuals) EXPECT_LT(r.max_mm, 1e-6) << r.name;
   EXPECT_NE(bvh->text.find("JOINT left_hand_little_dip"), std::string::npos);
   EXPECT_NE(bvh->text.find("Frames: 20\n"), std::string::npos);
