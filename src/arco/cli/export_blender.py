@@ -2,7 +2,7 @@
 
 Run: blender -b --factory-startup --python export_blender.py -- BVH GLB RESULT_DIR METHOD
 Checks, for each file: the frame count, the joint/node count, and that left fingertips'
-world positions at several frames are within 1 mm of points3d.npy (in the export's units:
+(and, in the BVH, instrument points') world positions at several frames are within 1 mm of points3d.npy (in the export's units:
 mm for BVH, metres for glTF). Exits 1 on the first failure.
 """
 import builtins
@@ -57,16 +57,20 @@ def main():
     if len(arm) != 1:
         fail(f"bvh: {len(arm)} armatures")
     arm = arm[0]
+    # 67 skeleton joints, the instrument root and its points, the bow root, frog and tip.
+    instrument = ["scroll_top", "nut_l", "nut_r", "bridge_l", "bridge_r", "tail_gut", "end_pin"]
+    instrument += [f"string{s}_{e}" for s in range(1, 5) for e in ("top", "bottom")]
+    expected = 67 + 1 + sum(n in names for n in instrument) + 3
     bones = len(arm.data.bones)
-    if bones != 67:
-        fail(f"bvh: {bones} bones, expected 67")
+    if bones != expected:
+        fail(f"bvh: {bones} bones, expected {expected}")
     start, end = arm.animation_data.action.frame_range
     if int(round(end - start)) + 1 != F:
         fail(f"bvh: action frames {start}..{end}, expected {F}")
     worst = 0.0
     for f in frames:
         bpy.context.scene.frame_set(f + 1)
-        for tip in tips:
+        for tip in tips + ["scroll_top", "string1_top", "string4_bottom"]:
             target = pts[f, names.index(tip)]
             if np.isnan(target).any():
                 continue
@@ -75,7 +79,8 @@ def main():
             worst = max(worst, err)
             if err > TOL_MM:
                 fail(f"bvh frame {f}: {tip} at {tuple(p)}, points3d {tuple(target)}: {err:.3f} mm")
-    print(f"blender bvh: {bones} bones, {F} frames, left fingertips within {worst:.4f} mm")
+    print(f"blender bvh: {bones} bones, {F} frames, left fingertips and instrument points "
+          f"within {worst:.4f} mm")
 
     # glTF. Blender 3.4's importer uses np.bool, which Debian's NumPy 1.24 no longer has.
     if "bool" not in np.__dict__:

@@ -7,7 +7,10 @@
 //       left_shoulder > left_elbow > left_wrist > left_hand_wrist > left_hand_thumb_cmc >
 //         .._mcp > .._ip > .._tip, and index/middle/ring/little mcp > pip > dip > tip
 //       (right alike)
-// The face points (face_00..67), the instrument and the contact points are not joints.
+// Then two rigid roots: "instrument" (scroll_top, nut_l/r, bridge_l/r, tail_gut, end_pin and
+// the strings' ends present in the layout) and "bow" (frog, tip), each at its points'
+// centroid with the points as child joints, fitted per frame as a rigid body (Kabsch; the
+// bow, a line, by the smallest rotation). The face and the contact points are not joints.
 //
 // Fit. Rest pose: the first frame where every joint exists, each bone rescaled to its
 // median length over the frames (so the rest offsets are the result's median lengths).
@@ -29,6 +32,7 @@
 #include <Eigen/SVD>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "arco/export/export.h"
 #include "arco/util/stats.h"
@@ -157,6 +161,89 @@ void WriteJoint(const Skeleton& s, int id, int depth, std::string& out) {
   out += pad + "}\n";
 }
 
+// A rigid body as a second (third) root: the instrument's points, the bow's frog and tip.
+// The root sits at the points' centroid; each point is a child joint at its rest offset.
+struct RigidRoot {
+  std::string name;
+  std::vector<int> keypoints;
+  std::vector<Eigen::Vector3d> rest;  // offsets from the rest centroid
+  std::vector<std::vector<double>> errors;
+};
+
+std::optional<RigidRoot> MakeRigidRoot(const ExportData& data,
+                                       const std::string& name,
+                                       const std::vector<std::string>& points) {
+  RigidRoot r;
+  r.name = name;
+  for (const auto& p : points) {
+    const int i = data.Find(p);
+    if (i >= 0) r.keypoints.push_back(i);
+  }
+  if (r.keypoints.size() < 2) return std::nullopt;
+  for (int64_t f = 0; f < data.frames(); ++f) {
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    bool all = true;
+    for (int k : r.keypoints) {
+      all = all && data.At(f, k).allFinite();
+      centroid += data.At(f, k);
+    }
+    if (!all) continue;
+    centroid /= r.keypoints.size();
+    for (int k : r.keypoints) r.rest.push_back(data.At(f, k) - centroid);
+    r.errors.resize(r.keypoints.size());
+    return r;
+  }
+  return std::nullopt;
+}
+
+// Rotation and centroid of frame f (the previous ones held when fewer than two points, or
+// for a body of more than two, fewer than three, exist).
+void FitRigid(const ExportData& data,
+              int64_t f,
+              RigidRoot& root,
+              Eigen::Matrix3d& rotation,
+              Eigen::Vector3d& centroid) {
+  std::vector<Eigen::Vector3d> rest, measured;
+  Eigen::Vector3d rest_mean = Eigen::Vector3d::Zero(), mean = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < root.keypoints.size(); ++i) {
+    const Eigen::Vector3d x = data.At(f, root.keypoints[i]);
+    if (!x.allFinite()) continue;
+    rest.push_back(root.rest[i]);
+    measured.push_back(x);
+    rest_mean += root.rest[i];
+    mean += x;
+  }
+  const size_t needed = root.keypoints.size() == 2 ? 2 : 3;
+  if (rest.size() >= needed) {
+    rest_mean /= rest.size();
+    mean /= rest.size();
+    for (size_t i = 0; i < rest.size(); ++i) {
+      rest[i] -= rest_mean;
+      measured[i] -= mean;
+    }
+    rotation = rest.size() == 2 ? Eigen::Matrix3d(Eigen::Quaterniond::FromTwoVectors(
+                                      rest[1] - rest[0], measured[1] - measured[0]))
+                                : Kabsch(rest, measured);
+    centroid = mean - rotation * rest_mean;
+  }
+  for (size_t i = 0; i < root.keypoints.size(); ++i) {
+    const Eigen::Vector3d x = data.At(f, root.keypoints[i]);
+    if (x.allFinite()) root.errors[i].push_back((centroid + rotation * root.rest[i] - x).norm());
+  }
+}
+
+void WriteRigidRoot(const ExportData& data, const RigidRoot& r, std::string& out) {
+  out += "ROOT " + r.name + "\n{\n  OFFSET 0.000000 0.000000 0.000000\n";
+  out += "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n";
+  for (size_t i = 0; i < r.keypoints.size(); ++i) {
+    out += "  JOINT " + data.keypoint_names[r.keypoints[i]] + "\n  {\n    OFFSET";
+    for (int k = 0; k < 3; ++k) AppendF(out, " %.6f", r.rest[i][k]);
+    out += "\n    CHANNELS 3 Zrotation Xrotation Yrotation\n";
+    out += "    End Site\n    {\n      OFFSET 0.000000 0.000000 1.000000\n    }\n  }\n";
+  }
+  out += "}\n";
+}
+
 }  // namespace
 
 StatusOr<BvhExport> ExportBvh(const ExportData& data) {
@@ -195,6 +282,25 @@ StatusOr<BvhExport> ExportBvh(const ExportData& data) {
   for (int i = 0; i < n; ++i) translation[i] = joints[i].offset_mm;
   Eigen::Vector3d root_position = Target(data, joints[0], rest);
   std::vector<std::vector<double>> errors(n);
+  // The instrument and the bow: rigid roots after the skeleton.
+  std::vector<RigidRoot> rigid;
+  {
+    std::vector<std::string> instrument;
+    for (const char* p :
+         {"scroll_top", "nut_l", "nut_r", "bridge_l", "bridge_r", "tail_gut", "end_pin"}) {
+      instrument.push_back(p);
+    }
+    for (int s = 1; s <= 4; ++s) {
+      instrument.push_back("string" + std::to_string(s) + "_top");
+      instrument.push_back("string" + std::to_string(s) + "_bottom");
+    }
+    for (auto r : {MakeRigidRoot(data, "instrument", instrument),
+                   MakeRigidRoot(data, "bow", {"frog", "tip"})}) {
+      if (r) rigid.push_back(std::move(*r));
+    }
+  }
+  std::vector<Eigen::Matrix3d> rigid_rotation(rigid.size(), Eigen::Matrix3d::Identity());
+  std::vector<Eigen::Vector3d> rigid_centroid(rigid.size(), Eigen::Vector3d::Zero());
   std::string motion;
   motion.reserve(static_cast<size_t>(frames) * (3 * n + 3) * 12);
   for (int64_t f = 0; f < frames; ++f) {
@@ -243,6 +349,13 @@ StatusOr<BvhExport> ExportBvh(const ExportData& data) {
       const Eigen::Vector3d zxy = local[i].eulerAngles(2, 0, 1) * (180.0 / M_PI);
       for (int k = 0; k < 3; ++k) AppendF(motion, " %.6f", zxy[k]);
     }
+    for (size_t r = 0; r < rigid.size(); ++r) {
+      FitRigid(data, f, rigid[r], rigid_rotation[r], rigid_centroid[r]);
+      for (int k = 0; k < 3; ++k) AppendF(motion, " %.6f", rigid_centroid[r][k]);
+      const Eigen::Vector3d zxy = rigid_rotation[r].eulerAngles(2, 0, 1) * (180.0 / M_PI);
+      for (int k = 0; k < 3; ++k) AppendF(motion, " %.6f", zxy[k]);
+      for (size_t i = 0; i < rigid[r].keypoints.size(); ++i) motion += " 0 0 0";
+    }
     motion += '\n';
   }
 
@@ -260,6 +373,18 @@ StatusOr<BvhExport> ExportBvh(const ExportData& data) {
     auto& group = pooled[joints[i].group];
     group.insert(group.end(), errors[i].begin(), errors[i].end());
     out.residuals.push_back(r);
+  }
+  for (const RigidRoot& r : rigid) {
+    for (size_t i = 0; i < r.keypoints.size(); ++i) {
+      BvhJointResidual res;
+      res.name = data.keypoint_names[r.keypoints[i]];
+      res.frames = static_cast<int>(r.errors[i].size());
+      if (res.frames > 0) {
+        res.median_mm = Median(r.errors[i]);
+        res.max_mm = *std::max_element(r.errors[i].begin(), r.errors[i].end());
+      }
+      out.residuals.push_back(res);
+    }
   }
   double* medians[3] = {&out.body_median_mm, &out.left_hand_median_mm, &out.right_hand_median_mm};
   for (int g = 0; g < 3; ++g) *medians[g] = pooled[g].empty() ? 0 : Median(pooled[g]);
@@ -288,6 +413,7 @@ StatusOr<BvhExport> ExportBvh(const ExportData& data) {
     text += line;
   }
   WriteJoint(skeleton, 0, 0, text);
+  for (const RigidRoot& r : rigid) WriteRigidRoot(data, r, text);
   text += "MOTION\nFrames: " + std::to_string(frames) + "\n";
   AppendF(text, "Frame Time: %.8f\n", 1.0 / data.fps);
   text += motion;
