@@ -49,8 +49,13 @@ def compare(read, pts, what):
 
 def check_csv(path, result, names, pts):
     rows = list(csv.reader(open(path)))
-    expect(rows[0] == ["frame", "time_s", "keypoint", "x_mm", "y_mm", "z_mm", "present"],
-           f"csv header {rows[0]}")
+    expect(rows[0] == ["frame", "time_s", "keypoint", "x_mm", "y_mm", "z_mm", "present",
+                       "reprojection_px", "views"], f"csv header {rows[0]}")
+    # The triangulation's evidence, by name.
+    tri_names = result["keypoint_names"]
+    rms = np.load(result_dir_of[0] + "/triangulation/reprojection_rms_px.npy")
+    inliers = np.load(result_dir_of[0] + "/triangulation/inlier_count.npy")
+    quality_checked = 0
     F, P, _ = pts.shape
     expect(len(rows) == 1 + F * P, f"csv rows {len(rows) - 1} != {F * P}")
     read = np.full((F, P, 3), np.nan)
@@ -60,11 +65,23 @@ def check_csv(path, result, names, pts):
         f, p = divmod(i, P)
         expect(int(row[0]) == first + f and row[2] == names[p], f"csv row {i + 2}: {row[:3]}")
         expect(abs(float(row[1]) - f / fps) < 1e-5, f"csv row {i + 2}: time_s {row[1]}")
+        name = names[p]
+        expect(len(row) == 9, f"csv row {i + 2}: {len(row)} fields")
+        t = tri_names.index(name) if name in tri_names else -1
+        if t >= 0 and np.isfinite(rms[f, t]):
+            expect(abs(float(row[7]) - rms[f, t]) <= 5e-4 and int(row[8]) == inliers[f, t],
+                   f"csv row {i + 2}: reprojection_px/views {row[7:]} != {rms[f, t]}, "
+                   f"{inliers[f, t]}")
+            quality_checked += 1
+        else:
+            expect(row[7:] == ["", ""], f"csv row {i + 2}: quality {row[7:]} without one")
         if row[6] == "1":
             read[f, p] = [float(v) for v in row[3:6]]
         else:
             expect(row[3:6] == ["", "", ""], f"csv row {i + 2}: a gap with values")
+    expect(quality_checked > 0, "csv: no reprojection_px values")
     compare(read, pts, "csv")
+    print(f"csv: {quality_checked} reprojection_px/views values as in triangulation/")
 
 
 def check_trc(path, result, names, pts):
@@ -316,8 +333,12 @@ def check_bvh(path, result, names, pts):
           f"{np.median([residual[k][0] for k in hand]):.4f} mm")
 
 
+result_dir_of = []
+
+
 def main():
     fmt, path, result_dir, method = sys.argv[1:5]
+    result_dir_of.append(result_dir)
     result, names, pts = load_result(result_dir, method)
     {"csv": check_csv, "trc": check_trc, "c3d": check_c3d, "gltf": check_glb,
      "bvh": check_bvh}[fmt](path, result, names, pts)

@@ -2,12 +2,15 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "arco/pipeline/result_folder.h"
 #include "arco/util/file_io.h"
 
 namespace arco::exporter {
 namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 struct FormatName {
   ExportFormat format;
@@ -99,6 +102,30 @@ StatusOr<ExportData> LoadExportData(const ExportOptions& options) {
     return Status::Error(stage->points3d_path + ": shape is not (frames >= 1, " +
                          std::to_string(data.keypoint_names.size()) + ", 3)");
   }
+  // The triangulation's quality, matched by name (absent in results of older versions).
+  auto quality = folder.ReadTriangulationQuality();
+  if (quality.ok()) {
+    const auto& rms = quality->rms_reprojection_px;
+    const auto& inliers = quality->num_inliers;
+    const int64_t tri_points = static_cast<int64_t>(header.keypoint_names.size());
+    if (rms.shape == std::vector<int64_t>{shape[0], tri_points} && inliers.shape == rms.shape) {
+      data.reprojection_px.shape = {shape[0], shape[1]};
+      data.reprojection_px.data.assign(shape[0] * shape[1], kNaN);
+      data.views.shape = {shape[0], shape[1]};
+      data.views.data.assign(shape[0] * shape[1], 0);
+      for (int64_t p = 0; p < shape[1]; ++p) {
+        int t = -1;
+        for (int64_t i = 0; i < tri_points && t < 0; ++i) {
+          if (header.keypoint_names[i] == data.keypoint_names[p]) t = static_cast<int>(i);
+        }
+        if (t < 0) continue;
+        for (int64_t f = 0; f < shape[0]; ++f) {
+          data.reprojection_px.at(f, p) = rms.at(f, t);
+          data.views.at(f, p) = inliers.at(f, t);
+        }
+      }
+    }
+  }
   ARCO_ASSIGN_OR_RETURN(const bool has_instrument, folder.HasStage(pipeline::kInstrumentStage));
   if (has_instrument) {
     ARCO_ASSIGN_OR_RETURN(pipeline::InstrumentRecord inst, folder.ReadInstrument());
@@ -112,7 +139,8 @@ StatusOr<ExportData> LoadExportData(const ExportOptions& options) {
 }
 
 std::string CsvText(const ExportData& data) {
-  std::string out = "frame,time_s,keypoint,x_mm,y_mm,z_mm,present\n";
+  std::string out = "frame,time_s,keypoint,x_mm,y_mm,z_mm,present,reprojection_px,views\n";
+  const bool quality = !data.reprojection_px.shape.empty();
   out.reserve(out.size() + data.frames() * data.points() * 48);
   for (int64_t f = 0; f < data.frames(); ++f) {
     const std::string frame = std::to_string(data.frame_first + f) + ",";
@@ -128,7 +156,15 @@ std::string CsvText(const ExportData& data) {
         out += ',';
         if (present) AppendNumber(out, x[k]);
       }
-      out += present ? ",1\n" : ",0\n";
+      out += present ? ",1," : ",0,";
+      const double rms = quality ? data.reprojection_px.at(f, p) : kNaN;
+      if (std::isfinite(rms)) {
+        char q[48];
+        std::snprintf(q, sizeof(q), "%.3f,%d\n", rms, data.views.at(f, p));
+        out += q;
+      } else {
+        out += ",\n";
+      }
     }
   }
   return out;

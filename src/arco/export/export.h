@@ -45,6 +45,12 @@ struct ExportData {
   // The instrument's strings, nut and bridge per frame: (F, S, 2, 3) mm; empty when the
   // result has no instrument stage.
   NpyArray<double> strings_mm;
+  // The triangulation's evidence for each point (the same-named point of
+  // triangulation/): RMS reprojection error (px) and inlier views, (F, P); NaN and 0
+  // where the triangulation has no such point or did not triangulate it. Empty when the
+  // result has no triangulation quality files.
+  NpyArray<double> reprojection_px;
+  NpyArray<int32_t> views;
 
   int64_t frames() const { return points_mm.shape.empty() ? 0 : points_mm.shape[0]; }
   int points() const { return keypoint_names.size(); }
@@ -60,7 +66,9 @@ struct ExportData {
 // whose shape disagrees with the names.
 StatusOr<ExportData> LoadExportData(const ExportOptions& options);
 
-// The writers: the file's contents.
+// The writers: the file's contents. CSV columns: frame, time_s, keypoint, x_mm, y_mm, z_mm,
+// present (0: a gap, x/y/z empty), reprojection_px and views (the triangulation's evidence
+// for the point, empty when none).
 std::string CsvText(const ExportData& data);
 std::string TrcText(const ExportData& data, const std::string& file_name);
 // C3D (Motion Lab Systems' format, Intel floats, one parameter block set): POINT:LABELS are
