@@ -30,6 +30,7 @@
 // degrees (R = Rz Rx Ry, the usual BVH order).
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>

@@ -8,6 +8,7 @@
 //   params   4-byte header (0x01, 0x50, block count, processor 84 = Intel), then groups
 //            (negative id) and parameters (positive id), each with the offset to the next
 //   data     per frame, per point: X, Y, Z, residual (float); residual -1 marks a gap
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 

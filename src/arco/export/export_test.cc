@@ -95,6 +95,16 @@ TEST(C3dBytes, HeaderAndBlocks) {
   EXPECT_EQ(scale, -1.0f);
 }
 
+TEST(C3dBytes, RefusesMoreFramesThanTheHeaderHolds) {
+  ExportData d;
+  d.keypoint_names = {"nose"};
+  d.points_mm.shape = {70000, 1, 3};
+  d.points_mm.data.assign(70000 * 3, 1.0);
+  auto c3d = C3dBytes(d);
+  ASSERT_FALSE(c3d.ok());
+  EXPECT_NE(c3d.status().message().find("70000 frames"), std::string::npos);
+}
+
 TEST(GlbBytes, MagicAndLength) {
   const ExportData d = RigidData(3);
   const std::string glb = GlbBytes(d);

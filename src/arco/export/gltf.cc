@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstring>
+#include <functional>
 
 #include "arco/export/export.h"
 #include "arco/util/json_io.h"
