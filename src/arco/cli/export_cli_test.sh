@@ -4,7 +4,8 @@
 # points3d.npy (within 1e-3 mm; frame counts, rates, names, gaps; BVH forward kinematics
 # within the residuals the file reports), the .glb by the Khronos glTF-Validator with 0
 # errors; bad input (unknown format or method, a method the result lacks, no result, an
-# unwritable output) is one line "arco: error: ...", exit 1, and nothing written.
+# unwritable output, a damaged points3d.npy or result.json) is one line "arco: error: ...",
+# exit 1, and nothing written.
 # The validator comes from scripts/fetch_gltf_validator; without it (or node) the test
 # skips (exit 77) unless CI is set, where it fails.
 # usage: export_cli_test.sh ARCO_BINARY SOURCE_DIR
@@ -75,6 +76,17 @@ bad "output in a missing folder" "$tmp/w/missing/x.csv: *" \
   export "$tmp/res" --format csv -o "$tmp/w/missing/x.csv"
 bad "output under a file" "$tmp/w/take.csv/x.csv: *" \
   export "$tmp/res" --format csv -o "$tmp/w/take.csv/x.csv"
+# Damaged results: one line naming the file.
+cp -r "$tmp/res" "$tmp/garbage" && echo "not an npy" >"$tmp/garbage/arco/points3d.npy"
+bad "points3d.npy not an npy" "$tmp/garbage/arco/points3d.npy: *" \
+  export "$tmp/garbage" --format bvh -o "$tmp/w/x.bvh"
+cp -r "$tmp/res" "$tmp/shape"
+"$py" -c "import numpy as np, sys; np.save(sys.argv[1], np.zeros((4, 10, 3)))" \
+  "$tmp/shape/arco/points3d.npy"
+bad "points3d.npy of another layout" "$tmp/shape/arco/points3d.npy: shape is not (frames >= 1, 155, 3)" \
+  export "$tmp/shape" --format gltf -o "$tmp/w/x.glb"
+cp -r "$tmp/res" "$tmp/json" && echo "{" >"$tmp/json/result.json"
+bad "result.json not JSON" "$tmp/json/result.json: *" export "$tmp/json" --format trc -o "$tmp/w/x.trc"
 mkdir -p "$tmp/w/dir"
 bad "output is a folder" "$tmp/w/dir: *" export "$tmp/res" --format trc -o "$tmp/w/dir"
 
