@@ -45,6 +45,9 @@ inline constexpr FieldFlag kRefineFlags[] = {{"num_threads", "--threads"},
 inline constexpr FieldFlag kEvalFlags[] = {{"truth_frames", "--truth-frame"},
                                            {"pck_thresholds_mm", "--pck-mm"},
                                            {"joint_limit_tolerance_deg", "--limit-tolerance-deg"}};
+// Export (exporter::ExportOptions, as set by `arco export`).
+inline constexpr FieldFlag kExportFlags[] = {
+    {"result_dir", "RESULT_DIR"}, {"format", "--format"}, {"method", "--method"}};
 // Synthesis (CaptureWriteOptions, as set by `arco synth`).
 inline constexpr FieldFlag kSynthFlags[] = {{"overwrite", "--overwrite"},
                                             {"max_duration_s", "--duration-s"},

@@ -127,6 +127,15 @@ bad "eval plot in a missing folder" "$w/nodir/e.svg" "${E[@]}" -o "$w/e.json" --
 bad "eval -o a folder" "$w/dir" "${E[@]}" -o "$w/dir"
 bad "eval plot under a file" "$w/file/e.svg" "${E[@]}" -o "$w/e.json" --plot "$w/file/e.svg"
 
+# export: one file.
+X=(export "$w/res" --format c3d --method vision)
+ok "export -o" "${X[@]}" -o "$w/x.c3d"
+check '[ -s "$w/x.c3d" ]' "export writes its file"
+rm "$w/x.c3d"
+bad "export in a missing folder" "$w/nodir/x.c3d" "${X[@]}" -o "$w/nodir/x.c3d"
+bad "export -o a folder" "$w/dir" "${X[@]}" -o "$w/dir"
+bad "export under a file" "$w/file/x.c3d" "${X[@]}" -o "$w/file/x.c3d"
+
 # pitch: pitch.csv, --fine, --notes, --midi, all or none.
 P=(pitch "$spd/pgy.wav" --frames 60)
 ok "pitch every output" "${P[@]}" -o "$w/p.csv" --fine "$w/f.csv" --notes "$w/n.csv" --midi "$w/m.mid"

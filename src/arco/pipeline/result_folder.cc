@@ -246,6 +246,15 @@ StatusOr<NpyArray<double>> ResultFolder::ReadPoints3d(const std::string& stage) 
   return ReadNpy<double>(Points3dPath(stage));
 }
 
+StatusOr<ResultFolder::TriangulationQuality> ResultFolder::ReadTriangulationQuality() const {
+  TriangulationQuality q;
+  ARCO_ASSIGN_OR_RETURN(q.rms_reprojection_px,
+                        ReadNpy<float>(StagePath(kTriangulationStage, kReprojectionRmsFile)));
+  ARCO_ASSIGN_OR_RETURN(q.num_inliers,
+                        ReadNpy<int32_t>(StagePath(kTriangulationStage, kInlierCountFile)));
+  return q;
+}
+
 // ---- instrument/
 
 Status ResultFolder::WriteInstrument(const InstrumentRecord& r) const {

@@ -158,6 +158,13 @@ class ResultFolder {
                             const TriangulationRecord& record) const;
   // <stage>/points3d.npy of any stage (triangulation, vision, paper, arco).
   StatusOr<NpyArray<double>> ReadPoints3d(const std::string& stage) const;
+  // triangulation/reprojection_rms_px.npy and inlier_count.npy, each (F, P) in the
+  // result's layout (NaN / 0 where a point was not triangulated); shapes unchecked.
+  struct TriangulationQuality {
+    NpyArray<float> rms_reprojection_px;
+    NpyArray<int32_t> num_inliers;
+  };
+  StatusOr<TriangulationQuality> ReadTriangulationQuality() const;
 
   Status WriteInstrument(const InstrumentRecord& record) const;
   // The scale recorded by the instrument stage; an error naming result.json without one.
