@@ -138,6 +138,14 @@ StatusOr<std::array<double, kNumIntrinsics>> CalibrateIntrinsics(
   cv::Mat K, dist;
   std::vector<cv::Mat> rvecs, tvecs;
   try {
+    // OpenCV's own thread pool would split calibrateCamera's sums in a varying order:
+    // one thread keeps the intrinsics the same bit for bit from run to run.
+    const int opencv_threads = cv::getNumThreads();
+    cv::setNumThreads(1);
+    struct Restore {
+      int n;
+      ~Restore() { cv::setNumThreads(n); }
+    } restore{opencv_threads};
     cv::calibrateCamera(
         object_points,
         image_points,
