@@ -233,9 +233,11 @@ struct InstrumentTracker::State {
     }
   }
 
-  std::vector<PoseCorrespondence> Correspondences(const std::vector<std::vector<Feature>>& extra) {
+  std::vector<PoseCorrespondence> Correspondences(const std::vector<std::vector<Feature>>& extra,
+                                                  const std::vector<cv::Mat>& images) {
     std::vector<PoseCorrespondence> c;
     for (size_t v = 0; v < views.size(); ++v) {
+      if (images[v].empty()) continue;  // no frame: its features are from an older one
       for (const Feature& f : views[v].features) {
         c.push_back({static_cast<int>(v), f.in_template, f.pixel, 1.0});
       }
@@ -448,12 +450,24 @@ TrackFrame InstrumentTracker::Start(const std::vector<const media::Image*>& fram
   return s.Result(true, inliers, 0);
 }
 
-TrackFrame InstrumentTracker::Next(const std::vector<const media::Image*>& frames) {
+TrackFrame InstrumentTracker::Next(const std::vector<const media::Image*>& frames,
+                                   const std::vector<std::vector<Eigen::Vector2d>>* labels) {
   State& s = *state_;
   if (frames.size() != s.views.size()) throw std::invalid_argument("Next: one frame per view");
   const int n = static_cast<int>(s.views.size());
   std::vector<cv::Mat> images(n);
-  for (int v = 0; v < n; ++v) images[v] = AsMat(*frames[v]);
+  for (int v = 0; v < n; ++v)
+    if (frames[v] != nullptr) images[v] = AsMat(*frames[v]);
+  // This frame's labels, as correspondences on the template's own points.
+  std::vector<PoseCorrespondence> labelled;
+  if (labels != nullptr) {
+    for (int v = 0; v < n && v < static_cast<int>(labels->size()); ++v) {
+      for (size_t p = 0; p < (*labels)[v].size() && p < s.body.points.size(); ++p) {
+        if (!std::isfinite((*labels)[v][p].x()) || !std::isfinite(s.body.points[p].x())) continue;
+        labelled.push_back({v, s.body.points[p], (*labels)[v][p], 10 * s.options.anchor_weight});
+      }
+    }
+  }
   // Constant-velocity prediction.
   const Rigid3d velocity = s.pose * s.previous_pose.Inverse();
   const Rigid3d prediction = s.frames >= 2 ? velocity * s.pose : s.pose;
@@ -469,7 +483,8 @@ TrackFrame InstrumentTracker::Next(const std::vector<const media::Image*>& frame
       },
       1);
   std::vector<std::vector<Feature>> no_extra(n);
-  std::vector<PoseCorrespondence> c = s.Correspondences(no_extra);
+  std::vector<PoseCorrespondence> c = s.Correspondences(no_extra, images);
+  c.insert(c.end(), labelled.begin(), labelled.end());
   std::optional<PoseSolution> solved = SolveRigidPose(
       [&] {
         std::vector<Camera> cams;
@@ -499,7 +514,8 @@ TrackFrame InstrumentTracker::Next(const std::vector<const media::Image*>& frame
     size_t total = 0;
     for (const auto& m : matches) total += m.size();
     if (total > 0) {
-      c = s.Correspondences(matches);
+      c = s.Correspondences(matches, images);
+      c.insert(c.end(), labelled.begin(), labelled.end());
       auto again = SolveRigidPose(cams, c, pose, s.options.pose, 6);
       if (again) {
         solved = again;

@@ -112,8 +112,12 @@ class InstrumentTracker {
   // The labelled frame, one Gray8 image per view (the cameras' sizes): corners and
   // anchors are found; the pose is the identity.
   TrackFrame Start(const std::vector<const media::Image*>& frames);
-  // The next frame in tracking order (forwards or backwards in time).
-  TrackFrame Next(const std::vector<const media::Image*>& frames);
+  // The next frame in tracking order (forwards or backwards in time). A null frame is a
+  // view that did not record this frame (its features wait for its next frame).
+  // `labels` ([view][template point], NaN = none), when given, are labels of this frame:
+  // they enter the pose solve with 10 x anchor_weight.
+  TrackFrame Next(const std::vector<const media::Image*>& frames,
+                  const std::vector<std::vector<Eigen::Vector2d>>* labels = nullptr);
 
   const RigidTemplate& body() const;
 
