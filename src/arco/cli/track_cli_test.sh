@@ -63,6 +63,8 @@ labels front.json 0
 labels side.json 60
 labels chin.json 60 ', {"label": "chin", "points": [[10, 10]], "shape_type": "point"}'
 labels far.json 60 ', {"label": "tip_plate", "points": [[10, 10]], "shape_type": "point"}'
+labels bowfront.json 0 ', {"label": "frog", "points": [[150, 200]], "shape_type": "point"}, {"label": "tip_plate", "points": [[400, 120]], "shape_type": "point"}'
+labels bowside.json 60 ', {"label": "frog", "points": [[210, 200]], "shape_type": "point"}, {"label": "tip_plate", "points": [[460, 120]], "shape_type": "point"}'
 echo '{"version": "5.3.1", "shapes": [{"label": "foo", "points": [[10, 10]], "shape_type": "point"}]}' > foo.json
 sed 's/\[\[260, 60\]\]/[[600, 60]]/' side.json > outside.json
 
@@ -102,8 +104,12 @@ check '[ -f cap/keypoints2d.npy ] && grep -q "arco-track-report" cap/track.json'
 check 'grep -q "keypoints2d.npy" cap/capture.json && grep -q "spd_cello" cap/capture.json' \
   "capture.json does not name the keypoints"
 "$arco" track cap --labels front=front.json --labels side=far.json >/dev/null 2>err.txt
-check '! grep -q tip_plate err.txt && grep -q "the bow is not tracked yet" err.txt' \
+check '! grep -q tip_plate err.txt && grep -q "the bow is not tracked (its frog and tip need labels in two views of frame 1)" err.txt' \
   "the bow's label was warned about: $(cat err.txt)"
 check 'grep -A1 "\"tracked_points\"" cap/track.json | grep -q "\"scroll_top\""' \
   "track.json lacks the tracked points"
+# The bow labelled in both views: tracked as its own thin body, no warning.
+"$arco" track cap --labels front=bowfront.json --labels side=bowside.json >/dev/null 2>err.txt
+check '[ ! -s err.txt ] && grep -q "\"bow_tracked\": true" cap/track.json' \
+  "the bow was not tracked: $(cat err.txt)"
 exit $fail

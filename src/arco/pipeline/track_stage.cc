@@ -177,6 +177,8 @@ Json ToJson(const TrackStageSummary& s) {
               {"untracked_points", s.untracked_points},
               {"label_rms_px", s.label_rms_px},
               {"frames_without_pose", s.frames_without_pose},
+              {"bow_tracked", s.bow_tracked},
+              {"bow_frames_without_pose", s.bow_frames_without_pose},
               {"kept_other_points", s.kept_other_points},
               {"cameras", cameras},
               {"warnings", s.warnings},
@@ -256,9 +258,11 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   // The labels: per labelled frame, per view, per instrument point.
   std::vector<std::string> names;  // instrument points, layout order
   for (int slot : *instrument_slots) names.push_back(layout->names[slot]);
-  std::set<std::string> bow_names;
+  std::vector<std::string> bow_names;  // frog, tip
   if (bow_slots != nullptr)
-    for (int slot : *bow_slots) bow_names.insert(layout->names[slot]);
+    for (int slot : *bow_slots) bow_names.push_back(layout->names[slot]);
+  // frame -> [view][bow point]
+  std::map<int64_t, std::vector<std::vector<Eigen::Vector2d>>> bow_labelled;
   const int64_t default_frame = options.labels_frame >= 0 ? options.labels_frame : first;
   if (default_frame < first || default_frame > last) {
     return Status::Error("labels_frame " + std::to_string(default_frame) +
@@ -296,12 +300,18 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
       frame_labels.assign(
           views, std::vector<Eigen::Vector2d>(names.size(), Eigen::Vector2d::Constant(kNaN)));
     }
+    auto& bow_frame_labels = bow_labelled[frame];
+    if (bow_frame_labels.empty()) {
+      bow_frame_labels.assign(
+          views, std::vector<Eigen::Vector2d>(bow_names.size(), Eigen::Vector2d::Constant(kNaN)));
+    }
     int matched = 0;
     for (const LabeledPoint& p : a.points) {
       const std::string name = CanonicalKeypointName(p.label);
       const auto it = std::find(names.begin(), names.end(), name);
-      if (it == names.end()) {
-        if (bow_names.count(name) == 0) unknown.insert(p.label);
+      const auto bow_it = std::find(bow_names.begin(), bow_names.end(), name);
+      if (it == names.end() && bow_it == bow_names.end()) {
+        unknown.insert(p.label);
         continue;
       }
       if (!(p.pixel.x() >= -0.5 && p.pixel.y() >= -0.5 && p.pixel.x() < cam.width - 0.5 &&
@@ -311,7 +321,8 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
                              ") is outside the " + std::to_string(cam.width) + "x" +
                              std::to_string(cam.height) + " image of camera " + cam.name);
       }
-      auto& slot = frame_labels[v][it - names.begin()];
+      auto& slot = it != names.end() ? frame_labels[v][it - names.begin()]
+                                     : bow_frame_labels[v][bow_it - bow_names.begin()];
       if (std::isfinite(slot.x())) {
         return Status::Error(file.path + ": camera " + file.camera + " frame " +
                              std::to_string(frame) + " is labelled twice");
@@ -358,8 +369,23 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   for (const auto& n : summary.untracked_points) {
     summary.warnings.push_back("point " + n + " is labelled in fewer than two views: left NaN");
   }
-  if (bow_slots != nullptr && !bow_slots->empty()) {
-    summary.warnings.push_back("the bow is not tracked yet: its points are kept as they were");
+  // The bow: a thin rigid body from its frog and tip labelled in two views of the
+  // template frame; else its slots are kept.
+  std::optional<track::RigidTemplate> bow_body;
+  if (!bow_names.empty()) {
+    track::FrameLabels bow_frame_labels{bow_names, bow_labelled[template_frame]};
+    auto bow = track::TriangulateTemplate(cameras, bow_frame_labels, 10, /*thin=*/true);
+    size_t bow_points = 0;
+    if (bow.ok())
+      for (const auto& x : bow->points) bow_points += std::isfinite(x.x());
+    if (bow.ok() && bow_points == bow_names.size()) {
+      bow_body = *bow;
+      summary.bow_tracked = true;
+    } else {
+      summary.warnings.push_back(
+          "the bow is not tracked (its frog and tip need labels in two views of frame " +
+          std::to_string(template_frame) + "): its points are kept as they were");
+    }
   }
 
   // The keypoints already there are kept (body and hands from `arco detect`, the bow).
@@ -386,12 +412,16 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   track::InstrumentTrackerOptions tracker_options = options.tracker;
   tracker_options.num_threads = threads;
   std::vector<track::TrackFrame> results(static_cast<size_t>(manifest.frame_count));
+  std::vector<track::TrackFrame> bow_results(results.size());
   std::vector<char> done(results.size(), 0);
   const auto track_start = std::chrono::steady_clock::now();
   progress.SetTotal(manifest.frame_count * views);
   for (const int step : {+1, -1}) {
     if (step < 0 && template_frame == first) break;
     track::InstrumentTracker tracker(cameras, *body, tracker_options);
+    std::optional<track::InstrumentTracker> bow_tracker;
+    if (bow_body) bow_tracker.emplace(cameras, *bow_body, tracker_options);
+    track::TrackFrame bow_r;
     Frames frames(manifest, inputs);
     for (int64_t g = template_frame; g >= first && g <= last; g += step) {
       ARCO_ASSIGN_OR_RETURN(std::vector<const media::Image*> images,
@@ -407,13 +437,20 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
           images[v] = &blanks[v];
         }
         r = tracker.Start(images);
+        if (bow_tracker) bow_r = bow_tracker->Start(images);
       } else {
         const auto it = labelled.find(g);
         r = tracker.Next(images, it != labelled.end() ? &it->second : nullptr);
+        if (bow_tracker) {
+          const auto bow_it = bow_labelled.find(g);
+          bow_r =
+              bow_tracker->Next(images, bow_it != bow_labelled.end() ? &bow_it->second : nullptr);
+        }
       }
       const size_t f = static_cast<size_t>(g - first);
       if (!done[f]) {
         results[f] = std::move(r);
+        bow_results[f] = std::move(bow_r);
         done[f] = 1;
         progress.Advance(views);
       }
@@ -451,12 +488,32 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
         out.data[k + 1] = ok ? static_cast<float>(q.pixel.y()) : kNaNf;
         out.data[k + 2] = ok ? static_cast<float>(q.score) : kNaNf;
       }
+      for (size_t p = 0; bow_body && p < bow_names.size(); ++p) {
+        const size_t k = at(f, v, (*bow_slots)[p]);
+        const track::TrackedPoint& q = bow_results[f].points[v][p];
+        const bool ok = recorded && std::isfinite(q.pixel.x());
+        out.data[k] = ok ? static_cast<float>(q.pixel.x()) : kNaNf;
+        out.data[k + 1] = ok ? static_cast<float>(q.pixel.y()) : kNaNf;
+        out.data[k + 2] = ok ? static_cast<float>(q.score) : kNaNf;
+      }
+    }
+    Json bow_json = nullptr;
+    if (bow_body) {
+      const track::TrackFrame& b = bow_results[f];
+      if (!b.pose_ok) ++summary.bow_frames_without_pose;
+      Json bow_views = Json::array();
+      for (const auto& vr : b.views) bow_views.push_back(ViewJson(vr));
+      bow_json = Json{{"pose_ok", b.pose_ok},
+                      {"inliers", b.inliers},
+                      {"residual_px", b.residual_px},
+                      {"views", bow_views}};
     }
     frames_json.push_back({{"frame", first + f},
                            {"pose_ok", r.pose_ok},
                            {"inliers", r.inliers},
                            {"residual_px", r.residual_px},
-                           {"views", view_json}});
+                           {"views", view_json},
+                           {"bow", bow_json}});
   }
   for (int v = 0; v < views; ++v) {
     TrackCameraSummary& c = summary.cameras[v];

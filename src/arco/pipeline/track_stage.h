@@ -57,6 +57,8 @@ struct TrackStageSummary {
   std::vector<std::string> untracked_points;  // labelled in fewer than two views
   double label_rms_px = 0;                    // the labels' triangulation residual
   int64_t frames_without_pose = 0;            // the pose was the prediction
+  bool bow_tracked = false;  // frog and tip labelled in two views: the bow slots written
+  int64_t bow_frames_without_pose = 0;
   std::vector<TrackCameraSummary> cameras;
   std::vector<std::string> warnings;
   bool kept_other_points = false;  // body/hand slots kept from keypoints2d.npy
@@ -68,8 +70,9 @@ Json ToJson(const TrackStageSummary& summary);
 // Checks the capture (manifest, calibration, every camera's video) and the labels (files
 // readable, cameras known, frames inside the capture, labels inside the image, at least
 // two views, names that match the instrument's points) before any frame is decoded;
-// then tracks and replaces CAPTURE/keypoints2d.npy (instrument slots; body, hand and bow
-// slots kept, NaN in a new file), track.json and capture.json together
+// then tracks and replaces CAPTURE/keypoints2d.npy (instrument slots, and the bow's when
+// its frog and tip are labelled in two views; the other slots kept, NaN in a new file),
+// track.json and capture.json together
 // (util/output_set.h). Progress: total = frames x cameras.
 StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options,
                                           Progress& progress = NoProgress());

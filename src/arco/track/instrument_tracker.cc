@@ -92,7 +92,7 @@ struct InstrumentTracker::State {
       }
     }
     std::vector<cv::Point> hull;
-    if (points.size() < 3 * 8) return hull;
+    if (points.size() < 2 * 8) return hull;
     std::vector<cv::Point2f> h;
     cv::convexHull(points, h);
     for (const auto& q : h) hull.emplace_back(cvRound(q.x), cvRound(q.y));
@@ -331,7 +331,8 @@ Json ToJson(const InstrumentTrackerOptions& o) {
 
 StatusOr<RigidTemplate> TriangulateTemplate(const std::vector<Camera>& cameras,
                                             const FrameLabels& labels,
-                                            double max_label_error_px) {
+                                            double max_label_error_px,
+                                            bool thin) {
   const int views = static_cast<int>(cameras.size());
   if (static_cast<int>(labels.pixels.size()) != views) {
     throw std::invalid_argument("TriangulateTemplate: labels for " +
@@ -381,11 +382,31 @@ StatusOr<RigidTemplate> TriangulateTemplate(const std::vector<Camera>& cameras,
     sum2 += x->rms_reprojection_px * x->rms_reprojection_px;
     ++count;
   }
-  if (known.size() < 3) {
+  const size_t needed = thin ? 2 : 3;
+  if (known.size() < needed) {
     return Status::Error(std::to_string(known.size()) +
-                         " point(s) labelled in two views: at least three are needed");
+                         " point(s) labelled in two views: at least " + std::to_string(needed) +
+                         " are needed");
   }
   body.rms_reprojection_px = std::sqrt(sum2 / count);
+  if (thin) {
+    // The plane through the axis that faces the labelling cameras best.
+    const Eigen::Vector3d a = known.front(), b = known.back();
+    const Eigen::Vector3d axis = (b - a).normalized();
+    Eigen::Vector3d towards = Eigen::Vector3d::Zero();
+    for (int v = 0; v < views; ++v) {
+      bool any = false;
+      for (const auto& p : labels.pixels[v]) any = any || std::isfinite(p.x());
+      if (any) towards += (cameras[v].CenterInWorld() - 0.5 * (a + b)).normalized();
+    }
+    const Eigen::Vector3d normal = towards - towards.dot(axis) * axis;
+    if (!((b - a).norm() > 0) || normal.norm() < 1e-6) {
+      return Status::Error("the thin body's points coincide or its axis points at the cameras");
+    }
+    body.plane_point = 0.5 * (a + b);
+    body.plane_normal = normal.normalized();
+    return body;
+  }
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const auto& x : known) mean += x;
   mean /= static_cast<double>(known.size());

@@ -47,11 +47,13 @@ struct RigidTemplate {
 };
 
 // Errors: fewer than two views with labels, fewer than three points labelled in two
-// views, labels that do not triangulate (rays that miss each other by more than
-// max_label_error_px).
+// views (two with `thin`), labels that do not triangulate (rays that miss each other by
+// more than max_label_error_px). `thin`: a stick such as the bow, two points on its axis;
+// its plane contains the axis and faces the cameras that labelled it.
 StatusOr<RigidTemplate> TriangulateTemplate(const std::vector<Camera>& cameras,
                                             const FrameLabels& labels,
-                                            double max_label_error_px = 10);
+                                            double max_label_error_px = 10,
+                                            bool thin = false);
 
 struct InstrumentTrackerOptions {
   int max_features_per_view = 200;
