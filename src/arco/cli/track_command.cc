@@ -17,6 +17,7 @@ namespace {
 
 inline constexpr FieldFlag kTrackFlags[] = {{"num_threads", "--threads"},
                                             {"labels_frame", "--labels-frame"},
+                                            {"track_bow", "--bow"},
                                             {"max_features_per_view", "--max-features"},
                                             {"keyframe_interval", "--keyframe-interval"},
                                             {"inlier_px", "--inlier-px"}};
@@ -45,7 +46,9 @@ int RunTrack(const TrackArgs& a) {
   bar.Finish();
   if (!summary.ok()) return PrintError(summary.status().message());
   const auto& s = *summary;
-  for (const auto& w : s.warnings) std::fprintf(stderr, "arco: warning: %s\n", w.c_str());
+  for (const auto& w : s.warnings) {
+    std::fprintf(stderr, "arco: warning: %s\n", WithFlagNames(w, kTrackFlags).c_str());
+  }
   std::printf("tracked frames %lld:%lld in %zu cameras from labels of frame %lld (layout %s)\n",
               static_cast<long long>(s.first_frame),
               static_cast<long long>(s.last_frame),
@@ -122,6 +125,10 @@ std::function<int()> SetupTrack(CLI::App& app) {
             "A tracked corner farther than this from the pose's projection is an outlier",
             AboveZero(1000))
       ->capture_default_str();
+  sub->add_flag("--bow",
+                a->o.track_bow,
+                "Experimental: also track the bow from its frog and tip labels (fails on a thin "
+                "bow moving fast; docs/track.md)");
   sub->parse_complete_callback([a] { ApplyAndValidate(*a); });
   return [a]() { return RunTrack(*a); };
 }

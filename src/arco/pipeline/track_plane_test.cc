@@ -198,6 +198,7 @@ class TrackPlane : public ::testing::Test {
       o.labels.push_back({cam, -1, g_scene->dir / LabelFile(cam, 0)});
     }
     o.num_threads = threads;
+    o.track_bow = true;  // the bow lies on the picture here
     return o;
   }
 };

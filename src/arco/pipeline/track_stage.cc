@@ -156,7 +156,10 @@ Json ToJson(const TrackStageOptions& o) {
   for (const auto& l : o.labels) {
     labels.push_back({{"camera", l.camera}, {"frame", l.frame}, {"file", l.path}});
   }
-  return Json{{"labels", labels}, {"labels_frame", o.labels_frame}, {"tracker", ToJson(o.tracker)}};
+  return Json{{"labels", labels},
+              {"labels_frame", o.labels_frame},
+              {"track_bow", o.track_bow},
+              {"tracker", ToJson(o.tracker)}};
 }
 
 Json ToJson(const TrackStageSummary& s) {
@@ -372,7 +375,10 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   // The bow: a thin rigid body from its frog and tip labelled in two views of the
   // template frame; else its slots are kept.
   std::optional<track::RigidTemplate> bow_body;
-  if (!bow_names.empty()) {
+  if (!bow_names.empty() && !options.track_bow) {
+    summary.warnings.push_back(
+        "the bow is not tracked (experimental: track_bow): its points are kept as they were");
+  } else if (!bow_names.empty()) {
     track::FrameLabels bow_frame_labels{bow_names, bow_labelled[template_frame]};
     auto bow = track::TriangulateTemplate(cameras, bow_frame_labels, 10, /*thin=*/true);
     size_t bow_points = 0;
@@ -420,7 +426,17 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
     if (step < 0 && template_frame == first) break;
     track::InstrumentTracker tracker(cameras, *body, tracker_options);
     std::optional<track::InstrumentTracker> bow_tracker;
-    if (bow_body) bow_tracker.emplace(cameras, *bow_body, tracker_options);
+    if (bow_body) {
+      // The bow is a few pixels wide: corners on it only, small Lucas-Kanade windows
+      // (the prediction carries the fast motion).
+      track::InstrumentTrackerOptions bow_options = tracker_options;
+      bow_options.outline_margin_px = 3;
+      bow_options.lk_window_px = 11;
+      bow_options.lk_levels = 2;
+      bow_options.min_feature_distance_px = 4;
+      bow_options.ncc_patch_px = 9;
+      bow_tracker.emplace(cameras, *bow_body, bow_options);
+    }
     track::TrackFrame bow_r;
     Frames frames(manifest, inputs);
     for (int64_t g = template_frame; g >= first && g <= last; g += step) {

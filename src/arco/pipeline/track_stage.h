@@ -35,6 +35,11 @@ struct TrackStageOptions {
   int64_t labels_frame = -1;                // -1: the capture's first frame
   track::InstrumentTrackerOptions tracker;  // its num_threads is num_threads below
   int num_threads = 0;                      // 0 = all cores; results do not depend on it
+  // Experimental: the bow as a thin rigid body from its frog and tip labels (corners on
+  // the stick, docs/track.md). It holds on a textured bow lying on the picture but loses
+  // a thin bow moving on its own (pipeline_track_bow_test), so it is off by default and
+  // the bow's slots are kept.
+  bool track_bow = false;
   Status Validate() const;
 };
 

@@ -142,19 +142,37 @@ struct InstrumentTracker::State {
   }
 
   // Lucas-Kanade from the previous frame with the forward-backward check.
-  void Flow(int v, const cv::Mat& image) {
+  // `prediction`: the body's predicted pose; each feature starts where the prediction
+  // moves it (its offset from its projection kept), so a fast body (the bow) needs only
+  // a small correction from Lucas-Kanade.
+  void Flow(int v, const cv::Mat& image, const Rigid3d& prediction) {
     View& view = views[v];
     if (view.features.empty()) return;
     std::vector<cv::Point2f> from, to, back;
     for (const Feature& f : view.features) {
       from.emplace_back(static_cast<float>(f.pixel.x()), static_cast<float>(f.pixel.y()));
+      Eigen::Vector2d start = f.pixel;
+      const auto was = view.camera.Project(pose * f.in_template);
+      const auto will = view.camera.Project(prediction * f.in_template);
+      if (was && will) start += *will - *was;
+      to.emplace_back(static_cast<float>(start.x()), static_cast<float>(start.y()));
     }
+    back = from;
     std::vector<uchar> ok_forward, ok_backward;
     std::vector<float> err;
     const cv::Size window(options.lk_window_px, options.lk_window_px);
     const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
-    cv::calcOpticalFlowPyrLK(
-        view.previous, image, from, to, ok_forward, err, window, options.lk_levels, stop);
+    cv::calcOpticalFlowPyrLK(view.previous,
+                             image,
+                             from,
+                             to,
+                             ok_forward,
+                             err,
+                             window,
+                             options.lk_levels,
+                             stop,
+                             cv::OPTFLOW_USE_INITIAL_FLOW);
+    // Backwards from scratch: the check must not start where it should end.
     cv::calcOpticalFlowPyrLK(
         image, view.previous, to, back, ok_backward, err, window, options.lk_levels, stop);
     std::vector<Feature> kept;
@@ -499,7 +517,7 @@ TrackFrame InstrumentTracker::Next(const std::vector<const media::Image*>& frame
       [&](int64_t v, int) {
         View& view = s.views[v];
         view.report = ViewTrackReport();
-        s.Flow(static_cast<int>(v), images[v]);
+        s.Flow(static_cast<int>(v), images[v], prediction);
         view.report.tracked = static_cast<int>(view.features.size());
       },
       1);
