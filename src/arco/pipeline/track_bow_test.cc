@@ -1,0 +1,259 @@
+// `arco track` with a bow that moves on its own (issue 13's second test): the real photo
+// of a cellist (the instrument, moving a little) and a textured bow (a random-block strip
+// 720 x 24 mm) on their own rigid planes, rendered exactly (synth::PlaneRenderer, the bow
+// over the picture) into 6 distorted cameras: bowing strokes of +-200 mm at 0.7 Hz (about
+// 9 px per frame), string crossings (the bow turns +-10 degrees in its plane), and a
+// hand-shaped blob that holds the frog and hides part of the stick. Labels on frame 1 in
+// two views; `capture new` -> `track` -> `triangulate`; frog and tip against their exact
+// 3D positions (issue's bound: median 8 mm), the instrument's points against theirs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "arco/calibration/calibration_file.h"
+#include "arco/media/video_reader.h"
+#include "arco/media/video_writer.h"
+#include "arco/mocap/labelme.h"
+#include "arco/pipeline/capture_new.h"
+#include "arco/pipeline/track_stage.h"
+#include "arco/pipeline/triangulate_stage.h"
+#include "arco/registry/keypoint_layout.h"
+#include "arco/synth/plane_scene.h"
+#include "arco/util/file_io.h"
+#include "arco/util/json_io.h"
+#include "arco/util/npy.h"
+#include "arco/util/stats.h"
+#include "arco/util/test_dir.h"
+
+namespace arco::pipeline {
+namespace {
+
+constexpr int kCameras = 6;
+constexpr int kFrames = 36;
+constexpr int kLabelViews[2] = {1, 4};
+
+std::string LabelmeText(const Camera& cam,
+                        const std::vector<std::string>& names,
+                        const std::vector<Eigen::Vector2d>& pixels) {
+  Json shapes = Json::array();
+  for (size_t i = 0; i < names.size(); ++i) {
+    shapes.push_back(
+        {{"label", names[i]},
+         {"points", Json::array({Json::array({pixels[i].x() + 0.5, pixels[i].y() + 0.5})})},
+         {"shape_type", "point"}});
+  }
+  return Json{{"version", "5.3.1"},
+              {"shapes", shapes},
+              {"imageWidth", cam.width},
+              {"imageHeight", cam.height}}
+      .dump(1);
+}
+
+// A filled disc of one grey level (the hand).
+void Disc(media::Image* image, const Eigen::Vector2d& centre, double radius, uint8_t value) {
+  for (int y = std::max(0, static_cast<int>(centre.y() - radius));
+       y <= std::min(image->height - 1, static_cast<int>(centre.y() + radius));
+       ++y)
+    for (int x = std::max(0, static_cast<int>(centre.x() - radius));
+         x <= std::min(image->width - 1, static_cast<int>(centre.x() + radius));
+         ++x)
+      if ((Eigen::Vector2d(x, y) - centre).norm() <= radius) image->row(y)[x] = value;
+}
+
+// Disabled: the experimental bow tracker (TrackStageOptions::track_bow) fails it. Measured
+// at commit time: bow 2D median 13 px, 3D median 62 mm (bound 8 mm); the instrument under
+// the moving bow stays at 0.04 px / 0.24 mm. Lucas-Kanade loses the corners of an 8 px
+// wide stick over a textured background within a few frames, and corners added at a
+// wrong pose keep it wrong. Run it with --gtest_also_run_disabled_tests.
+TEST(TrackBow, DISABLED_TheBowMovesOnItsOwn) {
+  testing::TempDir dir;
+  // The instrument: the photo, moving a little.
+  const std::string data = ARCO_SHARED_DATA_DIR;
+  auto reader = media::VideoReader::Open(data + "/spd/example.jpg");
+  ASSERT_TRUE(reader.ok()) << reader.status().message();
+  synth::PlaneTexture cello;
+  cello.image = *reader->ReadFrame(0);
+  cello.width_mm = cello.image.width * 0.778;
+  cello.height_mm = cello.image.height * 0.778;
+  synth::BuildMipmaps(&cello);
+  synth::PlaneMotionOptions motion;
+  motion.frames = kFrames;
+  motion.max_translation_mm = 40;
+  motion.max_rotation_deg = 4;
+  const std::vector<Rigid3d> world_from_cello = synth::MakePlaneMotion(motion);
+  // The bow: random 6 mm blocks on a 720 x 24 mm strip; frog and tip on its axis.
+  synth::PlaneTexture bow;
+  bow.image = media::MakeImage(720, 24, media::PixelFormat::kGray8);
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> grey(40, 220);
+  for (int by = 0; by < 24; by += 6)
+    for (int bx = 0; bx < 720; bx += 6) {
+      const uint8_t g = static_cast<uint8_t>(grey(rng));
+      for (int y = by; y < by + 6; ++y)
+        for (int x = bx; x < bx + 6; ++x) bow.image.row(y)[x] = g;
+    }
+  bow.width_mm = 720;
+  bow.height_mm = 24;
+  synth::BuildMipmaps(&bow);
+  const Eigen::Vector2d frog_px(20, 11.5), tip_px(700, 11.5);
+  std::vector<Rigid3d> world_from_bow;
+  const Eigen::Quaterniond rest = synth::PlaneRestPose().rotation;
+  for (int f = 0; f < kFrames; ++f) {
+    const double t = f / 30.0;
+    const double crossing = 10 * M_PI / 180 * std::sin(2 * M_PI * 0.35 * t);
+    const Eigen::Quaterniond turn(Eigen::AngleAxisd(crossing, Eigen::Vector3d::UnitY()));
+    const Eigen::Vector3d axis = turn * Eigen::Vector3d::UnitX();
+    const double stroke = 200 * std::sin(2 * M_PI * 0.7 * t);
+    world_from_bow.emplace_back(turn * rest, Eigen::Vector3d(0, -200, -150) + stroke * axis);
+  }
+
+  // The rig and the videos.
+  synth::PlaneRigOptions rig_options;
+  rig_options.cameras = kCameras;
+  rig_options.width = 768;
+  rig_options.height = 886;
+  rig_options.focal_px = 760;
+  const Rig rig = synth::MakePlaneRig(rig_options);
+  const std::string scene = dir / "scene";
+  ASSERT_TRUE(MakeDirectories(scene).ok());
+  ASSERT_TRUE(SaveCalibration(scene + "/calibration.json", rig).ok());
+  synth::PlaneRenderOptions render;
+  render.supersampling = 1;
+  render.threads = 2;
+  CaptureNewOptions c;
+  c.calibration = scene + "/calibration.json";
+  c.instrument = "cello";
+  for (const Camera& cam : rig.cameras) {
+    const synth::PlaneRenderer renderer(cam, render);
+    const media::Image background =
+        synth::MakeSolidImage(cam.width, cam.height, media::PixelFormat::kGray8, {90, 90, 90});
+    media::VideoWriterOptions w;
+    w.width = cam.width;
+    w.height = cam.height;
+    w.source_format = media::PixelFormat::kGray8;
+    const std::string video = scene + "/" + cam.name + ".mkv";
+    auto writer = media::VideoWriter::Open(video, w);
+    ASSERT_TRUE(writer.ok()) << writer.status().message();
+    media::Image picture, frame;
+    for (int f = 0; f < kFrames; ++f) {
+      renderer.Render(world_from_cello[f], cello, background, &picture);
+      renderer.Render(world_from_bow[f], bow, picture, &frame);
+      // The right hand: a dark blob around the frog end, moving with the bow.
+      const auto frog = synth::ProjectPlanePoint(cam, world_from_bow[f], bow, frog_px);
+      const auto tip = synth::ProjectPlanePoint(cam, world_from_bow[f], bow, tip_px);
+      ASSERT_TRUE(frog && tip);
+      const Eigen::Vector2d along = (*tip - *frog).normalized();
+      Disc(&frame, *frog + 30 * along + Eigen::Vector2d(0, 8), 16, 35);
+      ASSERT_TRUE(writer->Write(frame).ok());
+    }
+    ASSERT_TRUE(writer->Close().ok());
+    c.inputs.push_back({cam.name, video, false});
+  }
+
+  // Labels on frame 1 in two views.
+  auto photo_labels = ReadLabelme(data + "/spd/example.json");
+  ASSERT_TRUE(photo_labels.ok());
+  const KeypointLayout* layout = FindKeypointLayout("spd_cello");
+  const std::vector<int>& slots = *layout->Group("instrument");
+  const std::vector<int>& bow_slots = *layout->Group("bow");
+  std::vector<Eigen::Vector2d> cello_px;
+  for (int slot : slots) {
+    cello_px.push_back(photo_labels->points[photo_labels->Find(layout->names[slot])].pixel);
+  }
+  c.output_dir = dir / "capture";
+  ASSERT_TRUE(CreateCapture(c).ok());
+  TrackStageOptions o;
+  o.capture_dir = c.output_dir;
+  o.num_threads = 2;
+  o.track_bow = true;
+  for (int v : kLabelViews) {
+    const Camera& cam = rig.cameras[v];
+    std::vector<std::string> names;
+    std::vector<Eigen::Vector2d> px;
+    for (size_t p = 0; p < slots.size(); ++p) {
+      names.push_back(layout->names[slots[p]]);
+      px.push_back(*synth::ProjectPlanePoint(cam, world_from_cello[0], cello, cello_px[p]));
+    }
+    names.push_back("frog");
+    px.push_back(*synth::ProjectPlanePoint(cam, world_from_bow[0], bow, frog_px));
+    names.push_back("tip_plate");
+    px.push_back(*synth::ProjectPlanePoint(cam, world_from_bow[0], bow, tip_px));
+    const std::string file = dir / (cam.name + ".json");
+    ASSERT_TRUE(AtomicWriteFile(file, LabelmeText(cam, names, px)).ok());
+    o.labels.push_back({cam.name, -1, file});
+  }
+  auto tracked = RunTrackStage(o);
+  ASSERT_TRUE(tracked.ok()) << tracked.status().message();
+  EXPECT_TRUE(tracked->bow_tracked);
+  TriangulateStageOptions t;
+  t.capture_dir = c.output_dir;
+  t.result_dir = dir / "result";
+  ASSERT_TRUE(RunTriangulateStage(t).ok());
+  auto kp = ReadNpy<float>(c.output_dir + "/keypoints2d.npy");
+  auto p3 = ReadNpy<double>(t.result_dir + "/triangulation/points3d_raw.npy");
+  ASSERT_TRUE(kp.ok() && p3.ok());
+
+  // Errors: 2D in every view where the truth is in the image, 3D per frame.
+  const auto measure = [&](const std::vector<int>& which,
+                           const std::vector<Rigid3d>& poses,
+                           const synth::PlaneTexture& texture,
+                           const std::vector<Eigen::Vector2d>& texture_px,
+                           std::vector<double>* px_err,
+                           std::vector<double>* mm_err,
+                           int* missing) {
+    for (int f = 0; f < kFrames; ++f)
+      for (size_t p = 0; p < which.size(); ++p) {
+        for (int v = 0; v < kCameras; ++v) {
+          const float* x =
+              &kp->data[static_cast<size_t>(((f * kCameras + v) * kp->shape[2] + which[p]) * 3)];
+          const auto truth =
+              synth::ProjectPlanePoint(rig.cameras[v], poses[f], texture, texture_px[p]);
+          if (!truth || !synth::InImage(rig.cameras[v], *truth)) continue;
+          if (std::isfinite(x[0])) px_err->push_back((Eigen::Vector2d(x[0], x[1]) - *truth).norm());
+        }
+        const double* x = &p3->data[static_cast<size_t>((f * p3->shape[1] + which[p]) * 3)];
+        if (!std::isfinite(x[0])) {
+          ++*missing;
+          continue;
+        }
+        const Eigen::Vector3d truth =
+            synth::PlaneToWorld(poses[f], synth::TexturePixelToPlane(texture, texture_px[p]));
+        mm_err->push_back((Eigen::Vector3d(x[0], x[1], x[2]) - truth).norm());
+      }
+  };
+  std::vector<double> bow_px, bow_mm, cello_err_px, cello_mm;
+  int bow_missing = 0, cello_missing = 0;
+  measure(bow_slots, world_from_bow, bow, {frog_px, tip_px}, &bow_px, &bow_mm, &bow_missing);
+  measure(slots, world_from_cello, cello, cello_px, &cello_err_px, &cello_mm, &cello_missing);
+  ASSERT_FALSE(bow_mm.empty());
+  ASSERT_FALSE(cello_mm.empty());
+  std::printf(
+      "| moving bow: bow (frog, tip) | %.2f px | %.2f px | %.2f mm | %.2f mm | %d of %d missing "
+      "|\n",
+      Median(bow_px),
+      InterpolatedQuantile(bow_px, 0.95),
+      Median(bow_mm),
+      InterpolatedQuantile(bow_mm, 0.95),
+      bow_missing,
+      2 * kFrames);
+  std::printf(
+      "| moving bow: instrument | %.2f px | %.2f px | %.2f mm | %.2f mm | %d of %d missing |\n",
+      Median(cello_err_px),
+      InterpolatedQuantile(cello_err_px, 0.95),
+      Median(cello_mm),
+      InterpolatedQuantile(cello_mm, 0.95),
+      cello_missing,
+      7 * kFrames);
+  EXPECT_LE(Median(bow_mm), 8.0);
+  EXPECT_LE(bow_missing, 0.02 * 2 * kFrames);
+  EXPECT_LE(Median(cello_err_px), 2.0);
+  EXPECT_LE(Median(cello_mm), 4.0);
+}
+
+}  // namespace
+}  // namespace arco::pipeline

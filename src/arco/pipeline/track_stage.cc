@@ -1,0 +1,574 @@
+#include "arco/pipeline/track_stage.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <utility>
+
+#include "arco/calibration/calibration_file.h"
+#include "arco/media/video_reader.h"
+#include "arco/mocap/capture.h"
+#include "arco/mocap/labelme.h"
+#include "arco/pipeline/preflight.h"
+#include "arco/registry/keypoint_layout.h"
+#include "arco/util/file_io.h"
+#include "arco/util/npy.h"
+#include "arco/util/output_set.h"
+#include "arco/util/parallel.h"
+
+namespace arco::pipeline {
+namespace {
+
+constexpr float kNaNf = std::numeric_limits<float>::quiet_NaN();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr char kKeypointsFile[] = "keypoints2d.npy";
+constexpr char kReportFile[] = "track.json";
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+struct CameraInput {
+  std::string name;
+  std::string video;
+  int rotate_deg = 0;
+  int64_t video_frames = 0;
+};
+
+// Each camera's video, read in order or by seeking; frames turned by rotate_deg.
+class Frames {
+ public:
+  Frames(const CaptureManifest& manifest, const std::vector<CameraInput>& inputs)
+      : manifest_(manifest), inputs_(inputs), readers_(inputs.size()), images_(inputs.size()) {}
+
+  // Reads global frame g of every view (in parallel over views); a null pointer for a
+  // view that dropped it.
+  StatusOr<std::vector<const media::Image*>> Read(int64_t g, int threads, double* decode_s) {
+    const auto start = std::chrono::steady_clock::now();
+    const int n = static_cast<int>(inputs_.size());
+    std::vector<Status> status(n, Status::Ok());
+    std::vector<const media::Image*> out(n, nullptr);
+    ParallelFor(
+        n,
+        threads,
+        [&](int64_t v, int) {
+          const int64_t k = manifest_.VideoFrameNumber(static_cast<int>(v), g);
+          if (k < 0) return;
+          if (!readers_[v]) {
+            media::VideoReaderOptions o;
+            o.format = media::PixelFormat::kGray8;
+            auto r = media::VideoReader::Open(inputs_[v].video, o);
+            if (!r.ok()) {
+              status[v] = r.status();
+              return;
+            }
+            readers_[v].emplace(std::move(*r));
+          }
+          media::VideoReader& reader = *readers_[v];
+          if (reader.next_frame() != k - 1) {
+            const Status s = reader.Seek(k - 1);
+            if (!s.ok()) {
+              status[v] = s;
+              return;
+            }
+          }
+          media::Image frame;
+          auto more = reader.Read(&frame);
+          if (!more.ok() || !*more) {
+            status[v] = more.ok()
+                            ? Status::Error(inputs_[v].video + ": frame " + std::to_string(k - 1) +
+                                            " could not be read (the video ends early)")
+                            : more.status();
+            return;
+          }
+          images_[v] = inputs_[v].rotate_deg != 0
+                           ? media::RotateClockwise(frame, inputs_[v].rotate_deg)
+                           : std::move(frame);
+          out[v] = &images_[v];
+        },
+        1);
+    for (const Status& s : status) ARCO_RETURN_IF_ERROR(s);
+    *decode_s += SecondsSince(start);
+    return out;
+  }
+
+ private:
+  const CaptureManifest& manifest_;
+  const std::vector<CameraInput>& inputs_;
+  std::vector<std::optional<media::VideoReader>> readers_;
+  std::vector<media::Image> images_;
+};
+
+Json ViewJson(const track::ViewTrackReport& r) {
+  return Json{{"tracked", r.tracked},
+              {"inliers", r.inliers},
+              {"residual_px", r.residual_px},
+              {"rematched", r.rematched},
+              {"added", r.added},
+              {"lost", r.lost},
+              {"reacquired", r.reacquired}};
+}
+
+}  // namespace
+
+StatusOr<TrackLabelsFile> ParseTrackLabelsSpec(const std::string& text) {
+  const size_t eq = text.find('=');
+  const auto bad = [&] {
+    return Status::Error("--labels \"" + text +
+                         "\" must look like CAMERA=FILE or CAMERA@FRAME=FILE");
+  };
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) return bad();
+  TrackLabelsFile f;
+  f.path = text.substr(eq + 1);
+  std::string camera = text.substr(0, eq);
+  const size_t at = camera.rfind('@');
+  if (at != std::string::npos) {
+    const std::string frame = camera.substr(at + 1);
+    if (frame.empty() || frame.size() > 12 ||
+        frame.find_first_not_of("0123456789") != std::string::npos) {
+      return bad();
+    }
+    f.frame = std::stoll(frame);
+    camera = camera.substr(0, at);
+  }
+  if (camera.empty()) return bad();
+  f.camera = camera;
+  return f;
+}
+
+Status TrackStageOptions::Validate() const {
+  if (capture_dir.empty()) return Status::Error("capture_dir is empty");
+  if (labels.empty()) return Status::Error("labels is empty (labelme files of two views)");
+  if (labels_frame < -1) return Status::Error("labels_frame must be -1 (the first) or >= 0");
+  ARCO_RETURN_IF_ERROR(CheckInRange("num_threads", num_threads, Closed(0, 1024)));
+  track::InstrumentTrackerOptions t = tracker;
+  t.num_threads = 1;
+  ARCO_RETURN_IF_ERROR(t.Validate().WithContext("tracker"));
+  return Status::Ok();
+}
+
+Json ToJson(const TrackStageOptions& o) {
+  Json labels = Json::array();
+  for (const auto& l : o.labels) {
+    labels.push_back({{"camera", l.camera}, {"frame", l.frame}, {"file", l.path}});
+  }
+  return Json{{"labels", labels},
+              {"labels_frame", o.labels_frame},
+              {"track_bow", o.track_bow},
+              {"tracker", ToJson(o.tracker)}};
+}
+
+Json ToJson(const TrackStageSummary& s) {
+  Json cameras = Json::array();
+  for (const auto& c : s.cameras) {
+    cameras.push_back({{"camera", c.camera},
+                       {"frames", c.frames},
+                       {"lost_frames", c.lost_frames},
+                       {"reacquired", c.reacquired},
+                       {"mean_inliers", c.mean_inliers},
+                       {"mean_residual_px", c.mean_residual_px}});
+  }
+  return Json{{"layout", s.layout},
+              {"first_frame", s.first_frame},
+              {"last_frame", s.last_frame},
+              {"template_frame", s.template_frame},
+              {"tracked_points", s.tracked_points},
+              {"untracked_points", s.untracked_points},
+              {"label_rms_px", s.label_rms_px},
+              {"frames_without_pose", s.frames_without_pose},
+              {"bow_tracked", s.bow_tracked},
+              {"bow_frames_without_pose", s.bow_frames_without_pose},
+              {"kept_other_points", s.kept_other_points},
+              {"cameras", cameras},
+              {"warnings", s.warnings},
+              {"decode_s", s.decode_s},
+              {"track_s", s.track_s},
+              {"wall_s", s.wall_s}};
+}
+
+StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Progress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  const std::string& dir = options.capture_dir;
+  const std::string manifest_path = JoinPath(dir, kCaptureManifestName);
+  ARCO_ASSIGN_OR_RETURN(CaptureManifest manifest, ReadCaptureManifest(dir));
+  TrackStageSummary summary;
+
+  // --- Checks before any frame is decoded -------------------------------------------
+  if (manifest.instrument == "none") {
+    return Status::Error(manifest_path + ": instrument is \"none\": nothing to track");
+  }
+  ARCO_ASSIGN_OR_RETURN(const std::string layout_name, DetectionLayoutName(manifest.instrument));
+  const KeypointLayout* layout = FindKeypointLayout(layout_name);
+  if (layout == nullptr) return Status::Error(manifest_path + ": no layout " + layout_name);
+  const std::vector<int>* instrument_slots = layout->Group("instrument");
+  const std::vector<int>* bow_slots = layout->Group("bow");
+  if (instrument_slots == nullptr || instrument_slots->empty()) {
+    return Status::Error(manifest_path + ": layout " + layout_name + " has no instrument points");
+  }
+  const int64_t points = layout->size();
+  if (manifest.frame_count <= 0) return Status::Error(manifest_path + ": frames.count is 0");
+  const int64_t first = manifest.frame_first;
+  const int64_t last = manifest.frame_first + manifest.frame_count - 1;
+  const std::string calibration_path = ResolveCapturePath(dir, manifest.calibration);
+  StatusOr<Calibration> calibration = LoadCalibration(calibration_path);
+  if (!calibration.ok()) return calibration.status().WithContext(manifest_path + ": calibration");
+  ARCO_ASSIGN_OR_RETURN(const std::vector<int> rig_index,
+                        MatchCaptureCameras(dir, manifest, calibration->rig, calibration_path));
+  const int views = static_cast<int>(manifest.cameras.size());
+  std::vector<Camera> cameras(views);
+  std::vector<CameraInput> inputs(views);
+  for (int v = 0; v < views; ++v) {
+    const CaptureCamera& cam = manifest.cameras[v];
+    cameras[v] = calibration->rig.cameras[rig_index[v]];
+    CameraInput& in = inputs[v];
+    in.name = cam.name;
+    if (cam.video.empty()) {
+      return Status::Error(manifest_path + ": camera " + cam.name +
+                           " has no video (make the capture with `arco capture new --video "
+                           "CAMERA=FILE`)");
+    }
+    in.video = ResolveCapturePath(dir, cam.video);
+    in.rotate_deg = cam.rotate_deg;
+    ARCO_ASSIGN_OR_RETURN(media::VideoReader reader, media::VideoReader::Open(in.video));
+    const media::VideoProperties& p = reader.properties();
+    const bool swap = in.rotate_deg == 90 || in.rotate_deg == 270;
+    const int w = swap ? p.height : p.width, h = swap ? p.width : p.height;
+    if (w != cameras[v].width || h != cameras[v].height) {
+      return Status::Error(in.video + ": frames are " + std::to_string(w) + "x" +
+                           std::to_string(h) + " after rotate_deg " +
+                           std::to_string(in.rotate_deg) + ", camera " + cam.name + " of " +
+                           calibration_path + " is " + std::to_string(cameras[v].width) + "x" +
+                           std::to_string(cameras[v].height));
+    }
+    in.video_frames = p.frame_count;
+    for (int64_t g = last; g >= first; --g) {
+      const int64_t n = manifest.VideoFrameNumber(v, g);
+      if (n < 0) continue;
+      if (n > in.video_frames) {
+        return Status::Error(in.video + ": has " + std::to_string(in.video_frames) +
+                             " frames, capture frame " + std::to_string(g) + " is its frame " +
+                             std::to_string(n) + " (" + manifest_path + ")");
+      }
+      break;
+    }
+  }
+
+  // The labels: per labelled frame, per view, per instrument point.
+  std::vector<std::string> names;  // instrument points, layout order
+  for (int slot : *instrument_slots) names.push_back(layout->names[slot]);
+  std::vector<std::string> bow_names;  // frog, tip
+  if (bow_slots != nullptr)
+    for (int slot : *bow_slots) bow_names.push_back(layout->names[slot]);
+  // frame -> [view][bow point]
+  std::map<int64_t, std::vector<std::vector<Eigen::Vector2d>>> bow_labelled;
+  const int64_t default_frame = options.labels_frame >= 0 ? options.labels_frame : first;
+  if (default_frame < first || default_frame > last) {
+    return Status::Error("labels_frame " + std::to_string(default_frame) +
+                         " is outside the capture's frames " + std::to_string(first) + ":" +
+                         std::to_string(last) + " (" + manifest_path + ")");
+  }
+  std::map<int64_t, std::vector<std::vector<Eigen::Vector2d>>> labelled;  // frame -> [view][point]
+  std::set<std::string> unknown;
+  for (const TrackLabelsFile& file : options.labels) {
+    const int v = manifest.FindCamera(file.camera);
+    if (v < 0) {
+      return Status::Error(file.path + ": camera " + file.camera + " is not in " + manifest_path);
+    }
+    const int64_t frame = file.frame >= 0 ? file.frame : default_frame;
+    if (frame < first || frame > last) {
+      return Status::Error(file.path + ": labelled frame " + std::to_string(frame) +
+                           " is outside the capture's frames " + std::to_string(first) + ":" +
+                           std::to_string(last));
+    }
+    if (manifest.VideoFrameNumber(v, frame) < 0) {
+      return Status::Error(file.path + ": camera " + file.camera + " dropped frame " +
+                           std::to_string(frame));
+    }
+    ARCO_ASSIGN_OR_RETURN(const LabelmeAnnotation a, ReadLabelme(file.path));
+    const Camera& cam = cameras[v];
+    if ((a.image_width > 0 && a.image_width != cam.width) ||
+        (a.image_height > 0 && a.image_height != cam.height)) {
+      return Status::Error(file.path + ": image is " + std::to_string(a.image_width) + "x" +
+                           std::to_string(a.image_height) + ", camera " + cam.name + " is " +
+                           std::to_string(cam.width) + "x" + std::to_string(cam.height) +
+                           " (label the frame as turned by rotate_deg)");
+    }
+    auto& frame_labels = labelled[frame];
+    if (frame_labels.empty()) {
+      frame_labels.assign(
+          views, std::vector<Eigen::Vector2d>(names.size(), Eigen::Vector2d::Constant(kNaN)));
+    }
+    auto& bow_frame_labels = bow_labelled[frame];
+    if (bow_frame_labels.empty()) {
+      bow_frame_labels.assign(
+          views, std::vector<Eigen::Vector2d>(bow_names.size(), Eigen::Vector2d::Constant(kNaN)));
+    }
+    int matched = 0;
+    for (const LabeledPoint& p : a.points) {
+      const std::string name = CanonicalKeypointName(p.label);
+      const auto it = std::find(names.begin(), names.end(), name);
+      const auto bow_it = std::find(bow_names.begin(), bow_names.end(), name);
+      if (it == names.end() && bow_it == bow_names.end()) {
+        unknown.insert(p.label);
+        continue;
+      }
+      if (!(p.pixel.x() >= -0.5 && p.pixel.y() >= -0.5 && p.pixel.x() < cam.width - 0.5 &&
+            p.pixel.y() < cam.height - 0.5)) {
+        return Status::Error(file.path + ": label " + p.label + " at (" +
+                             std::to_string(p.pixel.x()) + ", " + std::to_string(p.pixel.y()) +
+                             ") is outside the " + std::to_string(cam.width) + "x" +
+                             std::to_string(cam.height) + " image of camera " + cam.name);
+      }
+      auto& slot = it != names.end() ? frame_labels[v][it - names.begin()]
+                                     : bow_frame_labels[v][bow_it - bow_names.begin()];
+      if (std::isfinite(slot.x())) {
+        return Status::Error(file.path + ": camera " + file.camera + " frame " +
+                             std::to_string(frame) + " is labelled twice");
+      }
+      slot = p.pixel;
+      ++matched;
+    }
+    if (matched == 0) {
+      std::string expected;
+      for (const auto& n : names) expected += (expected.empty() ? "" : ", ") + n;
+      return Status::Error(file.path + ": no label names a point of the " + manifest.instrument +
+                           " (" + expected + ")");
+    }
+  }
+  for (const auto& u : unknown) {
+    summary.warnings.push_back("label \"" + u + "\" is not a point of the " + manifest.instrument +
+                               " (ignored)");
+  }
+  // The template from the labelled frame with the most views (ties: the earliest).
+  int64_t template_frame = -1;
+  int best_views = -1;
+  for (const auto& [frame, per_view] : labelled) {
+    int n = 0;
+    for (const auto& v : per_view)
+      n += std::any_of(v.begin(), v.end(), [](const auto& p) { return std::isfinite(p.x()); });
+    if (n > best_views) {
+      best_views = n;
+      template_frame = frame;
+    }
+  }
+  track::FrameLabels frame_labels{names, labelled[template_frame]};
+  StatusOr<track::RigidTemplate> body = track::TriangulateTemplate(cameras, frame_labels);
+  if (!body.ok()) {
+    std::string files;
+    for (const auto& l : options.labels) files += (files.empty() ? "" : ", ") + l.path;
+    return Status::Error(files + ": " + body.status().message());
+  }
+  summary.template_frame = template_frame;
+  summary.label_rms_px = body->rms_reprojection_px;
+  for (size_t p = 0; p < names.size(); ++p) {
+    (std::isfinite(body->points[p].x()) ? summary.tracked_points : summary.untracked_points)
+        .push_back(names[p]);
+  }
+  for (const auto& n : summary.untracked_points) {
+    summary.warnings.push_back("point " + n + " is labelled in fewer than two views: left NaN");
+  }
+  // The bow: a thin rigid body from its frog and tip labelled in two views of the
+  // template frame; else its slots are kept.
+  std::optional<track::RigidTemplate> bow_body;
+  if (!bow_names.empty() && !options.track_bow) {
+    summary.warnings.push_back(
+        "the bow is not tracked (experimental: track_bow): its points are kept as they were");
+  } else if (!bow_names.empty()) {
+    track::FrameLabels bow_frame_labels{bow_names, bow_labelled[template_frame]};
+    auto bow = track::TriangulateTemplate(cameras, bow_frame_labels, 10, /*thin=*/true);
+    size_t bow_points = 0;
+    if (bow.ok())
+      for (const auto& x : bow->points) bow_points += std::isfinite(x.x());
+    if (bow.ok() && bow_points == bow_names.size()) {
+      bow_body = *bow;
+      summary.bow_tracked = true;
+    } else {
+      summary.warnings.push_back(
+          "the bow is not tracked (its frog and tip need labels in two views of frame " +
+          std::to_string(template_frame) + "): its points are kept as they were");
+    }
+  }
+
+  // The keypoints already there are kept (body and hands from `arco detect`, the bow).
+  NpyArray<float> out;
+  out.shape = {manifest.frame_count, views, points, 3};
+  out.data.assign(static_cast<size_t>(manifest.frame_count * views * points * 3), kNaNf);
+  if (!manifest.keypoints2d.empty() && manifest.layout == layout_name) {
+    ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(dir, manifest));
+    ARCO_ASSIGN_OR_RETURN(NpyArray<double> old, ReadCaptureKeypoints2d(dir, manifest));
+    for (size_t i = 0; i < out.data.size(); ++i) out.data[i] = static_cast<float>(old.data[i]);
+    summary.kept_other_points = true;
+  }
+  const auto at = [&](int64_t f, int v, int64_t p) {
+    return static_cast<size_t>(((f * views + v) * points + p) * 3);
+  };
+
+  OutputSet outputs;
+  ARCO_ASSIGN_OR_RETURN(const std::string npy_tmp, outputs.AddFile(JoinPath(dir, kKeypointsFile)));
+  ARCO_ASSIGN_OR_RETURN(const std::string manifest_tmp, outputs.AddFile(manifest_path));
+  ARCO_ASSIGN_OR_RETURN(const std::string report_tmp, outputs.AddFile(JoinPath(dir, kReportFile)));
+
+  // --- The work: forwards from the labelled frame, then backwards ---------------------
+  const int threads = ResolveThreadCount(options.num_threads);
+  track::InstrumentTrackerOptions tracker_options = options.tracker;
+  tracker_options.num_threads = threads;
+  std::vector<track::TrackFrame> results(static_cast<size_t>(manifest.frame_count));
+  std::vector<track::TrackFrame> bow_results(results.size());
+  std::vector<char> done(results.size(), 0);
+  const auto track_start = std::chrono::steady_clock::now();
+  progress.SetTotal(manifest.frame_count * views);
+  for (const int step : {+1, -1}) {
+    if (step < 0 && template_frame == first) break;
+    track::InstrumentTracker tracker(cameras, *body, tracker_options);
+    std::optional<track::InstrumentTracker> bow_tracker;
+    if (bow_body) {
+      // The bow is a few pixels wide: corners on it only, small Lucas-Kanade windows
+      // (the prediction carries the fast motion).
+      track::InstrumentTrackerOptions bow_options = tracker_options;
+      bow_options.outline_margin_px = 3;
+      bow_options.lk_window_px = 11;
+      bow_options.lk_levels = 2;
+      bow_options.min_feature_distance_px = 4;
+      bow_options.ncc_patch_px = 9;
+      bow_tracker.emplace(cameras, *bow_body, bow_options);
+    }
+    track::TrackFrame bow_r;
+    Frames frames(manifest, inputs);
+    for (int64_t g = template_frame; g >= first && g <= last; g += step) {
+      ARCO_ASSIGN_OR_RETURN(std::vector<const media::Image*> images,
+                            frames.Read(g, threads, &summary.decode_s));
+      track::TrackFrame r;
+      if (g == template_frame) {
+        // A view that dropped the labelled frame starts from a blank picture.
+        std::vector<media::Image> blanks(views);
+        for (int v = 0; v < views; ++v) {
+          if (images[v] != nullptr) continue;
+          blanks[v] =
+              media::MakeImage(cameras[v].width, cameras[v].height, media::PixelFormat::kGray8);
+          images[v] = &blanks[v];
+        }
+        r = tracker.Start(images);
+        if (bow_tracker) bow_r = bow_tracker->Start(images);
+      } else {
+        const auto it = labelled.find(g);
+        r = tracker.Next(images, it != labelled.end() ? &it->second : nullptr);
+        if (bow_tracker) {
+          const auto bow_it = bow_labelled.find(g);
+          bow_r =
+              bow_tracker->Next(images, bow_it != bow_labelled.end() ? &bow_it->second : nullptr);
+        }
+      }
+      const size_t f = static_cast<size_t>(g - first);
+      if (!done[f]) {
+        results[f] = std::move(r);
+        bow_results[f] = std::move(bow_r);
+        done[f] = 1;
+        progress.Advance(views);
+      }
+    }
+  }
+  summary.track_s = SecondsSince(track_start);
+
+  // --- Outputs ------------------------------------------------------------------------
+  summary.layout = layout_name;
+  summary.first_frame = first;
+  summary.last_frame = last;
+  summary.cameras.resize(views);
+  Json frames_json = Json::array();
+  for (int64_t f = 0; f < manifest.frame_count; ++f) {
+    const track::TrackFrame& r = results[f];
+    if (!r.pose_ok) ++summary.frames_without_pose;
+    Json view_json = Json::array();
+    for (int v = 0; v < views; ++v) {
+      const bool recorded = manifest.VideoFrameNumber(v, first + f) >= 0;
+      const track::ViewTrackReport& vr = r.views[v];
+      view_json.push_back(ViewJson(vr));
+      TrackCameraSummary& c = summary.cameras[v];
+      if (recorded) {
+        ++c.frames;
+        c.lost_frames += vr.lost;
+        c.reacquired += vr.reacquired;
+        c.mean_inliers += vr.inliers;
+        c.mean_residual_px += vr.residual_px;
+      }
+      for (size_t p = 0; p < names.size(); ++p) {
+        const size_t k = at(f, v, (*instrument_slots)[p]);
+        const track::TrackedPoint& q = r.points[v][p];
+        const bool ok = recorded && std::isfinite(q.pixel.x());
+        out.data[k] = ok ? static_cast<float>(q.pixel.x()) : kNaNf;
+        out.data[k + 1] = ok ? static_cast<float>(q.pixel.y()) : kNaNf;
+        out.data[k + 2] = ok ? static_cast<float>(q.score) : kNaNf;
+      }
+      for (size_t p = 0; bow_body && p < bow_names.size(); ++p) {
+        const size_t k = at(f, v, (*bow_slots)[p]);
+        const track::TrackedPoint& q = bow_results[f].points[v][p];
+        const bool ok = recorded && std::isfinite(q.pixel.x());
+        out.data[k] = ok ? static_cast<float>(q.pixel.x()) : kNaNf;
+        out.data[k + 1] = ok ? static_cast<float>(q.pixel.y()) : kNaNf;
+        out.data[k + 2] = ok ? static_cast<float>(q.score) : kNaNf;
+      }
+    }
+    Json bow_json = nullptr;
+    if (bow_body) {
+      const track::TrackFrame& b = bow_results[f];
+      if (!b.pose_ok) ++summary.bow_frames_without_pose;
+      Json bow_views = Json::array();
+      for (const auto& vr : b.views) bow_views.push_back(ViewJson(vr));
+      bow_json = Json{{"pose_ok", b.pose_ok},
+                      {"inliers", b.inliers},
+                      {"residual_px", b.residual_px},
+                      {"views", bow_views}};
+    }
+    frames_json.push_back({{"frame", first + f},
+                           {"pose_ok", r.pose_ok},
+                           {"inliers", r.inliers},
+                           {"residual_px", r.residual_px},
+                           {"views", view_json},
+                           {"bow", bow_json}});
+  }
+  for (int v = 0; v < views; ++v) {
+    TrackCameraSummary& c = summary.cameras[v];
+    c.camera = inputs[v].name;
+    if (c.frames > 0) {
+      c.mean_inliers /= c.frames;
+      c.mean_residual_px /= c.frames;
+    }
+  }
+  Json template_json = Json::array();
+  for (size_t p = 0; p < names.size(); ++p) {
+    const Eigen::Vector3d& x = body->points[p];
+    template_json.push_back(
+        {{"name", names[p]},
+         {"label_views", body->label_views[p]},
+         {"point_in_world",
+          std::isfinite(x.x()) ? Json::array({x.x(), x.y(), x.z()}) : Json(nullptr)}});
+  }
+  ARCO_RETURN_IF_ERROR(WriteNpy(npy_tmp, out));
+  manifest.keypoints2d = kKeypointsFile;
+  manifest.layout = layout_name;
+  manifest.keypoint_names.clear();
+  ARCO_RETURN_IF_ERROR(WriteJsonFile(manifest_tmp, CaptureManifestToJson(manifest)));
+  Json report_summary = ToJson(summary);
+  report_summary.erase("decode_s");  // times differ between runs: left out
+  report_summary.erase("track_s");
+  report_summary.erase("wall_s");
+  Json cameras_json = Json::array();
+  for (const auto& in : inputs) cameras_json.push_back(in.name);
+  ARCO_RETURN_IF_ERROR(WriteJsonFile(report_tmp,
+                                     Json{{"format", "arco-track-report"},
+                                          {"options", ToJson(options)},
+                                          {"summary", report_summary},
+                                          {"template", template_json},
+                                          {"cameras", cameras_json},
+                                          {"frames", frames_json}}));
+  ARCO_RETURN_IF_ERROR(outputs.Commit());
+  summary.wall_s = SecondsSince(start);
+  return summary;
+}
+
+}  // namespace arco::pipeline

@@ -1,0 +1,85 @@
+// `arco track CAPTURE --labels CAMERA=LABELME.json ...` (docs/track.md): the instrument's
+// points in every camera and frame of a capture made from videos, from labels of one
+// frame in at least two views. The tracking itself is track::InstrumentTracker
+// (track/instrument_tracker.h); this stage reads and checks the labels, reads the frames
+// through media::VideoReader (turned by rotate_deg), tracks forwards from the labelled
+// frame (and backwards when it is not the first) and writes the instrument slots of
+// keypoints2d.npy, CAPTURE/track.json and capture.json together.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "arco/track/instrument_tracker.h"
+#include "arco/util/json_io.h"
+#include "arco/util/progress.h"
+#include "arco/util/status.h"
+
+namespace arco::pipeline {
+
+// One labelme file: the labels of `camera` (name or serial) on global frame `frame`
+// (-1: TrackStageOptions::labels_frame).
+struct TrackLabelsFile {
+  std::string camera;
+  int64_t frame = -1;
+  std::string path;
+};
+
+// "CAMERA=FILE" or "CAMERA@FRAME=FILE"; an error naming the text otherwise.
+StatusOr<TrackLabelsFile> ParseTrackLabelsSpec(const std::string& text);
+
+struct TrackStageOptions {
+  std::string capture_dir;
+  std::vector<TrackLabelsFile> labels;
+  int64_t labels_frame = -1;                // -1: the capture's first frame
+  track::InstrumentTrackerOptions tracker;  // its num_threads is num_threads below
+  int num_threads = 0;                      // 0 = all cores; results do not depend on it
+  // Experimental: the bow as a thin rigid body from its frog and tip labels (corners on
+  // the stick, docs/track.md). It holds on a textured bow lying on the picture but loses
+  // a thin bow moving on its own (pipeline_track_bow_test), so it is off by default and
+  // the bow's slots are kept.
+  bool track_bow = false;
+  Status Validate() const;
+};
+
+Json ToJson(const TrackStageOptions& options);
+
+struct TrackCameraSummary {
+  std::string camera;
+  int64_t frames = 0;       // frames read
+  int64_t lost_frames = 0;  // frames in which the view had lost the instrument
+  int64_t reacquired = 0;   // times it found it again
+  double mean_inliers = 0;  // per frame read
+  double mean_residual_px = 0;
+};
+
+struct TrackStageSummary {
+  std::string layout;
+  int64_t first_frame = 0, last_frame = 0;
+  int64_t template_frame = 0;                 // the labelled frame the template comes from
+  std::vector<std::string> tracked_points;    // instrument points with a template point
+  std::vector<std::string> untracked_points;  // labelled in fewer than two views
+  double label_rms_px = 0;                    // the labels' triangulation residual
+  int64_t frames_without_pose = 0;            // the pose was the prediction
+  bool bow_tracked = false;  // frog and tip labelled in two views: the bow slots written
+  int64_t bow_frames_without_pose = 0;
+  std::vector<TrackCameraSummary> cameras;
+  std::vector<std::string> warnings;
+  bool kept_other_points = false;  // body/hand slots kept from keypoints2d.npy
+  double decode_s = 0, track_s = 0, wall_s = 0;
+};
+
+Json ToJson(const TrackStageSummary& summary);
+
+// Checks the capture (manifest, calibration, every camera's video) and the labels (files
+// readable, cameras known, frames inside the capture, labels inside the image, at least
+// two views, names that match the instrument's points) before any frame is decoded;
+// then tracks and replaces CAPTURE/keypoints2d.npy (instrument slots, and the bow's when
+// its frog and tip are labelled in two views; the other slots kept, NaN in a new file),
+// track.json and capture.json together
+// (util/output_set.h). Progress: total = frames x cameras.
+StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options,
+                                          Progress& progress = NoProgress());
+
+}  // namespace arco::pipeline
