@@ -71,10 +71,12 @@ void ReportPerFrame(benchmark::State& state,
   }
 }
 
-// range(0): pose model 0 lite, 1 full, 2 heavy; range(1): 1 with a detection per frame.
+// range(0): pose model 0 lite, 1 full, 2 heavy; range(1): hand model 0 lite, 1 full.
 void WholeBody(benchmark::State& state, bool detect_every_frame) {
   const PoseModel model = static_cast<PoseModel>(state.range(0));
-  state.SetLabel(std::string("pose ") + PoseModelName(model) + ", hands full, recrop");
+  const HandModel hands = static_cast<HandModel>(state.range(1));
+  state.SetLabel(std::string("pose ") + PoseModelName(model) + ", hands " +
+                 HandModelName(hands) + ", recrop");
   StatusOr<media::VideoReader> reader = media::VideoReader::Open(kCellist);
   if (!reader.ok()) {
     state.SkipWithError(reader.status().message().c_str());
@@ -83,6 +85,7 @@ void WholeBody(benchmark::State& state, bool detect_every_frame) {
   StatusOr<media::Image> image = reader->ReadFrame(0);
   WholeBodyOptions options;
   options.pose_model = model;
+  options.hand_model = hands;
   options.num_threads = 2;
   StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(options);
   if (!image.ok() || !tracker.ok()) {
@@ -107,8 +110,11 @@ void WholeBody(benchmark::State& state, bool detect_every_frame) {
 }
 void BM_WholeBodyTracked(benchmark::State& state) { WholeBody(state, false); }
 void BM_WholeBodyDetected(benchmark::State& state) { WholeBody(state, true); }
-BENCHMARK(BM_WholeBodyTracked)->DenseRange(0, 2)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_WholeBodyDetected)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WholeBodyTracked)
+    ->ArgsProduct({{0, 1, 2}, {0, 1}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WholeBodyDetected)->Args({1, 1})->UseRealTime()->Unit(benchmark::kMillisecond);
 
 // range(0): 0 vtest.avi read sequentially (rewinding at the end), 1 the cellist JPEG.
 void BM_DecodeFrame(benchmark::State& state) {

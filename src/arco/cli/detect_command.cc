@@ -23,6 +23,7 @@ inline constexpr FieldFlag kDetectFlags[] = {{"num_threads", "--threads"},
 struct DetectArgs {
   pipeline::DetectStageOptions o;
   std::string model = "full";
+  std::string hand_model = "full";
   std::string frames;  // FIRST:LAST
   bool no_hand_recrop = false;
 };
@@ -52,6 +53,9 @@ void ApplyAndValidate(DetectArgs& a) {
   auto model = detect::ParsePoseModel(a.model);
   ThrowIfInvalid(model.status());
   a.o.detector.pose_model = *model;
+  auto hands = detect::ParseHandModel(a.hand_model);
+  ThrowIfInvalid(hands.status());
+  a.o.detector.hand_model = *hands;
   a.o.detector.hand_recrop = !a.no_hand_recrop;
   ThrowIfInvalid(ParseFrames(a.frames, &a.o));
   const Status valid = a.o.Validate();
@@ -105,6 +109,9 @@ std::function<int()> SetupDetect(CLI::App& app) {
       ->required();
   sub->add_option("--model", a->model, "Pose landmark model: lite, full or heavy")
       ->check(CLI::IsMember({"lite", "full", "heavy"}))
+      ->capture_default_str();
+  sub->add_option("--hand-model", a->hand_model, "Hand landmark model: lite or full")
+      ->check(CLI::IsMember({"lite", "full"}))
       ->capture_default_str();
   sub->add_option("--frames",
                   a->frames,

@@ -72,6 +72,20 @@ StatusOr<PoseModel> ParsePoseModel(const std::string& name) {
   return Status::Error("unknown pose model '" + name + "' (lite, full or heavy)");
 }
 
+const char* HandModelName(HandModel model) {
+  return model == HandModel::kLite ? "lite" : "full";
+}
+
+StatusOr<HandModel> ParseHandModel(const std::string& name) {
+  if (name == "lite") return HandModel::kLite;
+  if (name == "full") return HandModel::kFull;
+  return Status::Error("unknown hand model \"" + name + "\" (lite, full)");
+}
+
+ModelId HandLandmarkModel(HandModel model) {
+  return model == HandModel::kLite ? ModelId::kHandLandmarkLite : ModelId::kHandLandmarkFull;
+}
+
 ModelId PoseLandmarkModel(PoseModel model) {
   switch (model) {
     case PoseModel::kLite:
@@ -88,6 +102,9 @@ Status WholeBodyOptions::Validate() const {
   if (pose_model != PoseModel::kLite && pose_model != PoseModel::kFull &&
       pose_model != PoseModel::kHeavy) {
     return Status::Error("WholeBodyOptions.pose_model must be lite, full or heavy");
+  }
+  if (hand_model != HandModel::kLite && hand_model != HandModel::kFull) {
+    return Status::Error("WholeBodyOptions.hand_model must be lite or full");
   }
   ARCO_RETURN_IF_ERROR(CheckInRange(
       "WholeBodyOptions.min_detection_score", min_detection_score, kWholeBodyScoreRange));
@@ -310,7 +327,7 @@ StatusOr<WholeBodyTracker> WholeBodyTracker::Create(const WholeBodyOptions& opti
   const std::array<ModelId, 4> ids = {ModelId::kPoseDetection,
                                       PoseLandmarkModel(options.pose_model),
                                       ModelId::kHandRecrop,
-                                      ModelId::kHandLandmarkFull};
+                                      HandLandmarkModel(options.hand_model)};
   for (size_t k = 0; k < ids.size(); ++k) {
     impl->summary.models[k].model = ids[k];
     if (k == kRecropSlot && !options.hand_recrop) continue;

@@ -59,6 +59,14 @@ const char* PoseModelName(PoseModel model);  // "lite", "full", "heavy"
 StatusOr<PoseModel> ParsePoseModel(const std::string& name);
 ModelId PoseLandmarkModel(PoseModel model);
 
+// The hand landmark model's size: lite / full (about 10 / 16 ms per hand on a quiet
+// 2-core machine, docs/performance.md).
+enum class HandModel { kLite, kFull };
+const char* HandModelName(HandModel model);  // "lite", "full"
+// "lite" | "full"; an error listing them otherwise.
+StatusOr<HandModel> ParseHandModel(const std::string& name);
+ModelId HandLandmarkModel(HandModel model);
+
 // Declared ranges of WholeBodyOptions' numbers (util/number_range.h).
 inline constexpr NumberRange kWholeBodyScoreRange = Closed(0, 1);  // thresholds on scores
 inline constexpr NumberRange kWholeBodyThreadsRange = Closed(1, 1024);
@@ -66,6 +74,7 @@ inline constexpr NumberRange kWholeBodyTileLevelsRange = Closed(0, 2);
 
 struct WholeBodyOptions {
   PoseModel pose_model = PoseModel::kFull;
+  HandModel hand_model = HandModel::kFull;
   std::string models_dir;  // empty: DefaultModelsDir()
   // pose_detection: detections below this score are ignored (MediaPipe's 0.5).
   double min_detection_score = 0.5;

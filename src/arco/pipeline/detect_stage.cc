@@ -112,6 +112,7 @@ Status DetectStageOptions::Validate() const {
 
 Json ToJson(const DetectStageOptions& o) {
   return Json{{"pose_model", detect::PoseModelName(o.detector.pose_model)},
+              {"hand_model", detect::HandModelName(o.detector.hand_model)},
               {"min_detection_score", o.detector.min_detection_score},
               {"nms_min_iou", o.detector.nms_min_iou},
               {"min_pose_presence", o.detector.min_pose_presence},
