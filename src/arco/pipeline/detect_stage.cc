@@ -12,7 +12,7 @@
 #include "arco/calibration/calibration_file.h"
 #include "arco/media/video_reader.h"
 #include "arco/mocap/capture.h"
-#include "arco/pipeline/preflight.h"
+#include "arco/pipeline/capture_videos.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
@@ -29,15 +29,6 @@ constexpr char kReportFile[] = "detect.json";
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
-
-// One camera's video as the stage reads it.
-struct CameraInput {
-  std::string name;
-  std::string video;  // resolved path
-  int rotate_deg = 0;
-  int width = 0, height = 0;  // the calibration camera's image
-  int64_t video_frames = 0;
-};
 
 // One work item: frames [first, last] (global numbers) of one camera.
 struct Chunk {
@@ -168,51 +159,9 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
                          ":" + std::to_string(capture_last) + " (" + manifest_path + ")");
   }
 
-  const std::string calibration_path = ResolveCapturePath(dir, manifest.calibration);
-  StatusOr<Calibration> calibration = LoadCalibration(calibration_path);
-  if (!calibration.ok()) return calibration.status().WithContext(manifest_path + ": calibration");
-  ARCO_ASSIGN_OR_RETURN(const std::vector<int> rig_index,
-                        MatchCaptureCameras(dir, manifest, calibration->rig, calibration_path));
-
-  const int views = static_cast<int>(manifest.cameras.size());
-  std::vector<CameraInput> inputs(views);
-  for (int v = 0; v < views; ++v) {
-    const CaptureCamera& cam = manifest.cameras[v];
-    CameraInput& in = inputs[v];
-    in.name = cam.name;
-    if (cam.video.empty()) {
-      return Status::Error(manifest_path + ": camera " + cam.name +
-                           " has no video (make the capture with `arco capture new --video "
-                           "CAMERA=FILE`)");
-    }
-    in.video = ResolveCapturePath(dir, cam.video);
-    in.rotate_deg = cam.rotate_deg;
-    const Camera& calib = calibration->rig.cameras[rig_index[v]];
-    in.width = calib.width;
-    in.height = calib.height;
-    ARCO_ASSIGN_OR_RETURN(media::VideoReader reader, media::VideoReader::Open(in.video));
-    const media::VideoProperties& p = reader.properties();
-    const bool swap = in.rotate_deg == 90 || in.rotate_deg == 270;
-    const int w = swap ? p.height : p.width, h = swap ? p.width : p.height;
-    if (w != in.width || h != in.height) {
-      return Status::Error(
-          in.video + ": frames are " + std::to_string(w) + "x" + std::to_string(h) +
-          " after rotate_deg " + std::to_string(in.rotate_deg) + ", camera " + cam.name + " of " +
-          calibration_path + " is " + std::to_string(in.width) + "x" + std::to_string(in.height));
-    }
-    in.video_frames = p.frame_count;
-    // The last global frame this camera recorded must be in its video.
-    for (int64_t g = last; g >= first; --g) {
-      const int64_t n = manifest.VideoFrameNumber(v, g);
-      if (n < 0) continue;
-      if (n > in.video_frames) {
-        return Status::Error(in.video + ": has " + std::to_string(in.video_frames) +
-                             " frames, capture frame " + std::to_string(g) + " is its frame " +
-                             std::to_string(n) + " (" + manifest_path + ")");
-      }
-      break;
-    }
-  }
+  ARCO_ASSIGN_OR_RETURN(const std::vector<CaptureVideo> inputs,
+                        OpenCaptureVideos(dir, manifest, first, last));
+  const int views = static_cast<int>(inputs.size());
 
   // Keypoints already in the capture: the slots after the body and hands (instrument and
   // bow, from `arco track`) and the frames outside [first, last] are kept.
@@ -271,7 +220,7 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
       [&](int64_t i, int t) {
         Worker& w = pool[t];
         const Chunk& c = chunks[i];
-        const CameraInput& in = inputs[c.view];
+        const CaptureVideo& in = inputs[c.view];
         const auto fail = [&](Status s) { chunk_status[i] = std::move(s); };
         if (!w.tracker) {
           auto tracker = detect::WholeBodyTracker::Create(detector);
@@ -336,7 +285,7 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
   summary.kept_other_points = kept;
   summary.cameras.resize(views);
   for (int v = 0; v < views; ++v) {
-    summary.cameras[v].camera = inputs[v].name;
+    summary.cameras[v].camera = inputs[v].camera;
     summary.cameras[v].video = inputs[v].video;
   }
   for (size_t i = 0; i < chunks.size(); ++i) {

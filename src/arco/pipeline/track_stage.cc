@@ -13,7 +13,7 @@
 #include "arco/media/video_reader.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/labelme.h"
-#include "arco/pipeline/preflight.h"
+#include "arco/pipeline/capture_videos.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
@@ -32,17 +32,10 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-struct CameraInput {
-  std::string name;
-  std::string video;
-  int rotate_deg = 0;
-  int64_t video_frames = 0;
-};
-
 // Each camera's video, read in order or by seeking; frames turned by rotate_deg.
 class Frames {
  public:
-  Frames(const CaptureManifest& manifest, const std::vector<CameraInput>& inputs)
+  Frames(const CaptureManifest& manifest, const std::vector<CaptureVideo>& inputs)
       : manifest_(manifest), inputs_(inputs), readers_(inputs.size()), images_(inputs.size()) {}
 
   // Reads global frame g of every view (in parallel over views); a null pointer for a
@@ -98,7 +91,7 @@ class Frames {
 
  private:
   const CaptureManifest& manifest_;
-  const std::vector<CameraInput>& inputs_;
+  const std::vector<CaptureVideo>& inputs_;
   std::vector<std::optional<media::VideoReader>> readers_;
   std::vector<media::Image> images_;
 };
@@ -214,49 +207,11 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   if (manifest.frame_count <= 0) return Status::Error(manifest_path + ": frames.count is 0");
   const int64_t first = manifest.frame_first;
   const int64_t last = manifest.frame_first + manifest.frame_count - 1;
-  const std::string calibration_path = ResolveCapturePath(dir, manifest.calibration);
-  StatusOr<Calibration> calibration = LoadCalibration(calibration_path);
-  if (!calibration.ok()) return calibration.status().WithContext(manifest_path + ": calibration");
-  ARCO_ASSIGN_OR_RETURN(const std::vector<int> rig_index,
-                        MatchCaptureCameras(dir, manifest, calibration->rig, calibration_path));
-  const int views = static_cast<int>(manifest.cameras.size());
+  ARCO_ASSIGN_OR_RETURN(const std::vector<CaptureVideo> inputs,
+                        OpenCaptureVideos(dir, manifest, first, last));
+  const int views = static_cast<int>(inputs.size());
   std::vector<Camera> cameras(views);
-  std::vector<CameraInput> inputs(views);
-  for (int v = 0; v < views; ++v) {
-    const CaptureCamera& cam = manifest.cameras[v];
-    cameras[v] = calibration->rig.cameras[rig_index[v]];
-    CameraInput& in = inputs[v];
-    in.name = cam.name;
-    if (cam.video.empty()) {
-      return Status::Error(manifest_path + ": camera " + cam.name +
-                           " has no video (make the capture with `arco capture new --video "
-                           "CAMERA=FILE`)");
-    }
-    in.video = ResolveCapturePath(dir, cam.video);
-    in.rotate_deg = cam.rotate_deg;
-    ARCO_ASSIGN_OR_RETURN(media::VideoReader reader, media::VideoReader::Open(in.video));
-    const media::VideoProperties& p = reader.properties();
-    const bool swap = in.rotate_deg == 90 || in.rotate_deg == 270;
-    const int w = swap ? p.height : p.width, h = swap ? p.width : p.height;
-    if (w != cameras[v].width || h != cameras[v].height) {
-      return Status::Error(in.video + ": frames are " + std::to_string(w) + "x" +
-                           std::to_string(h) + " after rotate_deg " +
-                           std::to_string(in.rotate_deg) + ", camera " + cam.name + " of " +
-                           calibration_path + " is " + std::to_string(cameras[v].width) + "x" +
-                           std::to_string(cameras[v].height));
-    }
-    in.video_frames = p.frame_count;
-    for (int64_t g = last; g >= first; --g) {
-      const int64_t n = manifest.VideoFrameNumber(v, g);
-      if (n < 0) continue;
-      if (n > in.video_frames) {
-        return Status::Error(in.video + ": has " + std::to_string(in.video_frames) +
-                             " frames, capture frame " + std::to_string(g) + " is its frame " +
-                             std::to_string(n) + " (" + manifest_path + ")");
-      }
-      break;
-    }
-  }
+  for (int v = 0; v < views; ++v) cameras[v] = inputs[v].calibration;
 
   // The labels: per labelled frame, per view, per instrument point.
   std::vector<std::string> names;  // instrument points, layout order
@@ -533,7 +488,7 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   }
   for (int v = 0; v < views; ++v) {
     TrackCameraSummary& c = summary.cameras[v];
-    c.camera = inputs[v].name;
+    c.camera = inputs[v].camera;
     if (c.frames > 0) {
       c.mean_inliers /= c.frames;
       c.mean_residual_px /= c.frames;
@@ -558,7 +513,7 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   report_summary.erase("track_s");
   report_summary.erase("wall_s");
   Json cameras_json = Json::array();
-  for (const auto& in : inputs) cameras_json.push_back(in.name);
+  for (const auto& in : inputs) cameras_json.push_back(in.camera);
   ARCO_RETURN_IF_ERROR(WriteJsonFile(report_tmp,
                                      Json{{"format", "arco-track-report"},
                                           {"options", ToJson(options)},

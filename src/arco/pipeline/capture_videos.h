@@ -1,0 +1,31 @@
+// The videos of a capture made by `arco capture new`, checked before a stage decodes
+// them (`arco detect`, `arco track`): every camera has a video, it opens, its frame size
+// after rotate_deg is its calibration camera's, and the last frame the camera recorded
+// in [first, last] is inside it. One line naming the file on each failure.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "arco/camera/camera.h"
+#include "arco/mocap/capture.h"
+#include "arco/util/status.h"
+
+namespace arco::pipeline {
+
+struct CaptureVideo {
+  std::string camera;  // the capture camera's name
+  std::string video;   // resolved path
+  int rotate_deg = 0;  // clockwise turn of decoded frames to the calibration's image
+  Camera calibration;  // the calibration camera it matches (name, else serial)
+  int64_t video_frames = 0;
+};
+
+// In the manifest's camera order. `first`, `last`: global frame numbers checked.
+StatusOr<std::vector<CaptureVideo>> OpenCaptureVideos(const std::string& capture_dir,
+                                                      const CaptureManifest& manifest,
+                                                      int64_t first,
+                                                      int64_t last);
+
+}  // namespace arco::pipeline
