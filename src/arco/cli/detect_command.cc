@@ -9,6 +9,7 @@
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
 #include "arco/pipeline/detect_stage.h"
+#include "arco/util/output_set.h"
 
 namespace arco::cli {
 namespace {
@@ -94,7 +95,8 @@ int RunDetect(const DetectArgs& a) {
               frames > 0 ? 1e3 * s.total.inference_s / frames : 0.0,
               frames > 0 ? 1e3 * s.decode_s / frames : 0.0);
   if (s.kept_other_points) std::printf("kept the instrument and bow points already there\n");
-  std::printf("wrote %s/keypoints2d.npy and capture.json\n", a.o.capture_dir.c_str());
+  std::printf("wrote %s/keypoints2d.npy and capture.json\n",
+              NormalizeOutputPath(a.o.capture_dir).c_str());
   return 0;
 }
 

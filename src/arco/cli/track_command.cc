@@ -11,6 +11,7 @@
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
 #include "arco/pipeline/track_stage.h"
+#include "arco/util/output_set.h"
 
 namespace arco::cli {
 namespace {
@@ -79,7 +80,8 @@ int RunTrack(const TrackArgs& a) {
               s.wall_s,
               view_frames > 0 ? 1e3 * (s.track_s - s.decode_s) / view_frames : 0.0,
               view_frames > 0 ? 1e3 * s.decode_s / view_frames : 0.0);
-  std::printf("wrote %s/keypoints2d.npy, track.json and capture.json\n", a.o.capture_dir.c_str());
+  std::printf("wrote %s/keypoints2d.npy, track.json and capture.json\n",
+              NormalizeOutputPath(a.o.capture_dir).c_str());
   return 0;
 }
 
