@@ -9,8 +9,7 @@ arco=$1
 spd=$2/spd
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fail=0
-check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
+source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 
 "$arco" calibration show "$spd/cello_1113_scale_camera.xml" --json >"$tmp/show.json" 2>"$tmp/err"
 check '[ $? -eq 0 ] && [ ! -s "$tmp/err" ]' "show --json exits 0 without warnings"

@@ -11,32 +11,15 @@ spd=$2/spd
 videos=/usr/share/doc/opencv-doc/examples/data
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fail=0
-check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
+source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 if [ ! -f "$videos/vtest.avi" ] || [ ! -f "$videos/Megamind.avi" ]; then
   echo "FAILED: $videos/vtest.avi and Megamind.avi are needed (apt-get install opencv-doc)"
   exit 1
 fi
 cd "$tmp" || exit 1
 w=$tmp/w
+SNAPSHOT_DIR=$w
 mkdir -p "$w" videos
-snapshot() { (cd "$w" && find . | sort && find . -type f -exec md5sum {} + | sort); }
-ok() {
-  local name=$1; shift
-  "$arco" "$@" >"$tmp/out" 2>"$tmp/err"
-  local rc=$?
-  check '[ $rc -eq 0 ]' "$name: exit $rc: $(tail -1 "$tmp/err")"
-}
-# bad NAME PATH ARGS...: exit 1, one stderr line "arco: error: PATH: ...", $w unchanged.
-bad() {
-  local name=$1 path=$2; shift 2
-  local before; before=$(snapshot)
-  "$arco" "$@" >/dev/null 2>"$tmp/err"
-  local rc=$?
-  local line; line=$(cat "$tmp/err")
-  check '[ $rc -eq 1 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ] && [[ "$line" == "arco: error: $path: "* ]]' "$name: exit $rc: $line"
-  check '[ "$(snapshot)" = "$before" ]' "$name: the working folder changed"
-}
 
 # A rig of three SPD cameras resized for the videos: cam A 768x576, cam B 576x768 (a
 # portrait camera: vtest turned 90 degrees), cam C 720x528.
@@ -96,23 +79,23 @@ check 'grep -q "1 cameras x 3 frames at 25 fps" "$tmp/out"' "an image folder: $(
 N=(capture new --calibration rig.json)
 echo "not a video" >"$w/text.avi"
 head -c 3000000 "$videos/vtest.avi" >"$w/cut.avi"
-bad "unreadable video" "$w/text.avi" "${N[@]}" --video "$A=$w/text.avi" -o "$w/cap"
-bad "missing video" "$w/none.avi" "${N[@]}" --video "$A=$w/none.avi" -o "$w/cap"
-bad "truncated video" "$w/cut.avi" "${N[@]}" --video "$A=$w/cut.avi" -o "$w/cap"
-bad "camera not in the calibration" rig.json "${N[@]}" --video "cam9=videos/vtest.avi" -o "$w/cap"
-bad "size mismatch" "$videos/Megamind.avi" "${N[@]}" --video "$A=$videos/Megamind.avi" -o "$w/cap"
-bad "size mismatch: no rotation" videos/vtest.avi "${N[@]}" --video "$B=videos/vtest.avi" -o "$w/cap"
-bad "frame-count mismatch" frames "${N[@]}" --video "$A=videos/vtest.avi" \
+bad_at "unreadable video" "$w/text.avi" "${N[@]}" --video "$A=$w/text.avi" -o "$w/cap"
+bad_at "missing video" "$w/none.avi" "${N[@]}" --video "$A=$w/none.avi" -o "$w/cap"
+bad_at "truncated video" "$w/cut.avi" "${N[@]}" --video "$A=$w/cut.avi" -o "$w/cap"
+bad_at "camera not in the calibration" rig.json "${N[@]}" --video "cam9=videos/vtest.avi" -o "$w/cap"
+bad_at "size mismatch" "$videos/Megamind.avi" "${N[@]}" --video "$A=$videos/Megamind.avi" -o "$w/cap"
+bad_at "size mismatch: no rotation" videos/vtest.avi "${N[@]}" --video "$B=videos/vtest.avi" -o "$w/cap"
+bad_at "frame-count mismatch" frames "${N[@]}" --video "$A=videos/vtest.avi" \
   --images "$B=frames" --rotate "$B=90" -o "$w/cap"
-bad "empty image folder" empty "${N[@]}" --images "$A=empty" --fps 25 -o "$w/cap"
-bad "images without a frame rate" frames "${N[@]}" --images "$A=frames" -o "$w/cap"
-bad "a video at another rate" videos/vtest.avi "${N[@]}" --video "$A=videos/vtest.avi" --images "$B=frames" \
+bad_at "empty image folder" empty "${N[@]}" --images "$A=empty" --fps 25 -o "$w/cap"
+bad_at "images without a frame rate" frames "${N[@]}" --images "$A=frames" -o "$w/cap"
+bad_at "a video at another rate" videos/vtest.avi "${N[@]}" --video "$A=videos/vtest.avi" --images "$B=frames" \
   --rotate "$B=90" --fps 25 --dropped-frames "$B=$(seq -s, 4 795)" -o "$w/cap"
-bad "rotate of an unknown camera" --rotate "${N[@]}" --video "$A=videos/vtest.avi" \
+bad_at "rotate of an unknown camera" --rotate "${N[@]}" --video "$A=videos/vtest.avi" \
   --rotate "$C=90" -o "$w/cap"
-bad "rotate by 45 degrees" --rotate "${N[@]}" --video "$A=videos/vtest.avi" --rotate "$A=45" \
+bad_at "rotate by 45 degrees" --rotate "${N[@]}" --video "$A=videos/vtest.avi" --rotate "$A=45" \
   -o "$w/cap"
-bad "dropped frames not a list" --dropped-frames "${N[@]}" --video "$A=videos/vtest.avi" \
+bad_at "dropped frames not a list" --dropped-frames "${N[@]}" --video "$A=videos/vtest.avi" \
   --dropped-frames "$A=1,x" -o "$w/cap"
 # Dropped frames put the counts right: 3 images + 792 dropped = 795.
 ok "capture new with dropped frames" "${N[@]}" --video "$A=videos/vtest.avi" \
@@ -139,15 +122,15 @@ ok "import-keypoints" capture import-keypoints caps/img --format openpose --came
 check 'grep -q "\"layout\": \"coco_wholebody_133\"" caps/img/capture.json && [ -f caps/img/keypoints2d.npy ]' \
   "import-keypoints names keypoints2d.npy: $(cat "$tmp/out")"
 cp -r caps/img "$w/img"
-bad "import-keypoints again" "$w/img/capture.json" capture import-keypoints "$w/img" \
+bad_at "import-keypoints again" "$w/img/capture.json" capture import-keypoints "$w/img" \
   --format openpose --camera "$A=op"
 ok "import-keypoints --overwrite" capture import-keypoints "$w/img" --format openpose \
   --camera "$A=op" --overwrite
 rm op/v_2_keypoints.json
-bad "import-keypoints: too few frames" op capture import-keypoints "$w/img" --format openpose \
+bad_at "import-keypoints: too few frames" op capture import-keypoints "$w/img" --format openpose \
   --camera "$A=op" --overwrite
 echo '{"people": [{"pose_keypoints_2d": [1, 2]}]}' >op/v_2_keypoints.json
-bad "import-keypoints: a malformed file" op/v_2_keypoints.json capture import-keypoints "$w/img" \
+bad_at "import-keypoints: a malformed file" op/v_2_keypoints.json capture import-keypoints "$w/img" \
   --format openpose --camera "$A=op" --overwrite
 
 check '[ -z "$(find "$tmp" -name ".tmp-*" -o -name ".old-*")" ]' "no temporaries left"

@@ -17,19 +17,7 @@ check_py=$src/src/arco/cli/export_check.py
 validator=$src/tools/gltf_validate
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fail=0
-check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
-snapshot() { (cd "$tmp/w" && find . | sort && find . -type f -exec md5sum {} + | sort); }
-bad() {  # bad NAME PATTERN ARGS...: exit 1, one "arco: error: PATTERN" line, nothing written
-  local name=$1 pattern=$2; shift 2
-  local before; before=$(snapshot)
-  "$arco" "$@" >/dev/null 2>"$tmp/err"
-  local rc=$?
-  local line; line=$(cat "$tmp/err")
-  check '[ $rc -eq 1 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ] && [[ "$line" == "arco: error: "$pattern ]]' \
-    "$name: exit $rc: $line"
-  check '[ "$(snapshot)" = "$before" ]' "$name: something was written"
-}
+source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 
 "$arco" synth -o "$tmp/cap" --duration-s 2 >/dev/null 2>&1 &&
   "$arco" run "$tmp/cap" -o "$tmp/res" >/dev/null 2>&1 ||
@@ -47,6 +35,7 @@ np.save(d + "/arco/points3d.npy", x)
 PY
 
 mkdir -p "$tmp/w"
+SNAPSHOT_DIR=$tmp/w
 for format in csv trc c3d gltf bvh; do
   out=$tmp/w/take.$format
   if ! "$arco" export "$tmp/res" --format $format -o "$out" >"$tmp/out" 2>"$tmp/err"; then
@@ -64,31 +53,31 @@ cp -r "$tmp/res" "$tmp/nopaper"
 import json, sys
 p = sys.argv[1] + '/result.json'; r = json.load(open(p)); del r['stages']['paper']
 json.dump(r, open(p, 'w'))" "$tmp/nopaper"
-bad "unknown format" "--format: 'fbx' is not csv, trc, c3d, gltf (glb) or bvh" \
+expect_error "unknown format" "--format: 'fbx' is not csv, trc, c3d, gltf (glb) or bvh" \
   export "$tmp/res" --format fbx -o "$tmp/w/x.fbx"
-bad "unknown method" "--method: 'truth' is not arco, paper or vision" \
+expect_error "unknown method" "--method: 'truth' is not arco, paper or vision" \
   export "$tmp/res" --format csv --method truth -o "$tmp/w/x.csv"
-bad "method not in the result" "$tmp/nopaper/result.json: the result has no 'paper' points*" \
+expect_error "method not in the result" "$tmp/nopaper/result.json: the result has no 'paper' points*" \
   export "$tmp/nopaper" --format csv --method paper -o "$tmp/w/x.csv"
-bad "no result folder" "$tmp/none/result.json: *" \
+expect_error "no result folder" "$tmp/none/result.json: *" \
   export "$tmp/none" --format csv -o "$tmp/w/x.csv"
-bad "output in a missing folder" "$tmp/w/missing/x.csv: *" \
+expect_error "output in a missing folder" "$tmp/w/missing/x.csv: *" \
   export "$tmp/res" --format csv -o "$tmp/w/missing/x.csv"
-bad "output under a file" "$tmp/w/take.csv/x.csv: *" \
+expect_error "output under a file" "$tmp/w/take.csv/x.csv: *" \
   export "$tmp/res" --format csv -o "$tmp/w/take.csv/x.csv"
 # Damaged results: one line naming the file.
 cp -r "$tmp/res" "$tmp/garbage" && echo "not an npy" >"$tmp/garbage/arco/points3d.npy"
-bad "points3d.npy not an npy" "$tmp/garbage/arco/points3d.npy: *" \
+expect_error "points3d.npy not an npy" "$tmp/garbage/arco/points3d.npy: *" \
   export "$tmp/garbage" --format bvh -o "$tmp/w/x.bvh"
 cp -r "$tmp/res" "$tmp/shape"
 "$py" -c "import numpy as np, sys; np.save(sys.argv[1], np.zeros((4, 10, 3)))" \
   "$tmp/shape/arco/points3d.npy"
-bad "points3d.npy of another layout" "$tmp/shape/arco/points3d.npy: shape is not (frames >= 1, 155, 3)" \
+expect_error "points3d.npy of another layout" "$tmp/shape/arco/points3d.npy: shape is not (frames >= 1, 155, 3)" \
   export "$tmp/shape" --format gltf -o "$tmp/w/x.glb"
 cp -r "$tmp/res" "$tmp/json" && echo "{" >"$tmp/json/result.json"
-bad "result.json not JSON" "$tmp/json/result.json: *" export "$tmp/json" --format trc -o "$tmp/w/x.trc"
+expect_error "result.json not JSON" "$tmp/json/result.json: *" export "$tmp/json" --format trc -o "$tmp/w/x.trc"
 mkdir -p "$tmp/w/dir"
-bad "output is a folder" "$tmp/w/dir: *" export "$tmp/res" --format trc -o "$tmp/w/dir"
+expect_error "output is a folder" "$tmp/w/dir: *" export "$tmp/res" --format trc -o "$tmp/w/dir"
 
 # The Khronos validator: 0 errors.
 if command -v node >/dev/null && [ -d "$validator/node_modules/gltf-validator" ]; then

@@ -12,8 +12,7 @@ arco=$(realpath "$1")
 export ARCO_SHARED_DATA_DIR=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fail=0
-check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
+source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 
 "$arco" synth --duration-s 1.5 --seed 5 -o "$tmp/good" >"$tmp/synth.log" 2>&1
 rc=$?

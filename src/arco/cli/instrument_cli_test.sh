@@ -3,8 +3,7 @@
 # input (one error line, exit 1). usage: instrument_cli_test.sh ARCO_BINARY
 set -uo pipefail
 arco=$1
-fail=0
-check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
+source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 
 out=$("$arco" instrument cello --f0-hz 440 2>&1); rc=$?
 check '[ $rc -eq 0 ]' "cello --f0-hz 440 exits 0"

@@ -6,8 +6,7 @@
 set -uo pipefail
 arco=$1
 export ARCO_SHARED_DATA_DIR=$2
-fail=0
-check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
+source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 # json FILE EXPR: the value of a Python expression over the parsed file `d`.

@@ -12,29 +12,10 @@ spd=$2/spd
 calib=$spd/cello_1113_scale_camera.xml
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 w=$tmp/w
+SNAPSHOT_DIR=$w
 mkdir -p "$w" "$tmp/in/h/21334181" "$tmp/in/h/21334237"
-fail=0
-check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
-snapshot() { (cd "$w" && find . | sort && find . -type f -exec md5sum {} + | sort); }
-# ok NAME ARGS...: exit 0.
-ok() {
-  local name=$1; shift
-  "$arco" "$@" >"$tmp/out" 2>"$tmp/err"
-  local rc=$?
-  check '[ $rc -eq 0 ]' "$name: exit $rc: $(tail -1 "$tmp/err")"
-}
-# bad NAME PATH ARGS...: non-zero exit, one stderr line "arco: error: PATH: ...", the
-# working folder unchanged (no partial output, old outputs intact, no temporaries).
-bad() {
-  local name=$1 path=$2; shift 2
-  local before; before=$(snapshot)
-  "$arco" "$@" >/dev/null 2>"$tmp/err"
-  local rc=$?
-  local line; line=$(cat "$tmp/err")
-  check '[ $rc -ne 0 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ] && [[ "$line" == "arco: error: $path: "* ]]' "$name: exit $rc: $line"
-  check '[ "$(snapshot)" = "$before" ]' "$name: the working folder changed"
-}
 
 echo "not a folder" >"$w/file"
 mkdir -p "$w/photos" "$w/dir"
@@ -44,13 +25,13 @@ echo "precious" >"$w/photos/a.jpg"
 S=(synth --calibration "$calib" --duration-s 1 --no-audio)
 ok "synth -o cap/" "${S[@]}" -o "$w/cap/"
 check '[ -f "$w/cap/capture.json" ] && [ -f "$w/cap/truth/points3d.npy" ]' "synth -o cap/ writes cap"
-bad "synth over a capture" "$w/cap" "${S[@]}" -o "$w/cap/"
+bad_at "synth over a capture" "$w/cap" "${S[@]}" -o "$w/cap/"
 echo old >"$w/cap/old.txt"
 ok "synth --overwrite" "${S[@]}" --seed 1 -o "$w/cap/" --overwrite
 check '[ -f "$w/cap/capture.json" ] && [ ! -e "$w/cap/old.txt" ]' "synth --overwrite replaces the capture"
-bad "synth --overwrite over another folder" "$w/photos" "${S[@]}" -o "$w/photos" --overwrite
-bad "synth over a file" "$w/file" "${S[@]}" -o "$w/file" --overwrite
-bad "synth under a file" "$w/file/sub/cap" "${S[@]}" -o "$w/file/sub/cap"
+bad_at "synth --overwrite over another folder" "$w/photos" "${S[@]}" -o "$w/photos" --overwrite
+bad_at "synth over a file" "$w/file" "${S[@]}" -o "$w/file" --overwrite
+bad_at "synth under a file" "$w/file/sub/cap" "${S[@]}" -o "$w/file/sub/cap"
 ok "synth into a missing parent" "${S[@]}" -o "$w/new/parent/cap"
 rm -rf "$w/new"
 
@@ -59,10 +40,10 @@ I=(import-spd --calibration "$calib" --human "$tmp/in/h" --serials 21334181 --se
    --first 1 --last 2)
 ok "import-spd -o imp/" "${I[@]}" -o "$w/imp/"
 check '[ -f "$w/imp/capture.json" ] && grep -q "\"name\": \"imp\"" "$w/imp/capture.json"' "import-spd -o imp/ names the capture imp"
-bad "import-spd over a capture" "$w/imp" "${I[@]}" -o "$w/imp"
+bad_at "import-spd over a capture" "$w/imp" "${I[@]}" -o "$w/imp"
 ok "import-spd --overwrite" "${I[@]}" -o "$w/imp/" --overwrite
-bad "import-spd --overwrite over another folder" "$w/photos" "${I[@]}" -o "$w/photos/" --overwrite
-bad "import-spd under a file" "$w/file/imp" "${I[@]}" -o "$w/file/imp"
+bad_at "import-spd --overwrite over another folder" "$w/photos" "${I[@]}" -o "$w/photos/" --overwrite
+bad_at "import-spd under a file" "$w/file/imp" "${I[@]}" -o "$w/file/imp"
 
 # capture new: a capture folder referencing its videos (here one 2300x2656 image, SPD's
 # rotated frame size); capture import-keypoints: keypoints2d.npy and capture.json together.
@@ -78,14 +59,14 @@ PY
 C=(capture new --calibration "$calib" --video "21334181=$tmp/in/frame.png" --fps 30)
 ok "capture new -o new/" "${C[@]}" -o "$w/new/"
 check '[ -f "$w/new/capture.json" ] && grep -q "\"name\": \"new\"" "$w/new/capture.json"' "capture new -o new/ writes new"
-bad "capture new over a capture" "$w/new" "${C[@]}" -o "$w/new"
+bad_at "capture new over a capture" "$w/new" "${C[@]}" -o "$w/new"
 ok "capture new --overwrite" "${C[@]}" -o "$w/new/" --overwrite
-bad "capture new --overwrite over another folder" "$w/photos" "${C[@]}" -o "$w/photos/" --overwrite
-bad "capture new under a file" "$w/file/new" "${C[@]}" -o "$w/file/new"
+bad_at "capture new --overwrite over another folder" "$w/photos" "${C[@]}" -o "$w/photos/" --overwrite
+bad_at "capture new under a file" "$w/file/new" "${C[@]}" -o "$w/file/new"
 echo '[{"frame_id": 0, "instances": []}]' >"$tmp/in/mm.json"
 K=(capture import-keypoints --format mmpose --camera "21334181=$tmp/in/mm.json")
 mkdir "$w/new/keypoints2d.npy"
-bad "capture import-keypoints onto a folder" "$w/new/keypoints2d.npy" "${K[@]}" "$w/new"
+bad_at "capture import-keypoints onto a folder" "$w/new/keypoints2d.npy" "${K[@]}" "$w/new"
 rmdir "$w/new/keypoints2d.npy"
 ok "capture import-keypoints" "${K[@]}" "$w/new/"
 check '[ -f "$w/new/keypoints2d.npy" ] && grep -q "keypoints2d.npy" "$w/new/capture.json"' "capture import-keypoints writes both"
@@ -93,12 +74,12 @@ check '[ -f "$w/new/keypoints2d.npy" ] && grep -q "keypoints2d.npy" "$w/new/capt
 # run: a result folder.
 ok "run -o res/" run "$w/cap" -o "$w/res/" --threads 2
 check '[ -f "$w/res/result.json" ] && [ -f "$w/res/vision/points3d.npy" ]' "run -o res/ writes res"
-bad "run over a result" "$w/res" run "$w/cap" -o "$w/res"
+bad_at "run over a result" "$w/res" run "$w/cap" -o "$w/res"
 echo old >"$w/res/old.txt"
 ok "run --overwrite" run "$w/cap" -o "$w/res/" --overwrite --threads 2
 check '[ -f "$w/res/result.json" ] && [ ! -e "$w/res/old.txt" ]' "run --overwrite replaces the result"
-bad "run --overwrite over another folder" "$w/photos" run "$w/cap" -o "$w/photos" --overwrite
-bad "run under a file" "$w/file/res" run "$w/cap" -o "$w/file/res"
+bad_at "run --overwrite over another folder" "$w/photos" run "$w/cap" -o "$w/photos" --overwrite
+bad_at "run under a file" "$w/file/res" run "$w/cap" -o "$w/file/res"
 
 # refine: updates a result folder in place.
 ok "refine res/" refine "$w/res/" --mode vision
@@ -106,53 +87,53 @@ ok "refine res/" refine "$w/res/" --mode vision
 # triangulate: a capture into a result folder; labelled views into a JSON file.
 ok "triangulate -o tri/" triangulate "$w/cap" -o "$w/tri/"
 check '[ -f "$w/tri/result.json" ] && [ -f "$w/tri/triangulation/points3d.npy" ]' "triangulate -o tri/ writes tri"
-bad "triangulate into another folder" "$w/photos" triangulate "$w/cap" -o "$w/photos"
-bad "triangulate under a file" "$w/file/tri" triangulate "$w/cap" -o "$w/file/tri"
+bad_at "triangulate into another folder" "$w/photos" triangulate "$w/cap" -o "$w/photos"
+bad_at "triangulate under a file" "$w/file/tri" triangulate "$w/cap" -o "$w/file/tri"
 V=(triangulate --calibration "$spd/camera.xml")
 for serial in 21334181 21334190 21334211 21334237; do
   V+=(--view "$serial=$spd/labels_frame128/cello_1113_scale_${serial}_128.json")
 done
 V=(triangulate --calibration "$calib" "${V[@]:3}")
 ok "triangulate views" "${V[@]}" -o "$w/points.json"
-bad "triangulate views into a folder" "$w/dir" "${V[@]}" -o "$w/dir"
-bad "triangulate views into a missing folder" "$w/nodir/p.json" "${V[@]}" -o "$w/nodir/p.json"
-bad "triangulate views under a file" "$w/file/p.json" "${V[@]}" -o "$w/file/p.json"
+bad_at "triangulate views into a folder" "$w/dir" "${V[@]}" -o "$w/dir"
+bad_at "triangulate views into a missing folder" "$w/nodir/p.json" "${V[@]}" -o "$w/nodir/p.json"
+bad_at "triangulate views under a file" "$w/file/p.json" "${V[@]}" -o "$w/file/p.json"
 
 # eval: metrics JSON and plot, both or neither.
 E=(eval "$w/res" --truth "$w/cap/truth")
 ok "eval -o --plot" "${E[@]}" -o "$w/e.json" --plot "$w/e.svg"
 check '[ -s "$w/e.json" ] && [ -s "$w/e.svg" ]' "eval writes both outputs"
 rm "$w/e.json" "$w/e.svg"
-bad "eval plot in a missing folder" "$w/nodir/e.svg" "${E[@]}" -o "$w/e.json" --plot "$w/nodir/e.svg"
-bad "eval -o a folder" "$w/dir" "${E[@]}" -o "$w/dir"
-bad "eval plot under a file" "$w/file/e.svg" "${E[@]}" -o "$w/e.json" --plot "$w/file/e.svg"
+bad_at "eval plot in a missing folder" "$w/nodir/e.svg" "${E[@]}" -o "$w/e.json" --plot "$w/nodir/e.svg"
+bad_at "eval -o a folder" "$w/dir" "${E[@]}" -o "$w/dir"
+bad_at "eval plot under a file" "$w/file/e.svg" "${E[@]}" -o "$w/e.json" --plot "$w/file/e.svg"
 
 # export: one file.
 X=(export "$w/res" --format c3d --method vision)
 ok "export -o" "${X[@]}" -o "$w/x.c3d"
 check '[ -s "$w/x.c3d" ]' "export writes its file"
 rm "$w/x.c3d"
-bad "export in a missing folder" "$w/nodir/x.c3d" "${X[@]}" -o "$w/nodir/x.c3d"
-bad "export -o a folder" "$w/dir" "${X[@]}" -o "$w/dir"
-bad "export under a file" "$w/file/x.c3d" "${X[@]}" -o "$w/file/x.c3d"
+bad_at "export in a missing folder" "$w/nodir/x.c3d" "${X[@]}" -o "$w/nodir/x.c3d"
+bad_at "export -o a folder" "$w/dir" "${X[@]}" -o "$w/dir"
+bad_at "export under a file" "$w/file/x.c3d" "${X[@]}" -o "$w/file/x.c3d"
 
 # pitch: pitch.csv, --fine, --notes, --midi, all or none.
 P=(pitch "$spd/pgy.wav" --frames 60)
 ok "pitch every output" "${P[@]}" -o "$w/p.csv" --fine "$w/f.csv" --notes "$w/n.csv" --midi "$w/m.mid"
 check '[ -s "$w/p.csv" ] && [ -s "$w/f.csv" ] && [ -s "$w/n.csv" ] && [ -s "$w/m.mid" ]' "pitch writes every output"
 rm "$w/p.csv" "$w/f.csv" "$w/n.csv" "$w/m.mid"
-bad "pitch notes in a missing folder" "$w/nodir/n.csv" "${P[@]}" -o "$w/p.csv" --notes "$w/nodir/n.csv"
-bad "pitch -o a folder" "$w/dir" "${P[@]}" -o "$w/dir"
-bad "pitch -o a folder path" "$w/p.csv/" "${P[@]}" -o "$w/p.csv/"
-bad "pitch midi under a file" "$w/file/m.mid" "${P[@]}" -o "$w/p.csv" --midi "$w/file/m.mid"
+bad_at "pitch notes in a missing folder" "$w/nodir/n.csv" "${P[@]}" -o "$w/p.csv" --notes "$w/nodir/n.csv"
+bad_at "pitch -o a folder" "$w/dir" "${P[@]}" -o "$w/dir"
+bad_at "pitch -o a folder path" "$w/p.csv/" "${P[@]}" -o "$w/p.csv/"
+bad_at "pitch midi under a file" "$w/file/m.mid" "${P[@]}" -o "$w/p.csv" --midi "$w/file/m.mid"
 echo old >"$w/p.csv"
-bad "pitch fine in a missing folder keeps the old pitch.csv" "$w/nodir/f.csv" "${P[@]}" -o "$w/p.csv" --fine "$w/nodir/f.csv"
+bad_at "pitch fine in a missing folder keeps the old pitch.csv" "$w/nodir/f.csv" "${P[@]}" -o "$w/p.csv" --fine "$w/nodir/f.csv"
 rm "$w/p.csv"
 
 # calibration convert: one file.
 ok "calibration convert" calibration convert "$calib" "$w/c.json"
-bad "calibration convert into a folder" "$w/dir" calibration convert "$calib" "$w/dir"
-bad "calibration convert into a missing folder" "$w/nodir/c.json" calibration convert "$calib" "$w/nodir/c.json"
+bad_at "calibration convert into a folder" "$w/dir" calibration convert "$calib" "$w/dir"
+bad_at "calibration convert into a missing folder" "$w/nodir/c.json" calibration convert "$calib" "$w/nodir/c.json"
 
 # calibrate: the calibration and its report, both or neither.
 data=/usr/share/doc/opencv-doc/examples/data
@@ -166,11 +147,11 @@ check '[ -f "$w/rig.json" ] && [ -f "$w/rig.report.json" ]' "calibrate writes ri
 ok "calibrate -o rig.yaml over an old report" "${K[@]}" -o "$w/rig.yaml"
 check 'grep -q "%YAML" "$w/rig.yaml"' "calibrate -o rig.yaml writes OpenCV YAML"
 rm "$w/rig.yaml" "$w/rig.json"
-bad "calibrate into a folder" "$w/dir" "${K[@]}" -o "$w/dir"
-bad "calibrate into a missing folder" "$w/nodir/rig.json" "${K[@]}" -o "$w/nodir/rig.json"
-bad "calibrate under a file" "$w/file/rig.json" "${K[@]}" -o "$w/file/rig.json"
+bad_at "calibrate into a folder" "$w/dir" "${K[@]}" -o "$w/dir"
+bad_at "calibrate into a missing folder" "$w/nodir/rig.json" "${K[@]}" -o "$w/nodir/rig.json"
+bad_at "calibrate under a file" "$w/file/rig.json" "${K[@]}" -o "$w/file/rig.json"
 mkdir "$w/r2.report.json"
-bad "calibrate: the report's path is a folder" "$w/r2.report.json" "${K[@]}" -o "$w/r2.json"
+bad_at "calibrate: the report's path is a folder" "$w/r2.report.json" "${K[@]}" -o "$w/r2.json"
 rmdir "$w/r2.report.json"
 rm "$w/rig.report.json"
 

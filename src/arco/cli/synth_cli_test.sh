@@ -8,8 +8,7 @@ arco=$1
 spd=$2/spd
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fail=0
-check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
+source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 # bad_input NAME ARGS...: exit 1, exactly one stderr line starting "arco: error:", no $tmp/bad
 bad_input() {
   local name=$1; shift

@@ -11,22 +11,8 @@ photo=/usr/share/doc/opencv-doc/examples/data/messi5.jpg
 if [ ! -f "$photo" ]; then echo "FAILED: $photo is needed (apt-get install opencv-doc)"; exit 1; fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fail=0
-check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
+source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 cd "$tmp" || exit 1
-snapshot() { (find . | sort && find . -type f -exec md5sum {} + | sort); }
-# bad NAME TEXT ARGS...: exit 1, one stderr line "arco: error: ...TEXT...", nothing changed.
-bad() {
-  local name=$1 text=$2; shift 2
-  local before; before=$(snapshot)
-  "$arco" "$@" >/dev/null 2>err.txt
-  local rc=$?
-  local line; line=$(cat err.txt)
-  rm -f err.txt
-  check '[ $rc -eq 1 ] && [ "$(echo "$line" | wc -l)" -eq 1 ] && [[ "$line" == "arco: error: "*"$text"* ]]' \
-    "$name: exit $rc: $line"
-  check '[ "$(snapshot)" = "$before" ]' "$name: the folder changed"
-}
 
 cat > cal.json <<'JSON'
 {"format": "arco-calibration", "version": 1, "units": "mm", "cameras": [

@@ -1,0 +1,52 @@
+# Shared helpers of the command-line tests (src/arco/cli/*_cli_test.sh), sourced after the
+# test has set `arco` (the binary) and made `tmp` (its scratch folder):
+#   source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
+# A bad input must give exactly one stderr line "arco: error: ...", exit status 1 and
+# leave the watched folder (SNAPSHOT_DIR, default: the current folder) exactly as it was:
+# no partial output, old outputs intact, no temporaries (docs/architecture.md, "Outputs").
+fail=0
+
+# check CONDITION MESSAGE: evaluates CONDITION; prints "FAILED: MESSAGE" when it is false.
+check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
+
+# snapshot: every path and every file's checksum below SNAPSHOT_DIR.
+snapshot() {
+  (cd "${SNAPSHOT_DIR:-.}" && find . | sort && find . -type f -exec md5sum {} + | sort)
+}
+
+# ok NAME ARGS...: `arco ARGS` exits 0 (its output in $tmp/out and $tmp/err).
+ok() {
+  local name=$1; shift
+  "$arco" "$@" >"$tmp/out" 2>"$tmp/err"
+  local rc=$?
+  check '[ $rc -eq 0 ]' "$name: exit $rc: $(tail -1 "$tmp/err")"
+}
+
+# expect_error NAME PATTERN ARGS...: `arco ARGS` exits 1 with one stderr line matching
+# "arco: error: PATTERN" (a shell glob: quote literal parts) and changes nothing.
+expect_error() {
+  local name=$1 pattern=$2; shift 2
+  local before; before=$(snapshot)
+  local line; line=$("$arco" "$@" 2>&1 >/dev/null)
+  local rc=$?
+  local one_line=0
+  if [ -n "$line" ] && [[ "$line" != *$'\n'* ]]; then one_line=1; fi
+  check '[ $rc -eq 1 ] && [ $one_line -eq 1 ] && [[ "$line" == "arco: error: "$pattern ]]' \
+    "$name: exit $rc: $line"
+  check '[ "$(snapshot)" = "$before" ]' "$name: the folder changed"
+}
+
+# glob_literal TEXT: TEXT with the glob characters escaped, to match it literally.
+glob_literal() { printf '%s' "$1" | sed 's/[][*?\\]/\\&/g'; }
+
+# bad NAME TEXT ARGS...: expect_error with a line that says TEXT (literally) anywhere.
+bad() {
+  local name=$1 text; text=$(glob_literal "$2"); shift 2
+  expect_error "$name" "*$text*" "$@"
+}
+
+# bad_at NAME PATH ARGS...: expect_error with a line that starts "arco: error: PATH: ".
+bad_at() {
+  local name=$1 path; path=$(glob_literal "$2"); shift 2
+  expect_error "$name" "$path: *" "$@"
+}
