@@ -49,7 +49,7 @@ rc=$?
 check '[ $rc -eq 0 ]' "detect: exit $rc: $(tail -1 err.txt)"
 check 'grep -q "detected frames 1:1 in 2 cameras (layout coco_wholebody_133)" out.txt' "summary: $(cat out.txt)"
 check 'grep -Eq "front +1 frames  person 100.0%" out.txt' "front camera line: $(cat out.txt)"
-check 'grep -q "wrote cap/keypoints2d.npy and capture.json" out.txt' "wrote line"
+check 'grep -q "wrote cap/keypoints2d.npy, detect.json and capture.json" out.txt' "wrote line"
 /usr/bin/python3 - <<'PY' || { echo "FAILED: keypoints2d.npy"; fail=1; }
 import json
 import numpy as np

@@ -95,7 +95,7 @@ int RunDetect(const DetectArgs& a) {
               frames > 0 ? 1e3 * s.total.inference_s / frames : 0.0,
               frames > 0 ? 1e3 * s.decode_s / frames : 0.0);
   if (s.kept_other_points) std::printf("kept the instrument and bow points already there\n");
-  std::printf("wrote %s/keypoints2d.npy and capture.json\n",
+  std::printf("wrote %s/keypoints2d.npy, detect.json and capture.json\n",
               NormalizeOutputPath(a.o.capture_dir).c_str());
   return 0;
 }
