@@ -11,7 +11,6 @@ namespace arco::cli {
 namespace {
 
 inline constexpr FieldFlag kOverlayFlags[] = {{"result_dir", "RESULT_DIR"},
-                                              {"camera", "--camera"},
                                               {"method", "--method"},
                                               {"scale", "--scale"},
                                               {"first_frame", "--frames"},
