@@ -505,8 +505,8 @@ StatusOr<std::vector<PlotScene>> BuildPlots(const PlotOptions& o) {
   const pipeline::ResultFolder folder(o.result_dir);
   ARCO_ASSIGN_OR_RETURN(const auto notes, folder.ReadFingering(o.method));
   if (notes.empty()) {
-    return Status::Error(folder.FingeringPath(o.method) +
-                         ": no notes (the method has no fingering: plot arco or paper)");
+    return Status::Error(folder.FingeringPath(o.method) + ": no notes (" + o.method +
+                         " has no fingering: plot arco or paper)");
   }
   ARCO_ASSIGN_OR_RETURN(const auto pitch, folder.ReadPitch());
   double a4_hz = 440, string_length_mm = 0;
