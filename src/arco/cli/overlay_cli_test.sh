@@ -44,17 +44,26 @@ frames=$("$py" -c "import json,sys; print(json.load(open(sys.argv[1]))['frames']
 cam=camera_21334181_1
 mkdir -p "$tmp/w"
 
+# World units other than mm (as SPD's Metashape rigs): the calibration in metres
+# (translations / 1000) and the result's world_units_per_mm 0.001 describe the same
+# scene, so the overlay must convert the method's mm points to project them.
 # No video: blank frames of the calibration's size (full size, a few frames; then all
 # frames at a quarter size). For the full-size check, camera 21334209 (which sees the left
 # hand farthest from its centre) gets a stronger lens (k1 -0.4; the result's 3D points do
 # not change), so that a projection without distortion misses the marks (MIN_SHIFTED).
-"$py" - "$tmp/cap/calibration.json" <<'PY' || { echo "FAILED: editing the calibration"; exit 1; }
+"$py" - "$tmp/cap/calibration.json" "$tmp/res/result.json" <<'PY' || { echo "FAILED: editing the calibration"; exit 1; }
 import json, sys
 c = json.load(open(sys.argv[1]))
+c["units"] = "m"
 for x in c["cameras"]:
+    x["t"] = [v / 1000 for v in x["t"]]
     if x["name"] == "camera_21334209_1":
         x["distortion"]["k1"] = -0.4
 json.dump(c, open(sys.argv[1], "w"), indent=2)
+r = json.load(open(sys.argv[2]))
+assert r["stages"]["instrument"]["world_units_per_mm"] == 1
+r["stages"]["instrument"]["world_units_per_mm"] = 0.001
+json.dump(r, open(sys.argv[2], "w"), indent=2)
 PY
 check '"$arco" overlay "$tmp/res" --camera camera_21334209_1 --frames 20:29 -o "$tmp/w/full.mp4" >"$tmp/out"' \
   "overlay without video: $(cat "$tmp/out" 2>/dev/null)"
