@@ -70,6 +70,9 @@ check '"$arco" overlay "$tmp/res" --camera camera_21334209_1 --frames 20:29 -o "
 grep -q "no video: blank frames" "$tmp/out" || { echo "FAILED: blank-frame line"; fail=1; }
 check 'MIN_SHIFTED=10 "$py" "$check_py" "$tmp/w/full.mp4" "$tmp/res" camera_21334209_1 1 20 29' \
   "blank frames, full size, distorted"
+# The same input gives the same bytes.
+check '"$arco" overlay "$tmp/res" --camera camera_21334209_1 --frames 20:29 -o "$tmp/again.mp4" >/dev/null && cmp -s "$tmp/w/full.mp4" "$tmp/again.mp4"' \
+  "a second run gives the same file"
 check '"$arco" overlay "$tmp/res" --camera $cam --scale 0.25 -o "$tmp/w/small.mkv" >/dev/null' \
   "overlay .mkv"
 check '"$py" "$check_py" "$tmp/w/small.mkv" "$tmp/res" $cam 0.25 1 $frames' "blank frames, all"

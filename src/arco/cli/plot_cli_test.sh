@@ -43,6 +43,8 @@ mkdir -p "$tmp/w"
 check '"$arco" plot "$tmp/res" -o "$tmp/w/plots" >"$tmp/out"' "plot: $(cat "$tmp/out" 2>/dev/null)"
 grep -q "errors against the truth" "$tmp/out" || { echo "FAILED: no error figure"; fail=1; }
 check '"$py" "$check_py" "$tmp/w/plots" "$tmp/res" arco 1200 600 1' "arco's figures"
+check '"$arco" plot "$tmp/res" -o "$tmp/again" >/dev/null && diff -r "$tmp/w/plots" "$tmp/again" >/dev/null' \
+  "a second run gives the same files"
 check '"$arco" plot "$tmp/res" --method paper --width 900 --height 500 -o "$tmp/w/paper" >/dev/null' \
   "plot paper"
 check '"$py" "$check_py" "$tmp/w/paper" "$tmp/res" paper 900 500 1' "paper's figures, 900x500"
