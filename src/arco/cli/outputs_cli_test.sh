@@ -117,6 +117,23 @@ bad_at "export in a missing folder" "$w/nodir/x.c3d" "${X[@]}" -o "$w/nodir/x.c3
 bad_at "export -o a folder" "$w/dir" "${X[@]}" -o "$w/dir"
 bad_at "export under a file" "$w/file/x.c3d" "${X[@]}" -o "$w/file/x.c3d"
 
+# overlay: one video file.
+O=(overlay "$w/res" --method vision --camera camera_21334181_1 --frames 1:3 --scale 0.1)
+ok "overlay -o" "${O[@]}" -o "$w/o.mkv"
+check '[ -s "$w/o.mkv" ]' "overlay writes its video"
+rm "$w/o.mkv"
+bad "overlay in a missing folder" "$w/nodir/o.mkv" "${O[@]}" -o "$w/nodir/o.mkv"
+bad "overlay -o a folder" "$w/dir" "${O[@]}" -o "$w/dir"
+bad "overlay under a file" "$w/file/o.mkv" "${O[@]}" -o "$w/file/o.mkv"
+
+# plot: one folder, replaced only with --overwrite and only when it is a plot folder (the
+# paths are checked before the work; this result has no fingering to plot, so the written
+# and replaced folders are in plot_cli_test).
+bad "plot over another folder" "$w/photos" plot "$w/res" -o "$w/photos/"
+bad "plot --overwrite over another folder" "$w/photos" plot "$w/res" -o "$w/photos/" --overwrite
+bad "plot over a file" "$w/file" plot "$w/res" -o "$w/file" --overwrite
+bad "plot under a file" "$w/file/plots" plot "$w/res" -o "$w/file/plots"
+
 # pitch: pitch.csv, --fine, --notes, --midi, all or none.
 P=(pitch "$spd/pgy.wav" --frames 60)
 ok "pitch every output" "${P[@]}" -o "$w/p.csv" --fine "$w/f.csv" --notes "$w/n.csv" --midi "$w/m.mid"

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <random>
 
+#include "arco/export/plot.h"
 #include "arco/registry/keypoint_layout.h"
 
 namespace arco::exporter {
@@ -142,6 +143,60 @@ TEST(LoadExportData, MissingResultNamesTheFile) {
   auto d = LoadExportData(o);
   ASSERT_FALSE(d.ok());
   EXPECT_NE(d.status().message().find("/nonexistent/result"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace arco::exporter
+
+namespace arco::exporter {
+namespace {
+
+// One scene, two writers: the SVG names what the raster shows.
+TEST(Plot, SvgAndRasterDrawTheSameScene) {
+  PlotScene scene{"t", 400, 300, {}};
+  PlotShape r;
+  r.kind = PlotShape::Kind::kRect;
+  r.points = {{100, 50}, {200, 90}};
+  r.filled = true;
+  r.fill = {10, 200, 30};
+  r.outlined = false;
+  r.css_class = "note";
+  r.data = {{"name", "C#2"}};
+  scene.shapes.push_back(r);
+  PlotShape c;
+  c.kind = PlotShape::Kind::kCircle;
+  c.points = {{300, 200}};
+  c.size = 9;
+  c.filled = true;
+  c.fill = {200, 0, 0};
+  c.stroke = {200, 0, 0};
+  scene.shapes.push_back(c);
+  PlotShape t;
+  t.kind = PlotShape::Kind::kText;
+  t.points = {{20, 280}};
+  t.text = "a<b & c";
+  t.size = 14;
+  scene.shapes.push_back(t);
+  const std::string svg = PlotSvg(scene);
+  EXPECT_NE(svg.find("<rect class=\"note\" data-name=\"C#2\" x=\"100.000\" y=\"50.000\" "
+                     "width=\"100.000\" height=\"40.000\" fill=\"#0ac81e\""),
+            std::string::npos)
+      << svg;
+  EXPECT_NE(svg.find("cx=\"300.000\" cy=\"200.000\" r=\"9\" fill=\"#c80000\""), std::string::npos);
+  EXPECT_NE(svg.find(">a&lt;b &amp; c</text>"), std::string::npos);
+  const media::Image png = RasterisePlot(scene);
+  ASSERT_EQ(png.width, 400);
+  ASSERT_EQ(png.height, 300);
+  EXPECT_EQ(png.at(150, 70, 0), 10);  // the rectangle's fill
+  EXPECT_EQ(png.at(150, 70, 1), 200);
+  EXPECT_EQ(png.at(300, 200, 0), 200);  // the disc
+  EXPECT_EQ(png.at(300, 200, 1), 0);
+  EXPECT_EQ(png.at(5, 5, 0), 255);  // background
+  int ink = 0;                      // the text is drawn near its anchor
+  for (int y = 265; y < 285; ++y) {
+    for (int x = 20; x < 90; ++x) ink += png.at(x, y, 0) < 128;
+  }
+  EXPECT_GT(ink, 20);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@ extern "C" {
 #include <libavcodec/avcodec.h>
 #include <libavformat/avformat.h>
 #include <libavutil/display.h>
+#include <libavutil/log.h>
 #include <libavutil/opt.h>
 #include <libavutil/pixdesc.h>
 #include <libswscale/swscale.h>
@@ -115,6 +116,9 @@ struct VideoWriter::State {
 
 StatusOr<VideoWriter> VideoWriter::Open(const std::string& path,
                                         const VideoWriterOptions& options) {
+  // libav (and libx264 through it) logs to stderr by default; every failure is returned
+  // as a Status instead (as the reader does, video_file.cc).
+  av_log_set_level(AV_LOG_QUIET);
   if (Status valid = options.Validate(); !valid.ok()) {
     return Status::Error(path + ": " + valid.message());
   }

@@ -28,4 +28,15 @@ StatusOr<std::vector<CaptureVideo>> OpenCaptureVideos(const std::string& capture
                                                       int64_t first,
                                                       int64_t last);
 
+// One camera's video (manifest index `view`), with the same checks; `calibration` is its
+// calibration camera (MatchCaptureCameras). For a stage that needs only one camera
+// (`arco overlay`): the others need no video.
+StatusOr<CaptureVideo> OpenCaptureVideo(const std::string& capture_dir,
+                                        const CaptureManifest& manifest,
+                                        int view,
+                                        const Camera& calibration,
+                                        const std::string& calibration_path,
+                                        int64_t first,
+                                        int64_t last);
+
 }  // namespace arco::pipeline

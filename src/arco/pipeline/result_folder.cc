@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <map>
 #include <sstream>
+#include <type_traits>
 
 #include "arco/hand/hand_params.h"
 #include "arco/refine/contacts_csv.h"
@@ -76,6 +77,89 @@ std::string ResultFolder::BoneLengthsPath() const {
 
 std::string ResultFolder::ContactsPath(const std::string& method) const {
   return StagePath(method, kContactsCsvFile);
+}
+
+std::string ResultFolder::FingeringPath(const std::string& method) const {
+  return StagePath(method, kFingeringCsvFile);
+}
+
+StatusOr<std::vector<refine::NoteFingering>> ResultFolder::ReadFingering(
+    const std::string& method) const {
+  const std::string path = FingeringPath(method);
+  std::vector<refine::NoteFingering> rows;
+  if (!FileExists(path)) return rows;
+  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
+  std::istringstream in(text);
+  std::string line;
+  if (!std::getline(in, line)) return Status::Error(path + ": empty (no header)");
+  const std::vector<std::string> header = SplitCsvLine(line);
+  const std::vector<std::string> wanted = SplitCsvLine(kFingeringCsvHeader);
+  std::vector<int> column(wanted.size(), -1);
+  for (size_t w = 0; w < wanted.size(); ++w) {
+    for (size_t h = 0; h < header.size(); ++h) {
+      if (header[h] == wanted[w]) column[w] = static_cast<int>(h);
+    }
+    // note_name is derived from midi_note; every other column is read.
+    if (column[w] < 0 && wanted[w] != "note_name") {
+      return Status::Error(path + ": no column '" + wanted[w] + "'");
+    }
+  }
+  int line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.empty()) continue;
+    const std::vector<std::string> cells = SplitCsvLine(line);
+    const std::string where = path + ": line " + std::to_string(line_number);
+    auto cell = [&](const char* name) -> const std::string* {
+      for (size_t w = 0; w < wanted.size(); ++w) {
+        if (wanted[w] == name) {
+          return column[w] < static_cast<int>(cells.size()) ? &cells[column[w]] : nullptr;
+        }
+      }
+      return nullptr;
+    };
+    bool ok = true;
+    auto integer = [&](const char* name, auto* out) {
+      const std::string* c = cell(name);
+      int64_t v = 0;
+      if (c == nullptr || !ParseCsvInt(*c, &v)) {
+        ok = false;
+        return;
+      }
+      *out = static_cast<std::remove_pointer_t<decltype(out)>>(v);
+    };
+    auto number = [&](const char* name, double* out) {
+      const std::string* c = cell(name);
+      if (c == nullptr || !ParseCsvDouble(*c, out)) ok = false;
+    };
+    refine::NoteFingering r;
+    integer("note", &r.note);
+    integer("first_frame", &r.first_frame);
+    integer("last_frame", &r.last_frame);
+    number("onset_s", &r.onset_s);
+    number("duration_s", &r.duration_s);
+    number("f0_hz", &r.f0_hz);
+    integer("midi_note", &r.midi_note);
+    number("cents_off", &r.cents_off);
+    const std::string* state = cell("state");
+    if (state == nullptr)
+      ok = false;
+    else
+      r.state = *state;
+    integer("string", &r.string);
+    integer("finger", &r.finger);
+    number("position_semitones", &r.position_semitones);
+    number("from_nut_mm", &r.from_nut_mm);
+    integer("pressed_frames", &r.pressed_frames);
+    integer("open_frames", &r.open_frames);
+    integer("uncertain_frames", &r.uncertain_frames);
+    if (!ok) return Status::Error(where + ": a short row or a cell that is not a number");
+    if (r.last_frame < r.first_frame) {
+      return Status::Error(where + ": last_frame is before first_frame");
+    }
+    rows.push_back(std::move(r));
+  }
+  return rows;
 }
 
 StatusOr<Json> ResultFolder::ReadManifest() const {

@@ -184,6 +184,11 @@ class ResultFolder {
 
   Status WriteMethod(const MethodRecord& record) const;
   std::string ContactsPath(const std::string& method) const;
+  std::string FingeringPath(const std::string& method) const;
+  // <method>/fingering.csv (kFingeringCsvHeader; columns found by name), empty when the
+  // method has none (vision). Errors name the file and line: a missing column, a short
+  // row, an unparsable number.
+  StatusOr<std::vector<refine::NoteFingering>> ReadFingering(const std::string& method) const;
 
   // result.json "options": every option `arco run` applied (pipeline::ToJson(RunOptions)),
   // written once all stages are done.

@@ -131,6 +131,41 @@ TEST(ResultFolder, WriteMethodWritesTheFolderAndTheManifestAndReadsBack) {
   EXPECT_EQ((*rows)[4].finger, 2);
   EXPECT_EQ((*rows)[4].point_mm, r.contacts[4].point_in_world_mm);  // exact round trip
   EXPECT_TRUE(FileExists(dir / "arco/fingering.csv"));
+  // fingering.csv reads back (%.17g: exact).
+  const auto fingering = ResultFolder(dir.path()).ReadFingering("arco");
+  ASSERT_TRUE(fingering.ok()) << fingering.status().message();
+  ASSERT_EQ(fingering->size(), r.fingering.size());
+  ASSERT_FALSE(r.fingering.empty());
+  for (size_t i = 0; i < r.fingering.size(); ++i) {
+    const refine::NoteFingering &a = (*fingering)[i], &b = r.fingering[i];
+    EXPECT_EQ(a.note, b.note);
+    EXPECT_EQ(a.first_frame, b.first_frame);
+    EXPECT_EQ(a.last_frame, b.last_frame);
+    EXPECT_EQ(a.onset_s, b.onset_s);
+    EXPECT_EQ(a.f0_hz, b.f0_hz);
+    EXPECT_EQ(a.midi_note, b.midi_note);
+    EXPECT_EQ(a.cents_off, b.cents_off);
+    EXPECT_EQ(a.state, b.state);
+    EXPECT_EQ(a.string, b.string);
+    EXPECT_EQ(a.finger, b.finger);
+    EXPECT_EQ(std::isnan(a.from_nut_mm), std::isnan(b.from_nut_mm));
+    if (!std::isnan(b.from_nut_mm)) EXPECT_EQ(a.from_nut_mm, b.from_nut_mm);
+    EXPECT_EQ(a.pressed_frames, b.pressed_frames);
+  }
+  // A damaged row names the file and line; a method without the file has no notes.
+  {
+    auto text = ReadFileToString(dir / "arco/fingering.csv");
+    ASSERT_TRUE(text.ok());
+    ASSERT_TRUE(AtomicWriteFile(dir / "arco/fingering.csv", *text + "9,x,3\n").ok());
+    const auto bad = ResultFolder(dir.path()).ReadFingering("arco");
+    ASSERT_FALSE(bad.ok());
+    EXPECT_NE(bad.status().message().find("fingering.csv: line"), std::string::npos)
+        << bad.status().message();
+    ASSERT_TRUE(AtomicWriteFile(dir / "arco/fingering.csv", *text).ok());
+    const auto none = ResultFolder(dir.path()).ReadFingering("vision");
+    ASSERT_TRUE(none.ok());
+    EXPECT_TRUE(none->empty());
+  }
   // A second method keeps the first in the manifest; vision has no contacts.
   out.method = "vision";
   out.contacts.clear();
