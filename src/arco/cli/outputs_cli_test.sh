@@ -122,17 +122,17 @@ O=(overlay "$w/res" --method vision --camera camera_21334181_1 --frames 1:3 --sc
 ok "overlay -o" "${O[@]}" -o "$w/o.mkv"
 check '[ -s "$w/o.mkv" ]' "overlay writes its video"
 rm "$w/o.mkv"
-bad "overlay in a missing folder" "$w/nodir/o.mkv" "${O[@]}" -o "$w/nodir/o.mkv"
-bad "overlay -o a folder" "$w/dir" "${O[@]}" -o "$w/dir"
-bad "overlay under a file" "$w/file/o.mkv" "${O[@]}" -o "$w/file/o.mkv"
+bad_at "overlay in a missing folder" "$w/nodir/o.mkv" "${O[@]}" -o "$w/nodir/o.mkv"
+bad_at "overlay -o a folder" "$w/dir" "${O[@]}" -o "$w/dir"
+bad_at "overlay under a file" "$w/file/o.mkv" "${O[@]}" -o "$w/file/o.mkv"
 
 # plot: one folder, replaced only with --overwrite and only when it is a plot folder (the
 # paths are checked before the work; this result has no fingering to plot, so the written
 # and replaced folders are in plot_cli_test).
-bad "plot over another folder" "$w/photos" plot "$w/res" -o "$w/photos/"
-bad "plot --overwrite over another folder" "$w/photos" plot "$w/res" -o "$w/photos/" --overwrite
-bad "plot over a file" "$w/file" plot "$w/res" -o "$w/file" --overwrite
-bad "plot under a file" "$w/file/plots" plot "$w/res" -o "$w/file/plots"
+bad_at "plot over another folder" "$w/photos" plot "$w/res" -o "$w/photos/"
+bad_at "plot --overwrite over another folder" "$w/photos" plot "$w/res" -o "$w/photos/" --overwrite
+bad_at "plot over a file" "$w/file" plot "$w/res" -o "$w/file" --overwrite
+bad_at "plot under a file" "$w/file/plots" plot "$w/res" -o "$w/file/plots"
 
 # pitch: pitch.csv, --fine, --notes, --midi, all or none.
 P=(pitch "$spd/pgy.wav" --frames 60)

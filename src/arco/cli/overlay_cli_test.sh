@@ -22,19 +22,8 @@ if ! command -v ffmpeg >/dev/null || ! command -v ffprobe >/dev/null; then
 fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fail=0
-check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
-snapshot() { (cd "$tmp/w" && find . | sort && find . -type f -exec md5sum {} + | sort); }
-bad() {  # bad NAME PATTERN ARGS...: exit 1, one "arco: error: PATTERN" line, nothing written
-  local name=$1 pattern=$2; shift 2
-  local before; before=$(snapshot)
-  "$arco" "$@" >/dev/null 2>"$tmp/err"
-  local rc=$?
-  local line; line=$(cat "$tmp/err")
-  check '[ $rc -eq 1 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ] && [[ "$line" == "arco: error: "$pattern ]]' \
-    "$name: exit $rc: $line"
-  check '[ "$(snapshot)" = "$before" ]' "$name: something was written"
-}
+source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
+SNAPSHOT_DIR=$tmp/w
 
 "$arco" synth -o "$tmp/cap" --duration-s 2 >/dev/null 2>&1 &&
   "$arco" run "$tmp/cap" -o "$tmp/res" >/dev/null 2>&1 ||
@@ -103,21 +92,21 @@ cp -r "$tmp/res" "$tmp/nopaper"
 import json, sys
 p = sys.argv[1] + '/result.json'; r = json.load(open(p)); del r['stages']['paper']
 json.dump(r, open(p, 'w'))" "$tmp/nopaper"
-bad "unknown camera" "$tmp/cap/capture.json: no camera 'cam99' (cameras: *" \
+expect_error "unknown camera" "$tmp/cap/capture.json: no camera 'cam99' (cameras: *" \
   overlay "$tmp/res" --camera cam99 -o "$tmp/w/x.mp4"
-bad "method not in the result" "$tmp/nopaper/result.json: the result has no 'paper' points*" \
+expect_error "method not in the result" "$tmp/nopaper/result.json: the result has no 'paper' points*" \
   overlay "$tmp/nopaper" --camera $cam --method paper -o "$tmp/w/x.mp4"
-bad "unknown method" "--method: 'truth' is not arco, paper or vision" \
+expect_error "unknown method" "--method: 'truth' is not arco, paper or vision" \
   overlay "$tmp/res" --camera $cam --method truth -o "$tmp/w/x.mp4"
-bad "output in a missing folder" "$tmp/w/missing/x.mp4: *" \
+expect_error "output in a missing folder" "$tmp/w/missing/x.mp4: *" \
   overlay "$tmp/res" --camera $cam -o "$tmp/w/missing/x.mp4"
-bad "output under a file" "$tmp/w/full.mp4/x.mp4: *" \
+expect_error "output under a file" "$tmp/w/full.mp4/x.mp4: *" \
   overlay "$tmp/res" --camera $cam -o "$tmp/w/full.mp4/x.mp4"
-bad "frames outside the result" "frames 1:9999 are outside the result's 1:$frames *" \
+expect_error "frames outside the result" "frames 1:9999 are outside the result's 1:$frames *" \
   overlay "$tmp/res" --camera $cam --frames 1:9999 -o "$tmp/w/x.mp4"
-bad "not a video extension" "$tmp/w/x.png: the overlay is a video: .mp4, .mov, .mkv or .avi" \
+expect_error "not a video extension" "$tmp/w/x.png: the overlay is a video: .mp4, .mov, .mkv or .avi" \
   overlay "$tmp/res" --camera $cam -o "$tmp/w/x.png"
-bad "no result folder" "$tmp/none/result.json: *" \
+expect_error "no result folder" "$tmp/none/result.json: *" \
   overlay "$tmp/none" --camera $cam -o "$tmp/w/x.mp4"
 
 [ $fail -eq 0 ] && echo "overlay_cli_test: ok"

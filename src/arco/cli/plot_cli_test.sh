@@ -21,19 +21,8 @@ if ! command -v ffmpeg >/dev/null; then
 fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fail=0
-check() { if ! eval "$1"; then echo "FAILED: $2"; fail=1; fi; }
-snapshot() { (cd "$tmp/w" && find . | sort && find . -type f -exec md5sum {} + | sort); }
-bad() {  # bad NAME PATTERN ARGS...: exit 1, one "arco: error: PATTERN" line, nothing written
-  local name=$1 pattern=$2; shift 2
-  local before; before=$(snapshot)
-  "$arco" "$@" >/dev/null 2>"$tmp/err"
-  local rc=$?
-  local line; line=$(cat "$tmp/err")
-  check '[ $rc -eq 1 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ] && [[ "$line" == "arco: error: "$pattern ]]' \
-    "$name: exit $rc: $line"
-  check '[ "$(snapshot)" = "$before" ]' "$name: something was written"
-}
+source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
+SNAPSHOT_DIR=$tmp/w
 
 "$arco" synth -o "$tmp/cap" --duration-s 3 >/dev/null 2>&1 &&
   "$arco" run "$tmp/cap" -o "$tmp/res" >/dev/null 2>&1 ||
@@ -57,14 +46,14 @@ check '"$py" "$check_py" "$tmp/w/notruth" "$tmp/res" arco 1200 600 0' "figures w
 mv "$tmp/truth" "$tmp/cap/truth"
 
 mkdir -p "$tmp/w/mine" && echo "keep" >"$tmp/w/mine/notes.txt"
-bad "a method without fingering" "$tmp/res/vision/fingering.csv: no notes *" \
+expect_error "a method without fingering" "$tmp/res/vision/fingering.csv: no notes *" \
   plot "$tmp/res" --method vision -o "$tmp/w/x"
-bad "unknown method" "--method: 'truth' is not arco, paper or vision" \
+expect_error "unknown method" "--method: 'truth' is not arco, paper or vision" \
   plot "$tmp/res" --method truth -o "$tmp/w/x"
-bad "an existing plot folder" "*--overwrite*" plot "$tmp/res" -o "$tmp/w/plots"
-bad "a folder that is not a plot folder" "*" plot "$tmp/res" --overwrite -o "$tmp/w/mine"
-bad "output under a file" "*" plot "$tmp/res" -o "$tmp/w/mine/notes.txt/x"
-bad "no result folder" "$tmp/none/result.json: *" plot "$tmp/none" -o "$tmp/w/x"
+expect_error "an existing plot folder" "*--overwrite*" plot "$tmp/res" -o "$tmp/w/plots"
+expect_error "a folder that is not a plot folder" "*" plot "$tmp/res" --overwrite -o "$tmp/w/mine"
+expect_error "output under a file" "*" plot "$tmp/res" -o "$tmp/w/mine/notes.txt/x"
+expect_error "no result folder" "$tmp/none/result.json: *" plot "$tmp/none" -o "$tmp/w/x"
 
 [ $fail -eq 0 ] && echo "plot_cli_test: ok"
 exit $fail
