@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# `arco view` in a real browser: view_browser_test.js on a synthetic result (arco synth +
+# arco run) and on a copy missing its arco stage. Skips (77) only when Debian's
+# /usr/bin/chromium is absent; a missing node or playwright-core (scripts/fetch_view_tools)
+# is a failure. Screenshots stay in WORK_DIR as the test's artefacts.
+# usage: view_browser_test.sh ARCO_BINARY SOURCE_DIR WORK_DIR
+set -uo pipefail
+arco=$1
+src=$2
+work=$3
+if [ ! -x /usr/bin/chromium ]; then
+  echo "SKIPPED: /usr/bin/chromium is not installed (apt-get install chromium)"
+  exit 77
+fi
+playwright=$src/tools/view/node_modules/playwright-core
+if ! command -v node >/dev/null || [ ! -f "$playwright/package.json" ]; then
+  echo "FAILED: node or $playwright missing (run scripts/fetch_view_tools)"
+  exit 1
+fi
+rm -rf "$work"
+mkdir -p "$work"
+"$arco" synth -o "$work/cap" --duration-s 3 >/dev/null 2>&1 &&
+  "$arco" run "$work/cap" -o "$work/res" >/dev/null 2>&1 ||
+  { echo "FAILED: synth + run"; exit 1; }
+# The same result without its arco stage (result.json's entry and the folder).
+cp -r "$work/res" "$work/res_no_arco"
+rm -rf "$work/res_no_arco/arco"
+/usr/bin/python3 - "$work/res_no_arco/result.json" <<'PY' || { echo "FAILED: editing result.json"; exit 1; }
+import json, sys
+d = json.load(open(sys.argv[1]))
+del d["stages"]["arco"]
+json.dump(d, open(sys.argv[1], "w"), indent=1)
+PY
+node "$src/src/arco/view/view_browser_test.js" "$arco" "$work/res" "$work/res_no_arco" \
+  "$work/shots" "$playwright"
