@@ -59,8 +59,7 @@ int WriteFolder(Args a) {
 }
 
 int Serve(const Args& a) {
-  std::string pattern =
-      (std::filesystem::temp_directory_path() / "arco-view-XXXXXX").string();
+  std::string pattern = (std::filesystem::temp_directory_path() / "arco-view-XXXXXX").string();
   if (mkdtemp(pattern.data()) == nullptr) return PrintError(pattern + ": cannot create");
   const std::string dir = pattern;
   auto summary = view::WriteViewFolder(a.options, dir);
@@ -89,8 +88,7 @@ std::function<int()> SetupView(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "view", "See and hear a result: 3D, audio, pitch, contacts in a local web page");
   auto a = std::make_shared<Args>();
-  cmd->add_option("result_dir", a->options.result_dir, "Result folder (from arco run)")
-      ->required();
+  cmd->add_option("result_dir", a->options.result_dir, "Result folder (from arco run)")->required();
   AddNumber(cmd,
             "--port",
             a->port,

@@ -19,8 +19,7 @@ Status ServeOptions::Validate() const {
   return Status::Ok();
 }
 
-Status ServeFolder(const ServeOptions& options,
-                   const std::function<void(int port)>& on_listening) {
+Status ServeFolder(const ServeOptions& options, const std::function<void(int port)>& on_listening) {
   ARCO_RETURN_IF_ERROR(options.Validate());
   httplib::Server server;
   // GET (and HEAD) of the folder's files only: the mount point serves nothing above `dir`
@@ -37,9 +36,8 @@ Status ServeFolder(const ServeOptions& options,
   server.Delete(".*", refuse);
   server.Patch(".*", refuse);
   const int port = options.port == 0 ? server.bind_to_any_port(options.host)
-                                     : server.bind_to_port(options.host, options.port)
-                                           ? options.port
-                                           : -1;
+                   : server.bind_to_port(options.host, options.port) ? options.port
+                                                                     : -1;
   if (port < 0) {
     return Status::Error(options.host + ":" + std::to_string(options.port) +
                          ": cannot listen (port in use? --port 0 picks a free one)");

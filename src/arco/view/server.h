@@ -10,10 +10,10 @@
 namespace arco::view {
 
 struct ServeOptions {
-  std::string dir;           // the folder served at "/"
+  std::string dir;  // the folder served at "/"
   std::string host = "127.0.0.1";
-  int port = 8765;           // 0: any free port
-  double exit_after_s = 0;   // > 0: stop after this long (tests); 0: until SIGINT/SIGTERM
+  int port = 8765;          // 0: any free port
+  double exit_after_s = 0;  // > 0: stop after this long (tests); 0: until SIGINT/SIGTERM
   Status Validate() const;
 };
 

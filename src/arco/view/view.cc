@@ -71,8 +71,7 @@ std::vector<float> ToFloat(const std::vector<double>& v) {
 
 // Median of the finite values; NaN when none.
 float FiniteMedian(std::vector<double>& v) {
-  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }),
-          v.end());
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
   if (v.empty()) return kNaNf;
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
@@ -127,8 +126,8 @@ std::string Base64(const std::string& bytes) {
   out.reserve((bytes.size() + 2) / 3 * 4);
   size_t i = 0;
   for (; i + 2 < bytes.size(); i += 3) {
-    const uint32_t v = (uint8_t(bytes[i]) << 16) | (uint8_t(bytes[i + 1]) << 8) |
-                       uint8_t(bytes[i + 2]);
+    const uint32_t v =
+        (uint8_t(bytes[i]) << 16) | (uint8_t(bytes[i + 1]) << 8) | uint8_t(bytes[i + 2]);
     for (int k = 3; k >= 0; --k) out += kAlphabet[(v >> (6 * k)) & 63];
   }
   const size_t rest = bytes.size() - i;
@@ -187,8 +186,8 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
   std::vector<exporter::ExportData> loaded;
   ARCO_ASSIGN_OR_RETURN(const auto stages, folder.PointStages());
   for (const char* method : kMethods) {
-    const bool present = std::any_of(
-        stages.begin(), stages.end(), [&](const auto& s) { return s.name == method; });
+    const bool present =
+        std::any_of(stages.begin(), stages.end(), [&](const auto& s) { return s.name == method; });
     if (!present) continue;
     if (std::string(method) == "triangulation" && !loaded.empty()) continue;
     exporter::ExportOptions eo;
@@ -228,8 +227,9 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
     loaded.push_back(std::move(data));
   }
   if (loaded.empty()) {
-    return Status::Error(folder.ManifestPath() +
-                         ": the result has no 3D points to show (run arco triangulate or arco run)");
+    return Status::Error(
+        folder.ManifestPath() +
+        ": the result has no 3D points to show (run arco triangulate or arco run)");
   }
   manifest["methods"] = methods;
   const exporter::ExportData& first = loaded.front();
@@ -239,8 +239,9 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
 
   manifest["strings"] = nullptr;
   if (!first.strings_mm.shape.empty()) {
-    ARCO_ASSIGN_OR_RETURN(manifest["strings"],
-                          arrays.Add("strings", first.strings_mm.shape, ToFloat(first.strings_mm.data)));
+    ARCO_ASSIGN_OR_RETURN(
+        manifest["strings"],
+        arrays.Add("strings", first.strings_mm.shape, ToFloat(first.strings_mm.data)));
   }
   // Per-frame quality: the median over the triangulated points of their RMS reprojection
   // error and of their inlier views.
@@ -309,7 +310,8 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
   // The page.
   for (const char* file : kWebFiles) {
     auto text = ReadFileToString(JoinPath(web_dir, file));
-    if (!text.ok()) return Status::Error(JoinPath(web_dir, file) + ": the viewer's page is missing");
+    if (!text.ok())
+      return Status::Error(JoinPath(web_dir, file) + ": the viewer's page is missing");
     ARCO_RETURN_IF_ERROR(AtomicWriteFile(JoinPath(dir, file), *text));
   }
   auto three = ReadFileToString(three_js);
@@ -319,9 +321,8 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
   ARCO_RETURN_IF_ERROR(AtomicWriteFile(JoinPath(dir, "three.min.js"), *three));
   ARCO_RETURN_IF_ERROR(AtomicWriteFile(JoinPath(dir, "manifest.json"), manifest.dump(1) + "\n"));
   // data.js always exists (index.html loads it): null when the page fetches the arrays.
-  const Json data = options.embed_data
-                        ? Json{{"manifest", manifest}, {"arrays", arrays.embedded()}}
-                        : Json(nullptr);
+  const Json data = options.embed_data ? Json{{"manifest", manifest}, {"arrays", arrays.embedded()}}
+                                       : Json(nullptr);
   ARCO_RETURN_IF_ERROR(
       AtomicWriteFile(JoinPath(dir, "data.js"), "window.ARCO_VIEW_DATA = " + data.dump() + ";\n"));
   summary.bytes = arrays.bytes();

@@ -43,8 +43,8 @@ struct ViewSummary {
   std::vector<MissingStage> missing;
   int64_t frames = 0;
   int keypoints = 0;
-  std::string audio;   // the audio file copied ("" when none)
-  int64_t bytes = 0;   // of the data arrays
+  std::string audio;  // the audio file copied ("" when none)
+  int64_t bytes = 0;  // of the data arrays
 };
 
 // The stages a complete result has and the command that writes each (the page and the

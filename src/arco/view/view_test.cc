@@ -23,7 +23,8 @@ TEST(Base64, Rfc4648Vectors) {
 }
 
 TEST(WriteViewFolder, RejectsAFolderWithoutResultJson) {
-  const std::string dir = (std::filesystem::temp_directory_path() / "arco_view_test_empty").string();
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / "arco_view_test_empty").string();
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir + "/out");
   ViewOptions options;
@@ -36,9 +37,7 @@ TEST(WriteViewFolder, RejectsAFolderWithoutResultJson) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(ViewOptions, RejectsAnEmptyResultDir) {
-  EXPECT_FALSE(ViewOptions{}.Validate().ok());
-}
+TEST(ViewOptions, RejectsAnEmptyResultDir) { EXPECT_FALSE(ViewOptions{}.Validate().ok()); }
 
 TEST(MissingStages, ListsEveryStageOfAnEmptyFolder) {
   const auto missing = MissingStages("/nonexistent_arco_result");

@@ -135,32 +135,43 @@
   const orbit = { target: new THREE.Vector3(), distance: 3, azimuth: 0.6, elevation: 0.25 };
   let homeOrbit = null;
 
-  // The up direction and centre of the first frame where the body is seen.
+  // The body's frame in the first frame where it is seen: up (hips -> shoulders), right
+  // (left -> right shoulder) and forward = up x right (the way the player faces), as the
+  // rotation that turns them to three.js's +Y, -X and +Z; and the box of that frame's
+  // points in the turned axes (mm).
   function bodyFrame(method) {
     const idx = new Map(method.keypoint_names.map((n, i) => [n, i]));
+    const get = (frame, name) => (idx.has(name) ? point(method.points, frame, idx.get(name)) : [NaN, NaN, NaN]);
+    const vec = (p) => new THREE.Vector3(p[0], p[1], p[2]);
     const mean = (frame, names) => {
-      const s = [0, 0, 0]; let n = 0;
-      for (const name of names) {
-        if (!idx.has(name)) continue;
-        const p = point(method.points, frame, idx.get(name));
-        if (finite3(p)) { s[0] += p[0]; s[1] += p[1]; s[2] += p[2]; ++n; }
-      }
-      return n ? s.map((v) => v / n) : null;
+      const s = new THREE.Vector3(); let n = 0;
+      for (const name of names) { const p = get(frame, name); if (finite3(p)) { s.add(vec(p)); ++n; } }
+      return n ? s.divideScalar(n) : null;
     };
+    const rotation = new THREE.Quaternion();
+    let frame = 0;
     for (let f = 0; f < method.points.shape[0]; ++f) {
-      const low = mean(f, ['left_ankle', 'right_ankle', 'left_hip', 'right_hip']);
-      const high = mean(f, ['left_shoulder', 'right_shoulder', 'nose']);
-      if (low && high) {
-        const up = new THREE.Vector3(high[0] - low[0], high[1] - low[1], high[2] - low[2]).normalize();
-        const all = mean(f, method.keypoint_names);
-        return { up, centre: new THREE.Vector3(all[0], all[1], all[2]) };
+      const low = mean(f, ['left_hip', 'right_hip']), high = mean(f, ['left_shoulder', 'right_shoulder']);
+      const l = get(f, 'left_shoulder'), r = get(f, 'right_shoulder');
+      if (!low || !high || !finite3(l) || !finite3(r)) continue;
+      const up = high.sub(low).normalize();
+      const right = vec(r).sub(vec(l));
+      right.addScaledVector(up, -right.dot(up)).normalize();
+      const forward = new THREE.Vector3().crossVectors(up, right);
+      const basis = new THREE.Matrix4().makeBasis(right.clone().negate(), up, forward).transpose();
+      rotation.setFromRotationMatrix(basis);
+      frame = f;
+      break;
+    }
+    const box = new THREE.Box3();
+    for (let f = frame; f < method.points.shape[0] && box.isEmpty(); ++f) {
+      for (let i = 0; i < method.keypoint_names.length; ++i) {
+        const p = point(method.points, f, i);
+        if (finite3(p)) box.expandByPoint(vec(p).applyQuaternion(rotation));
       }
     }
-    for (let f = 0; f < method.points.shape[0]; ++f) {
-      const all = mean(f, method.keypoint_names);
-      if (all) return { up: new THREE.Vector3(0, 1, 0), centre: new THREE.Vector3(all[0], all[1], all[2]) };
-    }
-    return { up: new THREE.Vector3(0, 1, 0), centre: new THREE.Vector3() };
+    if (box.isEmpty()) box.set(new THREE.Vector3(-500, -500, -500), new THREE.Vector3(500, 500, 500));
+    return { rotation, box };
   }
 
   function buildScene(manifest) {
@@ -176,11 +187,16 @@
     camera = new THREE.PerspectiveCamera(40, 1, 0.01, 100);
     root = new THREE.Group();  // data (mm, arco's axes) -> scene (m, +Y up, centred)
     scene.add(root);
-    const { up, centre } = bodyFrame(manifest.methods[0]);
-    root.quaternion.setFromUnitVectors(up, new THREE.Vector3(0, 1, 0));
+    const { rotation, box } = bodyFrame(manifest.methods[0]);
+    root.quaternion.copy(rotation);
     root.scale.setScalar(0.001);
-    root.position.copy(centre.clone().applyQuaternion(root.quaternion).multiplyScalar(-0.001));
-    scene.add(new THREE.GridHelper(4, 20, 0x444444, 0x333333)).position.y = -0.9;
+    const centre = box.getCenter(new THREE.Vector3()), size = box.getSize(new THREE.Vector3());
+    root.position.copy(centre).multiplyScalar(-0.001);  // the box's centre at the origin
+    const grid = new THREE.GridHelper(4, 20, 0x444444, 0x333333);
+    grid.position.y = -0.001 * size.y / 2;  // the floor under the lowest point
+    scene.add(grid);
+    const radius = 0.0005 * size.length();
+    orbit.distance = 1.1 * radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
 
     figures = manifest.methods.map((m) => makeFigure(m, 1));
     figures.forEach((fig) => root.add(fig.group));
@@ -192,8 +208,10 @@
       strings.frustumCulled = false;
       root.add(strings);
     }
-    contactMarker = new THREE.Mesh(new THREE.SphereGeometry(9, 16, 12),
-      new THREE.MeshBasicMaterial({ color: 0xff2040 }));
+    // The pressing finger's contact on the string, drawn over the hand that hides it.
+    contactMarker = new THREE.Mesh(new THREE.SphereGeometry(10, 16, 12),
+      new THREE.MeshBasicMaterial({ color: 0xff2040, depthTest: false, transparent: true, opacity: 0.9 }));
+    contactMarker.renderOrder = 10;
     root.add(contactMarker);
     orbit.target.set(0, 0, 0);
     homeOrbit = { ...orbit, target: orbit.target.clone() };
