@@ -4,11 +4,14 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 
 #include "arco/export/export.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/refine/contacts_csv.h"
+#include "arco/registry/keypoint_layout.h"
+#include "arco/synth/truth_folder.h"
 #include "arco/util/check.h"
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
@@ -112,6 +115,45 @@ StatusOr<AudioSource> FindAudio(const pipeline::ResultHeader& header) {
   return out;
 }
 
+// Per-frame errors of a method against a synthetic truth (CAPTURE/truth/, synth/): the
+// mean distance of the left hand's 21 points, and the distance between the pressed
+// contacts when both press (mm; NaN where not defined). Points are matched by name.
+struct FrameErrors {
+  std::vector<float> left_hand_mm, contact_mm;
+};
+FrameErrors ErrorsAgainstTruth(const exporter::ExportData& data,
+                               const std::vector<refine::ContactRow>& contacts,
+                               const synth::TruthFolder& truth,
+                               const KeypointLayout& truth_layout) {
+  const int64_t f = data.frames();
+  FrameErrors out{std::vector<float>(f, kNaNf), std::vector<float>(f, kNaNf)};
+  std::vector<std::pair<int, int>> hand;  // (method column, truth column)
+  for (int p = 0; p < data.points(); ++p) {
+    const std::string& name = data.keypoint_names[p];
+    const int t = truth_layout.Find(name);
+    if (name.rfind("left_hand_", 0) == 0 && t >= 0) hand.emplace_back(p, t);
+  }
+  for (int64_t i = 0; i < f; ++i) {
+    double sum = 0;
+    int n = 0;
+    for (const auto& [p, t] : hand) {
+      const Eigen::Vector3d d = data.At(i, p) - pipeline::PointAt(truth.points3d, i, t);
+      if (d.allFinite()) sum += d.norm(), ++n;
+    }
+    if (n > 0) out.left_hand_mm[i] = static_cast<float>(sum / n);
+  }
+  for (const auto& r : contacts) {
+    if (r.frame < 0 || r.frame >= f || r.frame >= static_cast<int64_t>(truth.contacts.size())) {
+      continue;
+    }
+    const auto& t = truth.contacts[r.frame];
+    if (r.state != "pressed" || t.state != "pressed") continue;
+    const double d = (r.point_mm - t.point_mm).norm();
+    if (std::isfinite(d)) out.contact_mm[r.frame] = static_cast<float>(d);
+  }
+  return out;
+}
+
 }  // namespace
 
 Status ViewOptions::Validate() const {
@@ -181,6 +223,22 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
                    {"fps", header.fps},
                    {"frame_first", header.frame_first}};
 
+  // A synthetic capture's truth, when there is one whose frames match the result's.
+  std::optional<synth::TruthFolder> truth;
+  const KeypointLayout* truth_layout = nullptr;
+  const std::string truth_dir =
+      header.capture_dir.empty() ? "" : JoinPath(header.capture_dir, synth::kTruthFolderName);
+  if (!truth_dir.empty() && FileExists(synth::TruthManifestPath(truth_dir))) {
+    auto read = synth::ReadTruthFolder(truth_dir);
+    if (read.ok()) {
+      truth_layout = FindKeypointLayout(read->manifest.truth_layout);
+      if (truth_layout != nullptr && read->manifest.frames == header.frame_count) {
+        truth = std::move(*read);
+      }
+    }
+  }
+  manifest["truth"] = truth.has_value();
+
   // Every method's points through the export layer's reader.
   Json methods = Json::array();
   std::vector<exporter::ExportData> loaded;
@@ -200,8 +258,9 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
         arrays.Add("points_" + data.method, data.points_mm.shape, ToFloat(data.points_mm.data)));
     // Contacts of the refined methods (contacts.csv, refine/contacts_csv.h).
     const std::string contacts_path = folder.ContactsPath(method);
+    std::vector<refine::ContactRow> rows;
     if (FileExists(contacts_path)) {
-      ARCO_ASSIGN_OR_RETURN(const auto rows, refine::ReadContactsCsv(contacts_path));
+      ARCO_ASSIGN_OR_RETURN(rows, refine::ReadContactsCsv(contacts_path));
       const int64_t f = data.frames();
       std::vector<float> state(f, 0), string(f, 0), finger(f, 0), from_nut(f, kNaNf),
           point(f * 3, kNaNf);
@@ -221,6 +280,15 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
       ARCO_ASSIGN_OR_RETURN(c["from_nut_mm"], arrays.Add(p + "from_nut_mm", {f}, from_nut));
       ARCO_ASSIGN_OR_RETURN(c["point_mm"], arrays.Add(p + "point_mm", {f, 3}, point));
       m["contacts"] = c;
+    }
+    if (truth.has_value() && data.frames() == truth->points3d.shape[0]) {
+      const FrameErrors e = ErrorsAgainstTruth(data, rows, *truth, *truth_layout);
+      Json ej;
+      const int64_t f = data.frames();
+      const std::string p = "error_" + data.method + "_";
+      ARCO_ASSIGN_OR_RETURN(ej["left_hand_mm"], arrays.Add(p + "left_hand_mm", {f}, e.left_hand_mm));
+      ARCO_ASSIGN_OR_RETURN(ej["contact_mm"], arrays.Add(p + "contact_mm", {f}, e.contact_mm));
+      m["errors"] = ej;
     }
     methods.push_back(m);
     summary.methods.push_back(method);

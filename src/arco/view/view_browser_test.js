@@ -7,6 +7,7 @@
 //    of the shown method projects through the camera the page reports (0.5 px), and so it
 //    moves by the amount the data says;
 //  - the audio element's duration equals the capture's audio.wav (from its RIFF header);
+//  - the left hand's error against the synthetic truth (CAPTURE/truth/points3d.npy) as shown;
 //  - switching the method moves the hand to the other method's point;
 //  - the speed control slows the audio without changing its pitch (preservesPitch);
 //  - the --no-serve folder works from file:// with no server;
@@ -213,6 +214,23 @@ function stopServer(server) {
     await page.waitForFunction(() => Number.isFinite(window.arcoView.audioDuration()), null, { timeout: 30000 });
     const gotS = await page.evaluate(() => window.arcoView.audioDuration());
     check(Math.abs(gotS - wantS) < 1e-3, `audio duration ${gotS.toFixed(4)} s, the take's ${wantS.toFixed(4)} s`);
+
+    // Errors against the synthetic truth, as the quality panel prints them.
+    const truthJson = JSON.parse(fs.readFileSync(path.join(capture, 'truth', 'truth.json'), 'utf8'));
+    check(truthJson.truth_layout === resultJson.stages.arco.layout, 'truth and arco share the layout ' + truthJson.truth_layout);
+    const truth = { names: arcoPts.names, points: readNpy(path.join(capture, 'truth', 'points3d.npy')) };
+    const errFrame = Math.floor(arcoPts.points.shape[0] / 2);
+    let sum = 0, n = 0;
+    for (const name of arcoPts.names.filter((k) => k.startsWith('left_hand_'))) {
+      const a = pointAt(arcoPts, errFrame, name), t = pointAt(truth, errFrame, name);
+      const d = Math.hypot(a[0] - t[0], a[1] - t[1], a[2] - t[2]);
+      if (Number.isFinite(d)) { sum += d; ++n; }
+    }
+    await page.evaluate((f) => window.arcoView.seek(f), errFrame);
+    const quality = await page.locator('#quality').innerText();
+    const shownErr = Number((quality.match(/left hand ([0-9.]+) mm/) || [])[1]);
+    check(n === 21 && Math.abs(shownErr - sum / n) <= 0.05 + 1e-9,
+      `frame ${errFrame}: left hand error shown ${shownErr} mm, truth says ${(sum / n).toFixed(3)} mm`);
 
     // Method switch: a frame where arco's and vision's fingertips differ most.
     let frame = 0, gap = -1;

@@ -344,6 +344,12 @@
       $('quality').textContent = 'views used (median over points): ' + (Number.isFinite(v) ? v.toFixed(0) : '–') +
         '\nreprojection error (median): ' + (Number.isFinite(rms) ? rms.toFixed(2) + ' px' : '–');
     } else $('quality').textContent = 'no triangulation quality in this result';
+    const e = manifest.methods[view.method].errors;
+    if (e) {
+      const mm = (v) => (Number.isFinite(v) ? v.toFixed(1) + ' mm' : '–');
+      $('quality').textContent += '\nagainst the truth (' + manifest.methods[view.method].name + '): left hand ' +
+        mm(e.left_hand_mm.data[f]) + ' (mean of 21 points), contact ' + mm(e.contact_mm.data[f]);
+    }
   }
 
   function drawPitch(f) {
