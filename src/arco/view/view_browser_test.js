@@ -8,6 +8,7 @@
 //    moves by the amount the data says;
 //  - the audio element's duration equals the capture's audio.wav (from its RIFF header);
 //  - the left hand's error against the synthetic truth (CAPTURE/truth/points3d.npy) as shown;
+//  - the contact marker sits on contacts.csv's pressed point, and is hidden at rest;
 //  - switching the method moves the hand to the other method's point;
 //  - the speed control slows the audio without changing its pitch (preservesPitch);
 //  - the --no-serve folder works from file:// with no server;
@@ -231,6 +232,23 @@ function stopServer(server) {
     const shownErr = Number((quality.match(/left hand ([0-9.]+) mm/) || [])[1]);
     check(n === 21 && Math.abs(shownErr - sum / n) <= 0.05 + 1e-9,
       `frame ${errFrame}: left hand error shown ${shownErr} mm, truth says ${(sum / n).toFixed(3)} mm`);
+
+    // The contact marker where arco/contacts.csv puts the pressed contact, hidden at rest.
+    const rows = fs.readFileSync(path.join(result, 'arco', 'contacts.csv'), 'utf8').trim().split('\n');
+    const col = Object.fromEntries(rows[0].split(',').map((n, i) => [n, i]));
+    const cells = rows.slice(1).map((r) => r.split(','));
+    const pressedRow = cells[cells.map((c) => c[col.state]).lastIndexOf('pressed')];
+    const restRow = cells.find((c) => c[col.state] === 'rest');
+    const pf = Number(pressedRow[col.frame]);
+    await page.evaluate((f) => window.arcoView.seek(f), pf);
+    const marker = await page.evaluate(() => window.arcoView.projectContact());
+    const markerWant = project(await page.evaluate(() => window.arcoView.dataToClip()),
+      ['contact_x_mm', 'contact_y_mm', 'contact_z_mm'].map((k) => Number(pressedRow[col[k]])));
+    check(marker !== null && dist(marker, markerWant) < 0.5,
+      `frame ${pf}: contact marker at ${marker && dist(marker, markerWant).toFixed(3)} px of contacts.csv's point`);
+    await page.evaluate((f) => window.arcoView.seek(f), Number(restRow[col.frame]));
+    check(await page.evaluate(() => window.arcoView.projectContact()) === null,
+      `frame ${restRow[col.frame]} (rest): no contact marker`);
 
     // Method switch: a frame where arco's and vision's fingertips differ most.
     let frame = 0, gap = -1;

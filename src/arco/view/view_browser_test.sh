@@ -8,6 +8,27 @@ set -uo pipefail
 arco=$1
 src=$2
 work=$3
+rm -rf "$work"
+# Bad input, without a browser: one line "arco: error: ...", exit 1, nothing written.
+mkdir -p "$work"
+fail=0
+bad() {  # bad NAME PATTERN ARGS...
+  local name=$1 pattern=$2; shift 2
+  "$arco" "$@" >/dev/null 2>"$work/err"
+  local rc=$? line; line=$(cat "$work/err")
+  if [ $rc -ne 1 ] || [ "$(wc -l <"$work/err")" -ne 1 ] || [[ "$line" != "arco: error: "$pattern ]]; then
+    echo "FAILED: $name: exit $rc: $line"; fail=1
+  fi
+  if [ -e "$work/out" ]; then echo "FAILED: $name: $work/out was written"; fail=1; fi
+}
+mkdir -p "$work/not_a_result"
+bad "no result.json" "*not_a_result/result.json: not found (not an arco result folder)" \
+  view "$work/not_a_result" --no-serve -o "$work/out"
+bad "--no-serve without -o" "*--no-serve needs -o DIR*" view "$work/not_a_result" --no-serve
+bad "-o without --no-serve" "*-o is for --no-serve*" view "$work/not_a_result" -o "$work/out"
+bad "port out of range" "*--port*" view "$work/not_a_result" --port 70000
+[ $fail -eq 0 ] || exit 1
+
 if [ ! -x /usr/bin/chromium ]; then
   echo "SKIPPED: /usr/bin/chromium is not installed (apt-get install chromium)"
   exit 77
@@ -17,8 +38,6 @@ if ! command -v node >/dev/null || [ ! -f "$playwright/package.json" ]; then
   echo "FAILED: node or $playwright missing (run scripts/fetch_view_tools)"
   exit 1
 fi
-rm -rf "$work"
-mkdir -p "$work"
 "$arco" synth -o "$work/cap" --duration-s 3 >/dev/null 2>&1 &&
   "$arco" run "$work/cap" -o "$work/res" >/dev/null 2>&1 ||
   { echo "FAILED: synth + run"; exit 1; }

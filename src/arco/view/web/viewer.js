@@ -196,7 +196,7 @@
     grid.position.y = -0.001 * size.y / 2;  // the floor under the lowest point
     scene.add(grid);
     const radius = 0.0005 * size.length();
-    orbit.distance = 1.1 * radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
+    orbit.distance = 0.85 * radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
 
     figures = manifest.methods.map((m) => makeFigure(m, 1));
     figures.forEach((fig) => root.add(fig.group));
@@ -299,7 +299,7 @@
       strings.geometry.attributes.position.needsUpdate = true;
     }
     const c = manifest.methods[view.method].contacts;
-    const cp = c ? point(c.point_mm, f, 0) : [NaN, NaN, NaN];
+    const cp = c ? Array.from(c.point_mm.data.subarray(3 * f, 3 * f + 3)) : [NaN, NaN, NaN];
     contactMarker.visible = finite3(cp) && c.state.data[f] === 2;
     if (contactMarker.visible) contactMarker.position.set(cp[0], cp[1], cp[2]);
     $('timeline').value = String(f);
@@ -439,7 +439,7 @@
     view.ghost = i;
     $('ghost').value = String(i);
     if (i >= 0 && i !== view.method) {
-      ghostFigure = makeFigure(manifest.methods[i], 0.3);
+      ghostFigure = makeFigure(manifest.methods[i], 0.45);
       root.add(ghostFigure.group);
     }
     showFrame(view.frame);
@@ -519,6 +519,14 @@
     const p = new THREE.Vector3().setFromMatrixPosition(m);
     root.updateMatrixWorld();
     p.applyMatrix4(fig.joints.matrixWorld).project(camera);
+    const c = renderer.domElement;
+    return { x: (p.x + 1) / 2 * c.clientWidth, y: (1 - p.y) / 2 * c.clientHeight };
+  };
+  // Screen position of the drawn contact marker; null when hidden.
+  view.projectContact = () => {
+    if (!contactMarker.visible) return null;
+    root.updateMatrixWorld();
+    const p = new THREE.Vector3().setFromMatrixPosition(contactMarker.matrixWorld).project(camera);
     const c = renderer.domElement;
     return { x: (p.x + 1) / 2 * c.clientWidth, y: (1 - p.y) / 2 * c.clientHeight };
   };
