@@ -10,6 +10,7 @@
 //  - the left hand's error against the synthetic truth (CAPTURE/truth/points3d.npy) as shown;
 //  - the contact marker sits on contacts.csv's pressed point, and is hidden at rest;
 //  - switching the method moves the hand to the other method's point;
+//  - playing, the frame follows the audio clock;
 //  - the speed control slows the audio without changing its pitch (preservesPitch);
 //  - the --no-serve folder works from file:// with no server;
 //  - a result missing a stage shows which in the page and in the terminal.
@@ -266,6 +267,18 @@ function stopServer(server) {
     check(dist(onArco, onVision) > 1 && dist(onVision, wantVision) < 0.5,
       `method arco -> vision at frame ${frame} (${gap.toFixed(1)} mm apart): the hand moved ` +
       `${dist(onArco, onVision).toFixed(2)} px, to ${dist(onVision, wantVision).toFixed(3)} px of vision's point`);
+    // Playing: the frame follows the audio clock.
+    await page.evaluate(() => window.arcoView.seek(0));
+    await page.click('#play');
+    await page.waitForTimeout(800);
+    const played = await page.evaluate(() => {
+      const a = document.getElementById('audio');
+      return { frame: window.arcoView.frame, t: a.currentTime, paused: a.paused };
+    });
+    await page.click('#play');
+    const clockFrame = Math.floor((played.t - (captureJson.audio.offset_s || 0)) * resultJson.fps);
+    check(!played.paused && played.frame >= 10 && Math.abs(played.frame - clockFrame) <= 2,
+      `playing 0.8 s: frame ${played.frame}, audio clock ${played.t.toFixed(3)} s (frame ${clockFrame})`);
     await page.selectOption('#ghost', { label: 'arco' });
     await page.selectOption('#speed', '0.25');
     const rate = await page.evaluate(() => { const a = document.getElementById('audio'); return [a.playbackRate, a.preservesPitch]; });

@@ -314,19 +314,26 @@
     if (audio) audio.currentTime = Math.max(0, audioOffset() + (view.frame + 0.5) / fps());
   }
 
+  // The clock: the audio's when there is audio, else the page's (same speed control).
+  let silentStart = null;
+  function clockFrame() {
+    if (audio) return Math.floor((audio.currentTime - audioOffset()) * fps());
+    const rate = Number($('speed').value);
+    return silentStart.frame + Math.floor(((performance.now() - silentStart.ms) / 1000) * rate * fps());
+  }
   function tick() {
-    if (view.playing && audio) {
-      const f = Math.floor((audio.currentTime - audioOffset()) * fps());
+    if (view.playing) {
+      const f = clockFrame();
       if (f !== view.frame) showFrame(f);
-      if (audio.ended) setPlaying(false);
+      if ((audio && audio.ended) || f >= frameCount - 1) setPlaying(false);
     }
     requestAnimationFrame(tick);
   }
 
   function setPlaying(on) {
-    view.playing = on && !!audio;
+    view.playing = on;
     $('play').textContent = view.playing ? 'pause' : 'play';
-    if (!audio) return;
+    if (!audio) { silentStart = { frame: view.frame, ms: performance.now() }; return; }
     if (view.playing) audio.play().catch(() => setPlaying(false));
     else audio.pause();
   }
@@ -460,7 +467,10 @@
     $('next').addEventListener('click', () => { setPlaying(false); seek(view.frame + 1); });
     $('play').addEventListener('click', () => setPlaying(!view.playing));
     $('reset').addEventListener('click', () => { Object.assign(orbit, homeOrbit, { target: homeOrbit.target.clone() }); render(); });
-    $('speed').addEventListener('change', () => { if (audio) audio.playbackRate = Number($('speed').value); });
+    $('speed').addEventListener('change', () => {
+      if (audio) audio.playbackRate = Number($('speed').value);
+      else if (view.playing) silentStart = { frame: view.frame, ms: performance.now() };
+    });
     document.addEventListener('keydown', (e) => {
       if (e.target.tagName === 'SELECT' || e.target.tagName === 'INPUT') return;
       if (e.key === ' ') { e.preventDefault(); setPlaying(!view.playing); }
