@@ -27,6 +27,11 @@ Status ServeFolder(const ServeOptions& options, const std::function<void(int por
   if (!server.set_mount_point("/", options.dir)) {
     return Status::Error(options.dir + ": not a folder to serve");
   }
+  // No compression: on 127.0.0.1 it gains nothing, and httplib compresses the types it
+  // deems compressible (text/*, application/javascript, ...) with brotli at its highest
+  // quality when the browser accepts it, which takes seconds for three.min.js (600 KB).
+  // application/x-javascript is one of HTML's JavaScript MIME types and not on that list.
+  server.set_file_extension_and_mimetype_mapping("js", "application/x-javascript");
   server.set_file_extension_and_mimetype_mapping("wav", "audio/wav");
   server.set_file_extension_and_mimetype_mapping("bin", "application/octet-stream");
   server.set_default_headers({{"Cache-Control", "no-store"}});

@@ -286,7 +286,8 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
       Json ej;
       const int64_t f = data.frames();
       const std::string p = "error_" + data.method + "_";
-      ARCO_ASSIGN_OR_RETURN(ej["left_hand_mm"], arrays.Add(p + "left_hand_mm", {f}, e.left_hand_mm));
+      ARCO_ASSIGN_OR_RETURN(ej["left_hand_mm"],
+                            arrays.Add(p + "left_hand_mm", {f}, e.left_hand_mm));
       ARCO_ASSIGN_OR_RETURN(ej["contact_mm"], arrays.Add(p + "contact_mm", {f}, e.contact_mm));
       m["errors"] = ej;
     }

@@ -22,7 +22,7 @@ const zlib = require('zlib');
 const { spawn, execFileSync } = require('child_process');
 
 const [arco, result, badResult, work, playwrightDir] = process.argv.slice(2);
-const { chromium } = require(playwrightDir);
+const { chromium } = require(path.resolve(playwrightDir));
 const tip = 'left_hand_index_tip';
 let failures = 0;
 function check(ok, what) {

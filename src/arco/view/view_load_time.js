@@ -10,7 +10,7 @@ const path = require('path');
 const { spawn, execFileSync } = require('child_process');
 const [arco, result, work, playwrightDir, runsText] = process.argv.slice(2);
 const runs = Number(runsText || 3);
-const { chromium } = require(playwrightDir);
+const { chromium } = require(path.resolve(playwrightDir));
 
 async function timeLoad(browser, url) {
   const page = await browser.newPage({ viewport: { width: 1280, height: 720 } });
@@ -18,6 +18,9 @@ async function timeLoad(browser, url) {
   await page.goto(url);
   await page.waitForFunction(() => window.arcoView && window.arcoView.ready, null, { timeout: 120000, polling: 10 });
   const loadS = (Date.now() - start) / 1000;
+  const timings = await page.evaluate(() => window.arcoView.timings);
+  console.log(`  ${url.slice(0, 30)}: ${loadS.toFixed(2)} s; in the page: data ${timings.data_ms.toFixed(0)} ms, ready ${timings.ready_ms.toFixed(0)} ms`);
+  await page.waitForTimeout(1000);  // the page's work after ready (audio metadata, GC)
   const frameMs = await page.evaluate(() => {
     const n = Math.min(200, window.arcoView.seek(1e9) + 1);
     const t0 = performance.now();

@@ -42,6 +42,7 @@
       const want = e.shape.reduce((a, b) => a * b, 1);
       if (e.data.length !== want) throw new Error(e.file + ': ' + e.data.length + ' values, shape says ' + want);
     }));
+    window.ARCO_VIEW_DATA = null;  // the base64 text is decoded: let it go
     return manifest;
   }
 
@@ -488,8 +489,10 @@
   }
 
   async function main() {
+    const t0 = performance.now();
     try {
       manifest = await loadData();
+      view.timings = { data_ms: performance.now() - t0 };
     } catch (err) {
       $('error').hidden = false;
       $('error').textContent = 'Cannot load the data: ' + err.message;
@@ -510,6 +513,7 @@
     seek(0);
     requestAnimationFrame(tick);
     $('status').textContent = frameCount + ' frames at ' + manifest.fps + ' fps';
+    view.timings.ready_ms = performance.now() - t0;
     view.ready = true;
   }
 
