@@ -67,13 +67,14 @@ int Serve(const Args& a) {
   if (!summary.ok()) {
     rc = PrintError(summary.status().message());
   } else {
-    PrintMissing(*summary);
-    PrintShown(a, *summary);
     view::ServeOptions serve;
     serve.dir = dir;
     serve.port = a.port;
     serve.exit_after_s = a.exit_after_s;
-    const Status served = view::ServeFolder(serve, [](int port) {
+    // Printed once the port is bound: a busy port is the error line alone.
+    const Status served = view::ServeFolder(serve, [&](int port) {
+      PrintMissing(*summary);
+      PrintShown(a, *summary);
       std::printf("arco view: http://127.0.0.1:%d/ (Ctrl-C stops)\n", port);
       std::fflush(stdout);
     });

@@ -3,6 +3,7 @@
 #include <httplib.h>
 #include <pthread.h>
 #include <signal.h>
+#include <sys/socket.h>
 
 #include <atomic>
 #include <chrono>
@@ -35,6 +36,13 @@ Status ServeFolder(const ServeOptions& options, const std::function<void(int por
   server.set_file_extension_and_mimetype_mapping("wav", "audio/wav");
   server.set_file_extension_and_mimetype_mapping("bin", "application/octet-stream");
   server.set_default_headers({{"Cache-Control", "no-store"}});
+  // SO_REUSEADDR only: httplib's default SO_REUSEPORT would let a second `arco view` bind
+  // the same port and share its connections with the first, so that one URL showed
+  // either result. Here a busy port is an error.
+  server.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+  });
   const auto refuse = [](const httplib::Request&, httplib::Response& res) { res.status = 405; };
   server.Post(".*", refuse);
   server.Put(".*", refuse);

@@ -1,6 +1,7 @@
 // `arco view` in a real browser (docs/view.md): Debian's /usr/bin/chromium, headless,
 // driven by playwright-core (scripts/fetch_view_tools). Checked against the result folder
 // read here independently (the .npy and .wav files themselves, not the page's arrays):
+//  - a second `arco view` on the same port fails with one line (the port is not shared);
 //  - the served page loads with no console error, failed request or page error;
 //  - the 3D canvas is not blank (pixel variance of a screenshot, decoded here);
 //  - after seeking to two frames, the drawn left index fingertip sits where the points3d.npy
@@ -201,6 +202,14 @@ function stopServer(server) {
 
     // 1. Served.
     const server = await startServer(result);
+    // A second server on the same port: one error line, exit 1 (no shared port).
+    const port = server.url.match(/:(\d+)\//)[1];
+    let busy = { status: 0, stderr: '' };
+    try { execFileSync(arco, ['view', result, '--port', port, '--exit-after-s', '5'], { stdio: 'pipe' }); }
+    catch (e) { busy = { status: e.status, stderr: String(e.stderr), stdout: String(e.stdout) }; }
+    check(busy.status === 1 && busy.stdout === '' &&
+          /^arco: error: 127\.0\.0\.1:\d+: cannot listen \(port in use\? --port 0 picks a free one\)\n$/.test(busy.stderr),
+      'a busy port: ' + JSON.stringify(busy));
     const { page, errors, loadS } = await openPage(browser, server.url);
     console.log(`info    served page ready in ${loadS.toFixed(2)} s`);
     const methods = await page.evaluate(() => window.arcoView.methods());
