@@ -302,6 +302,21 @@ function stopServer(server) {
     const folder = path.join(work, 'page');
     fs.rmSync(folder, { recursive: true, force: true });
     execFileSync(arco, ['view', result, '--no-serve', '-o', folder], { stdio: 'pipe' });
+    // The folder's arrays: points_arco.bin is arco/points3d.npy in float32, and data.js
+    // embeds the same bytes.
+    const bin = fs.readFileSync(path.join(folder, 'points_arco.bin'));
+    const f32 = new Float32Array(bin.buffer.slice(bin.byteOffset, bin.byteOffset + bin.length));
+    let same = f32.length === arcoPts.points.data.length;
+    for (let i = 0; same && i < f32.length; ++i) {
+      const want = Math.fround(arcoPts.points.data[i]);
+      same = Number.isNaN(want) ? Number.isNaN(f32[i]) : f32[i] === want;
+    }
+    check(same, `points_arco.bin is arco/points3d.npy in float32 (${f32.length} values)`);
+    const dataJs = fs.readFileSync(path.join(folder, 'data.js'), 'utf8');
+    const embedded = JSON.parse(dataJs.slice(dataJs.indexOf('{'), dataJs.lastIndexOf('}') + 1));
+    check(Buffer.from(embedded.arrays['points_arco.bin'], 'base64').equals(bin) &&
+          Object.keys(embedded.arrays).length === fs.readdirSync(folder).filter((n) => n.endsWith('.bin')).length,
+      'data.js embeds every .bin, byte for byte');
     const disk = await openPage(browser, 'file://' + path.join(folder, 'index.html'));
     const diskVariance = await canvasVariance(disk.page, path.join(work, 'file_canvas.png'));
     check(diskVariance > 20, `file://: canvas not blank: luma variance ${diskVariance.toFixed(1)}`);
