@@ -136,6 +136,19 @@ bad "export in a missing folder" "$w/nodir/x.c3d" "${X[@]}" -o "$w/nodir/x.c3d"
 bad "export -o a folder" "$w/dir" "${X[@]}" -o "$w/dir"
 bad "export under a file" "$w/file/x.c3d" "${X[@]}" -o "$w/file/x.c3d"
 
+# view --no-serve: a viewer folder (its marker: manifest.json).
+V=(view "$w/res" --no-serve)
+ok "view -o page/" "${V[@]}" -o "$w/page/"
+check '[ -f "$w/page/index.html" ] && [ -f "$w/page/data.js" ] && [ -f "$w/page/manifest.json" ]' "view -o writes the page"
+bad "view over a viewer folder" "$w/page" "${V[@]}" -o "$w/page"
+echo old >"$w/page/old.txt"
+ok "view --overwrite" "${V[@]}" -o "$w/page" --overwrite
+check '[ -f "$w/page/index.html" ] && [ ! -e "$w/page/old.txt" ]' "view --overwrite replaces the page"
+bad "view --overwrite over another folder" "$w/photos" "${V[@]}" -o "$w/photos" --overwrite
+bad "view over a file" "$w/file" "${V[@]}" -o "$w/file" --overwrite
+bad "view under a file" "$w/file/sub/page" "${V[@]}" -o "$w/file/sub/page"
+rm -rf "$w/page"
+
 # pitch: pitch.csv, --fine, --notes, --midi, all or none.
 P=(pitch "$spd/pgy.wav" --frames 60)
 ok "pitch every output" "${P[@]}" -o "$w/p.csv" --fine "$w/f.csv" --notes "$w/n.csv" --midi "$w/m.mid"
