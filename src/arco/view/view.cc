@@ -351,12 +351,18 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
     ARCO_ASSIGN_OR_RETURN(pj["f0_hz"], arrays.Add("pitch_f0_hz", {f}, f0));
     ARCO_ASSIGN_OR_RETURN(pj["confidence"], arrays.Add("pitch_confidence", {f}, confidence));
     manifest["pitch"] = pj;
+    // notes.csv's reader returns times and median pitch only: the note and its cents are
+    // derived here as notes.csv derives them, s = 69 + 12 log2(f0 / a4) (audio/notes.h).
     ARCO_ASSIGN_OR_RETURN(const auto notes, folder.ReadNotes());
+    const double a4_hz = pj["a4_hz"].get<double>();
     for (const auto& n : notes) {
+      const double semitones = 69.0 + 12.0 * std::log2(n.median_f0_hz / a4_hz);
+      const int midi = static_cast<int>(std::lround(semitones));
       manifest["notes"].push_back({{"onset_s", n.onset_s},
                                    {"offset_s", n.offset_s},
-                                   {"midi_note", n.midi_note},
-                                   {"cents", n.cents_from_et}});
+                                   {"median_f0_hz", n.median_f0_hz},
+                                   {"midi_note", midi},
+                                   {"cents", 100.0 * (semitones - midi)}});
     }
   }
 

@@ -9,6 +9,7 @@
 //    moves by the amount the data says;
 //  - the audio element's duration equals the capture's audio.wav (from its RIFF header);
 //  - the left hand's error against the synthetic truth (CAPTURE/truth/points3d.npy) as shown;
+//  - the note of notes.csv is named in the pitch panel;
 //  - the contact marker sits on contacts.csv's pressed point, and is hidden at rest;
 //  - switching the method moves the hand to the other method's point;
 //  - playing, the frame follows the audio clock;
@@ -242,6 +243,19 @@ function stopServer(server) {
     const shownErr = Number((quality.match(/left hand ([0-9.]+) mm/) || [])[1]);
     check(n === 21 && Math.abs(shownErr - sum / n) <= 0.05 + 1e-9,
       `frame ${errFrame}: left hand error shown ${shownErr} mm, truth says ${(sum / n).toFixed(3)} mm`);
+
+    // The note of notes.csv at the middle of one of its notes, named as notes.csv names it.
+    const noteRows = fs.readFileSync(path.join(result, 'notes.csv'), 'utf8').trim().split('\n');
+    const ncol = Object.fromEntries(noteRows[0].split(',').map((n, i) => [n, i]));
+    const notes = noteRows.slice(1).map((r) => r.split(',')).filter((r) => r[ncol.kind] === 'note');
+    const mid = notes[Math.floor(notes.length / 2)];
+    const noteFrame = Math.floor(0.5 * (Number(mid[ncol.onset_s]) + Number(mid[ncol.offset_s])) * resultJson.fps);
+    await page.evaluate((f) => window.arcoView.seek(f), noteFrame);
+    const noteText = await page.locator('#note').innerText();
+    const shownCents = Number((noteText.match(/note \S+ \(([+-]?\d+) cents median/) || [])[1]);
+    check(notes.length > 2 && noteText.includes('note ' + mid[ncol.note_name] + ' (') &&
+          Math.abs(shownCents - Number(mid[ncol.cents_from_et])) <= 0.55,
+      `frame ${noteFrame}: notes.csv says ${mid[ncol.note_name]} ${mid[ncol.cents_from_et]} cents, the page: ${JSON.stringify(noteText)}`);
 
     // The contact marker where arco/contacts.csv puts the pressed contact, hidden at rest.
     const rows = fs.readFileSync(path.join(result, 'arco', 'contacts.csv'), 'utf8').trim().split('\n');

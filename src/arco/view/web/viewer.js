@@ -387,6 +387,13 @@
       if (f0[k] > 0) { const yy = y(midiOf(f0[k], a4)); pen ? g.lineTo(x(k), yy) : g.moveTo(x(k), yy); pen = true; } else pen = false;
     }
     g.stroke(); g.lineWidth = 1;
+    // The notes (notes.csv) as bars at their equal-tempered note, on the same clock.
+    g.fillStyle = 'rgba(255, 200, 80, 0.35)';
+    for (const n of manifest.notes) {
+      const a = x(n.onset_s * fps()), b = x(n.offset_s * fps());
+      if (b < 0 || a > cv.width) continue;
+      g.fillRect(a, y(n.midi_note) - 2, b - a, 4);
+    }
     g.strokeStyle = '#ff5060'; g.beginPath(); g.moveTo(x(f), 0); g.lineTo(x(f), cv.height); g.stroke();
     const c = manifest.methods[view.method].contacts;
     let text = f0[f] > 0 ? (() => {
@@ -394,6 +401,12 @@
       const cents = Math.round(100 * (m - n));
       return noteName(n) + ' ' + (cents >= 0 ? '+' : '') + cents + ' cents (' + f0[f].toFixed(1) + ' Hz)';
     })() : 'unvoiced';
+    const t = frameTime(f);
+    const note = manifest.notes.find((n) => n.onset_s <= t && t < n.offset_s);
+    if (note) {
+      text += '\nnote ' + noteName(note.midi_note) + ' (' + (note.cents >= 0 ? '+' : '') +
+        note.cents.toFixed(0) + ' cents median, ' + note.onset_s.toFixed(2) + '-' + note.offset_s.toFixed(2) + ' s)';
+    }
     if (c) {
       const st = c.state.data[f];
       text += '\n' + manifest.methods[view.method].name + ': ' + kStates[st] +
