@@ -172,12 +172,16 @@ async function checkSeek(page, label, m) {
 
 function startServer(res) {
   return new Promise((resolve, reject) => {
-    const child = spawn(arco, ['view', res, '--port', '0', '--exit-after-s', '240']);
+    // Its own TMPDIR, to see that the served folder is removed when it stops.
+    const tmpdir = path.join(work, 'tmp_' + path.basename(res));
+    fs.mkdirSync(tmpdir, { recursive: true });
+    const child = spawn(arco, ['view', res, '--port', '0', '--exit-after-s', '240'],
+                        { env: { ...process.env, TMPDIR: tmpdir } });
     let out = '', err = '';
     child.stdout.on('data', (d) => {
       out += d;
       const m = out.match(/http:\/\/127\.0\.0\.1:\d+\//);
-      if (m) resolve({ child, url: m[0], stderr: () => err });
+      if (m) resolve({ child, url: m[0], stderr: () => err, tmpdir });
     });
     child.stderr.on('data', (d) => { err += d; });
     child.on('exit', (code) => reject(new Error('arco view exited ' + code + ': ' + err)));
@@ -309,8 +313,11 @@ function stopServer(server) {
     await page.evaluate(() => window.arcoView.seek(Math.floor(window.arcoView.frame + 0)));
     await page.screenshot({ path: path.join(work, 'served_page.png') });
     check(errors.length === 0, 'served: no console errors' + (errors.length ? ': ' + errors.join(' | ') : ''));
+    const servedFiles = fs.readdirSync(server.tmpdir);
     const stopped = await stopServer(server);
     check(stopped.code === 0, `arco view stops on SIGINT with exit 0 (got ${stopped.code}, ${stopped.signal})`);
+    check(servedFiles.length === 1 && fs.readdirSync(server.tmpdir).length === 0,
+      `the served folder (${servedFiles.join(', ')}) is removed when the server stops`);
 
     // 2. --no-serve, from disk, with no server running.
     const folder = path.join(work, 'page');
