@@ -134,6 +134,19 @@ bad_at "plot --overwrite over another folder" "$w/photos" plot "$w/res" -o "$w/p
 bad_at "plot over a file" "$w/file" plot "$w/res" -o "$w/file" --overwrite
 bad_at "plot under a file" "$w/file/plots" plot "$w/res" -o "$w/file/plots"
 
+# view --no-serve: a viewer folder (its marker: manifest.json).
+V=(view "$w/res" --no-serve)
+ok "view -o page/" "${V[@]}" -o "$w/page/"
+check '[ -f "$w/page/index.html" ] && [ -f "$w/page/data.js" ] && [ -f "$w/page/manifest.json" ]' "view -o writes the page"
+bad_at "view over a viewer folder" "$w/page" "${V[@]}" -o "$w/page"
+echo old >"$w/page/old.txt"
+ok "view --overwrite" "${V[@]}" -o "$w/page" --overwrite
+check '[ -f "$w/page/index.html" ] && [ ! -e "$w/page/old.txt" ]' "view --overwrite replaces the page"
+bad_at "view --overwrite over another folder" "$w/photos" "${V[@]}" -o "$w/photos" --overwrite
+bad_at "view over a file" "$w/file" "${V[@]}" -o "$w/file" --overwrite
+bad_at "view under a file" "$w/file/sub/page" "${V[@]}" -o "$w/file/sub/page"
+rm -rf "$w/page"
+
 # pitch: pitch.csv, --fine, --notes, --midi, all or none.
 P=(pitch "$spd/pgy.wav" --frames 60)
 ok "pitch every output" "${P[@]}" -o "$w/p.csv" --fine "$w/f.csv" --notes "$w/n.csv" --midi "$w/m.mid"

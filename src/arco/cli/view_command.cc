@@ -1,0 +1,124 @@
+// `arco view`: a result folder as a local web page with its audio (docs/view.md), served
+// on 127.0.0.1 or written as a folder that opens from disk (--no-serve -o DIR).
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
+#include "arco/cli/command.h"
+#include "arco/cli/number_option.h"
+#include "arco/util/output_set.h"
+#include "arco/view/server.h"
+#include "arco/view/view.h"
+
+namespace arco::cli {
+namespace {
+
+struct Args {
+  view::ViewOptions options;
+  int port = 8765;
+  double exit_after_s = 0;
+  bool no_serve = false;
+  bool overwrite = false;
+  std::string output;
+};
+
+void PrintMissing(const view::ViewSummary& summary) {
+  for (const auto& m : summary.missing) {
+    std::fprintf(stderr, "arco view: %s is missing: %s\n", m.stage.c_str(), m.why.c_str());
+  }
+}
+
+void PrintShown(const Args& a, const view::ViewSummary& summary) {
+  std::string methods;
+  for (const auto& m : summary.methods) methods += (methods.empty() ? "" : ", ") + m;
+  std::printf("arco view: %s: %lld frames, methods %s, audio %s, %.1f MB of arrays\n",
+              a.options.result_dir.c_str(),
+              static_cast<long long>(summary.frames),
+              methods.c_str(),
+              summary.audio.empty() ? "none" : summary.audio.c_str(),
+              summary.bytes / 1e6);
+}
+
+int WriteFolder(Args a) {
+  a.options.embed_data = true;
+  OutputSet outputs;
+  FolderReplace replace;
+  replace.overwrite = a.overwrite;
+  replace.marker = "manifest.json";
+  replace.kind = "viewer folder";
+  auto tmp = outputs.AddFolder(a.output, replace);
+  if (!tmp.ok()) return PrintError(tmp.status().message());
+  auto summary = view::WriteViewFolder(a.options, *tmp);
+  if (!summary.ok()) return PrintError(summary.status().message());
+  const Status committed = outputs.Commit();
+  if (!committed.ok()) return PrintError(committed.message());
+  PrintMissing(*summary);
+  PrintShown(a, *summary);
+  std::printf("open %s/index.html in a browser (works from disk, no server)\n", a.output.c_str());
+  return 0;
+}
+
+int Serve(const Args& a) {
+  std::string pattern = (std::filesystem::temp_directory_path() / "arco-view-XXXXXX").string();
+  if (mkdtemp(pattern.data()) == nullptr) return PrintError(pattern + ": cannot create");
+  const std::string dir = pattern;
+  auto summary = view::WriteViewFolder(a.options, dir);
+  int rc = 0;
+  if (!summary.ok()) {
+    rc = PrintError(summary.status().message());
+  } else {
+    view::ServeOptions serve;
+    serve.dir = dir;
+    serve.port = a.port;
+    serve.exit_after_s = a.exit_after_s;
+    // Printed once the port is bound: a busy port is the error line alone.
+    const Status served = view::ServeFolder(serve, [&](int port) {
+      PrintMissing(*summary);
+      PrintShown(a, *summary);
+      std::printf("arco view: http://127.0.0.1:%d/ (Ctrl-C stops)\n", port);
+      std::fflush(stdout);
+    });
+    if (!served.ok()) rc = PrintError(served.message());
+  }
+  std::error_code ignored;
+  std::filesystem::remove_all(dir, ignored);
+  return rc;
+}
+
+std::function<int()> SetupView(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "view", "See and hear a result: 3D, audio, pitch, contacts in a local web page");
+  auto a = std::make_shared<Args>();
+  cmd->add_option("result_dir", a->options.result_dir, "Result folder (from arco run)")->required();
+  AddNumber(cmd,
+            "--port",
+            a->port,
+            "Port on 127.0.0.1 (0: any free port; the URL is printed)",
+            Closed(0, 65535))
+      ->capture_default_str();
+  AddNumber(cmd,
+            "--exit-after-s",
+            a->exit_after_s,
+            "Stop serving after this many seconds (0: until Ctrl-C)",
+            Closed(0, 86400))
+      ->capture_default_str();
+  cmd->add_flag("--no-serve",
+                a->no_serve,
+                "Write the page to -o DIR (opens from disk: the data embedded in data.js)");
+  cmd->add_option("-o,--output", a->output, "Output folder of --no-serve");
+  cmd->add_flag("--overwrite", a->overwrite, "Replace an existing viewer folder");
+  cmd->parse_complete_callback([a] {
+    if (a->no_serve && a->output.empty()) {
+      throw CLI::ValidationError("--no-serve needs -o DIR");
+    }
+    if (!a->no_serve && !a->output.empty()) {
+      throw CLI::ValidationError("-o is for --no-serve (the server writes no folder)");
+    }
+    ThrowIfInvalid(a->options.Validate());
+  });
+  return [a] { return a->no_serve ? WriteFolder(*a) : Serve(*a); };
+}
+
+}  // namespace
+ARCO_REGISTER_COMMAND(view, 76, SetupView);
+}  // namespace arco::cli

@@ -1,0 +1,62 @@
+// `arco view`: a result folder as a self-contained web page (docs/view.md): the 3D of every
+// method with the take's audio, pitch, contacts and per-frame quality. Results are read
+// through the export layer's reader (exporter::LoadExportData) and pipeline::ResultFolder,
+// never a second reader.
+//
+// The page folder: index.html, viewer.js and viewer.css (src/arco/view/web/), three.min.js
+// (npm `three`, fetched by scripts/fetch_view_tools), the capture's audio file, and the data:
+// manifest.json (shapes, names, fps, methods, notes, what is missing) and one
+// little-endian float32 .bin per array, row-major as the .npy it comes from. A page opened
+// from disk (file://) cannot fetch(), so with `embed_data` the same manifest and arrays
+// are also written as data.js (the arrays base64-encoded), which the page reads first.
+//
+// Time: frame k of the arrays (from 0) is shown at k / fps of the video; the audio time of
+// frame k is audio_offset_s + k / fps (mocap/capture.h).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "arco/util/status.h"
+
+namespace arco::view {
+
+struct ViewOptions {
+  std::string result_dir;   // an `arco run` result folder (result.json)
+  bool embed_data = false;  // also write data.js, for pages opened from disk
+  // Where the page's own files and three.min.js are; "" = the paths compiled in
+  // (ARCO_VIEW_WEB_DIR, ARCO_VIEW_THREE_JS).
+  std::string web_dir;
+  std::string three_js;
+  Status Validate() const;
+};
+
+// A stage the page cannot show, and what writes it.
+struct MissingStage {
+  std::string stage;
+  std::string why;
+};
+
+struct ViewSummary {
+  std::vector<std::string> methods;  // shown, in the page's order (arco, paper, vision)
+  std::vector<MissingStage> missing;
+  int64_t frames = 0;
+  int keypoints = 0;
+  std::string audio;  // the audio file copied ("" when none)
+  int64_t bytes = 0;  // of the data arrays
+};
+
+// The stages a complete result has and the command that writes each (the page and the
+// terminal both list those missing).
+std::vector<MissingStage> MissingStages(const std::string& result_dir);
+
+// Writes the page folder into `dir` (an existing empty folder: a caller wanting an atomic
+// output passes an OutputSet temporary). Errors: no result.json, a result with no
+// method points at all, a page file or three.min.js not found.
+StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::string& dir);
+
+// RFC 4648 base64 (with padding), for data.js.
+std::string Base64(const std::string& bytes);
+
+}  // namespace arco::view

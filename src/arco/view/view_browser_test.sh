@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# `arco view` in a real browser: view_browser_test.js on a synthetic result (arco synth +
+# arco run) and on a copy missing its arco stage. Skips (77) only when Debian's
+# /usr/bin/chromium is absent; a missing node or playwright-core (scripts/fetch_view_tools)
+# is a failure. Screenshots stay in WORK_DIR as the test's artefacts.
+# usage: view_browser_test.sh ARCO_BINARY SOURCE_DIR WORK_DIR
+set -uo pipefail
+arco=$1
+src=$2
+work=$3
+rm -rf "$work"
+# Bad input, without a browser: one line "arco: error: ...", exit 1, nothing written.
+mkdir -p "$work"
+fail=0
+bad() {  # bad NAME PATTERN ARGS...
+  local name=$1 pattern=$2; shift 2
+  "$arco" "$@" >/dev/null 2>"$work/err"
+  local rc=$? line; line=$(cat "$work/err")
+  if [ $rc -ne 1 ] || [ "$(wc -l <"$work/err")" -ne 1 ] || [[ "$line" != "arco: error: "$pattern ]]; then
+    echo "FAILED: $name: exit $rc: $line"; fail=1
+  fi
+  if [ -e "$work/out" ]; then echo "FAILED: $name: $work/out was written"; fail=1; fi
+}
+mkdir -p "$work/not_a_result"
+bad "no result.json" "*not_a_result/result.json: not found (not an arco result folder)" \
+  view "$work/not_a_result" --no-serve -o "$work/out"
+bad "--no-serve without -o" "*--no-serve needs -o DIR*" view "$work/not_a_result" --no-serve
+bad "-o without --no-serve" "*-o is for --no-serve*" view "$work/not_a_result" -o "$work/out"
+bad "port out of range" "*--port*" view "$work/not_a_result" --port 70000
+[ $fail -eq 0 ] || exit 1
+
+if [ ! -x /usr/bin/chromium ]; then
+  echo "SKIPPED: /usr/bin/chromium is not installed (apt-get install chromium)"
+  exit 77
+fi
+playwright=$src/tools/view/node_modules/playwright-core
+if ! command -v node >/dev/null || [ ! -f "$playwright/package.json" ]; then
+  echo "FAILED: node or $playwright missing (run scripts/fetch_view_tools)"
+  exit 1
+fi
+"$arco" synth -o "$work/cap" --duration-s 3 >/dev/null 2>&1 &&
+  "$arco" run "$work/cap" -o "$work/res" >/dev/null 2>&1 ||
+  { echo "FAILED: synth + run"; exit 1; }
+# The same result without its arco stage (result.json's entry and the folder).
+cp -r "$work/res" "$work/res_no_arco"
+rm -rf "$work/res_no_arco/arco"
+/usr/bin/python3 - "$work/res_no_arco/result.json" <<'PY' || { echo "FAILED: editing result.json"; exit 1; }
+import json, sys
+d = json.load(open(sys.argv[1]))
+del d["stages"]["arco"]
+json.dump(d, open(sys.argv[1], "w"), indent=1)
+PY
+node "$src/src/arco/view/view_browser_test.js" "$arco" "$work/res" "$work/res_no_arco" \
+  "$work/shots" "$playwright"
