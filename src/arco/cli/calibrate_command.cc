@@ -302,10 +302,14 @@ std::function<int()> SetupCalibrate(CLI::App& app) {
   auto json = std::make_shared<bool>(false);
   auto* check = cmd->add_subcommand(
       "check",
-      "Check a calibration against a capture's 2D keypoints: per camera the reprojection "
-      "residuals of the triangulated keypoints; a camera that stands out (moved or "
+      "Check a calibration against a capture's 2D keypoints (or a result's points): per "
+      "camera the reprojection residuals of the triangulated keypoints; a camera that stands out "
+      "(moved or "
       "mis-calibrated) is flagged with its frames");
-  check->add_option("capture", c->capture_dir, "Capture folder (capture.json, keypoints2d)");
+  check->add_option("capture",
+                    c->capture_dir,
+                    "Capture folder (capture.json, keypoints2d), or a result folder (its "
+                    "triangulated points against the capture its result.json names)");
   auto views = std::make_shared<std::vector<std::string>>();
   check->add_option("--view",
                     *views,
