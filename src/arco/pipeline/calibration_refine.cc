@@ -306,7 +306,7 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
   body.translation.assign(num_frames, Eigen::Vector3d::Zero());
   body.valid.assign(num_frames, 0);
   std::vector<Track> tracks;
-  progress.StartStage(1, 3, "refine");
+  // Progress counts passes (no stage line: an error is then the command's only line).
   progress.SetTotal(3);
 
   struct PassPlan {
