@@ -553,10 +553,11 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
 
     // 4. Back into the rig, the body and the tracks.
     for (int c = 0; c < num_cameras; ++c) {
-      if (c == reference && !options.refine_focal) continue;  // exactly as given
       Camera& cam = rig.cameras[c];
       const double* p = &x[c * kCameraStride];
-      ParamsToPose(p, &cam.cam_from_world_rotation, &cam.cam_from_world_translation);
+      // The reference's pose exactly as given (not through angle-axis and back).
+      if (c != reference)
+        ParamsToPose(p, &cam.cam_from_world_rotation, &cam.cam_from_world_translation);
       cam.fx = p[kPoseSize + kFx];
       cam.fy = p[kPoseSize + kFy];
     }
