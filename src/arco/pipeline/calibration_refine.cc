@@ -552,7 +552,8 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
     summary.passes.push_back(report);
 
     // 4. Back into the rig, the body and the tracks.
-    for (int c = 0; c < num_cameras; ++c) {
+    // Only the capture's cameras (a rig camera the capture lacks stays exactly as given).
+    for (int c : view_to_camera) {
       Camera& cam = rig.cameras[c];
       const double* p = &x[c * kCameraStride];
       // The reference's pose exactly as given (not through angle-axis and back).
