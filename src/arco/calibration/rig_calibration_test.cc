@@ -222,10 +222,12 @@ TEST(CalibrateRig, SurvivesBackwardChessboardViewsAndABadDetection) {
   EXPECT_EQ(result->report.cameras[1].views_used, result->report.cameras[1].views);
   EXPECT_EQ(result->report.cameras[2].views_used, result->report.cameras[2].views - 1);
   // The same result again, bit for bit. Heap noise between the runs moves where the second
-  // run's buffers land: the two sources of the ~1e-12 differences seen before were both
-  // addresses (calibrateCamera's result moves with its buffers' alignment, now rounded far
-  // above it; Ceres ordered the camera blocks by address, now one buffer in camera order).
-  // Without the rounding this fails (a few ulps in fx, cameras 1-3).
+  // run's buffers land. The ~1e-12 differences seen before came from calibrateCamera, whose
+  // result moves with its buffers' addresses (inputs copied elsewhere change fx by a few
+  // ulps): its result is now rounded far above that. Ceres also orders an elimination
+  // group's blocks by address (ceres/ordered_groups.h keeps a std::set<double*>), so the
+  // camera blocks now live in one buffer in camera order. Without the rounding this fails
+  // (a few ulps in fx, cameras 1-3).
   std::vector<std::unique_ptr<char[]>> noise;
   for (int i = 0; i < 100; ++i) noise.emplace_back(new char[64 + 1000 * i]);
   auto again = CalibrateRig(calibrate, board, synthetic.views);
