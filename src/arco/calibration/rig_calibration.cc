@@ -117,18 +117,25 @@ std::vector<int> SelectViewsCoveringImage(const CameraBoardViews& camera, int ma
 // Zhang's method through OpenCV, expressed in arco's model (skew 0).
 StatusOr<std::array<double, kNumIntrinsics>> CalibrateIntrinsics(
     const CameraBoardViews& camera, const std::vector<Eigen::Vector3d>& points, int max_views) {
-  std::vector<std::vector<cv::Point3f>> object_points;
-  std::vector<std::vector<cv::Point2f>> image_points;
+  // cv::Mat per view, not std::vector: OpenCV's results depend in the last bits on where its
+  // inputs lie in memory (its SIMD loops start on an aligned element, so the split between
+  // vector and scalar sums moves with the buffer's address: rig_calibration_test's repeat
+  // runs differed by ~1e-12 with std::vector inputs); cv::Mat data is always allocated
+  // 64-byte aligned, so the same input gives the same result every run.
+  std::vector<cv::Mat> object_points;
+  std::vector<cv::Mat> image_points;
   for (int v : SelectViewsCoveringImage(camera, max_views)) {
     const BoardView& view = camera.views[v];
     if (view.point_ids.size() < 6) continue;
-    object_points.emplace_back();
-    image_points.emplace_back();
-    for (size_t i = 0; i < view.point_ids.size(); ++i) {
+    const int n = static_cast<int>(view.point_ids.size());
+    cv::Mat object(n, 1, CV_32FC3), image(n, 1, CV_32FC2);
+    for (int i = 0; i < n; ++i) {
       const Eigen::Vector3d& p = points[view.point_ids[i]];
-      object_points.back().emplace_back(p.x(), p.y(), p.z());
-      image_points.back().emplace_back(view.corners_px[i].x(), view.corners_px[i].y());
+      object.at<cv::Vec3f>(i) = cv::Vec3f(p.x(), p.y(), p.z());
+      image.at<cv::Vec2f>(i) = cv::Vec2f(view.corners_px[i].x(), view.corners_px[i].y());
     }
+    object_points.push_back(object);
+    image_points.push_back(image);
   }
   if (object_points.size() < 3)
     return Status::Error(camera.camera + " (" + camera.source + "): only " +
@@ -139,8 +146,7 @@ StatusOr<std::array<double, kNumIntrinsics>> CalibrateIntrinsics(
   std::vector<cv::Mat> rvecs, tvecs;
   try {
     // OpenCV's own thread pool could split calibrateCamera's sums in a varying order:
-    // one thread, so the thread count plays no part (rig_calibration_test: repeat runs
-    // still differ by ~1e-12 px, an unresolved last-bit difference).
+    // one thread, so the thread count plays no part.
     const int opencv_threads = cv::getNumThreads();
     cv::setNumThreads(1);
     struct Restore {
@@ -171,6 +177,13 @@ StatusOr<std::array<double, kNumIntrinsics>> CalibrateIntrinsics(
   in[kP1] = dist.at<double>(2);
   in[kP2] = dist.at<double>(3);
   in[kK3] = dist.at<double>(4);
+  // calibrateCamera's last bits still depend on where OpenCV's own temporary buffers land
+  // (inputs moved in memory change fx by a few ulps, k1 by ~1e-15: rig_calibration_test),
+  // and everything after it starts from these values. Rounded to 1e-6 px and 1e-9 (far
+  // below any calibration's precision, far above those differences), the start is the same
+  // every run: the chance that a difference straddles a rounding step is ~1e-6 per value.
+  for (int i : {kFx, kFy, kCx, kCy}) in[i] = std::round(in[i] * 1e6) / 1e6;
+  for (int i : {kK1, kK2, kK3, kP1, kP2}) in[i] = std::round(in[i] * 1e9) / 1e9;
   for (double v : in)
     if (!std::isfinite(v))
       return Status::Error(camera.camera + " (" + camera.source +
@@ -183,12 +196,13 @@ std::optional<Pose> BoardPose(const std::array<double, kNumIntrinsics>& in,
                               const std::vector<Eigen::Vector3d>& points,
                               const BoardView& view) {
   if (view.point_ids.size() < 4) return std::nullopt;
-  std::vector<cv::Point3d> object;
-  std::vector<cv::Point2d> image;
-  for (size_t i = 0; i < view.point_ids.size(); ++i) {
+  // cv::Mat (64-byte aligned) for the same reason as in CalibrateIntrinsics.
+  const int n = static_cast<int>(view.point_ids.size());
+  cv::Mat object(n, 1, CV_64FC3), image(n, 1, CV_64FC2);
+  for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d& p = points[view.point_ids[i]];
-    object.emplace_back(p.x(), p.y(), p.z());
-    image.emplace_back(view.corners_px[i].x(), view.corners_px[i].y());
+    object.at<cv::Vec3d>(i) = cv::Vec3d(p.x(), p.y(), p.z());
+    image.at<cv::Vec2d>(i) = cv::Vec2d(view.corners_px[i].x(), view.corners_px[i].y());
   }
   const cv::Matx33d K(in[kFx], in[kSkew], in[kCx], 0, in[kFy], in[kCy], 0, 0, 1);
   const cv::Vec<double, 5> dist(in[kK1], in[kK2], in[kP1], in[kP2], in[kK3]);
@@ -555,6 +569,19 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   for (int c = 0; c < num_cameras; ++c) camera_params[c] = PoseToParams(cam_from_world[c]);
   std::vector<std::array<double, 6>> board_params(ba_frames.size());
   for (size_t f = 0; f < ba_frames.size(); ++f) board_params[f] = PoseToParams(world_from_board[f]);
+  // Every camera's pose and intrinsics in one buffer, camera after camera. Ceres orders the
+  // blocks of an elimination group by their addresses (ParameterBlockOrdering keeps a
+  // std::set<double*>): with the poses and the intrinsics in two separate allocations, their
+  // order in the reduced camera system depended on where the heap put them, and repeat runs
+  // differed in the last bits (~1e-12).
+  constexpr int kStride = 6 + kNumIntrinsics;
+  std::vector<double> camera_buffer(static_cast<size_t>(num_cameras) * kStride);
+  auto pose_block = [&](int c) { return &camera_buffer[static_cast<size_t>(c) * kStride]; };
+  auto intrinsics_block = [&](int c) { return pose_block(c) + 6; };
+  for (int c = 0; c < num_cameras; ++c) {
+    std::copy(camera_params[c].begin(), camera_params[c].end(), pose_block(c));
+    std::copy(intrinsics[c].begin(), intrinsics[c].end(), intrinsics_block(c));
+  }
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
@@ -569,27 +596,27 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
             new ceres::AutoDiffCostFunction<BoardCornerCost, 2, 6, 6, kNumIntrinsics>(
                 new BoardCornerCost(points[id], v.corners_px[i])),
             &loss,
-            camera_params[u.camera].data(),
+            pose_block(u.camera),
             board_params[f].data(),
-            intrinsics[u.camera].data());
+            intrinsics_block(u.camera));
       }
     }
   for (int c = 0; c < num_cameras; ++c) {
-    if (!problem.HasParameterBlock(camera_params[c].data())) continue;
-    if (c == root) problem.SetParameterBlockConstant(camera_params[c].data());
+    if (!problem.HasParameterBlock(pose_block(c))) continue;
+    if (c == root) problem.SetParameterBlockConstant(pose_block(c));
     if (!options.refine_intrinsics)
-      problem.SetParameterBlockConstant(intrinsics[c].data());
+      problem.SetParameterBlockConstant(intrinsics_block(c));
     else
-      problem.SetManifold(intrinsics[c].data(), new ceres::SubsetManifold(kNumIntrinsics, {kSkew}));
+      problem.SetManifold(intrinsics_block(c), new ceres::SubsetManifold(kNumIntrinsics, {kSkew}));
   }
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_SCHUR;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (auto& b : board_params) ordering->AddElementToGroup(b.data(), 0);
   for (int c = 0; c < num_cameras; ++c) {
-    if (!problem.HasParameterBlock(camera_params[c].data())) continue;
-    ordering->AddElementToGroup(camera_params[c].data(), 1);
-    ordering->AddElementToGroup(intrinsics[c].data(), 1);
+    if (!problem.HasParameterBlock(pose_block(c))) continue;
+    ordering->AddElementToGroup(pose_block(c), 1);
+    ordering->AddElementToGroup(intrinsics_block(c), 1);
   }
   solver_options.linear_solver_ordering = ordering;
   solver_options.max_num_iterations = options.max_iterations;
@@ -603,6 +630,10 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   ceres::Solve(solver_options, &problem, &summary);
   if (summary.termination_type == ceres::FAILURE)
     return Status::Error("bundle adjustment failed: " + summary.message);
+  for (int c = 0; c < num_cameras; ++c) {
+    std::copy(pose_block(c), pose_block(c) + 6, camera_params[c].begin());
+    std::copy(intrinsics_block(c), intrinsics_block(c) + kNumIntrinsics, intrinsics[c].begin());
+  }
 
   RigCalibration result;
   RigCalibrationReport& report = result.report;

@@ -11,6 +11,7 @@
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
 #include "arco/pipeline/calibration_check.h"
+#include "arco/pipeline/calibration_refine.h"
 
 namespace arco::cli {
 namespace {
@@ -66,6 +67,55 @@ int RunCheck(const pipeline::CalibrationCheckOptions& options, bool json) {
       std::printf("warning: %s: residuals stand out from the rig's: moved or mis-calibrated?\n",
                   name.c_str());
   }
+  return 0;
+}
+
+inline constexpr FieldFlag kRefineFlags[] = {{"min_score", "--min-score"},
+                                             {"min_views", "--min-views"},
+                                             {"max_frames", "--max-frames"},
+                                             {"initial_gate_px", "--initial-gate-px"},
+                                             {"gate_px", "--gate-px"},
+                                             {"loss_scale_px", "--loss-px"},
+                                             {"max_iterations", "--max-iterations"}};
+
+int RunRefine(const pipeline::CalibrationRefineOptions& options) {
+  ProgressBar bar("refine");
+  auto result = pipeline::RefineCalibration(options, bar);
+  bar.Finish();
+  if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kRefineFlags));
+  std::printf(
+      "refined %s with %lld frames of %s: %lld points, instrument in %lld frames "
+      "(string %.1f mm in the input's scale, %.1f mm now); reference camera %s held "
+      "fixed\n",
+      result->calibration.c_str(),
+      static_cast<long long>(result->frames),
+      options.capture_dir.c_str(),
+      static_cast<long long>(result->points),
+      static_cast<long long>(result->instrument_frames),
+      result->string_length_before_mm,
+      result->string_length_mm,
+      result->reference_camera.c_str());
+  std::printf("%-20s %8s %12s %11s %9s %10s %8s\n",
+              "camera",
+              "detections",
+              "rms before",
+              "rms after",
+              "turned",
+              "moved",
+              "focal");
+  for (const auto& c : result->cameras)
+    std::printf("%-20s %8lld %9.2f px %8.2f px %7.3f° %7.2f mm %+7.4f%s\n",
+                c.name.c_str(),
+                static_cast<long long>(c.observations),
+                c.rms_before_px,
+                c.rms_after_px,
+                c.rotation_change_deg,
+                c.centre_change_mm,
+                c.focal_change_rel,
+                c.reference ? "  (reference)" : "");
+  std::printf("reprojection rms %.2f px -> %.2f px\n", result->rms_before_px, result->rms_after_px);
+  for (const auto& w : result->warnings) std::printf("warning: %s\n", w.c_str());
+  std::printf("wrote %s and its .report.json\n", options.output.c_str());
   return 0;
 }
 
@@ -137,8 +187,11 @@ std::string FormatReport(const calibration::CalibrateResult& result, const std::
 
 // The cameras in the order --video and --images were given (the first is the default
 // origin). Nothing to check when `arco calibrate check` is what runs.
-void ApplyAndValidate(CalibrateArgs& a, const CLI::App& cmd, const CLI::App& check) {
-  if (check.parsed()) return;
+void ApplyAndValidate(CalibrateArgs& a,
+                      const CLI::App& cmd,
+                      const CLI::App& check,
+                      const CLI::App& refine) {
+  if (check.parsed() || refine.parsed()) return;
   if (a.options.board.empty()) ThrowIfInvalid(Status::Error("--board is required"));
   if (a.options.output.empty()) ThrowIfInvalid(Status::Error("--output is required"));
   a.options.inputs.clear();
@@ -249,10 +302,14 @@ std::function<int()> SetupCalibrate(CLI::App& app) {
   auto json = std::make_shared<bool>(false);
   auto* check = cmd->add_subcommand(
       "check",
-      "Check a calibration against a capture's 2D keypoints: per camera the reprojection "
-      "residuals of the triangulated keypoints; a camera that stands out (moved or "
+      "Check a calibration against a capture's 2D keypoints (or a result's points): per "
+      "camera the reprojection residuals of the triangulated keypoints; a camera that stands out "
+      "(moved or "
       "mis-calibrated) is flagged with its frames");
-  check->add_option("capture", c->capture_dir, "Capture folder (capture.json, keypoints2d)");
+  check->add_option("capture",
+                    c->capture_dir,
+                    "Capture folder (capture.json, keypoints2d), or a result folder (its "
+                    "triangulated points against the capture its result.json names)");
   auto views = std::make_shared<std::vector<std::string>>();
   check->add_option("--view",
                     *views,
@@ -302,9 +359,79 @@ std::function<int()> SetupCalibrate(CLI::App& app) {
     const Status valid = c->Validate();
     if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kCheckFlags)));
   });
-  cmd->parse_complete_callback([a, cmd, check] { ApplyAndValidate(*a, *cmd, *check); });
-  return [a, c, json, check] {
+  auto r = std::make_shared<pipeline::CalibrationRefineOptions>();
+  auto* refine = cmd->add_subcommand(
+      "refine",
+      "Refine a calibration's extrinsics (and optionally focal lengths) by bundle adjustment "
+      "over a capture's 2D keypoints and the instrument as a rigid body of known size");
+  refine->add_option("capture", r->capture_dir, "Capture folder (capture.json, keypoints2d)")
+      ->required();
+  refine->add_option("--calibration",
+                     r->calibration,
+                     "Calibration to refine instead of the capture's own (any format arco reads)");
+  refine
+      ->add_option("-o,--output",
+                   r->output,
+                   "Refined calibration to write: .json arco JSON, .yaml/.yml OpenCV YAML, "
+                   ".xml OpenCV XML; the report goes beside it as NAME.report.json; required")
+      ->required();
+  refine->add_flag("--overwrite", r->overwrite, "Replace an existing output file");
+  refine->add_option("--reference",
+                     r->reference_camera,
+                     "Camera held fixed, which keeps the world frame (default: the capture's "
+                     "first camera)");
+  refine->add_flag("--refine-focal", r->refine_focal, "Also refine every camera's fx and fy");
+  AddNumber(refine,
+            "--min-score",
+            r->min_score,
+            "Ignore detections below this confidence",
+            kFractionRange)
+      ->capture_default_str();
+  AddNumber(refine,
+            "--min-views",
+            r->min_views,
+            "Use keypoints seen by at least this many cameras that agree",
+            Closed(2, 1000))
+      ->capture_default_str();
+  AddNumber(refine,
+            "--max-frames",
+            r->max_frames,
+            "Use at most this many frames, evenly spread over the capture",
+            pipeline::kRefineMaxFramesRange)
+      ->capture_default_str();
+  AddNumber(refine,
+            "--initial-gate-px",
+            r->initial_gate_px,
+            "First pass: leave out views farther than this from their point (px)",
+            pipeline::kRefineGateRangePx)
+      ->capture_default_str();
+  AddNumber(refine,
+            "--gate-px",
+            r->gate_px,
+            "Last pass: keep views within this residual (px)",
+            pipeline::kRefineGateRangePx)
+      ->capture_default_str();
+  AddNumber(refine,
+            "--loss-px",
+            r->loss_scale_px,
+            "Cauchy loss scale of the last pass (px)",
+            pipeline::kRefineLossRangePx)
+      ->capture_default_str();
+  AddNumber(refine,
+            "--max-iterations",
+            r->max_iterations,
+            "Bundle adjustment iterations per pass at most",
+            pipeline::kRefineIterationsRange)
+      ->capture_default_str();
+  refine->parse_complete_callback([r] {
+    const Status valid = r->Validate();
+    if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kRefineFlags)));
+  });
+  cmd->parse_complete_callback(
+      [a, cmd, check, refine] { ApplyAndValidate(*a, *cmd, *check, *refine); });
+  return [a, c, r, json, check, refine] {
     if (check->parsed()) return RunCheck(*c, *json);
+    if (refine->parsed()) return RunRefine(*r);
     ProgressBar bar("calibrate");
     auto result = calibration::RunCalibrate(a->options, bar);
     bar.Finish();

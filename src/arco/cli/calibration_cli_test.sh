@@ -141,6 +141,37 @@ check '[ $rc -eq 0 ] && python3 -c "import json, sys; d = json.load(open(sys.arg
 rc=$?
 check '[ $rc -eq 1 ] && [ $(wc -l <"$tmp/err") -eq 1 ] && grep -q "^arco: error: $tmp/missing.json" "$tmp/err"' "check: missing calibration: $(cat "$tmp/err")"
 
+# calibrate check on a result folder (arco triangulate's): its points against its capture.
+"$arco" triangulate "$tmp/cap" -o "$tmp/res" >/dev/null 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ]' "triangulate for check: $(tail -1 "$tmp/err")"
+"$arco" calibrate check "$tmp/res" >"$tmp/check_res.out" 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ] && grep -q "no camera flagged" "$tmp/check_res.out"' "check on a result: $(tail -2 "$tmp/check_res.out") $(cat "$tmp/err")"
+"$arco" calibrate check "$tmp/res" --calibration "$tmp/turned.json" --json >"$tmp/check_res.json" 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ] && python3 -c "import json, sys; d = json.load(open(sys.argv[1])); assert d[\"flagged\"] == [sys.argv[2]] and d[\"result\"] == sys.argv[3], d" "$tmp/check_res.json" "$name" "$tmp/res"' \
+  "check on a result flags the turned camera $name: $(cat "$tmp/err")"
+
+# arco calibrate refine: the turned copy refined with the capture's keypoints and the
+# instrument (camera 0 held fixed): the turned camera turns back by about 1 degree.
+"$arco" calibrate refine "$tmp/cap" --calibration "$tmp/turned.json" --max-frames 15 -o "$tmp/refined.json" >"$tmp/refine.out" 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 0 ] && [ -f "$tmp/refined.json" ] && python3 -c "
+import json, sys
+r = json.load(open(sys.argv[1]))
+c = r[\"cameras\"][3]
+assert 0.9 < c[\"rotation_change_deg\"] < 1.1, c
+assert c[\"rms_after_px\"] < 0.2 * c[\"rms_before_px\"], c
+assert r[\"cameras\"][0][\"reference\"] and r[\"cameras\"][0][\"rotation_change_deg\"] == 0, r[\"cameras\"][0]
+" "$tmp/refined.report.json"' "refine turns camera 3 back: $(tail -3 "$tmp/refine.out") $(cat "$tmp/err")"
+"$arco" calibrate refine "$tmp/cap" --calibration "$tmp/turned.json" --max-frames 15 -o "$tmp/refined.json" >/dev/null 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 1 ] && [ $(wc -l <"$tmp/err") -eq 1 ] && grep -q "exists; give --overwrite" "$tmp/err"' "refine: existing output: $(cat "$tmp/err")"
+"$arco" calibrate refine "$tmp/cap" --min-score 1 -o "$tmp/none.json" >/dev/null 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 1 ] && [ $(wc -l <"$tmp/err") -eq 1 ] && grep -q "keypoints2d.npy: only" "$tmp/err" && [ ! -e "$tmp/none.json" ] && [ ! -e "$tmp/none.report.json" ]' "refine: too few keypoints: $(cat "$tmp/err")"
+
 # calibrate check on the real SPD labelled views of frame 128: nothing flagged with the
 # session's calibration.
 V=()

@@ -3,7 +3,7 @@
 # inputs is one line "arco: error: FILE: ..." naming the file and the field, a non-zero
 # exit, no output (and no temporary) left behind, on every command that reads that input:
 # arco run (before its first stage: no stage progress line), arco triangulate,
-# arco calibrate check,
+# arco calibrate check, arco calibrate refine,
 # arco pitch --capture and arco sync --capture. Also: a truncated WAV is a warning naming
 # the file; a capture whose audio starts late is still run.
 # usage: inputs_cli_test.sh ARCO_BINARY SHARED_DATA_DIR
@@ -86,8 +86,11 @@ sync_bad() {
     --capture "$tmp/$1"
 }
 check_bad() { bad "calibrate check: $1" "$2" "$3" calibrate check "$tmp/$1"; }
+refine_bad() { bad "calibrate refine: $1" "$2" "$3" calibrate refine "$tmp/$1" -o "$tmp/out/r.json"; }
 # every NAME FILE WORDS: the manifest defect on every command reading capture.json.
-every() { run_bad "$@"; tri_bad "$@"; pitch_bad "$@"; sync_bad "$@"; check_bad "$@"; }
+every() {
+  run_bad "$@"; tri_bad "$@"; pitch_bad "$@"; sync_bad "$@"; check_bad "$@"; refine_bad "$@"
+}
 
 M=capture.json
 # capture.json fields: the file and the field, never a flag.

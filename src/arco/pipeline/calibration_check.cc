@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "arco/calibration/calibration_file.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/triangulate_point.h"
 #include "arco/pipeline/label_views.h"
 #include "arco/pipeline/preflight.h"
+#include "arco/pipeline/result_folder.h"
+#include "arco/util/file_io.h"
 #include "arco/util/stats.h"
 
 namespace arco::pipeline {
@@ -29,6 +32,7 @@ Status CalibrationCheckOptions::Validate() const {
 Json CalibrationCheckSummary::ToJson() const {
   Json j;
   j["calibration"] = calibration;
+  if (!result.empty()) j["result"] = result;
   j["frames"] = frames;
   j["rig_median_px"] = rig_median_px;
   j["threshold_px"] = threshold_px;
@@ -107,25 +111,40 @@ StatusOr<CalibrationCheckSummary> CheckCalibration(const CalibrationCheckOptions
                                                    Progress& progress) {
   ARCO_RETURN_IF_ERROR(options.Validate());
   if (!options.label_views.empty()) return CheckLabelViews(options);
-  ARCO_ASSIGN_OR_RETURN(const CaptureManifest manifest, ReadCaptureManifest(options.capture_dir));
-  if (manifest.keypoints2d.empty())
-    return Status::Error(options.capture_dir + "/capture.json: no keypoints2d to check against");
+  // A result folder: its triangulated points against its capture's 2D keypoints.
   CalibrationCheckSummary summary;
+  std::string capture_dir = options.capture_dir;
+  std::optional<NpyArray<double>> result_points;
+  ResultHeader header;
+  if (FileExists(JoinPath(options.capture_dir, kResultManifestName))) {
+    const ResultFolder result(options.capture_dir);
+    ARCO_ASSIGN_OR_RETURN(header, result.ReadHeader());
+    if (header.capture_dir.empty())
+      return Status::Error(result.ManifestPath() + ": names no capture to check against");
+    ARCO_ASSIGN_OR_RETURN(result_points, result.ReadPoints3d(kTriangulationStage));
+    capture_dir = header.capture_dir;
+    summary.result = options.capture_dir;
+  }
+  ARCO_ASSIGN_OR_RETURN(const CaptureManifest manifest, ReadCaptureManifest(capture_dir));
+  if (manifest.keypoints2d.empty())
+    return Status::Error(capture_dir + "/capture.json: no keypoints2d to check against");
   summary.calibration = options.calibration.empty()
-                            ? ResolveCapturePath(options.capture_dir, manifest.calibration)
+                            ? ResolveCapturePath(capture_dir, manifest.calibration)
                             : options.calibration;
   // The capture's own calibration is checked as `arco run` checks it (messages name
   // capture.json's field); another one by its path.
   if (options.calibration.empty())
-    ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(options.capture_dir, manifest));
+    ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(capture_dir, manifest));
   ARCO_ASSIGN_OR_RETURN(const Calibration calibration, LoadCalibration(summary.calibration));
   const Rig& rig = calibration.rig;
-  ARCO_ASSIGN_OR_RETURN(
-      const std::vector<int> view_to_camera,
-      MatchCaptureCameras(options.capture_dir, manifest, rig, summary.calibration));
-  ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(options.capture_dir, manifest));
+  if (result_points && header.units != rig.units)
+    return Status::Error(options.capture_dir + "/result.json: points in '" + header.units +
+                         "', the calibration " + summary.calibration + " in '" + rig.units + "'");
+  ARCO_ASSIGN_OR_RETURN(const std::vector<int> view_to_camera,
+                        MatchCaptureCameras(capture_dir, manifest, rig, summary.calibration));
+  ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(capture_dir, manifest));
   ARCO_ASSIGN_OR_RETURN(const NpyArray<double> keypoints,
-                        ReadCaptureKeypoints2d(options.capture_dir, manifest));
+                        ReadCaptureKeypoints2d(capture_dir, manifest));
   const int64_t frames = keypoints.shape[0], views = keypoints.shape[1],
                 points = keypoints.shape[2];
 
@@ -152,12 +171,22 @@ StatusOr<CalibrationCheckSummary> CheckCalibration(const CalibrationCheckOptions
         observation_view.push_back(static_cast<int>(v));
       }
       if (static_cast<int>(observations.size()) < options.min_views) continue;
-      const auto point = triangulator.Triangulate(observations, &scratch);
-      if (!point || static_cast<int>(point->inlier_cameras.size()) < options.min_views) continue;
+      Eigen::Vector3d point_in_world;
+      if (result_points) {
+        // The result's point (triangulated when the result was made) at this frame.
+        const int64_t r = manifest.frame_first + f - header.frame_first;
+        if (r < 0 || r >= result_points->shape[0] || p >= result_points->shape[1]) continue;
+        for (int d = 0; d < 3; ++d) point_in_world[d] = result_points->at(r, p, d);
+        if (!point_in_world.allFinite()) continue;
+      } else {
+        const auto point = triangulator.Triangulate(observations, &scratch);
+        if (!point || static_cast<int>(point->inlier_cameras.size()) < options.min_views) continue;
+        point_in_world = point->point_in_world;
+      }
       // Every view's residual, inlier or not: a moved camera is an outlier of the rest.
       for (size_t i = 0; i < observations.size(); ++i) {
         const double r = ReprojectionErrorPx(
-            rig.cameras[observations[i].camera], point->point_in_world, observations[i].pixel);
+            rig.cameras[observations[i].camera], point_in_world, observations[i].pixel);
         if (!std::isfinite(r)) continue;
         residuals[observation_view[i]].push_back(r);
         per_frame[observation_view[i]][manifest.frame_first + f].push_back(r);

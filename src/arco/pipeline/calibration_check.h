@@ -1,8 +1,10 @@
-// `arco calibrate check CAPTURE`: is the calibration still consistent with the capture's
-// own 2D keypoints? Every keypoint seen by enough cameras is triangulated (robustly,
-// mocap/triangulate_point.h) and each camera's reprojection residuals are gathered over
-// the frames; a camera whose median residual stands out from the rig's (a camera that
-// moved or was mis-calibrated) is flagged, with the frames where it is off.
+// `arco calibrate check CAPTURE_OR_RESULT`: is the calibration still consistent with the
+// capture's own 2D keypoints? Every keypoint seen by enough cameras is triangulated
+// (robustly, mocap/triangulate_point.h) or, for a result folder, taken from the result's
+// triangulation (triangulation/points3d.npy, against the capture result.json names), and
+// each camera's reprojection residuals are gathered over the frames; a camera whose median residual
+// stands out from the rig's (a camera that moved or was mis-calibrated) is flagged, with the frames
+// where it is off.
 #pragma once
 
 #include <cstdint>
@@ -21,7 +23,7 @@ inline constexpr NumberRange kCheckRatioRange = Closed(1, 1000);
 inline constexpr NumberRange kCheckMinFlagRangePx = AboveZero(10000);
 
 struct CalibrationCheckOptions {
-  std::string capture_dir;  // a capture folder, or
+  std::string capture_dir;  // a capture folder or a result folder (holds result.json), or
   // labelled views instead (labelme files, corner pixel origin as labelme writes them):
   // (camera name or serial, file) per view; `calibration` is then required.
   std::vector<std::pair<std::string, std::string>> label_views;
@@ -47,6 +49,7 @@ struct CameraCheck {
 
 struct CalibrationCheckSummary {
   std::string calibration;           // the file checked
+  std::string result;                // the result folder whose points were used ("" = none)
   int64_t frames = 0;                // frames looked at
   double rig_median_px = 0;          // median of the cameras' medians
   double threshold_px = 0;           // max(min_flag_px, flag_ratio x rig_median_px)

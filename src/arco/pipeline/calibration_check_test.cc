@@ -6,6 +6,7 @@
 #include "arco/geometry/rotation.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/synthetic_views.h"
+#include "arco/pipeline/triangulate_stage.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/test_dir.h"
@@ -78,6 +79,47 @@ TEST(CheckCalibration, FlagsOnlyACameraTurnedByOneDegree) {
   ASSERT_EQ(bad->cameras[3].off_frames.size(), 1u);
   EXPECT_EQ(bad->cameras[3].off_frames[0], (std::pair<int64_t, int64_t>{1, 40}));
   EXPECT_EQ(bad->ToJson()["flagged"][0], rig.cameras[3].name);
+}
+
+// A result folder (`arco triangulate` of the capture): its points against the capture's
+// detections; the same copy with camera 3 turned by 1 degree is flagged.
+TEST(CheckCalibration, ResultFolderUsesItsPointsAndItsCapture) {
+  TempDir dir;
+  Rig rig;
+  WriteCapture(dir / "capture", &rig);
+  TriangulateStageOptions t;
+  t.capture_dir = dir / "capture";
+  t.result_dir = dir / "result";
+  auto triangulated = RunTriangulateStage(t);
+  ASSERT_TRUE(triangulated.ok()) << triangulated.status().message();
+  CalibrationCheckOptions options;
+  options.capture_dir = dir / "result";
+  auto good = CheckCalibration(options);
+  ASSERT_TRUE(good.ok()) << good.status().message();
+  EXPECT_EQ(good->result, dir / "result");
+  EXPECT_EQ(good->ToJson()["result"], dir / "result");
+  EXPECT_TRUE(good->flagged.empty()) << good->ToJson().dump();
+  EXPECT_EQ(good->frames, 40);
+  for (const CameraCheck& c : good->cameras) {
+    EXPECT_GT(c.residuals, 300) << c.name;
+    EXPECT_LT(c.median_px, 2.0) << c.name;
+  }
+  Rig moved = rig;
+  Camera& turned = moved.cameras[3];
+  const Eigen::Vector3d centre = turned.CenterInWorld();
+  turned.cam_from_world_rotation =
+      RotationFromAxisAngle(Eigen::Vector3d(0, M_PI / 180, 0)) * turned.cam_from_world_rotation;
+  turned.cam_from_world_translation = -turned.cam_from_world_rotation * centre;
+  ASSERT_TRUE(SaveCalibration(dir / "moved.json", moved).ok());
+  options.calibration = dir / "moved.json";
+  auto bad = CheckCalibration(options);
+  ASSERT_TRUE(bad.ok()) << bad.status().message();
+  std::printf("check result: rig median %.2f px; cam3 turned 1 deg: median %.1f px\n",
+              bad->rig_median_px,
+              bad->cameras[3].median_px);
+  ASSERT_EQ(bad->flagged, std::vector<std::string>{rig.cameras[3].name});
+  ASSERT_EQ(bad->cameras[3].off_frames.size(), 1u);
+  EXPECT_EQ(bad->cameras[3].off_frames[0], (std::pair<int64_t, int64_t>{1, 40}));
 }
 
 // The real SPD rig: the four labelled views of frame 128 with the session's Metashape

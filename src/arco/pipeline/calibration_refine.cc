@@ -1,0 +1,635 @@
+#include "arco/pipeline/calibration_refine.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <memory>
+
+#include "arco/calibration/calibration_file.h"
+#include "arco/geometry/rotation.h"
+#include "arco/instrument/instrument_model.h"
+#include "arco/instrument/template_fit.h"
+#include "arco/mocap/capture.h"
+#include "arco/mocap/triangulate_point.h"
+#include "arco/pipeline/preflight.h"
+#include "arco/registry/keypoint_layout.h"
+#include "arco/util/output_set.h"
+
+namespace arco::pipeline {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Per camera in the parameter buffer: cam_from_world (angle-axis, translation), then the
+// intrinsics (camera.h IntrinsicIndex order).
+constexpr int kPoseSize = 6;
+constexpr int kCameraStride = kPoseSize + kNumIntrinsics;
+// Every camera must keep this many detections, or its pose is left to a handful of points.
+constexpr int64_t kMinCameraObservations = 30;
+constexpr int64_t kMinPoints = 30;
+
+struct Observation {
+  int camera = 0;  // rig index
+  Eigen::Vector2d pixel;
+};
+
+// One keypoint in one frame with the views that agree on it.
+struct Track {
+  int frame = 0;   // index into the selected frames
+  int point = 0;   // layout index
+  int rigid = -1;  // instrument template index (model keypoint order), -1 = free point
+  Eigen::Vector3d point_in_world = Eigen::Vector3d::Zero();
+  std::vector<Observation> observations;
+};
+
+// Reprojection of a free point: x_cam = cam_from_world * X.
+struct PointReprojection {
+  explicit PointReprojection(const Eigen::Vector2d& px) : observed_px(px) {}
+  template <typename T>
+  bool operator()(const T* cam, const T* intrinsics, const T* point, T* residual) const {
+    T camera_point[3];
+    ceres::AngleAxisRotatePoint(cam, point, camera_point);
+    for (int i = 0; i < 3; ++i) camera_point[i] += cam[3 + i];
+    T pixel[2];
+    if (!PixelFromPointInCamera(intrinsics, camera_point, pixel)) return false;
+    residual[0] = pixel[0] - T(observed_px.x());
+    residual[1] = pixel[1] - T(observed_px.y());
+    return true;
+  }
+  Eigen::Vector2d observed_px;
+};
+
+// Reprojection of a point of the rigid instrument: X = world_from_instrument * X_template
+// (the template in world units, oriented in the instrument frame).
+struct RigidReprojection {
+  explicit RigidReprojection(const Eigen::Vector2d& px) : observed_px(px) {}
+  template <typename T>
+  bool operator()(const T* cam,
+                  const T* intrinsics,
+                  const T* world_from_instrument,
+                  const T* point_in_instrument,
+                  T* residual) const {
+    T world_point[3];
+    ceres::AngleAxisRotatePoint(world_from_instrument, point_in_instrument, world_point);
+    for (int i = 0; i < 3; ++i) world_point[i] += world_from_instrument[3 + i];
+    return PointReprojection(observed_px)(cam, intrinsics, world_point, residual);
+  }
+  Eigen::Vector2d observed_px;
+};
+
+// The template's nut-centre to bridge-centre distance held at the string length (world
+// units): the only residual that sees the scale, so it is met exactly at the optimum
+// whatever its weight (the weight only conditions the problem).
+struct NutBridgeLength {
+  NutBridgeLength(double target, double weight) : target(target), weight(weight) {}
+  template <typename T>
+  bool operator()(
+      const T* nut_l, const T* nut_r, const T* bridge_l, const T* bridge_r, T* residual) const {
+    T sq = T(0);
+    for (int i = 0; i < 3; ++i) {
+      const T d = T(0.5) * (nut_l[i] + nut_r[i]) - T(0.5) * (bridge_l[i] + bridge_r[i]);
+      sq += d * d;
+    }
+    residual[0] = T(weight) * (ceres::sqrt(sq) - T(target));
+    return true;
+  }
+  double target, weight;
+};
+
+std::string TerminationName(ceres::TerminationType type) {
+  switch (type) {
+    case ceres::CONVERGENCE:
+      return "CONVERGENCE";
+    case ceres::NO_CONVERGENCE:
+      return "NO_CONVERGENCE";
+    case ceres::FAILURE:
+      return "FAILURE";
+    case ceres::USER_SUCCESS:
+      return "USER_SUCCESS";
+    case ceres::USER_FAILURE:
+      return "USER_FAILURE";
+  }
+  return "UNKNOWN";
+}
+
+void PoseToParams(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, double* p) {
+  const Eigen::Vector3d aa = AxisAngleFromRotation(R);
+  for (int i = 0; i < 3; ++i) p[i] = aa[i], p[3 + i] = t[i];
+}
+
+void ParamsToPose(const double* p, Eigen::Matrix3d* R, Eigen::Vector3d* t) {
+  *R = RotationFromAxisAngle(Eigen::Vector3d(p[0], p[1], p[2]));
+  *t = Eigen::Vector3d(p[3], p[4], p[5]);
+}
+
+// The instrument as a rigid body: template points (world units, instrument frame; NaN =
+// not in the template) and a pose per selected frame (valid[f] false = none).
+struct RigidBody {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Matrix3d> rotation;
+  std::vector<Eigen::Vector3d> translation;
+  std::vector<char> valid;
+};
+
+double Rms(const std::vector<double>& v) {
+  if (v.empty()) return 0;
+  double s = 0;
+  for (double e : v) s += e * e;
+  return std::sqrt(s / v.size());
+}
+
+}  // namespace
+
+Status CalibrationRefineOptions::Validate() const {
+  if (capture_dir.empty()) return Status::Error("capture_dir: no capture folder given");
+  if (output.empty()) return Status::Error("output: no calibration file given");
+  ARCO_RETURN_IF_ERROR(CheckInRange("min_score", min_score, Closed(0, 1)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("min_views", min_views, Closed(2, 1000)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("max_frames", max_frames, kRefineMaxFramesRange));
+  ARCO_RETURN_IF_ERROR(CheckInRange("initial_gate_px", initial_gate_px, kRefineGateRangePx));
+  ARCO_RETURN_IF_ERROR(CheckInRange("gate_px", gate_px, kRefineGateRangePx));
+  ARCO_RETURN_IF_ERROR(CheckInRange("loss_scale_px", loss_scale_px, kRefineLossRangePx));
+  ARCO_RETURN_IF_ERROR(CheckInRange("max_iterations", max_iterations, kRefineIterationsRange));
+  return Status::Ok();
+}
+
+Json CalibrationRefineSummary::ToJson() const {
+  Json j;
+  j["calibration"] = calibration;
+  j["output"] = output;
+  j["units"] = units;
+  j["reference_camera"] = reference_camera;
+  j["frames"] = frames;
+  j["points"] = points;
+  j["instrument"] = {{"frames", instrument_frames},
+                     {"points", instrument_points},
+                     {"string_length_mm", string_length_mm},
+                     {"string_length_before_mm", string_length_before_mm}};
+  j["rms_before_px"] = rms_before_px;
+  j["rms_after_px"] = rms_after_px;
+  j["cameras"] = Json::array();
+  for (const CameraRefinement& c : cameras)
+    j["cameras"].push_back({{"name", c.name},
+                            {"reference", c.reference},
+                            {"observations", c.observations},
+                            {"rms_before_px", c.rms_before_px},
+                            {"rms_after_px", c.rms_after_px},
+                            {"rotation_change_deg", c.rotation_change_deg},
+                            {"centre_change_mm", c.centre_change_mm},
+                            {"focal_change_rel", c.focal_change_rel}});
+  j["passes"] = Json::array();
+  for (const Pass& p : passes)
+    j["passes"].push_back({{"termination", p.termination},
+                           {"iterations", p.iterations},
+                           {"initial_cost", p.initial_cost},
+                           {"final_cost", p.final_cost},
+                           {"residual_blocks", p.residual_blocks},
+                           {"time_s", p.time_s}});
+  j["warnings"] = warnings;
+  return j;
+}
+
+StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOptions& options,
+                                                     Progress& progress) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  const std::string extension = std::filesystem::path(options.output).extension().string();
+  CalibrationFormat format = CalibrationFormat::kArcoJson;
+  if (extension == ".yaml" || extension == ".yml")
+    format = CalibrationFormat::kOpenCvYaml;
+  else if (extension == ".xml")
+    format = CalibrationFormat::kOpenCvXml;
+  else if (extension != ".json")
+    return Status::Error(options.output +
+                         ": unknown calibration extension (.json arco JSON, .yaml/.yml OpenCV "
+                         "YAML, .xml OpenCV XML)");
+  std::filesystem::path report_path(options.output);
+  report_path.replace_extension();
+  const std::string report_file = report_path.string() + ".report.json";
+  for (const std::string& path : {options.output, report_file}) {
+    ARCO_RETURN_IF_ERROR(CheckOutputFile(path));
+    if (!options.overwrite && std::filesystem::exists(path))
+      return Status::Error(path + ": exists; give --overwrite to replace it");
+  }
+
+  ARCO_ASSIGN_OR_RETURN(const CaptureManifest manifest, ReadCaptureManifest(options.capture_dir));
+  if (manifest.keypoints2d.empty())
+    return Status::Error(options.capture_dir + "/capture.json: no keypoints2d to refine with");
+  CalibrationRefineSummary summary;
+  summary.calibration = options.calibration.empty()
+                            ? ResolveCapturePath(options.capture_dir, manifest.calibration)
+                            : options.calibration;
+  summary.output = options.output;
+  if (options.calibration.empty())
+    ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(options.capture_dir, manifest));
+  ARCO_ASSIGN_OR_RETURN(const Calibration calibration, LoadCalibration(summary.calibration));
+  const Rig& input = calibration.rig;
+  summary.units = input.units;
+  ARCO_ASSIGN_OR_RETURN(
+      const std::vector<int> view_to_camera,
+      MatchCaptureCameras(options.capture_dir, manifest, input, summary.calibration));
+  const int num_cameras = static_cast<int>(input.cameras.size());
+  if (view_to_camera.size() < 2)
+    return Status::Error(options.capture_dir +
+                         ": refining a calibration needs at least two "
+                         "cameras, the capture has " +
+                         std::to_string(view_to_camera.size()));
+  int reference = view_to_camera[0];
+  if (!options.reference_camera.empty()) {
+    reference = -1;
+    for (int c : view_to_camera)
+      if (input.cameras[c].name == options.reference_camera) reference = c;
+    if (reference < 0)
+      return Status::Error("reference camera '" + options.reference_camera +
+                           "' is not one of the capture's cameras");
+  }
+  summary.reference_camera = input.cameras[reference].name;
+
+  // The instrument: its rigid keypoints (layout columns) and the scale.
+  if (manifest.instrument.empty() || manifest.instrument == "none")
+    return Status::Error(options.capture_dir +
+                         "/capture.json: no instrument; refine takes the rig's metric scale "
+                         "from the instrument's string length");
+  ARCO_ASSIGN_OR_RETURN(const InstrumentModel model, InstrumentModel::Create(manifest.instrument));
+  const KeypointLayout* layout = FindKeypointLayout(manifest.layout);
+  if (layout == nullptr)
+    return Status::Error(options.capture_dir + "/capture.json: unknown layout '" + manifest.layout +
+                         "'");
+  const std::vector<std::string>& names = model.keypoint_names();
+  const int num_k = static_cast<int>(names.size());
+  std::vector<int> rigid_of_point(layout->size(), -1);
+  for (int k = 0; k < num_k; ++k) {
+    if (names[k] == "frog" || names[k] == "tip") continue;  // the bow: free points
+    const int column = layout->Find(names[k]);
+    if (column >= 0) rigid_of_point[column] = k;
+  }
+  const int nut_l = model.KeypointIndex("nut_l"), nut_r = model.KeypointIndex("nut_r"),
+            bridge_l = model.KeypointIndex("bridge_l"), bridge_r = model.KeypointIndex("bridge_r");
+  InstrumentFitOptions fit_options;
+  double units_per_mm = 0;
+  if (input.units == "mm") {
+    fit_options.scale = InstrumentFitOptions::Scale::kWorldIsMillimetres;
+    units_per_mm = 1;
+  } else if (input.units == "m") {
+    fit_options.scale = InstrumentFitOptions::Scale::kGiven;
+    fit_options.world_units_per_mm = units_per_mm = 1e-3;
+  }
+
+  ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(options.capture_dir, manifest));
+  ARCO_ASSIGN_OR_RETURN(const NpyArray<double> keypoints,
+                        ReadCaptureKeypoints2d(options.capture_dir, manifest));
+  const int64_t frames = keypoints.shape[0], views = keypoints.shape[1],
+                points = keypoints.shape[2];
+  if (points != layout->size())
+    return Status::Error(ResolveCapturePath(options.capture_dir, manifest.keypoints2d) + ": " +
+                         std::to_string(points) + " keypoints per view, layout " + manifest.layout +
+                         " has " + std::to_string(layout->size()));
+  // Frames evenly spread over the capture.
+  std::vector<int64_t> selected;
+  const int64_t used_frames = std::min<int64_t>(frames, options.max_frames);
+  for (int64_t i = 0; i < used_frames; ++i)
+    selected.push_back(used_frames == 1 ? 0 : i * (frames - 1) / (used_frames - 1));
+  const int num_frames = static_cast<int>(selected.size());
+  summary.frames = num_frames;
+
+  // Parameters in one buffer, in a fixed order: Ceres orders the blocks of an elimination
+  // group by address, so separate allocations would make the solution depend on where the
+  // heap put them (the last bits differ from run to run).
+  Rig rig = input;
+  RigidBody body;
+  body.points.assign(num_k, Eigen::Vector3d::Constant(kNaN));
+  body.rotation.assign(num_frames, Eigen::Matrix3d::Identity());
+  body.translation.assign(num_frames, Eigen::Vector3d::Zero());
+  body.valid.assign(num_frames, 0);
+  std::vector<Track> tracks;
+  // Progress counts passes (no stage line: an error is then the command's only line).
+  progress.SetTotal(3);
+
+  struct PassPlan {
+    double gate_px, loss_px;
+  };
+  const PassPlan plan[3] = {
+      {options.initial_gate_px, std::max(8 * options.loss_scale_px, 16.0)},
+      {std::max(3 * options.gate_px, options.gate_px), 4 * options.loss_scale_px},
+      {options.gate_px, options.loss_scale_px}};
+  // Enough to go on: the rig enough points, every camera enough detections of them.
+  auto enough = [&]() -> Status {
+    std::vector<int64_t> per_camera(num_cameras, 0);
+    for (const Track& t : tracks)
+      for (const Observation& o : t.observations) ++per_camera[o.camera];
+    if (static_cast<int64_t>(tracks.size()) < kMinPoints)
+      return Status::Error(ResolveCapturePath(options.capture_dir, manifest.keypoints2d) +
+                           ": only " + std::to_string(tracks.size()) + " keypoints are seen by " +
+                           std::to_string(options.min_views) +
+                           " cameras with a score of at least " + NumberText(options.min_score) +
+                           " (" + std::to_string(kMinPoints) + " needed to refine the rig)");
+    for (int c : view_to_camera)
+      if (per_camera[c] < kMinCameraObservations)
+        return Status::Error(ResolveCapturePath(options.capture_dir, manifest.keypoints2d) +
+                             ": camera " + input.cameras[c].name + " has only " +
+                             std::to_string(per_camera[c]) + " detections of keypoints that " +
+                             std::to_string(options.min_views) + " cameras agree on (" +
+                             std::to_string(kMinCameraObservations) +
+                             " needed to refine its pose)");
+
+    return Status::Ok();
+  };
+  for (int pass = 0; pass < 3; ++pass) {
+    // 1. Tracks: points triangulated with the current rig, their agreeing views.
+    TriangulationOptions triangulation;
+    triangulation.min_score = options.min_score;
+    triangulation.max_reprojection_px = plan[pass].gate_px;
+    const Triangulator triangulator(rig, triangulation);
+    TriangulationScratch scratch;
+    tracks.clear();
+    std::vector<PointObservation> observations;
+    for (int f = 0; f < num_frames; ++f)
+      for (int64_t p = 0; p < points; ++p) {
+        observations.clear();
+        for (int64_t v = 0; v < views; ++v) {
+          const double x = keypoints.at(selected[f], v, p, 0),
+                       y = keypoints.at(selected[f], v, p, 1),
+                       score = keypoints.at(selected[f], v, p, 2);
+          if (!std::isfinite(x) || !std::isfinite(y) || !(score >= options.min_score)) continue;
+          observations.push_back({view_to_camera[v], Eigen::Vector2d(x, y), score});
+        }
+        if (static_cast<int>(observations.size()) < options.min_views) continue;
+        const auto point = triangulator.Triangulate(observations, &scratch);
+        if (!point || static_cast<int>(point->inlier_cameras.size()) < options.min_views) continue;
+        Track track;
+        track.frame = f;
+        track.point = static_cast<int>(p);
+        track.rigid = rigid_of_point[p];
+        track.point_in_world = point->point_in_world;
+        for (const PointObservation& o : observations)
+          if (std::binary_search(
+                  point->inlier_cameras.begin(), point->inlier_cameras.end(), o.camera))
+            track.observations.push_back({o.camera, o.pixel});
+        tracks.push_back(std::move(track));
+      }
+
+    ARCO_RETURN_IF_ERROR(enough());
+
+    // 2. The rigid instrument: fitted to the first pass's points, then carried over.
+    if (pass == 0) {
+      std::vector<Eigen::Matrix3Xd> instrument_points(num_frames,
+                                                      Eigen::Matrix3Xd::Constant(3, num_k, kNaN));
+      std::vector<FrontHint> hints(num_frames);
+      std::vector<Eigen::Vector3d> shoulders(2 * num_frames, Eigen::Vector3d::Constant(kNaN));
+      for (const Track& t : tracks) {
+        if (t.rigid >= 0) instrument_points[t.frame].col(t.rigid) = t.point_in_world;
+        if (t.point == wholebody::kLeftShoulder) shoulders[2 * t.frame] = t.point_in_world;
+        if (t.point == wholebody::kRightShoulder) shoulders[2 * t.frame + 1] = t.point_in_world;
+      }
+      for (int f = 0; f < num_frames; ++f)
+        hints[f].value = 0.5 * (shoulders[2 * f] + shoulders[2 * f + 1]);
+      StatusOr<InstrumentFit> fit = FitInstrument(model, instrument_points, hints, fit_options);
+      if (!fit.ok())
+        return Status::Error(options.capture_dir +
+                             ": the instrument's keypoints give no rigid "
+                             "body to take the scale from (" +
+                             fit.status().message() + ")");
+      const double s = fit->instrument.world_units_per_mm;
+      if (units_per_mm == 0) units_per_mm = s;
+      for (int k = 0; k < num_k; ++k)
+        body.points[k] = s * fit->instrument.keypoints_in_instrument[k];
+      for (int f = 0; f < num_frames; ++f) {
+        const InstrumentFramePose& pose = fit->frames[f];
+        if (pose.status != FrameFitStatus::kOk) continue;
+        body.valid[f] = 1;
+        body.rotation[f] = pose.pose.rotation;
+        body.translation[f] = pose.pose.translation;
+      }
+      for (int k : {nut_l, nut_r, bridge_l, bridge_r})
+        if (k < 0 || !body.points[k].allFinite())
+          return Status::Error(options.capture_dir +
+                               ": the instrument's nut and bridge points are not seen well "
+                               "enough to give the scale");
+      summary.string_length_mm = model.string_length_mm();
+      summary.string_length_before_mm = (0.5 * (body.points[nut_l] + body.points[nut_r]) -
+                                         0.5 * (body.points[bridge_l] + body.points[bridge_r]))
+                                            .norm() /
+                                        units_per_mm;
+    }
+    // Rigid points only where the body has a pose and the template the point.
+    tracks.erase(std::remove_if(tracks.begin(),
+                                tracks.end(),
+                                [&](const Track& t) {
+                                  return t.rigid >= 0 && (!body.valid[t.frame] ||
+                                                          !body.points[t.rigid].allFinite());
+                                }),
+                 tracks.end());
+    // A frame's pose needs three of its points (two leave a rotation free).
+    std::vector<int> rigid_in_frame(num_frames, 0);
+    for (const Track& t : tracks) rigid_in_frame[t.frame] += t.rigid >= 0;
+    tracks.erase(
+        std::remove_if(tracks.begin(),
+                       tracks.end(),
+                       [&](const Track& t) { return t.rigid >= 0 && rigid_in_frame[t.frame] < 3; }),
+        tracks.end());
+    for (int f = 0; f < num_frames; ++f)
+      if (rigid_in_frame[f] < 3) body.valid[f] = 0;
+    ARCO_RETURN_IF_ERROR(enough());
+
+    // 3. The parameters, in one buffer: cameras, template, instrument poses, free points.
+    int64_t num_free = 0;
+    std::vector<int64_t> free_index(tracks.size(), -1);
+    for (size_t i = 0; i < tracks.size(); ++i)
+      if (tracks[i].rigid < 0) free_index[i] = num_free++;
+    const int64_t template_offset = int64_t{num_cameras} * kCameraStride;
+    const int64_t pose_offset = template_offset + 3 * num_k;
+    const int64_t point_offset = pose_offset + int64_t{kPoseSize} * num_frames;
+    std::vector<double> x(point_offset + 3 * num_free, 0.0);
+    for (int c = 0; c < num_cameras; ++c) {
+      const Camera& cam = rig.cameras[c];
+      PoseToParams(
+          cam.cam_from_world_rotation, cam.cam_from_world_translation, &x[c * kCameraStride]);
+      const auto intrinsics = cam.Intrinsics();
+      std::copy(intrinsics.begin(), intrinsics.end(), &x[c * kCameraStride + kPoseSize]);
+    }
+    for (int k = 0; k < num_k; ++k)
+      for (int i = 0; i < 3; ++i)
+        x[template_offset + 3 * k + i] = body.points[k].allFinite() ? body.points[k][i] : 0.0;
+    for (int f = 0; f < num_frames; ++f)
+      PoseToParams(body.rotation[f], body.translation[f], &x[pose_offset + kPoseSize * f]);
+    for (size_t i = 0; i < tracks.size(); ++i)
+      if (free_index[i] >= 0)
+        for (int d = 0; d < 3; ++d)
+          x[point_offset + 3 * free_index[i] + d] = tracks[i].point_in_world[d];
+
+    ceres::Problem::Options problem_options;
+    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(problem_options);
+    // Cauchy while gross errors may remain (pass 1); Huber once the gate has removed them:
+    // Cauchy's down-weighting near the noise level made the last pass's reduced system
+    // indefinite (failed Cholesky steps, 70 iterations instead of a few).
+    std::unique_ptr<ceres::LossFunction> loss;
+    if (pass == 0)
+      loss = std::make_unique<ceres::CauchyLoss>(plan[pass].loss_px);
+    else
+      loss = std::make_unique<ceres::HuberLoss>(plan[pass].loss_px);
+    for (size_t i = 0; i < tracks.size(); ++i) {
+      const Track& t = tracks[i];
+      for (const Observation& o : t.observations) {
+        double* cam = &x[o.camera * kCameraStride];
+        double* intrinsics = cam + kPoseSize;
+        if (t.rigid < 0) {
+          problem.AddResidualBlock(
+              new ceres::AutoDiffCostFunction<PointReprojection, 2, 6, kNumIntrinsics, 3>(
+                  new PointReprojection(o.pixel)),
+              loss.get(),
+              cam,
+              intrinsics,
+              &x[point_offset + 3 * free_index[i]]);
+        } else {
+          problem.AddResidualBlock(
+              new ceres::AutoDiffCostFunction<RigidReprojection, 2, 6, kNumIntrinsics, 6, 3>(
+                  new RigidReprojection(o.pixel)),
+              loss.get(),
+              cam,
+              intrinsics,
+              &x[pose_offset + kPoseSize * t.frame],
+              &x[template_offset + 3 * t.rigid]);
+        }
+      }
+    }
+    const double target = model.string_length_mm() * units_per_mm;
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<NutBridgeLength, 1, 3, 3, 3, 3>(
+                                 new NutBridgeLength(target, 10.0 / units_per_mm)),
+                             nullptr,
+                             &x[template_offset + 3 * nut_l],
+                             &x[template_offset + 3 * nut_r],
+                             &x[template_offset + 3 * bridge_l],
+                             &x[template_offset + 3 * bridge_r]);
+    std::vector<int> free_intrinsics = {kFx, kFy};
+    std::vector<int> held;
+    for (int i = 0; i < kNumIntrinsics; ++i)
+      if (i != kFx && i != kFy) held.push_back(i);
+    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+    for (int c = 0; c < num_cameras; ++c) {
+      double* cam = &x[c * kCameraStride];
+      if (!problem.HasParameterBlock(cam)) continue;
+      if (c == reference) problem.SetParameterBlockConstant(cam);
+      if (options.refine_focal)
+        problem.SetManifold(cam + kPoseSize, new ceres::SubsetManifold(kNumIntrinsics, held));
+      else
+        problem.SetParameterBlockConstant(cam + kPoseSize);
+      ordering->AddElementToGroup(cam, 1);
+      ordering->AddElementToGroup(cam + kPoseSize, 1);
+    }
+    for (int k = 0; k < num_k; ++k)
+      if (problem.HasParameterBlock(&x[template_offset + 3 * k]))
+        ordering->AddElementToGroup(&x[template_offset + 3 * k], 1);
+    for (int f = 0; f < num_frames; ++f)
+      if (problem.HasParameterBlock(&x[pose_offset + kPoseSize * f]))
+        ordering->AddElementToGroup(&x[pose_offset + kPoseSize * f], 0);
+    for (int64_t i = 0; i < num_free; ++i) ordering->AddElementToGroup(&x[point_offset + 3 * i], 0);
+    ceres::Solver::Options solver_options;
+    solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+    solver_options.linear_solver_ordering = ordering;
+    solver_options.max_num_iterations = options.max_iterations;
+    solver_options.function_tolerance = 1e-10;
+    solver_options.gradient_tolerance = 1e-12;
+    solver_options.parameter_tolerance = 1e-10;
+    // One thread: the multi-threaded Schur elimination sums in a varying order.
+    solver_options.num_threads = 1;
+    const auto start = std::chrono::steady_clock::now();
+    ceres::Solver::Summary solved;
+    ceres::Solve(solver_options, &problem, &solved);
+    if (solved.termination_type == ceres::FAILURE)
+      return Status::Error("bundle adjustment failed: " + solved.message);
+    CalibrationRefineSummary::Pass report;
+    report.termination = TerminationName(solved.termination_type);
+    report.iterations = static_cast<int>(solved.iterations.size()) - 1;
+    report.initial_cost = solved.initial_cost;
+    report.final_cost = solved.final_cost;
+    report.residual_blocks = solved.num_residual_blocks;
+    report.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    summary.passes.push_back(report);
+
+    // 4. Back into the rig, the body and the tracks.
+    // Only the capture's cameras (a rig camera the capture lacks stays exactly as given).
+    for (int c : view_to_camera) {
+      Camera& cam = rig.cameras[c];
+      const double* p = &x[c * kCameraStride];
+      // The reference's pose exactly as given (not through angle-axis and back).
+      if (c != reference)
+        ParamsToPose(p, &cam.cam_from_world_rotation, &cam.cam_from_world_translation);
+      cam.fx = p[kPoseSize + kFx];
+      cam.fy = p[kPoseSize + kFy];
+    }
+    for (int k = 0; k < num_k; ++k)
+      if (body.points[k].allFinite()) body.points[k] = Eigen::Vector3d(&x[template_offset + 3 * k]);
+    for (int f = 0; f < num_frames; ++f)
+      ParamsToPose(&x[pose_offset + kPoseSize * f], &body.rotation[f], &body.translation[f]);
+    progress.Advance(1);
+  }
+
+  // The report: per camera, the last pass's detections reprojected from points
+  // triangulated with the input and with the refined calibration (same views).
+  TriangulationOptions wide;
+  wide.max_reprojection_px = 1e6;
+  wide.min_score = 0;
+  const Triangulator before(input, wide), after(rig, wide);
+  std::vector<std::vector<double>> errors_before(num_cameras), errors_after(num_cameras);
+  std::vector<PointObservation> observations;
+  for (const Track& t : tracks) {
+    if (t.rigid < 0) ++summary.points;
+    observations.clear();
+    for (const Observation& o : t.observations) observations.push_back({o.camera, o.pixel, 1.0});
+    for (const auto& [triangulator, errors] :
+         {std::make_pair(&before, &errors_before), std::make_pair(&after, &errors_after)}) {
+      const auto point = triangulator->Triangulate(observations);
+      if (!point) continue;
+      for (const Observation& o : t.observations) {
+        const double e = ReprojectionErrorPx(
+            triangulator->rig().cameras[o.camera], point->point_in_world, o.pixel);
+        if (std::isfinite(e)) (*errors)[o.camera].push_back(e);
+      }
+    }
+  }
+  for (int f = 0; f < num_frames; ++f) summary.instrument_frames += body.valid[f];
+  for (int k = 0; k < num_k; ++k) summary.instrument_points += body.points[k].allFinite();
+  std::vector<double> all_before, all_after;
+  for (int c : view_to_camera) {
+    CameraRefinement r;
+    const Camera &a = input.cameras[c], &b = rig.cameras[c];
+    r.name = a.name;
+    r.reference = c == reference;
+    r.observations = static_cast<int64_t>(errors_after[c].size());
+    r.rms_before_px = Rms(errors_before[c]);
+    r.rms_after_px = Rms(errors_after[c]);
+    r.rotation_change_deg =
+        RotationAngleBetween(a.cam_from_world_rotation, b.cam_from_world_rotation) * 180 / M_PI;
+    r.centre_change_mm = (a.CenterInWorld() - b.CenterInWorld()).norm() / units_per_mm;
+    r.focal_change_rel = b.fx / a.fx - 1;
+    summary.cameras.push_back(r);
+    all_before.insert(all_before.end(), errors_before[c].begin(), errors_before[c].end());
+    all_after.insert(all_after.end(), errors_after[c].begin(), errors_after[c].end());
+  }
+  summary.rms_before_px = Rms(all_before);
+  summary.rms_after_px = Rms(all_after);
+  for (const CalibrationRefineSummary::Pass& p : summary.passes)
+    if (p.termination != "CONVERGENCE")
+      summary.warnings.push_back("a bundle adjustment pass ended with " + p.termination +
+                                 " after " + std::to_string(p.iterations) + " iterations");
+  summary.rig = rig;
+
+  OutputSet outputs;
+  ARCO_ASSIGN_OR_RETURN(const std::string calibration_tmp, outputs.AddFile(options.output));
+  ARCO_ASSIGN_OR_RETURN(const std::string report_tmp, outputs.AddFile(report_file));
+  ARCO_RETURN_IF_ERROR(SaveCalibration(calibration_tmp, rig, format));
+  {
+    std::ofstream out(report_tmp);
+    out << summary.ToJson().dump(2) << "\n";
+    if (!out) return Status::Error(report_file + ": cannot write");
+  }
+  ARCO_RETURN_IF_ERROR(outputs.Commit());
+  return summary;
+}
+
+}  // namespace arco::pipeline
