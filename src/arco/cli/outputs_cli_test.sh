@@ -189,14 +189,14 @@ rm "$w/rig.report.json"
 # --overwrite.
 "$arco" synth --duration-s 1 --no-audio -o "$tmp/cap" >/dev/null 2>&1
 R=(calibrate refine "$tmp/cap" --max-frames 5)
-bad "calibrate refine into a folder" "$w/dir" "${R[@]}" -o "$w/dir"
-bad "calibrate refine into a missing folder" "$w/nodir/r.json" "${R[@]}" -o "$w/nodir/r.json"
-bad "calibrate refine under a file" "$w/file/r.json" "${R[@]}" -o "$w/file/r.json"
+bad_at "calibrate refine into a folder" "$w/dir" "${R[@]}" -o "$w/dir"
+bad_at "calibrate refine into a missing folder" "$w/nodir/r.json" "${R[@]}" -o "$w/nodir/r.json"
+bad_at "calibrate refine under a file" "$w/file/r.json" "${R[@]}" -o "$w/file/r.json"
 mkdir "$w/r3.report.json"
-bad "calibrate refine: the report's path is a folder" "$w/r3.report.json" "${R[@]}" -o "$w/r3.json"
+bad_at "calibrate refine: the report's path is a folder" "$w/r3.report.json" "${R[@]}" -o "$w/r3.json"
 rmdir "$w/r3.report.json"
 echo "old" >"$w/r4.json"
-bad "calibrate refine over an existing file without --overwrite" "$w/r4.json" "${R[@]}" -o "$w/r4.json"
+bad_at "calibrate refine over an existing file without --overwrite" "$w/r4.json" "${R[@]}" -o "$w/r4.json"
 rm "$w/r4.json"
 
 check '[ -z "$(find "$w" -name ".tmp-*" -o -name ".old-*")" ]' "no temporaries left"
