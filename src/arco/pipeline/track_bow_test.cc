@@ -187,6 +187,12 @@ TEST(TrackBow, DISABLED_TheBowMovesOnItsOwn) {
     ASSERT_TRUE(AtomicWriteFile(file, LabelmeText(cam, names, px)).ok());
     o.labels.push_back({cam.name, -1, file});
   }
+  if (false)
+    for (int f = 0; f < kFrames; ++f) {
+      const Eigen::Vector3d a = synth::PlaneToWorld(world_from_bow[f], synth::TexturePixelToPlane(bow, frog_px));
+      const Eigen::Vector3d b = synth::PlaneToWorld(world_from_bow[f], synth::TexturePixelToPlane(bow, tip_px));
+      fprintf(stderr, "truth %d frog=(%.1f %.1f %.1f) tip=(%.1f %.1f %.1f)\n", f, a.x(), a.y(), a.z(), b.x(), b.y(), b.z());
+    }
   auto tracked = RunTrackStage(o);
   ASSERT_TRUE(tracked.ok()) << tracked.status().message();
   EXPECT_TRUE(tracked->bow_tracked);

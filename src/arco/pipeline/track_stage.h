@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "arco/track/bow_tracker.h"
 #include "arco/track/instrument_tracker.h"
 #include "arco/util/json_io.h"
 #include "arco/util/progress.h"
@@ -40,6 +41,7 @@ struct TrackStageOptions {
   // a thin bow moving on its own (pipeline_track_bow_test), so it is off by default and
   // the bow's slots are kept.
   bool track_bow = false;
+  track::BowTrackerOptions bow;  // its num_threads is num_threads above
   Status Validate() const;
 };
 
@@ -47,10 +49,11 @@ Json ToJson(const TrackStageOptions& options);
 
 struct TrackCameraSummary {
   std::string camera;
-  int64_t frames = 0;       // frames read
-  int64_t lost_frames = 0;  // frames in which the view had lost the instrument
-  int64_t reacquired = 0;   // times it found it again
-  double mean_inliers = 0;  // per frame read
+  int64_t frames = 0;           // frames read
+  int64_t lost_frames = 0;      // frames in which the view had lost the instrument
+  int64_t reacquired = 0;       // times it found it again
+  int64_t bow_lost_frames = 0;  // frames without a line segment near the predicted bow
+  double mean_inliers = 0;      // per frame read
   double mean_residual_px = 0;
 };
 
