@@ -36,10 +36,11 @@ struct TrackStageOptions {
   int64_t labels_frame = -1;                // -1: the capture's first frame
   track::InstrumentTrackerOptions tracker;  // its num_threads is num_threads below
   int num_threads = 0;                      // 0 = all cores; results do not depend on it
-  // Experimental: the bow as a thin rigid body from its frog and tip labels (corners on
-  // the stick, docs/track.md). It holds on a textured bow lying on the picture but loses
-  // a thin bow moving on its own (pipeline_track_bow_test), so it is off by default and
-  // the bow's slots are kept.
+  // Experimental: the bow as a thin rigid body of fixed length from its frog and tip
+  // labels (track/bow_tracker.h: line segments, the profile along the stick). It holds
+  // on a bow lying on the picture (pipeline_track_plane_test) but misses issue 13's bound
+  // on a bow moving on its own (pipeline_track_bow_test, disabled), so it is off by
+  // default and the bow's slots are kept.
   bool track_bow = false;
   track::BowTrackerOptions bow;  // its num_threads is num_threads above
   Status Validate() const;

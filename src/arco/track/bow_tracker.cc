@@ -43,19 +43,15 @@ std::optional<Eigen::Vector2d> IdealPixel(const Camera& cam, const Eigen::Vector
   return h.head<2>();
 }
 
-// A line segment in a view: its ideal pixels and the plane through the camera centre
-// that holds it (unit normal n, n . X = offset).
+// A line segment in a view, in ideal (undistorted) pixels.
 struct Segment {
   Eigen::Vector2d a, b;  // ideal pixels
-  Eigen::Vector3d normal;
-  double offset = 0;
   double length = 0;
   double residual_px = 0;  // to the fitted axis' projection
 };
 
 struct View {
   Camera camera;
-  Eigen::Matrix3d k_inverse;
   cv::Mat label_image;
   std::vector<double> profile;  // the labelled frame's, NaN where unseen
   std::vector<Segment> segments;
@@ -181,8 +177,6 @@ struct BowTracker::State {
     std::vector<cv::Vec4f> lines;
     lsd->detect(image(box).clone(), lines);
     const double sin_gate = std::sin(options.max_angle_deg * M_PI / 180);
-    const Eigen::Matrix3d world_from_cam = cam.cam_from_world_rotation.transpose();
-    const Eigen::Vector3d centre = cam.CenterInWorld();
     for (const cv::Vec4f& l : lines) {
       // LSD's coordinates put pixel centres at .5.
       const Eigen::Vector2d p(l[0] + box.x - 0.5, l[1] + box.y - 0.5);
@@ -200,10 +194,6 @@ struct BowTracker::State {
         continue;
       const double mid = t.dot(0.5 * (s.a + s.b) - *a);
       if (mid < -0.1 * extent || mid > 1.1 * extent) continue;
-      const Eigen::Vector3d ra = view.k_inverse * Eigen::Vector3d(s.a.x(), s.a.y(), 1);
-      const Eigen::Vector3d rb = view.k_inverse * Eigen::Vector3d(s.b.x(), s.b.y(), 1);
-      s.normal = (world_from_cam * ra.cross(rb)).normalized();
-      s.offset = s.normal.dot(centre);
       view.segments.push_back(s);
     }
   }
@@ -355,7 +345,6 @@ BowTracker::BowTracker(std::vector<Camera> cameras,
   for (Camera& c : cameras) {
     View v;
     v.camera = std::move(c);
-    v.k_inverse = v.camera.K().inverse();
     st.views.push_back(std::move(v));
   }
 }
