@@ -65,11 +65,15 @@ void Disc(media::Image* image, const Eigen::Vector2d& centre, double radius, uin
       if ((Eigen::Vector2d(x, y) - centre).norm() <= radius) image->row(y)[x] = value;
 }
 
-// Disabled: the experimental bow tracker (TrackStageOptions::track_bow) fails it. Measured
-// at commit time: bow 2D median 13 px, 3D median 62 mm (bound 8 mm); the instrument under
-// the moving bow stays at 0.04 px / 0.24 mm. Lucas-Kanade loses the corners of an 8 px
-// wide stick over a textured background within a few frames, and corners added at a
-// wrong pose keep it wrong. Run it with --gtest_also_run_disabled_tests.
+// Disabled: the bow tracker (TrackStageOptions::track_bow, track/bow_tracker.h: LSD
+// segments per view, the profile under the stick matched with the labelled frame's,
+// frog and tip triangulated at the fixed length) still misses issue 13's bound. Measured
+// at commit time: bow 2D median 2.42 px (95th 7.35 px), 3D median 10.3 mm (95th 34.3 mm;
+// bound 8 mm), none missing; the instrument under the moving bow stays at 0.04 px /
+// 0.24 mm. The corner tracker it replaced gave 13 px / 62 mm. The stick's 6 mm texture
+// blocks are under 2 px here, so each view's correlation peak along the stick is weak
+// and the views' slides disagree by a few millimetres, which the triangulation turns
+// into depth errors (docs/track.md). Run it with --gtest_also_run_disabled_tests.
 TEST(TrackBow, DISABLED_TheBowMovesOnItsOwn) {
   testing::TempDir dir;
   // The instrument: the photo, moving a little.

@@ -141,6 +141,7 @@ Status TrackStageOptions::Validate() const {
   track::InstrumentTrackerOptions t = tracker;
   t.num_threads = 1;
   ARCO_RETURN_IF_ERROR(t.Validate().WithContext("tracker"));
+  ARCO_RETURN_IF_ERROR(bow.Validate().WithContext("bow"));
   return Status::Ok();
 }
 
@@ -152,6 +153,7 @@ Json ToJson(const TrackStageOptions& o) {
   return Json{{"labels", labels},
               {"labels_frame", o.labels_frame},
               {"track_bow", o.track_bow},
+              {"bow", ToJson(o.bow)},
               {"tracker", ToJson(o.tracker)}};
 }
 
@@ -163,7 +165,8 @@ Json ToJson(const TrackStageSummary& s) {
                        {"lost_frames", c.lost_frames},
                        {"reacquired", c.reacquired},
                        {"mean_inliers", c.mean_inliers},
-                       {"mean_residual_px", c.mean_residual_px}});
+                       {"mean_residual_px", c.mean_residual_px},
+                       {"bow_lost_frames", c.bow_lost_frames}});
   }
   return Json{{"layout", s.layout},
               {"first_frame", s.first_frame},
@@ -380,17 +383,11 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   for (const int step : {+1, -1}) {
     if (step < 0 && template_frame == first) break;
     track::InstrumentTracker tracker(cameras, *body, tracker_options);
-    std::optional<track::InstrumentTracker> bow_tracker;
+    std::optional<track::BowTracker> bow_tracker;
     if (bow_body) {
-      // The bow is a few pixels wide: corners on it only, small Lucas-Kanade windows
-      // (the prediction carries the fast motion).
-      track::InstrumentTrackerOptions bow_options = tracker_options;
-      bow_options.outline_margin_px = 3;
-      bow_options.lk_window_px = 11;
-      bow_options.lk_levels = 2;
-      bow_options.min_feature_distance_px = 4;
-      bow_options.ncc_patch_px = 9;
-      bow_tracker.emplace(cameras, *bow_body, bow_options);
+      track::BowTrackerOptions bow_options = options.bow;
+      bow_options.num_threads = threads;
+      bow_tracker.emplace(cameras, bow_body->points[0], bow_body->points[1], bow_options);
     }
     track::TrackFrame bow_r;
     Frames frames(manifest, inputs);
@@ -474,7 +471,12 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
       if (!b.pose_ok) ++summary.bow_frames_without_pose;
       Json bow_views = Json::array();
       for (const auto& vr : b.views) bow_views.push_back(ViewJson(vr));
+      for (int v = 0; v < views; ++v) {
+        if (manifest.VideoFrameNumber(v, first + f) < 0) continue;
+        summary.cameras[v].bow_lost_frames += b.views[v].lost;
+      }
       bow_json = Json{{"pose_ok", b.pose_ok},
+                      {"match_ncc", b.match_ncc},
                       {"inliers", b.inliers},
                       {"residual_px", b.residual_px},
                       {"views", bow_views}};
@@ -485,6 +487,12 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
                            {"residual_px", r.residual_px},
                            {"views", view_json},
                            {"bow", bow_json}});
+  }
+  if (bow_body && summary.bow_frames_without_pose > 0) {
+    summary.warnings.push_back(
+        "the bow was not found in " + std::to_string(summary.bow_frames_without_pose) + " of " +
+        std::to_string(manifest.frame_count) +
+        " frames: frog and tip are its predicted positions there, with score 0.1");
   }
   for (int v = 0; v < views; ++v) {
     TrackCameraSummary& c = summary.cameras[v];

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "arco/track/bow_tracker.h"
 #include "arco/track/instrument_tracker.h"
 #include "arco/util/json_io.h"
 #include "arco/util/progress.h"
@@ -35,11 +36,13 @@ struct TrackStageOptions {
   int64_t labels_frame = -1;                // -1: the capture's first frame
   track::InstrumentTrackerOptions tracker;  // its num_threads is num_threads below
   int num_threads = 0;                      // 0 = all cores; results do not depend on it
-  // Experimental: the bow as a thin rigid body from its frog and tip labels (corners on
-  // the stick, docs/track.md). It holds on a textured bow lying on the picture but loses
-  // a thin bow moving on its own (pipeline_track_bow_test), so it is off by default and
-  // the bow's slots are kept.
+  // Experimental: the bow as a thin rigid body of fixed length from its frog and tip
+  // labels (track/bow_tracker.h: line segments, the profile along the stick). It holds
+  // on a bow lying on the picture (pipeline_track_plane_test) but misses issue 13's bound
+  // on a bow moving on its own (pipeline_track_bow_test, disabled), so it is off by
+  // default and the bow's slots are kept.
   bool track_bow = false;
+  track::BowTrackerOptions bow;  // its num_threads is num_threads above
   Status Validate() const;
 };
 
@@ -47,10 +50,11 @@ Json ToJson(const TrackStageOptions& options);
 
 struct TrackCameraSummary {
   std::string camera;
-  int64_t frames = 0;       // frames read
-  int64_t lost_frames = 0;  // frames in which the view had lost the instrument
-  int64_t reacquired = 0;   // times it found it again
-  double mean_inliers = 0;  // per frame read
+  int64_t frames = 0;           // frames read
+  int64_t lost_frames = 0;      // frames in which the view had lost the instrument
+  int64_t reacquired = 0;       // times it found it again
+  int64_t bow_lost_frames = 0;  // frames without a line segment near the predicted bow
+  double mean_inliers = 0;      // per frame read
   double mean_residual_px = 0;
 };
 

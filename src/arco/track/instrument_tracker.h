@@ -98,6 +98,7 @@ struct TrackFrame {
   Rigid3d world_from_template;
   int inliers = 0;
   double residual_px = 0;
+  double match_ncc = 0;  // the bow's profile match (bow_tracker.h); 0 for the instrument
   std::vector<ViewTrackReport> views;
   std::vector<std::vector<TrackedPoint>> points;  // [view][template point]
 };

@@ -1,0 +1,75 @@
+// The bow as a thin rigid body of fixed length (`arco track --bow`, docs/track.md): its
+// frog and tip triangulated from the labelled frame give the stick's axis and length, and
+// the labelled frame gives, per view, the intensity profile under the stick (1 mm steps
+// along the 3D axis, a little beyond frog and tip). Per frame, from a constant-velocity
+// prediction of frog and tip:
+//  1. per view, line segments (OpenCV's LSD, Grompone von Gioi et al., PAMI 2010) in a box
+//     around the predicted stick, kept when they run parallel to it (angle gate) and near
+//     it (distance gate); the stick's image line is their robust total-least-squares fit
+//     (both of its edges are segments, so the line runs between them);
+//  2. per view, the slide along that line: the profile under it is matched with the
+//     labelled frame's by normalised cross-correlation over +-slide_search_mm;
+//  3. frog and tip are triangulated from the views that matched (rays weighted by the
+//     match), then put the bow's fixed length apart.
+// Intersecting the views' line planes alone (no slide) was tried first: with cameras on
+// an arc around the player, a bow lying along the arc's baselines gives planes that all
+// but coincide, and the bow's depth came out 40-100 mm off.
+// A frame in which fewer than two views match keeps the prediction, with a low score.
+// OpenCV is private: no OpenCV type appears here.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "arco/camera/camera.h"
+#include "arco/media/image.h"
+#include "arco/track/instrument_tracker.h"
+#include "arco/util/json_io.h"
+#include "arco/util/status.h"
+
+namespace arco::track {
+
+struct BowTrackerOptions {
+  double roi_margin_px = 40;     // the box around the predicted stick grown by this much
+  double search_px = 15;         // segments farther than this from the predicted line: out
+  double max_angle_deg = 6;      // segments turned more than this from it: out
+  double min_segment_px = 8;     // shorter segments: out
+  double huber_px = 2;           // the image line fit's robust scale
+  double slide_search_mm = 40;   // +- along the axis around the predicted frog
+  double profile_margin = 0.04;  // of the length, profiled beyond frog and tip
+  double min_ncc = 0.3;          // a view whose profile matches less is not used
+  int num_threads = 1;           // views in parallel; results do not depend on it
+  Status Validate() const;
+};
+
+Json ToJson(const BowTrackerOptions& options);
+
+class BowTracker {
+ public:
+  // frog and tip: the labelled frame's triangulated points (world, mm). Throws
+  // std::invalid_argument on invalid options or a bow shorter than 50 mm.
+  BowTracker(std::vector<Camera> cameras,
+             const Eigen::Vector3d& frog,
+             const Eigen::Vector3d& tip,
+             const BowTrackerOptions& options);
+  ~BowTracker();
+  BowTracker(BowTracker&&) noexcept;
+
+  // The labelled frame (Gray8, the cameras' sizes): the stick's profile per view.
+  TrackFrame Start(const std::vector<const media::Image*>& frames);
+  // The next frame in tracking order. labels: [view][frog, tip] of this frame (NaN =
+  // none); both labelled in two views replace the estimate. Per view, the report's
+  // `tracked` counts the segments found near the prediction, `inliers` those within
+  // 3 x huber_px of the fitted line, `residual_px` their RMS distance to it, `lost` a
+  // view without segments. TrackFrame::match_ncc is the views' mean profile match.
+  TrackFrame Next(const std::vector<const media::Image*>& frames,
+                  const std::vector<std::vector<Eigen::Vector2d>>* labels = nullptr);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace arco::track
