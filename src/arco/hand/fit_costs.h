@@ -18,6 +18,15 @@
 
 namespace arco::hand::internal {
 
+// GCC leaves the small Jet operations of the projection's derivative out of line (about
+// a third of the fit's time in calls); flatten inlines them into the hot functions. The
+// same operations run in the same order, so results are unchanged bit for bit.
+#if defined(__GNUC__) && !defined(__clang__)
+#define ARCO_FLATTEN __attribute__((flatten))
+#else
+#define ARCO_FLATTEN
+#endif
+
 // sqrt(rho(s) / s) for the Cauchy loss rho(s) = c2 log(1 + s / c2).
 template <typename T>
 T CauchyScale(const T& s, double c2) {
@@ -63,7 +72,7 @@ struct ReprojectionResiduals {
     }
   }
   // Observation i: its 2 residuals and their derivative w.r.t. its keypoint.
-  int ResidualWithDerivative(int i,
+  ARCO_FLATTEN int ResidualWithDerivative(int i,
                              const Eigen::Vector3d* points,
                              double* residual,
                              Eigen::Matrix3d* d_residual,
@@ -110,7 +119,7 @@ struct PointResiduals {
     }
   }
   // Keypoint i: its 3 residuals (0 when missing) and their derivative.
-  int ResidualWithDerivative(int i,
+  ARCO_FLATTEN int ResidualWithDerivative(int i,
                              const Eigen::Vector3d* points,
                              double* residual,
                              Eigen::Matrix3d* d_residual,
@@ -167,7 +176,9 @@ class HandCostFunction : public ceres::CostFunction {
     set_num_residuals(r_.num_residuals());
     mutable_parameter_block_sizes()->assign({3, 3, kNumJointDofs});
   }
-  bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override {
+  ARCO_FLATTEN bool Evaluate(double const* const* x,
+                             double* residuals,
+                             double** jacobians) const override {
     if (jacobians == nullptr) {
       r_(x[0], x[1], x[2], residuals);
       return true;
