@@ -21,6 +21,12 @@
 namespace arco {
 namespace {
 
+#if defined(__GNUC__) && !defined(__clang__)
+#define ARCO_FLATTEN __attribute__((flatten))
+#else
+#define ARCO_FLATTEN
+#endif
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Reprojection residuals of one point in several views, with distortion, scaled by
@@ -37,8 +43,11 @@ struct RobustReprojection {
 
   int NumResiduals() const { return 2 * static_cast<int>(used->size()); }
 
+  // flatten: GCC leaves the Jet operations of the projection out of line (a third of
+  // the refinement's time in calls); inlined, the same operations run in the same
+  // order, so results are unchanged bit for bit.
   template <typename T>
-  bool operator()(const T* point_in_world, T* residuals) const {
+  ARCO_FLATTEN bool operator()(const T* point_in_world, T* residuals) const {
     for (size_t i = 0; i < used->size(); ++i) {
       const auto& v = scratch->views[(*used)[i]];
       T projected[2];
