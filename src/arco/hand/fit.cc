@@ -262,7 +262,7 @@ HandFitResult FitHandMultiView(const HandModel& model,
     ceres::Problem problem;
     const double c = options.robust_loss_px;
     problem.AddResidualBlock(
-        new HandCostFunction<ReprojectionResiduals>({&model, &observations, c * c}),
+        new internal::CompressedReprojectionCost({&model, &observations, c * c}),
         nullptr,
         params.aa,
         params.t,

@@ -69,9 +69,8 @@ struct RobustReprojection {
 };
 
 // The same residuals with their 2x3 Jacobians in closed form, for ceres::TinySolver (the
-// Jet version costs about twice as much). Chain rule: pixel <- distorted normalised
-// (fx, skew, fy) <- normalised (Brown-Conrady derivative) <- camera point (x = X/Z,
-// y = Y/Z) <- world point (R); then the soft-L1 scale s(q) = sqrt(2 / (1 + q)),
+// Jet version costs about twice as much): Camera::ProjectWithJacobian, then the
+// soft-L1 scale s(q) = sqrt(2 / (1 + q)),
 // q = sqrt(1 + |r|^2 / b^2), with ds/d|r|^2 = -s^3 / (8 b^2 q).
 struct AnalyticRobustReprojection {
   using Scalar = double;
@@ -87,35 +86,18 @@ struct AnalyticRobustReprojection {
     const Eigen::Map<const Eigen::Vector3d> x_world(point_in_world);
     for (size_t i = 0; i < cost->used->size(); ++i) {
       const auto& v = cost->scratch->views[(*cost->used)[i]];
-      const Camera& cam = cost->rig->cameras[v.camera];
       const int r0 = 2 * static_cast<int>(i), r1 = r0 + 1;
-      const Eigen::Vector3d p = cam.cam_from_world_rotation * x_world + cam.cam_from_world_translation;
-      if (!(p.z() > 0)) {
+      Eigen::Vector2d pixel;
+      Eigen::Matrix<double, 2, 3> d_pixel;
+      if (!cost->rig->cameras[v.camera].ProjectWithJacobian(x_world, &pixel, &d_pixel)) {
         residuals[r0] = residuals[r1] = 1e6;
         for (int c = 0; c < 3; ++c) jacobian[r0 + c * m] = jacobian[r1 + c * m] = 0;
         continue;
       }
-      const double iz = 1.0 / p.z(), x = p.x() * iz, y = p.y() * iz;
-      const Distortion& d = cam.distortion;
-      const double r2 = x * x + y * y;
-      const double radial = 1 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
-      const double dradial = d.k1 + r2 * (2 * d.k2 + 3 * d.k3 * r2);  // d radial / d r2
-      const double xd = x * radial + 2 * d.p1 * x * y + d.p2 * (r2 + 2 * x * x);
-      const double yd = y * radial + d.p1 * (r2 + 2 * y * y) + 2 * d.p2 * x * y;
-      Eigen::Matrix2d dist;  // d(xd, yd) / d(x, y)
-      dist << radial + 2 * x * x * dradial + 2 * d.p1 * y + 6 * d.p2 * x,
-          2 * x * y * dradial + 2 * d.p1 * x + 2 * d.p2 * y,
-          2 * x * y * dradial + 2 * d.p1 * x + 2 * d.p2 * y,
-          radial + 2 * y * y * dradial + 6 * d.p1 * y + 2 * d.p2 * x;
-      Eigen::Matrix2d k;
-      k << cam.fx, cam.skew, 0, cam.fy;
-      Eigen::Matrix<double, 2, 3> normalise;  // d(x, y) / d(camera point)
-      normalise << iz, 0, -x * iz, 0, iz, -y * iz;
       const double sqrt_w = cost->weight_by_score ? std::sqrt(v.score) : 1.0;
-      const Eigen::Matrix<double, 2, 3> dr =
-          sqrt_w * (k * dist * normalise * cam.cam_from_world_rotation);
-      const double rx = sqrt_w * (cam.fx * xd + cam.skew * yd + cam.cx - v.pixel.x());
-      const double ry = sqrt_w * (cam.fy * yd + cam.cy - v.pixel.y());
+      const Eigen::Matrix<double, 2, 3> dr = sqrt_w * d_pixel;
+      const double rx = sqrt_w * (pixel.x() - v.pixel.x());
+      const double ry = sqrt_w * (pixel.y() - v.pixel.y());
       const double q = std::sqrt(1 + (rx * rx + ry * ry) * cost->inv_b2);
       const double scale = std::sqrt(2 / (1 + q));
       const double dscale_ds = -scale * scale * scale * cost->inv_b2 / (8 * q);
