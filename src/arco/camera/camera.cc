@@ -51,6 +51,38 @@ Eigen::Vector3d Camera::PointInCamera(const Eigen::Vector3d& point_in_world) con
   return cam_from_world_rotation * point_in_world + cam_from_world_translation;
 }
 
+bool Camera::ProjectWithJacobian(const Eigen::Vector3d& point_in_world,
+                                 Eigen::Vector2d* pixel,
+                                 Eigen::Matrix<double, 2, 3>* d_pixel_d_point) const {
+  // Values in ProjectToPixel's order of operations, so the pixel is identical.
+  double p[3];
+  for (int r = 0; r < 3; ++r) {
+    p[r] = cam_from_world_translation[r];
+    for (int c = 0; c < 3; ++c) p[r] += cam_from_world_rotation(r, c) * point_in_world[c];
+  }
+  if (!(p[2] > 0)) return false;
+  const double x = p[0] / p[2], y = p[1] / p[2];
+  const Distortion& d = distortion;
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+  const double xd = x * radial + 2.0 * d.p1 * x * y + d.p2 * (r2 + 2.0 * x * x);
+  const double yd = y * radial + d.p1 * (r2 + 2.0 * y * y) + 2.0 * d.p2 * x * y;
+  (*pixel)[0] = fx * xd + skew * yd + cx;
+  (*pixel)[1] = fy * yd + cy;
+  const double dradial = d.k1 + r2 * (2.0 * d.k2 + 3.0 * d.k3 * r2);  // d radial / d r2
+  Eigen::Matrix2d dist;                                               // d(xd, yd) / d(x, y)
+  const double cross = 2.0 * x * y * dradial + 2.0 * d.p1 * x + 2.0 * d.p2 * y;
+  dist << radial + 2.0 * x * x * dradial + 2.0 * d.p1 * y + 6.0 * d.p2 * x, cross,  //
+      cross, radial + 2.0 * y * y * dradial + 6.0 * d.p1 * y + 2.0 * d.p2 * x;
+  Eigen::Matrix2d k;
+  k << fx, skew, 0.0, fy;
+  const double iz = 1.0 / p[2];
+  Eigen::Matrix<double, 2, 3> normalise;  // d(x, y) / d(point in camera)
+  normalise << iz, 0.0, -x * iz, 0.0, iz, -y * iz;
+  *d_pixel_d_point = (k * dist) * normalise * cam_from_world_rotation;
+  return true;
+}
+
 std::optional<Eigen::Vector2d> Camera::Project(const Eigen::Vector3d& point_in_world) const {
   Eigen::Vector2d pixel;
   if (!ProjectToPixel(point_in_world.data(), pixel.data())) return std::nullopt;
