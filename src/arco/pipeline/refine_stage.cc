@@ -3,6 +3,7 @@
 #include <cmath>
 #include <vector>
 
+#include "arco/body/skeleton_fit.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
@@ -11,9 +12,50 @@ namespace arco::pipeline {
 namespace {
 
 constexpr int kNumWholeBody = wholebody::kNumPoints;
+// A triangulated point's typical reprojection RMS (px; the detections' noise): above it the
+// point's weight falls off.
+constexpr double kTypicalRmsPx = 3.0;
 
 Status Expect(bool ok, const std::string& path, const std::string& what) {
   return ok ? Status::Ok() : Status::Error(path + ": " + what);
+}
+
+// Per-point weights of the skeleton fit from the triangulation's quality: a point seen by
+// more cameras that agree (low reprojection RMS) is more precise (its covariance shrinks
+// about as 1 / views). Empty (all 1) when the files are absent (older result folders) or
+// their shapes differ.
+NpyArray<double> TriangulationWeights(const ResultFolder& result, int64_t frames, int64_t points) {
+  NpyArray<double> w;
+  StatusOr<ResultFolder::TriangulationQuality> q = result.ReadTriangulationQuality();
+  const std::vector<int64_t> shape = {frames, points};
+  if (!q.ok() || q->num_inliers.shape != shape || q->rms_reprojection_px.shape != shape) return w;
+  w.shape = shape;
+  w.data.resize(static_cast<size_t>(frames * points));
+  for (size_t i = 0; i < w.data.size(); ++i) {
+    const double views = q->num_inliers.data[i];
+    const double rms = q->rms_reprojection_px.data[i];
+    w.data[i] = std::isfinite(rms) && views >= 2
+                    ? views / (1.0 + (rms / kTypicalRmsPx) * (rms / kTypicalRmsPx))
+                    : 0.0;
+  }
+  return w;
+}
+
+// The arco method's body and right hand: the triangulated points replaced by a skeleton
+// of fixed bone lengths fitted to them (body/skeleton_fit.h; docs/export.md, "BVH").
+StatusOr<NpyArray<double>> FitBody(const RefineInputs& inputs) {
+  const KeypointLayout* layout =
+      FindKeypointLayout(refine::SpdContactLayoutName(*inputs.instrument));
+  const NpyArray<double>& base = inputs.spd.base_points_mm;
+  if (layout == nullptr || layout->size() < base.shape[1]) {
+    return Status::Error("no keypoint layout for the instrument's points");
+  }
+  const std::vector<std::string> names(layout->names.begin(),
+                                       layout->names.begin() + base.shape[1]);
+  ARCO_ASSIGN_OR_RETURN(
+      body::SkeletonFitResult fit,
+      body::FitSkeleton(base, names, inputs.point_weights, body::SkeletonFitOptions{}));
+  return std::move(fit.points_mm);
 }
 
 }  // namespace
@@ -128,6 +170,7 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
   out.spd.hand_model = *hand_model;
   out.spd.base_points_mm = std::move(base_mm);
   out.spd.strings_in_world_mm = std::move(seg);
+  out.point_weights = TriangulationWeights(result, frames, num_base);
   return out;
 }
 
@@ -143,8 +186,14 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
   MethodRecord out;
   out.method = refine::RefineModeName(options.mode);
   out.layout = refine::SpdContactLayoutName(*inputs.instrument);
+  // Only arco fits a skeleton to the body and right hand: vision and paper keep the raw
+  // triangulation (the paper's method has no body model; vision is its baseline).
+  refine::SpdSources spd = inputs.spd;
+  if (options.mode == refine::RefineMode::kArco) {
+    ARCO_ASSIGN_OR_RETURN(spd.base_points_mm, FitBody(inputs));
+  }
   out.points3d = refine::BuildSpdPoints(
-      inputs.spd, r.hand, options.mode == refine::RefineMode::kVision ? nullptr : &r.contacts);
+      spd, r.hand, options.mode == refine::RefineMode::kVision ? nullptr : &r.contacts);
   out.hands = r.hand;
   out.contacts = r.contacts;
   out.fingering = r.fingering;
