@@ -29,7 +29,7 @@ struct SkeletonFitOptions {
   std::vector<JointGroup> groups = {JointGroup::kBody, JointGroup::kRightHand};
   // Huber loss scale (mm, on a point's weighted distance): beyond it a point counts
   // linearly, so one bad triangulation pulls the skeleton less.
-  double robust_scale_mm = 10.0;
+  double robust_scale_mm = 20.0;
   // Weight (mm per radian) of each rotation's pull towards the previous frame.
   double rotation_prior_mm_per_rad = 0.01;
   int max_iterations = 100;

@@ -12,37 +12,17 @@ namespace arco::pipeline {
 namespace {
 
 constexpr int kNumWholeBody = wholebody::kNumPoints;
-// A triangulated point's typical reprojection RMS (px; the detections' noise): above it the
-// point's weight falls off.
-constexpr double kTypicalRmsPx = 3.0;
 
 Status Expect(bool ok, const std::string& path, const std::string& what) {
   return ok ? Status::Ok() : Status::Error(path + ": " + what);
 }
 
-// Per-point weights of the skeleton fit from the triangulation's quality: a point seen by
-// more cameras that agree (low reprojection RMS) is more precise (its covariance shrinks
-// about as 1 / views). Empty (all 1) when the files are absent (older result folders) or
-// their shapes differ.
-NpyArray<double> TriangulationWeights(const ResultFolder& result, int64_t frames, int64_t points) {
-  NpyArray<double> w;
-  StatusOr<ResultFolder::TriangulationQuality> q = result.ReadTriangulationQuality();
-  const std::vector<int64_t> shape = {frames, points};
-  if (!q.ok() || q->num_inliers.shape != shape || q->rms_reprojection_px.shape != shape) return w;
-  w.shape = shape;
-  w.data.resize(static_cast<size_t>(frames * points));
-  for (size_t i = 0; i < w.data.size(); ++i) {
-    const double views = q->num_inliers.data[i];
-    const double rms = q->rms_reprojection_px.data[i];
-    w.data[i] = std::isfinite(rms) && views >= 2
-                    ? views / (1.0 + (rms / kTypicalRmsPx) * (rms / kTypicalRmsPx))
-                    : 0.0;
-  }
-  return w;
-}
-
 // The arco method's body and right hand: the triangulated points replaced by a skeleton
 // of fixed bone lengths fitted to them (body/skeleton_fit.h; docs/export.md, "BVH").
+// Every point weighs the same: weighting by the triangulation's inlier count and
+// reprojection RMS made the fit worse on the synthetic takes (body 7.02 -> 7.23 mm by
+// views alone, 7.43 mm with the RMS; docs/export.md), plausibly because the points are
+// temporally filtered after triangulation, so a frame's RMS no longer describes them.
 StatusOr<NpyArray<double>> FitBody(const RefineInputs& inputs) {
   const KeypointLayout* layout =
       FindKeypointLayout(refine::SpdContactLayoutName(*inputs.instrument));
@@ -52,9 +32,8 @@ StatusOr<NpyArray<double>> FitBody(const RefineInputs& inputs) {
   }
   const std::vector<std::string> names(layout->names.begin(),
                                        layout->names.begin() + base.shape[1]);
-  ARCO_ASSIGN_OR_RETURN(
-      body::SkeletonFitResult fit,
-      body::FitSkeleton(base, names, inputs.point_weights, body::SkeletonFitOptions{}));
+  ARCO_ASSIGN_OR_RETURN(body::SkeletonFitResult fit,
+                        body::FitSkeleton(base, names, {}, body::SkeletonFitOptions{}));
   return std::move(fit.points_mm);
 }
 
@@ -170,7 +149,6 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
   out.spd.hand_model = *hand_model;
   out.spd.base_points_mm = std::move(base_mm);
   out.spd.strings_in_world_mm = std::move(seg);
-  out.point_weights = TriangulationWeights(result, frames, num_base);
   return out;
 }
 

@@ -26,9 +26,6 @@ struct RefineInputs {
   refine::RefineInput input;  // input.pitch all unvoiced when the result has no pitch stage
   refine::SpdSources spd;
   bool has_pitch = false;
-  // (F, 133 + instrument keypoints): the triangulation's per-point weights for the arco
-  // method's skeleton fit (body/skeleton_fit.h); empty when the result has none.
-  NpyArray<double> point_weights;
 };
 // Errors name the file: no hand or instrument stage, shapes that disagree.
 StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir);
