@@ -247,12 +247,12 @@ void FitGroup(std::vector<Node>& nodes,
                                delta[j].data());
     }
     ceres::Solver::Options so;
-    so.linear_solver_type = ceres::DENSE_QR;
+    so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
     so.max_num_iterations = options.max_iterations;
     so.num_threads = 1;
-    so.function_tolerance = 1e-12;
+    so.function_tolerance = 1e-10;
     so.gradient_tolerance = 1e-14;
-    so.parameter_tolerance = 1e-12;
+    so.parameter_tolerance = 1e-10;
     so.logging_type = ceres::SILENT;
     ceres::Solver::Summary summary;
     ceres::Solve(so, &problem, &summary);
