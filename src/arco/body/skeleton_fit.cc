@@ -56,6 +56,32 @@ Eigen::Matrix3d Kabsch(const std::vector<Eigen::Vector3d>& a,
   return svd.matrixV() * d * svd.matrixU().transpose();
 }
 
+// The nodes measured at least once whose parents are kept, re-indexed: a keypoint the
+// capture never has (a body imported without feet, say) and everything hanging from it stay
+// as they are (missing) instead of keeping the rest of the group from being fitted.
+std::vector<Node> MeasuredSubtree(const std::vector<Node>& nodes,
+                                  const Points& pts,
+                                  int64_t frames) {
+  std::vector<int> index(nodes.size(), -1);
+  std::vector<Node> kept;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const Node& n = nodes[i];
+    if (n.parent >= 0 && index[static_cast<size_t>(n.parent)] < 0) continue;
+    if (n.parent < 0 && !kept.empty()) continue;
+    bool measured = false;
+    for (int64_t f = 0; f < frames && !measured; ++f) measured = pts.Target(n, f).allFinite();
+    if (!measured) continue;
+    Node copy = n;
+    copy.children.clear();
+    copy.parent = n.parent >= 0 ? index[static_cast<size_t>(n.parent)] : -1;
+    index[i] = static_cast<int>(kept.size());
+    if (copy.parent >= 0) kept[static_cast<size_t>(copy.parent)].children.push_back(index[i]);
+    kept.push_back(copy);
+  }
+  if (!kept.empty() && nodes.front().parent < 0 && index[0] != 0) kept.clear();
+  return kept;
+}
+
 // Rest offsets of the children of node j (false when a bone is never measured).
 bool RestOffsets(std::vector<Node>& nodes, int j, const Points& pts, int64_t frames) {
   const std::vector<int>& ch = nodes[static_cast<size_t>(j)].children;
@@ -326,6 +352,8 @@ StatusOr<SkeletonFitResult> FitSkeleton(const NpyArray<double>& points_mm,
       nodes.push_back(node);
     }
     if (!complete || nodes.empty()) continue;
+    nodes = MeasuredSubtree(nodes, pts, frames);
+    if (nodes.empty()) continue;  // the group's root never measured: the group stays raw
     for (int j = 0; j < static_cast<int>(nodes.size()) && complete; ++j) {
       complete = RestOffsets(nodes, j, pts, frames);
     }

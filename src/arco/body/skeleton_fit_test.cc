@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "arco/util/stats.h"
@@ -91,6 +92,12 @@ int Index(const Take& t, const std::string& name) {
   return static_cast<int>(std::find(t.names.begin(), t.names.end(), name) - t.names.begin());
 }
 
+// Equal bit for bit (NaN included).
+bool SameBits(const NpyArray<double>& a, const NpyArray<double>& b) {
+  return a.shape == b.shape &&
+         std::memcmp(a.data.data(), b.data.data(), a.data.size() * sizeof(double)) == 0;
+}
+
 double Distance(const NpyArray<double>& p, int64_t f, int a, int b) {
   Eigen::Vector3d d;
   for (int c = 0; c < 3; ++c) d[c] = p.at(f, a, c) - p.at(f, b, c);
@@ -161,7 +168,7 @@ TEST(FitSkeleton, ExactOnExactPointsAndDeterministic) {
   const StatusOr<SkeletonFitResult> a = FitSkeleton(clean, t.names, {}, SkeletonFitOptions{});
   const StatusOr<SkeletonFitResult> b = FitSkeleton(clean, t.names, {}, SkeletonFitOptions{});
   ASSERT_TRUE(a.ok() && b.ok());
-  EXPECT_EQ(a->points_mm.data, b->points_mm.data);
+  EXPECT_TRUE(SameBits(a->points_mm, b->points_mm));
   double worst = 0;
   for (size_t i = 0; i < clean.data.size(); ++i) {
     worst = std::max(worst, std::abs(a->points_mm.data[i] - clean.data[i]));
@@ -177,6 +184,44 @@ TEST(FitSkeleton, RejectsBadShapesAndLeavesUnmeasuredGroupsRaw) {
   SkeletonFitOptions o;
   o.robust_scale_mm = 0;
   EXPECT_FALSE(FitSkeleton(t.noisy, t.names, {}, o).ok());
+  // No feet in the capture (a COCO-17 import): the rest of the body is still fitted.
+  Take nofeet = t;
+  for (const char* foot : {"left_big_toe",
+                           "left_small_toe",
+                           "left_heel",
+                           "right_big_toe",
+                           "right_small_toe",
+                           "right_heel"}) {
+    for (int f = 0; f < 5; ++f) {
+      for (int c = 0; c < 3; ++c) nofeet.noisy.at(f, Index(t, foot), c) = kNaN;
+    }
+  }
+  const StatusOr<SkeletonFitResult> feet =
+      FitSkeleton(nofeet.noisy, t.names, {}, SkeletonFitOptions{});
+  ASSERT_TRUE(feet.ok());
+  ASSERT_EQ(feet->fitted_groups.size(), 2u);
+  const int knee = Index(t, "left_knee");
+  EXPECT_NE(feet->points_mm.at(1, knee, 0), t.noisy.at(1, knee, 0));  // fitted
+  EXPECT_TRUE(std::isnan(feet->points_mm.at(1, Index(t, "left_heel"), 0)));
+  // Weights: 1 everywhere is no weighting; weight 0 is a missing point.
+  NpyArray<double> ones;
+  ones.shape = {5, static_cast<int64_t>(t.names.size())};
+  ones.data.assign(5 * t.names.size(), 1.0);
+  const StatusOr<SkeletonFitResult> unweighted = FitSkeleton(t.noisy, t.names, {}, {});
+  const StatusOr<SkeletonFitResult> weighted = FitSkeleton(t.noisy, t.names, ones, {});
+  ASSERT_TRUE(unweighted.ok() && weighted.ok());
+  EXPECT_TRUE(SameBits(unweighted->points_mm, weighted->points_mm));
+  NpyArray<double> holes = t.noisy;
+  NpyArray<double> zero = ones;
+  zero.at(3, knee) = 0;
+  for (int c = 0; c < 3; ++c) holes.at(3, knee, c) = kNaN;
+  const StatusOr<SkeletonFitResult> a = FitSkeleton(holes, t.names, {}, {});
+  const StatusOr<SkeletonFitResult> b = FitSkeleton(t.noisy, t.names, zero, {});
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->points_mm.at(3, knee, 0), b->points_mm.at(3, knee, 0));
+  EXPECT_EQ(a->points_mm.at(4, Index(t, "nose"), 1), b->points_mm.at(4, Index(t, "nose"), 1));
+  EXPECT_FALSE(FitSkeleton(t.noisy, t.names, NpyArray<double>{{5, 3}, {}}, {}).ok());
+
   // The right hand never seen: the body is fitted, the hand stays NaN.
   const int first = Index(t, "right_hand_wrist");
   for (int f = 0; f < 5; ++f) {

@@ -166,12 +166,17 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
   out.layout = refine::SpdContactLayoutName(*inputs.instrument);
   // Only arco fits a skeleton to the body and right hand: vision and paper keep the raw
   // triangulation (the paper's method has no body model; vision is its baseline).
-  refine::SpdSources spd = inputs.spd;
+  const refine::SpdSources* spd = &inputs.spd;
+  refine::SpdSources fitted;
   if (options.mode == refine::RefineMode::kArco) {
-    ARCO_ASSIGN_OR_RETURN(spd.base_points_mm, FitBody(inputs));
+    fitted.instrument = inputs.spd.instrument;
+    fitted.hand_model = inputs.spd.hand_model;
+    fitted.strings_in_world_mm = inputs.spd.strings_in_world_mm;
+    ARCO_ASSIGN_OR_RETURN(fitted.base_points_mm, FitBody(inputs));
+    spd = &fitted;
   }
   out.points3d = refine::BuildSpdPoints(
-      spd, r.hand, options.mode == refine::RefineMode::kVision ? nullptr : &r.contacts);
+      *spd, r.hand, options.mode == refine::RefineMode::kVision ? nullptr : &r.contacts);
   out.hands = r.hand;
   out.contacts = r.contacts;
   out.fingering = r.fingering;
