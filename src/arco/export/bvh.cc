@@ -1,12 +1,9 @@
 // BVH writer: one skeleton for the body and both hands, fitted per frame.
 //
-// Skeleton (joint names are arco's keypoint names, plus two joints at midpoints):
-//   hips (root: mid left_hip/right_hip; position + rotation channels)
-//     left_hip > left_knee > left_ankle > left_big_toe, left_small_toe, left_heel (right alike)
-//     neck (mid shoulders) > nose > left_eye > left_ear (right alike)
-//       left_shoulder > left_elbow > left_wrist > left_hand_wrist > left_hand_thumb_cmc >
-//         .._mcp > .._ip > .._tip, and index/middle/ring/little mcp > pip > dip > tip
-//       (right alike)
+// Skeleton: body/skeleton.h's WholeBodySkeleton (joint names are arco's keypoint names,
+// plus two joints at midpoints, hips (the root: position + rotation channels) and neck),
+// the tree `arco run` fits to the arco method's body and right hand, so that this fit
+// reproduces those points exactly.
 // Then two rigid roots: "instrument" (scroll_top, nut_l/r, bridge_l/r, tail_gut, end_pin and
 // the strings' ends present in the layout) and "bow" (frog, tip), each at its points'
 // centroid with the points as child joints, fitted per frame as a rigid body (Kabsch; the
@@ -35,6 +32,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "arco/body/skeleton.h"
 #include "arco/export/export.h"
 #include "arco/util/stats.h"
 
@@ -69,6 +67,8 @@ class Skeleton {
   }
 };
 
+// The skeleton of body/skeleton.h (the one definition, shared with `arco run`'s skeleton
+// fit) on the data's keypoints.
 StatusOr<Skeleton> BuildSkeleton(const ExportData& data) {
   std::string missing;
   auto kp = [&](const std::string& name) {
@@ -77,40 +77,16 @@ StatusOr<Skeleton> BuildSkeleton(const ExportData& data) {
     return i;
   };
   Skeleton s;
-  const int hips = s.Add("hips", -1, -1);
-  s.joints[hips].mid_a = kp("left_hip");
-  s.joints[hips].mid_b = kp("right_hip");
-  for (const std::string side : {"left", "right"}) {
-    int j = s.Add(side + "_hip", hips, kp(side + "_hip"));
-    j = s.Add(side + "_knee", j, kp(side + "_knee"));
-    j = s.Add(side + "_ankle", j, kp(side + "_ankle"));
-    for (const char* toe : {"_big_toe", "_small_toe", "_heel"})
-      s.Add(side + toe, j, kp(side + toe));
-  }
-  const int neck = s.Add("neck", hips, -1);
-  s.joints[neck].mid_a = kp("left_shoulder");
-  s.joints[neck].mid_b = kp("right_shoulder");
-  const int nose = s.Add("nose", neck, kp("nose"));
-  for (const std::string side : {"left", "right"}) {
-    const int eye = s.Add(side + "_eye", nose, kp(side + "_eye"));
-    s.Add(side + "_ear", eye, kp(side + "_ear"));
-  }
-  for (const std::string side : {"left", "right"}) {
-    int j = s.Add(side + "_shoulder", neck, kp(side + "_shoulder"));
-    j = s.Add(side + "_elbow", j, kp(side + "_elbow"));
-    j = s.Add(side + "_wrist", j, kp(side + "_wrist"));
-    const std::string h = side + "_hand_";
-    const int hand = side == "left" ? 1 : 2;
-    const int wrist = s.Add(h + "wrist", j, kp(h + "wrist"), hand);
-    s.joints[wrist].positioned = true;
-    int t = wrist;
-    for (const char* joint : {"thumb_cmc", "thumb_mcp", "thumb_ip", "thumb_tip"})
-      t = s.Add(h + joint, t, kp(h + joint), hand);
-    for (const std::string finger : {"index", "middle", "ring", "little"}) {
-      int f = wrist;
-      for (const char* joint : {"_mcp", "_pip", "_dip", "_tip"})
-        f = s.Add(h + finger + joint, f, kp(h + finger + joint), hand);
+  for (const body::SkeletonJoint& b : body::WholeBodySkeleton()) {
+    const int id = s.Add(b.name, b.parent, -1, static_cast<int>(b.group));
+    Joint& j = s.joints[static_cast<size_t>(id)];
+    if (!b.keypoint.empty()) {
+      j.keypoint = kp(b.keypoint);
+    } else {
+      j.mid_a = kp(b.mid_a);
+      j.mid_b = kp(b.mid_b);
     }
+    j.positioned = b.positioned;
   }
   if (!missing.empty()) {
     return Status::Error("BVH needs the body and both hands; the result's points lack " + missing);

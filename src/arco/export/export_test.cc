@@ -7,6 +7,7 @@
 #include <cstring>
 #include <random>
 
+#include "arco/body/skeleton_fit.h"
 #include "arco/export/plot.h"
 #include "arco/registry/keypoint_layout.h"
 
@@ -127,6 +128,34 @@ TEST(ExportBvh, RigidMotionFitsExactly) {
   for (const auto& r : bvh->residuals) EXPECT_LT(r.max_mm, 1e-6) << r.name;
   EXPECT_NE(bvh->text.find("JOINT left_hand_little_dip"), std::string::npos);
   EXPECT_NE(bvh->text.find("Frames: 20\n"), std::string::npos);
+}
+
+// `arco run` gives the arco method's body and right hand a skeleton of fixed bone lengths
+// (body/skeleton_fit.h) on the BVH's own tree, so the BVH reproduces them exactly even
+// when the triangulated points were noisy (their bones changing length by millimetres).
+TEST(ExportBvh, SkeletonFittedPointsFitExactly) {
+  ExportData d = RigidData(30);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 3.0);
+  for (double& v : d.points_mm.data) v += noise(rng);
+  const ExportData noisy = d;
+  auto raw = ExportBvh(noisy);
+  ASSERT_TRUE(raw.ok());
+  EXPECT_GT(raw->body_median_mm, 1.0);  // noisy points: no fixed skeleton reproduces them
+  EXPECT_GT(raw->right_hand_median_mm, 1.0);
+  auto fit = body::FitSkeleton(d.points_mm, d.keypoint_names, {}, body::SkeletonFitOptions{});
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  d.points_mm = fit->points_mm;
+  auto bvh = ExportBvh(d);
+  ASSERT_TRUE(bvh.ok()) << bvh.status().message();
+  EXPECT_LT(bvh->body_median_mm, 1e-6);
+  EXPECT_LT(bvh->right_hand_median_mm, 1e-6);
+  for (const auto& r : bvh->residuals) {
+    if (r.name.rfind("left_hand_", 0) == 0)
+      continue;  // noisy, not fitted: left to arco's hand model
+    if (d.Find(r.name) >= wholebody::kNumPoints) continue;  // the instrument and bow
+    EXPECT_LT(r.max_mm, 1e-6) << r.name;
+  }
 }
 
 TEST(ExportBvh, NeedsTheHands) {
