@@ -297,15 +297,24 @@ function stopServer(server) {
     // Playing: the frame follows the audio clock.
     await page.evaluate(() => window.arcoView.seek(0));
     await page.click('#play');
-    await page.waitForTimeout(800);
-    const played = await page.evaluate(() => {
+    // Wait on the audio clock itself (a loaded machine may start the sound late), then
+    // read the frame right after the page's next animation frame, in the same task as
+    // the clock: the frame drawn must be the clock's.
+    await page.waitForFunction(() => document.getElementById('audio').currentTime > 0.4, null, { timeout: 30000 });
+    const played = await page.evaluate(() => new Promise((resolve) => requestAnimationFrame(() => {
+      const a = document.getElementById('audio');
+      resolve({ frame: window.arcoView.frame, t: a.currentTime, paused: a.paused });
+    })));
+    const frameOf = (t) => Math.floor((t - (captureJson.audio.offset_s || 0)) * resultJson.fps);
+    check(!played.paused && played.frame >= 10 && Math.abs(played.frame - frameOf(played.t)) <= 1,
+      `playing: frame ${played.frame}, audio clock ${played.t.toFixed(3)} s (frame ${frameOf(played.t)})`);
+    await page.click('#play');
+    const paused = await page.evaluate(() => {
       const a = document.getElementById('audio');
       return { frame: window.arcoView.frame, t: a.currentTime, paused: a.paused };
     });
-    await page.click('#play');
-    const clockFrame = Math.floor((played.t - (captureJson.audio.offset_s || 0)) * resultJson.fps);
-    check(!played.paused && played.frame >= 10 && Math.abs(played.frame - clockFrame) <= 2,
-      `playing 0.8 s: frame ${played.frame}, audio clock ${played.t.toFixed(3)} s (frame ${clockFrame})`);
+    check(paused.paused && paused.frame === frameOf(paused.t),
+      `paused: frame ${paused.frame}, audio clock ${paused.t.toFixed(3)} s (frame ${frameOf(paused.t)})`);
     await page.selectOption('#ghost', { label: 'arco' });
     await page.selectOption('#speed', '0.25');
     const rate = await page.evaluate(() => { const a = document.getElementById('audio'); return [a.playbackRate, a.preservesPitch]; });

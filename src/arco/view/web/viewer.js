@@ -336,7 +336,11 @@
     $('play').textContent = view.playing ? 'pause' : 'play';
     if (!audio) { silentStart = { frame: view.frame, ms: performance.now() }; return; }
     if (view.playing) audio.play().catch(() => setPlaying(false));
-    else audio.pause();
+    else {
+      audio.pause();
+      // Paused, the picture is the frame the sound stopped at (not the last drawn one).
+      showFrame(Math.max(0, Math.min(frameCount - 1, clockFrame())));
+    }
   }
 
   // ---- panels ----------------------------------------------------------------------------
