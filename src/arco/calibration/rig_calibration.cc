@@ -275,22 +275,6 @@ struct BoardCornerCost {
   Eigen::Vector2d observed_px;
 };
 
-std::string TerminationName(ceres::TerminationType type) {
-  switch (type) {
-    case ceres::CONVERGENCE:
-      return "CONVERGENCE";
-    case ceres::NO_CONVERGENCE:
-      return "NO_CONVERGENCE";
-    case ceres::FAILURE:
-      return "FAILURE";
-    case ceres::USER_SUCCESS:
-      return "USER_SUCCESS";
-    case ceres::USER_FAILURE:
-      return "USER_FAILURE";
-  }
-  return "UNKNOWN";
-}
-
 // A view of a camera in the bundle adjustment.
 struct UsedView {
   int camera = 0;
@@ -638,7 +622,7 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   RigCalibration result;
   RigCalibrationReport& report = result.report;
   report.board = board.ToString();
-  report.bundle_adjustment.termination = TerminationName(summary.termination_type);
+  report.bundle_adjustment.termination = ceres::TerminationTypeToString(summary.termination_type);
   report.bundle_adjustment.iterations = static_cast<int>(summary.iterations.size()) - 1;
   report.bundle_adjustment.initial_cost = summary.initial_cost;
   report.bundle_adjustment.final_cost = summary.final_cost;

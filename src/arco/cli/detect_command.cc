@@ -6,6 +6,7 @@
 
 #include "arco/cli/command.h"
 #include "arco/cli/flag_names.h"
+#include "arco/cli/frame_range.h"
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
 #include "arco/pipeline/detect_stage.h"
@@ -29,27 +30,6 @@ struct DetectArgs {
   bool no_hand_recrop = false;
 };
 
-// "FIRST:LAST" (global frame numbers, either side may be empty) into the options.
-Status ParseFrames(const std::string& text, pipeline::DetectStageOptions* o) {
-  if (text.empty()) return Status::Ok();
-  const size_t colon = text.find(':');
-  const auto bad = [&] {
-    return Status::Error("--frames \"" + text + "\" must look like FIRST:LAST (frame numbers)");
-  };
-  if (colon == std::string::npos) return bad();
-  const auto number = [&](const std::string& s, int64_t* out) {
-    if (s.empty()) return true;
-    if (s.size() > 12 || s.find_first_not_of("0123456789") != std::string::npos) return false;
-    *out = std::stoll(s);
-    return true;
-  };
-  if (!number(text.substr(0, colon), &o->first_frame) ||
-      !number(text.substr(colon + 1), &o->last_frame)) {
-    return bad();
-  }
-  return Status::Ok();
-}
-
 void ApplyAndValidate(DetectArgs& a) {
   auto model = detect::ParsePoseModel(a.model);
   ThrowIfInvalid(model.status());
@@ -58,7 +38,7 @@ void ApplyAndValidate(DetectArgs& a) {
   ThrowIfInvalid(hands.status());
   a.o.detector.hand_model = *hands;
   a.o.detector.hand_recrop = !a.no_hand_recrop;
-  ThrowIfInvalid(ParseFrames(a.frames, &a.o));
+  ThrowIfInvalid(ParseFrameRange(a.frames, &a.o.first_frame, &a.o.last_frame));
   const Status valid = a.o.Validate();
   if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kDetectFlags)));
 }

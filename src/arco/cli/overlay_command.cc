@@ -3,6 +3,7 @@
 
 #include "arco/cli/command.h"
 #include "arco/cli/flag_names.h"
+#include "arco/cli/frame_range.h"
 #include "arco/cli/number_option.h"
 #include "arco/export/overlay.h"
 #include "arco/util/output_set.h"
@@ -21,27 +22,6 @@ struct Args {
   std::string frames;  // FIRST:LAST
   std::string output;
 };
-
-// "FIRST:LAST" (result frame numbers, either side may be empty).
-Status ParseFrames(const std::string& text, exporter::OverlayOptions* o) {
-  if (text.empty()) return Status::Ok();
-  const size_t colon = text.find(':');
-  const auto bad = [&] {
-    return Status::Error("--frames \"" + text + "\" must look like FIRST:LAST (frame numbers)");
-  };
-  if (colon == std::string::npos) return bad();
-  const auto number = [&](const std::string& s, int64_t* out) {
-    if (s.empty()) return true;
-    if (s.size() > 12 || s.find_first_not_of("0123456789") != std::string::npos) return false;
-    *out = std::stoll(s);
-    return true;
-  };
-  if (!number(text.substr(0, colon), &o->first_frame) ||
-      !number(text.substr(colon + 1), &o->last_frame)) {
-    return bad();
-  }
-  return Status::Ok();
-}
 
 int Run(const Args& a) {
   OutputSet outputs;
@@ -96,7 +76,7 @@ std::function<int()> SetupOverlay(CLI::App& app) {
                   "Output video: .mp4/.mov (H.264, else MPEG-4), .mkv (FFV1, lossless), .avi")
       ->required();
   cmd->parse_complete_callback([a] {
-    ThrowIfInvalid(ParseFrames(a->frames, &a->options));
+    ThrowIfInvalid(ParseFrameRange(a->frames, &a->options.first_frame, &a->options.last_frame));
     const Status valid = a->options.Validate();
     if (!valid.ok()) throw CLI::ValidationError(WithFlagNames(valid.message(), kOverlayFlags));
   });

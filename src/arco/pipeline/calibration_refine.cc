@@ -101,22 +101,6 @@ struct NutBridgeLength {
   double target, weight;
 };
 
-std::string TerminationName(ceres::TerminationType type) {
-  switch (type) {
-    case ceres::CONVERGENCE:
-      return "CONVERGENCE";
-    case ceres::NO_CONVERGENCE:
-      return "NO_CONVERGENCE";
-    case ceres::FAILURE:
-      return "FAILURE";
-    case ceres::USER_SUCCESS:
-      return "USER_SUCCESS";
-    case ceres::USER_FAILURE:
-      return "USER_FAILURE";
-  }
-  return "UNKNOWN";
-}
-
 void PoseToParams(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, double* p) {
   const Eigen::Vector3d aa = AxisAngleFromRotation(R);
   for (int i = 0; i < 3; ++i) p[i] = aa[i], p[3 + i] = t[i];
@@ -543,7 +527,7 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
     if (solved.termination_type == ceres::FAILURE)
       return Status::Error("bundle adjustment failed: " + solved.message);
     CalibrationRefineSummary::Pass report;
-    report.termination = TerminationName(solved.termination_type);
+    report.termination = ceres::TerminationTypeToString(solved.termination_type);
     report.iterations = static_cast<int>(solved.iterations.size()) - 1;
     report.initial_cost = solved.initial_cost;
     report.final_cost = solved.final_cost;
