@@ -10,6 +10,7 @@
 #include <cmath>
 #include <memory>
 
+#include "arco/geometry/rotation.h"
 #include "arco/util/stats.h"
 
 namespace arco::body {
@@ -44,17 +45,6 @@ class Points {
   const NpyArray<double>& p_;
   const NpyArray<double>& w_;
 };
-
-// The rotation R minimising sum |R a_i - b_i|^2 (Kabsch).
-Eigen::Matrix3d Kabsch(const std::vector<Eigen::Vector3d>& a,
-                       const std::vector<Eigen::Vector3d>& b) {
-  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-  for (size_t i = 0; i < a.size(); ++i) h += a[i] * b[i].transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
-  return svd.matrixV() * d * svd.matrixU().transpose();
-}
 
 // The nodes measured at least once whose parents are kept, re-indexed: a keypoint the
 // capture never has (a body imported without feet, say) and everything hanging from it stay
@@ -115,7 +105,7 @@ bool RestOffsets(std::vector<Node>& nodes, int j, const Points& pts, int64_t fra
       std::vector<Eigen::Vector3d> next(ch.size());
       std::vector<std::vector<double>> comp(ch.size() * 3);
       for (const auto& s : sets) {
-        const Eigen::Matrix3d r = Kabsch(s, shape);
+        const Eigen::Matrix3d r = KabschRotation(s, shape);
         for (size_t i = 0; i < ch.size(); ++i) {
           const Eigen::Vector3d a = r * s[i];
           for (int k = 0; k < 3; ++k) comp[3 * i + k].push_back(a[k]);
@@ -230,7 +220,7 @@ void FitGroup(std::vector<Node>& nodes,
           measured.push_back(d);
         }
         if (rest.size() >= 2) {
-          rot[i] = Kabsch(rest, measured);
+          rot[i] = KabschRotation(rest, measured);
         } else if (rest.size() == 1) {
           rot[i] = Eigen::Quaterniond::FromTwoVectors(rest[0], measured[0]).toRotationMatrix();
         } else if (nodes[i].parent >= 0) {

@@ -34,6 +34,7 @@
 
 #include "arco/body/skeleton.h"
 #include "arco/export/export.h"
+#include "arco/geometry/rotation.h"
 #include "arco/util/stats.h"
 
 namespace arco::exporter {
@@ -98,17 +99,6 @@ StatusOr<Skeleton> BuildSkeleton(const ExportData& data) {
 Eigen::Vector3d Target(const ExportData& data, const Joint& j, int64_t f) {
   if (j.keypoint >= 0) return data.At(f, j.keypoint);
   return 0.5 * (data.At(f, j.mid_a) + data.At(f, j.mid_b));
-}
-
-// The rotation R minimising sum |R a_i - b_i|^2 (Kabsch).
-Eigen::Matrix3d Kabsch(const std::vector<Eigen::Vector3d>& a,
-                       const std::vector<Eigen::Vector3d>& b) {
-  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-  for (size_t i = 0; i < a.size(); ++i) h += a[i] * b[i].transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
-  return svd.matrixV() * d * svd.matrixU().transpose();
 }
 
 void AppendF(std::string& out, const char* fmt, double v) {
@@ -200,7 +190,7 @@ void FitRigid(const ExportData& data,
     }
     rotation = rest.size() == 2 ? Eigen::Matrix3d(Eigen::Quaterniond::FromTwoVectors(
                                       rest[1] - rest[0], measured[1] - measured[0]))
-                                : Kabsch(rest, measured);
+                                : KabschRotation(rest, measured);
     centroid = mean - rotation * rest_mean;
   }
   for (size_t i = 0; i < root.keypoints.size(); ++i) {
@@ -310,7 +300,7 @@ StatusOr<BvhExport> ExportBvh(const ExportData& data) {
         world[i] = turn * parent_world;
         local[i] = parent_world.transpose() * world[i];
       } else if (j.children.size() > 1 && measured.size() >= 2) {
-        world[i] = Kabsch(rest_offsets, measured);
+        world[i] = KabschRotation(rest_offsets, measured);
         local[i] = parent_world.transpose() * world[i];
       } else {
         world[i] = parent_world * local[i];  // a leaf (identity) or a held rotation

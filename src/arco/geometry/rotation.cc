@@ -98,4 +98,15 @@ std::optional<Eigen::Quaterniond> AverageQuaternions(
   return q;
 }
 
+Eigen::Matrix3d KabschRotation(const std::vector<Eigen::Vector3d>& a,
+                               const std::vector<Eigen::Vector3d>& b) {
+  if (a.size() != b.size()) throw std::invalid_argument("KabschRotation: sizes differ");
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < a.size(); ++i) h += a[i] * b[i].transpose();
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
+  return svd.matrixV() * d * svd.matrixU().transpose();
+}
+
 }  // namespace arco

@@ -25,6 +25,11 @@ double RotationAngleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);
 // The rotation nearest to `matrix` in the Frobenius norm (SVD, det fixed to +1).
 Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& matrix);
 
+// The rotation R minimising sum_i |R a_i - b_i|^2 over vectors already relative to a
+// common origin (Kabsch 1976: SVD of sum a_i b_i^T, det fixed to +1). Sizes must match.
+Eigen::Matrix3d KabschRotation(const std::vector<Eigen::Vector3d>& a,
+                               const std::vector<Eigen::Vector3d>& b);
+
 // The 6D rotation representation (Zhou et al., CVPR 2019): the first two columns
 // of R, mapped back by Gram-Schmidt. Nullopt when the columns are (nearly) parallel
 // or zero.

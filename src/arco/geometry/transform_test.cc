@@ -133,6 +133,26 @@ TEST(NearestRotation, RecoversARotationFromANoisyMatrix) {
   EXPECT_LT((NearestRotation(r) - r).norm(), 1e-12);
 }
 
+TEST(KabschRotation, RecoversTheRotationOfVectorsAndNeverAReflection) {
+  std::mt19937 rng(16);
+  const Eigen::Matrix3d r = RandomRotation(&rng).toRotationMatrix();
+  std::vector<Eigen::Vector3d> a, b;
+  for (int i = 0; i < 6; ++i) {
+    a.push_back(Eigen::Vector3d::Random());
+    b.push_back(r * a.back());
+  }
+  EXPECT_LT((KabschRotation(a, b) - r).norm(), 1e-12);
+  // Mirrored vectors (x -> -x): no rotation maps them, and the answer is still a proper
+  // rotation (det +1), not the reflection the unconstrained solution would be.
+  std::vector<Eigen::Vector3d> mirrored;
+  for (const auto& p : a) mirrored.push_back(Eigen::Vector3d(-p.x(), p.y(), p.z()));
+  const Eigen::Matrix3d m = KabschRotation(a, mirrored);
+  EXPECT_NEAR(m.determinant(), 1.0, 1e-12);
+  EXPECT_LT((m.transpose() * m - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+  const std::vector<Eigen::Vector3d> plane = {{1, 0, 0}, {0, 1, 0}, {-1, -1, 0}};
+  EXPECT_THROW(KabschRotation(a, plane), std::invalid_argument);
+}
+
 TEST(Rotation6d, RoundTripsAndOrthonormalisesAndRejectsDegenerate) {
   std::mt19937 rng(15);
   for (int i = 0; i < 50; ++i) {
