@@ -104,7 +104,7 @@ expect_error "output under a file" "$tmp/w/full.mp4/x.mp4: *" \
   overlay "$tmp/res" --camera $cam -o "$tmp/w/full.mp4/x.mp4"
 expect_error "frames outside the result" "frames 1:9999 are outside the result's 1:$frames *" \
   overlay "$tmp/res" --camera $cam --frames 1:9999 -o "$tmp/w/x.mp4"
-expect_error "not a video extension" "$tmp/w/x.png: the overlay is a video: .mp4, .mov, .mkv or .avi" \
+expect_error "not a video extension" "$tmp/w/x.png: the overlay is a video: .mp4, .mov, .mkv, .avi or .webm" \
   overlay "$tmp/res" --camera $cam -o "$tmp/w/x.png"
 expect_error "no result folder" "$tmp/none/result.json: *" \
   overlay "$tmp/none" --camera $cam -o "$tmp/w/x.mp4"

@@ -71,9 +71,10 @@ std::function<int()> SetupOverlay(CLI::App& app) {
             "Output size relative to the calibration's image size",
             exporter::kOverlayScaleRange)
       ->capture_default_str();
-  cmd->add_option("-o,--output",
-                  a->output,
-                  "Output video: .mp4/.mov (H.264, else MPEG-4), .mkv (FFV1, lossless), .avi")
+  cmd->add_option(
+         "-o,--output",
+         a->output,
+         "Output video: .mp4/.mov (H.264, else MPEG-4), .mkv (FFV1, lossless), .avi, .webm (VP8)")
       ->required();
   cmd->parse_complete_callback([a] {
     ThrowIfInvalid(ParseFrameRange(a->frames, &a->options.first_frame, &a->options.last_frame));

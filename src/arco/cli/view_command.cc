@@ -19,6 +19,7 @@ struct Args {
   double exit_after_s = 0;
   bool no_serve = false;
   bool overwrite = false;
+  bool no_videos = false;
   std::string output;
 };
 
@@ -37,6 +38,16 @@ void PrintShown(const Args& a, const view::ViewSummary& summary) {
               methods.c_str(),
               summary.audio.empty() ? "none" : summary.audio.c_str(),
               summary.bytes / 1e6);
+  for (const auto& v : summary.videos) {
+    std::printf("arco view: video of %s (%dx%d, %lld frames, %s overlay, %s) written in %.1f s\n",
+                v.camera.c_str(),
+                v.width,
+                v.height,
+                static_cast<long long>(v.frames),
+                v.method.c_str(),
+                v.source.empty() ? "no video: black" : v.source.c_str(),
+                v.seconds);
+  }
 }
 
 int WriteFolder(Args a) {
@@ -107,6 +118,19 @@ std::function<int()> SetupView(CLI::App& app) {
                 "Write the page to -o DIR (opens from disk: the data embedded in data.js)");
   cmd->add_option("-o,--output", a->output, "Output folder of --no-serve");
   cmd->add_flag("--overwrite", a->overwrite, "Replace an existing viewer folder");
+  cmd->add_option("--video-camera",
+                  a->options.video_cameras,
+                  "A camera whose video is shown with the overlay (name or serial; repeatable; "
+                  "default: the first camera with a video)");
+  cmd->add_flag("--no-videos",
+                a->no_videos,
+                "Show no camera video (writing one takes about as long as the take)");
+  AddNumber(cmd,
+            "--video-scale",
+            a->options.video_scale,
+            "Size of the videos as a fraction of the calibration's image size",
+            view::kViewVideoScaleRange)
+      ->capture_default_str();
   cmd->parse_complete_callback([a] {
     if (a->no_serve && a->output.empty()) {
       throw CLI::ValidationError("--no-serve needs -o DIR");
@@ -114,6 +138,10 @@ std::function<int()> SetupView(CLI::App& app) {
     if (!a->no_serve && !a->output.empty()) {
       throw CLI::ValidationError("-o is for --no-serve (the server writes no folder)");
     }
+    if (a->no_videos && !a->options.video_cameras.empty()) {
+      throw CLI::ValidationError("--no-videos and --video-camera contradict each other");
+    }
+    a->options.videos = !a->no_videos;
     ThrowIfInvalid(a->options.Validate());
   });
   return [a] { return a->no_serve ? WriteFolder(*a) : Serve(*a); };

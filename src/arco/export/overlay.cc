@@ -281,11 +281,16 @@ StatusOr<OverlaySummary> WriteOverlay(const OverlayOptions& options,
   } else if (ext == "mkv") {
     writer_options.container = "matroska";
     writer_options.codec = "ffv1";
+  } else if (ext == "webm") {
+    // VP8 in WebM: what every browser plays (arco view's videos).
+    writer_options.container = "webm";
+    writer_options.codec = "libvpx";
   } else if (ext == "avi") {
     writer_options.container = "avi";
     writer_options.codec = "mpeg4";
   } else {
-    return Status::Error(container_hint + ": the overlay is a video: .mp4, .mov, .mkv or .avi");
+    return Status::Error(container_hint +
+                         ": the overlay is a video: .mp4, .mov, .mkv, .avi or .webm");
   }
 
   ExportOptions export_options;

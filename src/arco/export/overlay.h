@@ -52,9 +52,9 @@ struct OverlaySummary {
 // Writes the overlay video to `path` (a caller wanting an atomic output passes an
 // OutputSet temporary); `container_hint` is the user's file name, whose extension picks
 // the container and codec: .mp4/.mov: H.264 (libx264, else MPEG-4 part 2); .mkv: FFV1
-// (lossless); .avi: MPEG-4 part 2. Errors (one line naming the file): no result or
-// capture, a method the result lacks, an unknown camera, frames outside the result, a
-// video that does not match its calibration camera.
+// (lossless); .avi: MPEG-4 part 2; .webm: VP8 (libvpx), which browsers play. Errors (one line
+// naming the file): no result or capture, a method the result lacks, an unknown camera, frames
+// outside the result, a video that does not match its calibration camera.
 StatusOr<OverlaySummary> WriteOverlay(const OverlayOptions& options,
                                       const std::string& path,
                                       const std::string& container_hint);

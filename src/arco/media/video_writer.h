@@ -35,8 +35,8 @@ struct VideoWriterOptions {
   // libavformat muxer name ("matroska", "mp4", "avi"); empty: guessed from the file's
   // extension.
   std::string container = "matroska";
-  // libavcodec encoder name: "ffv1" (lossless), "mpeg4", "libx264" (when the FFmpeg
-  // build has it, see HasVideoEncoder).
+  // libavcodec encoder name: "ffv1" (lossless), "mpeg4", "libx264", "libvpx" (VP8, for
+  // WebM; the last two when the FFmpeg build has them, see HasVideoEncoder).
   std::string codec = "ffv1";
   int width = 0, height = 0;  // of every frame written, px
   Rational fps{30, 1};
@@ -52,7 +52,7 @@ struct VideoWriterOptions {
   int gop = 12;      // key frame interval (frames)
   int b_frames = 0;  // B-frames between reference frames (reordered timestamps)
   // Lossy codecs: target bit rate in bit/s; 0 = constant high quality (mpeg4
-  // qscale 2, libx264 crf 16).
+  // qscale 2, libx264 crf 16, libvpx crf 10 capped at 0.25 bit per pixel).
   int64_t bit_rate = 0;
   int threads = 1;  // encoder threads; 1 encodes on the calling thread
   // Reproducible files: no random ids (Matroska's segment UID) or version strings, so

@@ -1,12 +1,14 @@
 #include "arco/view/view.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <optional>
 
 #include "arco/export/export.h"
+#include "arco/export/overlay.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/refine/contacts_csv.h"
@@ -154,10 +156,75 @@ FrameErrors ErrorsAgainstTruth(const exporter::ExportData& data,
   return out;
 }
 
+// The camera videos with the overlay of `method` (exporter::WriteOverlay), as WebM VP8.
+// The cameras: the options' (each must be one of the capture's), else the first camera
+// with a video; none when the capture has no video (not an error).
+StatusOr<std::vector<ViewVideo>> WriteVideos(const ViewOptions& options,
+                                             const pipeline::ResultHeader& header,
+                                             const std::string& method,
+                                             const std::string& dir) {
+  std::vector<ViewVideo> out;
+  if (!options.videos || header.capture_dir.empty()) return out;
+  auto read = ReadCaptureManifest(header.capture_dir);
+  if (!read.ok()) {
+    if (options.video_cameras.empty()) return out;  // no capture: no videos to show
+    return read.status();
+  }
+  const CaptureManifest& capture = *read;
+  std::vector<int> views;
+  for (const auto& id : options.video_cameras) {
+    const int v = capture.FindCamera(id);
+    if (v < 0) {
+      std::string names;
+      for (const auto& c : capture.cameras) names += (names.empty() ? "" : ", ") + c.name;
+      return Status::Error(JoinPath(header.capture_dir, kCaptureManifestName) + ": no camera '" +
+                           id + "' (cameras: " + names + ")");
+    }
+    if (std::find(views.begin(), views.end(), v) == views.end()) views.push_back(v);
+  }
+  if (options.video_cameras.empty()) {
+    for (size_t v = 0; v < capture.cameras.size(); ++v) {
+      if (!capture.cameras[v].video.empty()) {
+        views.push_back(static_cast<int>(v));
+        break;
+      }
+    }
+  }
+  for (const int v : views) {
+    exporter::OverlayOptions overlay;
+    overlay.result_dir = options.result_dir;
+    overlay.camera = capture.cameras[v].name;
+    overlay.method = method;
+    overlay.scale = options.video_scale;
+    ViewVideo video;
+    video.file = "video_" + std::to_string(v) + ".webm";
+    const auto start = std::chrono::steady_clock::now();
+    const std::string path = JoinPath(dir, video.file);
+    ARCO_ASSIGN_OR_RETURN(const exporter::OverlaySummary written,
+                          exporter::WriteOverlay(overlay, path, path));
+    video.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    video.camera = written.camera;
+    video.source = written.video;
+    video.method = method;
+    video.width = written.width;
+    video.height = written.height;
+    video.frames = written.frames;
+    out.push_back(video);
+  }
+  return out;
+}
+
 }  // namespace
 
 Status ViewOptions::Validate() const {
   if (result_dir.empty()) return Status::Error("result_dir is empty");
+  ARCO_RETURN_IF_ERROR(CheckInRange("video_scale", video_scale, kViewVideoScaleRange));
+  if (!videos && !video_cameras.empty()) {
+    return Status::Error("video cameras are named but videos are off");
+  }
+  for (const auto& c : video_cameras) {
+    if (c.empty()) return Status::Error("a video camera's name is empty");
+  }
   return Status::Ok();
 }
 
@@ -377,6 +444,29 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
     summary.audio = audio->path;
   } else {
     summary.missing.push_back({"audio", audio.status().message()});
+  }
+  // The camera videos, with the overlay of the first method that has one.
+  manifest["videos"] = Json::array();
+  std::string overlay_method;
+  for (const auto& m : summary.methods) {
+    const auto& names = exporter::ExportMethodNames();
+    if (overlay_method.empty() && std::find(names.begin(), names.end(), m) != names.end()) {
+      overlay_method = m;
+    }
+  }
+  if (!overlay_method.empty()) {
+    ARCO_ASSIGN_OR_RETURN(summary.videos, WriteVideos(options, header, overlay_method, dir));
+  } else if (!options.video_cameras.empty()) {
+    return Status::Error(folder.ManifestPath() +
+                         ": no refined method (arco, paper, vision) to draw over the videos");
+  }
+  for (const auto& v : summary.videos) {
+    manifest["videos"].push_back({{"camera", v.camera},
+                                  {"file", v.file},
+                                  {"method", v.method},
+                                  {"width", v.width},
+                                  {"height", v.height},
+                                  {"frames", v.frames}});
   }
   Json missing = Json::array();
   for (const auto& m : summary.missing) missing.push_back({{"stage", m.stage}, {"why", m.why}});

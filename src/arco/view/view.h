@@ -12,15 +12,23 @@
 //
 // Time: frame k of the arrays (from 0) is shown at k / fps of the video; the audio time of
 // frame k is audio_offset_s + k / fps (mocap/capture.h).
+//
+// Videos: the capture's camera videos, each written with the overlay of the page's first
+// method (exporter::WriteOverlay: skeleton, strings, contact, finger numbers, note) as
+// video_<camera index>.webm (VP8, which every browser plays), one frame per result frame
+// at the capture's fps, so frame k of the page is the video's k / fps too.
 #pragma once
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "arco/util/number_range.h"
 #include "arco/util/status.h"
 
 namespace arco::view {
+
+inline constexpr NumberRange kViewVideoScaleRange = Closed(0.05, 1);
 
 struct ViewOptions {
   std::string result_dir;   // an `arco run` result folder (result.json)
@@ -29,7 +37,24 @@ struct ViewOptions {
   // (ARCO_VIEW_WEB_DIR, ARCO_VIEW_THREE_JS).
   std::string web_dir;
   std::string three_js;
+  // The camera videos with the overlay: the cameras (names or serials; empty: the first
+  // camera of capture.json that has a video, none when no camera has one), and their size
+  // as a fraction of the calibration's image.
+  bool videos = true;
+  std::vector<std::string> video_cameras;
+  double video_scale = 0.5;
   Status Validate() const;
+};
+
+// A camera video written into the page.
+struct ViewVideo {
+  std::string camera;  // the capture camera's name
+  std::string file;    // in the page's folder
+  std::string source;  // the capture's video ("": none, the overlay on black)
+  std::string method;  // whose overlay is drawn
+  int width = 0, height = 0;
+  int64_t frames = 0;
+  double seconds = 0;  // the time it took to write
 };
 
 // A stage the page cannot show, and what writes it.
@@ -45,6 +70,7 @@ struct ViewSummary {
   int keypoints = 0;
   std::string audio;  // the audio file copied ("" when none)
   int64_t bytes = 0;  // of the data arrays
+  std::vector<ViewVideo> videos;
 };
 
 // The stages a complete result has and the command that writes each (the page and the
@@ -53,7 +79,8 @@ std::vector<MissingStage> MissingStages(const std::string& result_dir);
 
 // Writes the page folder into `dir` (an existing empty folder: a caller wanting an atomic
 // output passes an OutputSet temporary). Errors: no result.json, a result with no
-// method points at all, a page file or three.min.js not found.
+// method points at all, a page file or three.min.js not found, a video camera the
+// capture does not have (or a video that cannot be read).
 StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::string& dir);
 
 // RFC 4648 base64 (with padding), for data.js.

@@ -1,7 +1,8 @@
 // arco view: the page of a result folder (docs/view.md). Reads manifest.json and its
 // float32 arrays (fetched, or embedded in data.js for pages opened from disk), draws every
 // method's points with three.js, and keeps the 3D, the panels and the audio on one frame.
-// Time: frame k (from 0) is shown at k / fps; its audio time is audio.offset_s + k / fps.
+// Time: frame k (from 0) is shown at k / fps; its audio time is audio.offset_s + k / fps,
+// and its camera videos' time k / fps (one video frame per result frame).
 // World: the arrays are mm in arco's world axes; the scene root scales them to metres and
 // turns the body's up direction (ankles -> shoulders) to three.js's +Y.
 (function () {
@@ -13,7 +14,7 @@
   const kFingers = ['open', 'index', 'middle', 'ring', 'little'];
   const kStates = ['rest', 'open string', 'pressed', 'uncertain'];
 
-  const view = { ready: false, frame: 0, method: 0, ghost: -1, playing: false };
+  const view = { ready: false, frame: 0, method: 0, ghost: -1, side: false, playing: false };
   window.arcoView = view;  // the test hooks (see the end of this file)
 
   // ---- data ----------------------------------------------------------------------------
@@ -265,19 +266,54 @@
     const canvas = renderer.domElement;
     const w = canvas.parentElement.clientWidth, h = canvas.parentElement.clientHeight;
     renderer.setSize(w, h, false);
-    camera.aspect = w / Math.max(1, h);
-    camera.updateProjectionMatrix();
     render();
+  }
+
+  // Side by side: the shown method in the left half, the ghost method in the right half,
+  // one camera for both (the same view of two methods).
+  const sideBySide = () => view.side && ghostFigure !== null;
+  // The viewport of the shown method (which 0) or of the side-by-side ghost (which 1), CSS px.
+  function viewport(which) {
+    const c = renderer.domElement, w = c.clientWidth, h = c.clientHeight;
+    if (!sideBySide()) return { x: 0, y: 0, w, h };
+    const half = Math.floor(w / 2);
+    return which === 0 ? { x: 0, y: 0, w: half, h } : { x: half, y: 0, w: w - half, h };
   }
 
   function render() {
     if (!renderer) return;
+    const left = viewport(0);
+    camera.aspect = left.w / Math.max(1, left.h);
+    camera.updateProjectionMatrix();
     placeCamera();
+    if (!sideBySide()) {
+      renderer.setScissorTest(false);
+      renderer.setViewport(0, 0, left.w, left.h);
+      renderer.render(scene, camera);
+      return;
+    }
+    const shown = figures[view.method].group;
+    const right = viewport(1);
+    renderer.setScissorTest(true);
+    // WebGL viewports count from the bottom; both halves span the full height.
+    ghostFigure.group.visible = false;
+    renderer.setViewport(left.x, 0, left.w, left.h);
+    renderer.setScissor(left.x, 0, left.w, left.h);
     renderer.render(scene, camera);
+    ghostFigure.group.visible = true;
+    shown.visible = false;
+    const contact = contactMarker.visible;
+    contactMarker.visible = false;  // the marker is the shown method's contact
+    renderer.setViewport(right.x, 0, right.w, right.h);
+    renderer.setScissor(right.x, 0, right.w, right.h);
+    renderer.render(scene, camera);
+    shown.visible = true;
+    contactMarker.visible = contact;
+    renderer.setScissorTest(false);
   }
 
   // ---- time ------------------------------------------------------------------------------
-  let manifest = null, audio = null, frameCount = 0;
+  let manifest = null, audio = null, video = null, frameCount = 0;
   const fps = () => manifest.fps;
   const audioOffset = () => (manifest.audio ? manifest.audio.offset_s : 0);
   const frameTime = (f) => f / fps();
@@ -307,6 +343,35 @@
     $('time').textContent = frameTime(f).toFixed(3) + ' s · frame ' + (manifest.frame_first + f);
     drawPanels(f);
     render();
+    syncVideo();
+  }
+
+  // The camera video follows the page's frame: paused, it is seeked to the middle of the
+  // frame's interval (WebM stores times in ms, so k / fps itself may fall just before the
+  // frame's timestamp); playing, it plays by itself at the same rate and is put back when it
+  // drifts more than two frames from the audio clock.
+  const videoTime = (f) => (f + 0.5) / fps();
+  function syncVideo() {
+    if (!video || video.readyState < 1) return;
+    const want = videoTime(view.frame);
+    if (view.playing) {
+      if (Math.abs(video.currentTime - want) > 2 / fps()) video.currentTime = want;
+    } else if (video.currentTime !== want) {
+      video.currentTime = want;
+    }
+  }
+  function setVideoCamera(i) {
+    if (!video) return;
+    const v = manifest.videos[i];
+    view.videoCamera = i;
+    $('videocam').value = String(i);
+    $('videoname').textContent = v.camera + ' · ' + v.method + ' overlay';
+    video.src = v.file;
+    video.addEventListener('loadedmetadata', () => {
+      video.playbackRate = Number($('speed').value);
+      syncVideo();
+      if (view.playing) video.play().catch(() => {});
+    }, { once: true });
   }
 
   function seek(frame) {
@@ -334,6 +399,10 @@
   function setPlaying(on) {
     view.playing = on;
     $('play').textContent = view.playing ? 'pause' : 'play';
+    if (video) {
+      if (view.playing) video.play().catch(() => {});
+      else { video.pause(); syncVideo(); }
+    }
     if (!audio) { silentStart = { frame: view.frame, ms: performance.now() }; return; }
     if (view.playing) audio.play().catch(() => setPlaying(false));
     else {
@@ -464,10 +533,21 @@
     view.ghost = i;
     $('ghost').value = String(i);
     if (i >= 0 && i !== view.method) {
-      ghostFigure = makeFigure(manifest.methods[i], 0.45);
+      ghostFigure = makeFigure(manifest.methods[i], view.side ? 1 : 0.45);
       root.add(ghostFigure.group);
     }
     showFrame(view.frame);
+  }
+
+  // Side by side needs a second method: without a ghost, the next method is taken.
+  function setSide(on) {
+    view.side = on;
+    $('layout').value = on ? 'side' : 'ghost';
+    let g = view.ghost;
+    if (on && (g < 0 || g === view.method) && manifest.methods.length > 1) {
+      g = (view.method + 1) % manifest.methods.length;
+    }
+    setGhost(g);
   }
 
   function installControls() {
@@ -478,6 +558,7 @@
     });
     methodSel.addEventListener('change', () => setMethod(Number(methodSel.value)));
     ghostSel.addEventListener('change', () => setGhost(Number(ghostSel.value)));
+    $('layout').addEventListener('change', () => setSide($('layout').value === 'side'));
     const timeline = $('timeline');
     timeline.max = String(frameCount - 1);
     timeline.addEventListener('input', () => seek(Number(timeline.value)));
@@ -486,6 +567,7 @@
     $('play').addEventListener('click', () => setPlaying(!view.playing));
     $('reset').addEventListener('click', () => { Object.assign(orbit, homeOrbit, { target: homeOrbit.target.clone() }); render(); });
     $('speed').addEventListener('change', () => {
+      if (video) video.playbackRate = Number($('speed').value);
       if (audio) audio.playbackRate = Number($('speed').value);
       else if (view.playing) silentStart = { frame: view.frame, ms: performance.now() };
     });
@@ -525,6 +607,15 @@
       audio.preservesPitch = true;  // slow playback keeps the pitch
       audio.src = manifest.audio.file;
     }
+    if (manifest.videos && manifest.videos.length) {
+      video = $('video');
+      $('videopanel').hidden = false;
+      const sel = $('videocam');
+      manifest.videos.forEach((v, i) => sel.add(new Option(v.camera, String(i))));
+      sel.hidden = manifest.videos.length < 2;
+      sel.addEventListener('change', () => setVideoCamera(Number(sel.value)));
+      setVideoCamera(0);
+    }
     buildScene(manifest);
     installControls();
     seek(0);
@@ -541,33 +632,57 @@
   view.setGhost = (name) => setGhost(manifest.methods.findIndex((m) => m.name === name));
   // Screen position (CSS px from the canvas' top-left) of the drawn joint `name` of the
   // shown method, from the instance the renderer draws; null when hidden or absent.
-  view.projectKeypoint = (name) => {
-    const fig = figures[view.method];
+  // With `ghost` true: of the ghost method (side by side: in the right half).
+  view.projectKeypoint = (name, ghost) => {
+    const fig = ghost ? ghostFigure : figures[view.method];
+    if (!fig) return null;
     const i = fig.index.get(name);
     if (i === undefined) return null;
     const m = new THREE.Matrix4();
     fig.joints.getMatrixAt(i, m);
     const p = new THREE.Vector3().setFromMatrixPosition(m);
     root.updateMatrixWorld();
+    // The visible flags change while rendering side by side, never the matrices.
+    fig.joints.updateWorldMatrix(true, false);
     p.applyMatrix4(fig.joints.matrixWorld).project(camera);
-    const c = renderer.domElement;
-    return { x: (p.x + 1) / 2 * c.clientWidth, y: (1 - p.y) / 2 * c.clientHeight };
+    const vp = viewport(ghost ? 1 : 0);
+    return { x: vp.x + (p.x + 1) / 2 * vp.w, y: vp.y + (1 - p.y) / 2 * vp.h };
   };
   // Screen position of the drawn contact marker; null when hidden.
   view.projectContact = () => {
     if (!contactMarker.visible) return null;
     root.updateMatrixWorld();
     const p = new THREE.Vector3().setFromMatrixPosition(contactMarker.matrixWorld).project(camera);
-    const c = renderer.domElement;
-    return { x: (p.x + 1) / 2 * c.clientWidth, y: (1 - p.y) / 2 * c.clientHeight };
+    const vp = viewport(0);
+    return { x: vp.x + (p.x + 1) / 2 * vp.w, y: vp.y + (1 - p.y) / 2 * vp.h };
   };
   // projection * view * root (data mm -> clip), column-major, and the canvas size in CSS px.
   view.dataToClip = () => {
     root.updateMatrixWorld();
     const m = new THREE.Matrix4().multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse)
       .multiply(root.matrixWorld);
-    const c = renderer.domElement;
-    return { matrix: m.elements.slice(), width: c.clientWidth, height: c.clientHeight };
+    const vp = viewport(0);
+    return { matrix: m.elements.slice(), width: vp.w, height: vp.h };
+  };
+  view.setSide = (on) => setSide(on);
+  // The camera video's state (null when the page shows none).
+  view.video = () => (video ? {
+    camera: manifest.videos[view.videoCamera].camera, src: video.currentSrc,
+    readyState: video.readyState, error: video.error ? video.error.code : null,
+    duration: video.duration, currentTime: video.currentTime, paused: video.paused,
+    seeking: video.seeking, width: video.videoWidth, height: video.videoHeight } : null);
+  view.setVideoCamera = (name) => setVideoCamera(manifest.videos.findIndex((v) => v.camera === name));
+  // The video's picture at its own pixel (x, y), once the current seek is done: [r, g, b].
+  view.videoPixel = async (x, y) => {
+    for (let i = 0; video.seeking || video.readyState < 2; ++i) {
+      if (i > 500 || video.error) throw new Error('the video does not show a frame');
+      await new Promise((r) => setTimeout(r, 20));
+    }
+    const c = document.createElement('canvas');
+    c.width = video.videoWidth; c.height = video.videoHeight;
+    const g = c.getContext('2d');
+    g.drawImage(video, 0, 0);
+    return Array.from(g.getImageData(x, y, 1, 1).data.subarray(0, 3));
   };
   view.audioDuration = () => (audio ? audio.duration : null);
 
