@@ -94,13 +94,15 @@ function decodePng(buf) {
   }
   return { width, height, bpp, pixels: out };
 }
-function lumaVariance(png) {
-  let s = 0, s2 = 0;
-  const n = png.width * png.height;
-  for (let i = 0; i < n; ++i) {
-    const k = i * png.bpp;
-    const l = 0.299 * png.pixels[k] + 0.587 * png.pixels[k + 1] + 0.114 * png.pixels[k + 2];
-    s += l; s2 += l * l;
+// Over the columns [x0, x1) (default: all).
+function lumaVariance(png, x0 = 0, x1 = png.width) {
+  let s = 0, s2 = 0, n = 0;
+  for (let y = 0; y < png.height; ++y) {
+    for (let x = x0; x < x1; ++x, ++n) {
+      const k = (y * png.width + x) * png.bpp;
+      const l = 0.299 * png.pixels[k] + 0.587 * png.pixels[k + 1] + 0.114 * png.pixels[k + 2];
+      s += l; s2 += l * l;
+    }
   }
   return s2 / n - (s / n) * (s / n);
 }
@@ -315,6 +317,33 @@ function stopServer(server) {
     });
     check(paused.paused && paused.frame === frameOf(paused.t),
       `paused: frame ${paused.frame}, audio clock ${paused.t.toFixed(3)} s (frame ${frameOf(paused.t)})`);
+    // Side by side: the shown method (arco) in the left half, the ghost (vision) in the
+    // right half, through one camera: each fingertip where its own data projects.
+    await page.selectOption('#method', { label: 'arco' });
+    await page.selectOption('#ghost', { label: 'vision' });
+    await page.selectOption('#layout', 'side');
+    await page.evaluate((f) => window.arcoView.seek(f), frame);
+    const half = await page.evaluate(() => window.arcoView.dataToClip());
+    const sideArco = await page.evaluate((n) => window.arcoView.projectKeypoint(n), tip);
+    const sideVision = await page.evaluate((n) => window.arcoView.projectKeypoint(n, true), tip);
+    const wantArco = project(half, pointAt(arcoPts, frame, tip));
+    const wantSide = project(half, pointAt(visionPts, frame, tip));
+    wantSide.x += half.width;
+    check(half.width < 0.51 * clip.width && dist(sideArco, wantArco) < 0.5 && dist(sideVision, wantSide) < 0.5 &&
+          sideArco.x < half.width && sideVision.x >= half.width &&
+          dist(sideArco, { x: sideVision.x - half.width, y: sideVision.y }) > 1,
+      `side by side at frame ${frame}: arco's fingertip ${dist(sideArco, wantArco).toFixed(3)} px from its point in the ` +
+      `left half (${half.width} px), vision's ${dist(sideVision, wantSide).toFixed(3)} px from its point in the right half, ` +
+      `${dist(sideArco, { x: sideVision.x - half.width, y: sideVision.y }).toFixed(2)} px apart`);
+    const sidePng = decodePng(await page.locator('#canvas3d').screenshot({ path: path.join(work, 'side_by_side.png') }));
+    const vl = lumaVariance(sidePng, 0, half.width), vr = lumaVariance(sidePng, half.width, sidePng.width);
+    check(vl > 20 && vr > 20, `side by side: both halves drawn (luma variance ${vl.toFixed(1)}, ${vr.toFixed(1)})`);
+    await page.screenshot({ path: path.join(work, 'side_by_side_page.png') });
+    await page.selectOption('#layout', 'ghost');
+    // Without camera videos in the capture, no video panel.
+    check(await page.evaluate(() => window.arcoView.video() === null &&
+                                    document.getElementById('videopanel').hidden),
+      'a capture without videos: no video panel');
     await page.selectOption('#ghost', { label: 'arco' });
     await page.selectOption('#speed', '0.25');
     const rate = await page.evaluate(() => { const a = document.getElementById('audio'); return [a.playbackRate, a.preservesPitch]; });

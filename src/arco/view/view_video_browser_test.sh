@@ -30,7 +30,8 @@ frames=$(/usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1])
   "$work/res/result.json")
 # The calibration's image is 2300x2656: the file is 2656x2300, rotate_deg 90 turns it back.
 cam=camera_21334181_1
-ffmpeg -v error -f lavfi -i "testsrc2=size=2656x2300:rate=30" -frames:v "$frames" \
+# Grey (hue=s=0): no magenta in the picture but the overlay's fingertip marks.
+ffmpeg -v error -f lavfi -i "testsrc2=size=2656x2300:rate=30" -vf hue=s=0 -frames:v "$frames" \
   -c:v mpeg4 -q:v 3 "$work/cap/$cam.mp4" || { echo "FAILED: making the test video"; exit 1; }
 /usr/bin/python3 - "$work/cap/capture.json" $cam <<'PY' || { echo "FAILED: editing capture.json"; exit 1; }
 import json, sys

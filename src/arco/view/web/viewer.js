@@ -277,7 +277,7 @@
     const c = renderer.domElement, w = c.clientWidth, h = c.clientHeight;
     if (!sideBySide()) return { x: 0, y: 0, w, h };
     const half = Math.floor(w / 2);
-    return which === 0 ? { x: 0, y: 0, w: half, h } : { x: half, y: 0, w: w - half, h };
+    return { x: which === 0 ? 0 : half, y: 0, w: half, h };  // equal halves: one aspect
   }
 
   function render() {
