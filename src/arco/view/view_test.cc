@@ -39,6 +39,24 @@ TEST(WriteViewFolder, RejectsAFolderWithoutResultJson) {
 
 TEST(ViewOptions, RejectsAnEmptyResultDir) { EXPECT_FALSE(ViewOptions{}.Validate().ok()); }
 
+TEST(ViewOptions, ChecksTheVideoOptions) {
+  ViewOptions o;
+  o.result_dir = "/tmp";
+  EXPECT_TRUE(o.Validate().ok());
+  o.video_scale = 0;
+  EXPECT_FALSE(o.Validate().ok());
+  o.video_scale = 1.5;
+  EXPECT_FALSE(o.Validate().ok());
+  o.video_scale = 1;
+  o.video_cameras = {"cam0"};
+  EXPECT_TRUE(o.Validate().ok());
+  o.videos = false;  // cameras named, videos off: a contradiction
+  EXPECT_FALSE(o.Validate().ok());
+  o.videos = true;
+  o.video_cameras = {""};
+  EXPECT_FALSE(o.Validate().ok());
+}
+
 TEST(MissingStages, ListsEveryStageOfAnEmptyFolder) {
   const auto missing = MissingStages("/nonexistent_arco_result");
   ASSERT_EQ(missing.size(), 7u);
