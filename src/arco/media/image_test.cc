@@ -50,6 +50,28 @@ TEST(RotateClockwise, MovesEveryPixelWhereAPlayerShowsIt) {
   EXPECT_EQ(RotateClockwise(src, 0).pixels, src.pixels);
 }
 
+// Larger than the 64-pixel tiles the turn works in, with partial tiles at both edges:
+// every pixel lands where the definition puts it.
+TEST(RotateClockwise, LargeImagesAcrossTiles) {
+  Image src = MakeImage(150, 97, PixelFormat::kRgb8);
+  for (size_t i = 0; i < src.pixels.size(); ++i)
+    src.pixels[i] = static_cast<uint8_t>(i * 7 + i / 251);
+  const Image r90 = RotateClockwise(src, 90), r180 = RotateClockwise(src, 180),
+              r270 = RotateClockwise(src, 270);
+  ASSERT_EQ(r90.width, 97);
+  ASSERT_EQ(r90.height, 150);
+  ASSERT_EQ(r270.width, 97);
+  for (int y = 0; y < src.height; ++y) {
+    for (int x = 0; x < src.width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_EQ(r90.at(src.height - 1 - y, x, c), src.at(x, y, c));
+        ASSERT_EQ(r180.at(src.width - 1 - x, src.height - 1 - y, c), src.at(x, y, c));
+        ASSERT_EQ(r270.at(y, src.width - 1 - x, c), src.at(x, y, c));
+      }
+    }
+  }
+}
+
 TEST(RotateClockwise, GrayAndBadAngles) {
   Image gray = MakeImage(2, 1, PixelFormat::kGray8);
   gray.pixels = {10, 20};
