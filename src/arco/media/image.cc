@@ -1,6 +1,7 @@
 #include "arco/media/image.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 
@@ -36,7 +37,8 @@ Image RotateClockwise(const Image& image, int degrees) {
       MakeImage(swap ? image.height : image.width, swap ? image.width : image.height, image.format);
   const int c = image.channels();
   const int w = image.width, h = image.height;
-  const size_t in_row = image.row_bytes(), out_row = out.row_bytes();
+  const auto in_row = static_cast<ptrdiff_t>(image.row_bytes());
+  const auto out_row = static_cast<ptrdiff_t>(out.row_bytes());
   // In square tiles: a 90/270 degree turn reads rows and writes columns, and a tile keeps
   // both in the cache (a whole-row loop misses on every written pixel of a large frame).
   constexpr int kTile = 64;
@@ -45,24 +47,31 @@ Image RotateClockwise(const Image& image, int degrees) {
     for (int x0 = 0; x0 < w; x0 += kTile) {
       const int x1 = std::min(w, x0 + kTile);
       for (int y = y0; y < y1; ++y) {
-        const uint8_t* src = image.pixels.data() + static_cast<size_t>(y) * in_row;
-        for (int x = x0; x < x1; ++x) {
-          // Where source pixel (x, y) lands in the turned image.
-          int ox = x, oy = y;
-          if (degrees == 90) {
-            ox = h - 1 - y;
-            oy = x;
-          } else if (degrees == 180) {
-            ox = w - 1 - x;
-            oy = h - 1 - y;
-          } else {  // 270
-            ox = y;
-            oy = w - 1 - x;
+        // Source pixel (x, y) lands at (h-1-y, x) for 90, (w-1-x, h-1-y) for 180 and
+        // (y, w-1-x) for 270: along a source row, the target moves by a fixed step.
+        ptrdiff_t start = 0, step = 0;
+        if (degrees == 90) {
+          start = x0 * out_row + static_cast<ptrdiff_t>(h - 1 - y) * c;
+          step = out_row;
+        } else if (degrees == 180) {
+          start = (h - 1 - y) * out_row + static_cast<ptrdiff_t>(w - 1 - x0) * c;
+          step = -c;
+        } else {  // 270
+          start = (w - 1 - x0) * out_row + static_cast<ptrdiff_t>(y) * c;
+          step = -out_row;
+        }
+        const uint8_t* from = image.pixels.data() + y * in_row + static_cast<ptrdiff_t>(x0) * c;
+        uint8_t* dst = out.pixels.data() + start;
+        if (c == 3) {
+          for (int x = x0; x < x1; ++x, from += 3, dst += step) {
+            dst[0] = from[0];
+            dst[1] = from[1];
+            dst[2] = from[2];
           }
-          uint8_t* dst =
-              out.pixels.data() + static_cast<size_t>(oy) * out_row + static_cast<size_t>(ox) * c;
-          const uint8_t* from = src + static_cast<size_t>(x) * c;
-          for (int k = 0; k < c; ++k) dst[k] = from[k];
+        } else {
+          for (int x = x0; x < x1; ++x, from += c, dst += step) {
+            for (int k = 0; k < c; ++k) dst[k] = from[k];
+          }
         }
       }
     }
