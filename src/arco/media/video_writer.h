@@ -52,7 +52,7 @@ struct VideoWriterOptions {
   int gop = 12;      // key frame interval (frames)
   int b_frames = 0;  // B-frames between reference frames (reordered timestamps)
   // Lossy codecs: target bit rate in bit/s; 0 = constant high quality (mpeg4
-  // qscale 2, libx264 crf 16, libvpx crf 10 capped at 0.25 bit per pixel).
+  // qscale 2, libx264 crf 16, libvpx crf 16 capped at 0.12 bit per pixel).
   int64_t bit_rate = 0;
   int threads = 1;  // encoder threads; 1 encodes on the calling thread
   // Reproducible files: no random ids (Matroska's segment UID) or version strings, so
