@@ -536,6 +536,11 @@
       ghostFigure = makeFigure(manifest.methods[i], view.side ? 1 : 0.45);
       root.add(ghostFigure.group);
     }
+    $('sidelabels').hidden = !sideBySide();
+    if (sideBySide()) {
+      $('sideleft').textContent = manifest.methods[view.method].name;
+      $('sideright').textContent = manifest.methods[i].name;
+    }
     showFrame(view.frame);
   }
 
