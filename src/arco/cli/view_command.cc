@@ -124,7 +124,7 @@ std::function<int()> SetupView(CLI::App& app) {
                   "default: the first camera with a video)");
   cmd->add_flag("--no-videos",
                 a->no_videos,
-                "Show no camera video (writing one takes 1-2x the take's duration)");
+                "Show no camera video (writing one takes about the take's duration)");
   AddNumber(cmd,
             "--video-scale",
             a->options.video_scale,
