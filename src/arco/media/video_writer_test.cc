@@ -173,6 +173,8 @@ TEST_F(VideoWriterTest, RotationIsReadBackInEveryContainer) {
 TEST_F(VideoWriterTest, LossyCodecsRoundTripWithinPsnr) {
   std::vector<std::pair<std::string, std::string>> cases = {{"mp4", "mpeg4"}, {"avi", "mpeg4"}};
   if (HasVideoEncoder("libx264")) cases.push_back({"mp4", "libx264"});
+  // VP8 in WebM: arco view's videos (exporter::WriteOverlay's .webm).
+  if (HasVideoEncoder("libvpx")) cases.push_back({"webm", "libvpx"});
   for (const auto& [container, codec] : cases) {
     SCOPED_TRACE(container + "/" + codec);
     const std::string path = Path(codec + "." + container);
