@@ -16,6 +16,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "arco/calibration/reprojection_cost.h"
 #include "arco/geometry/alignment.h"
 #include "arco/geometry/rotation.h"
 #include "arco/geometry/triangulation.h"
@@ -260,16 +261,9 @@ struct BoardCornerCost {
                   const T* intrinsics,
                   T* residual) const {
     const T board_point[3] = {T(point_in_board.x()), T(point_in_board.y()), T(point_in_board.z())};
-    T world_point[3], camera_point[3];
-    ceres::AngleAxisRotatePoint(world_from_board, board_point, world_point);
-    for (int i = 0; i < 3; ++i) world_point[i] += world_from_board[3 + i];
-    ceres::AngleAxisRotatePoint(cam_from_world, world_point, camera_point);
-    for (int i = 0; i < 3; ++i) camera_point[i] += cam_from_world[3 + i];
-    T pixel[2];
-    if (!PixelFromPointInCamera(intrinsics, camera_point, pixel)) return false;
-    residual[0] = pixel[0] - T(observed_px.x());
-    residual[1] = pixel[1] - T(observed_px.y());
-    return true;
+    T world_point[3];
+    TransformByPose(world_from_board, board_point, world_point);
+    return ReprojectionResidual(cam_from_world, intrinsics, world_point, observed_px, residual);
   }
   Eigen::Vector3d point_in_board;
   Eigen::Vector2d observed_px;

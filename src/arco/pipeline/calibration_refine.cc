@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "arco/calibration/calibration_file.h"
+#include "arco/calibration/reprojection_cost.h"
 #include "arco/geometry/rotation.h"
 #include "arco/instrument/instrument_model.h"
 #include "arco/instrument/template_fit.h"
@@ -52,14 +53,7 @@ struct PointReprojection {
   explicit PointReprojection(const Eigen::Vector2d& px) : observed_px(px) {}
   template <typename T>
   bool operator()(const T* cam, const T* intrinsics, const T* point, T* residual) const {
-    T camera_point[3];
-    ceres::AngleAxisRotatePoint(cam, point, camera_point);
-    for (int i = 0; i < 3; ++i) camera_point[i] += cam[3 + i];
-    T pixel[2];
-    if (!PixelFromPointInCamera(intrinsics, camera_point, pixel)) return false;
-    residual[0] = pixel[0] - T(observed_px.x());
-    residual[1] = pixel[1] - T(observed_px.y());
-    return true;
+    return ReprojectionResidual(cam, intrinsics, point, observed_px, residual);
   }
   Eigen::Vector2d observed_px;
 };
@@ -75,9 +69,8 @@ struct RigidReprojection {
                   const T* point_in_instrument,
                   T* residual) const {
     T world_point[3];
-    ceres::AngleAxisRotatePoint(world_from_instrument, point_in_instrument, world_point);
-    for (int i = 0; i < 3; ++i) world_point[i] += world_from_instrument[3 + i];
-    return PointReprojection(observed_px)(cam, intrinsics, world_point, residual);
+    TransformByPose(world_from_instrument, point_in_instrument, world_point);
+    return ReprojectionResidual(cam, intrinsics, world_point, observed_px, residual);
   }
   Eigen::Vector2d observed_px;
 };

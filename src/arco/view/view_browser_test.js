@@ -21,33 +21,15 @@
 const fs = require('fs');
 const path = require('path');
 const zlib = require('zlib');
-const { spawn, execFileSync } = require('child_process');
+const { execFileSync } = require('child_process');
+const lib = require('./browser_test_lib.js');
 
 const [arco, result, badResult, work, playwrightDir] = process.argv.slice(2);
-const { chromium } = require(path.resolve(playwrightDir));
 const tip = 'left_hand_index_tip';
-let failures = 0;
-function check(ok, what) {
-  console.log((ok ? 'ok      ' : 'FAILED  ') + what);
-  if (!ok) failures += 1;
-}
+const { check, failures } = lib.makeChecker();
+const { readNpy, openPage, stopServer } = lib;
 
 // ---- independent readers ------------------------------------------------------------------
-function readNpy(file) {
-  const buf = fs.readFileSync(file);
-  if (buf.toString('latin1', 1, 6) !== 'NUMPY') throw new Error(file + ': not .npy');
-  const major = buf[6];
-  const headerLen = major === 1 ? buf.readUInt16LE(8) : buf.readUInt32LE(8);
-  const start = (major === 1 ? 10 : 12);
-  const header = buf.toString('latin1', start, start + headerLen);
-  if (!/'descr': '<f8'/.test(header) || /'fortran_order': True/.test(header)) {
-    throw new Error(file + ': expected little-endian float64, C order: ' + header);
-  }
-  const shape = header.match(/'shape': \(([^)]*)\)/)[1].split(',').filter((s) => s.trim()).map(Number);
-  const data = new Float64Array(buf.buffer.slice(buf.byteOffset + start + headerLen,
-                                                 buf.byteOffset + buf.length));
-  return { shape, data };
-}
 function wavDurationS(file) {
   const b = fs.readFileSync(file);
   let rate = 0, blockAlign = 0, dataBytes = 0;
@@ -125,18 +107,14 @@ function project(clip, x) {
 }
 const dist = (a, b) => Math.hypot(a.x - b.x, a.y - b.y);
 
-// ---- the browser ---------------------------------------------------------------------------
-async function openPage(browser, url) {
-  const page = await browser.newPage({ viewport: { width: 1280, height: 720 } });
-  const errors = [];
-  page.on('console', (m) => { if (m.type() === 'error') errors.push('console: ' + m.text()); });
-  page.on('pageerror', (e) => errors.push('page error: ' + e.message));
-  page.on('requestfailed', (r) => errors.push('request failed: ' + r.url()));
-  const start = Date.now();
-  await page.goto(url);
-  await page.waitForFunction(() => window.arcoView && window.arcoView.ready, null, { timeout: 60000 });
-  return { page, errors, loadS: (Date.now() - start) / 1000 };
+// `arco view` with its own TMPDIR, to see that the served folder is removed when it stops.
+async function startServer(res) {
+  const tmpdir = path.join(work, 'tmp_' + path.basename(res));
+  fs.mkdirSync(tmpdir, { recursive: true });
+  return { ...(await lib.startServer(arco, res, [], { TMPDIR: tmpdir })), tmpdir };
 }
+
+// ---- the browser ---------------------------------------------------------------------------
 async function canvasVariance(page, file) {
   const png = await page.locator('#canvas3d').screenshot({ path: file });
   return lumaVariance(decodePng(png));
@@ -172,38 +150,10 @@ async function checkSeek(page, label, m) {
     `${label}: frames ${f1} -> ${f2}: the fingertip moved ${moved.toFixed(2)} px, the data says ${want.toFixed(2)} px`);
 }
 
-function startServer(res) {
-  return new Promise((resolve, reject) => {
-    // Its own TMPDIR, to see that the served folder is removed when it stops.
-    const tmpdir = path.join(work, 'tmp_' + path.basename(res));
-    fs.mkdirSync(tmpdir, { recursive: true });
-    const child = spawn(arco, ['view', res, '--port', '0', '--exit-after-s', '240'],
-                        { env: { ...process.env, TMPDIR: tmpdir } });
-    let out = '', err = '';
-    child.stdout.on('data', (d) => {
-      out += d;
-      const m = out.match(/http:\/\/127\.0\.0\.1:\d+\//);
-      if (m) resolve({ child, url: m[0], stderr: () => err, tmpdir });
-    });
-    child.stderr.on('data', (d) => { err += d; });
-    child.on('exit', (code) => reject(new Error('arco view exited ' + code + ': ' + err)));
-  });
-}
-function stopServer(server) {
-  return new Promise((resolve) => {
-    server.child.removeAllListeners('exit');
-    server.child.on('exit', (code, signal) => resolve({ code, signal }));
-    server.child.kill('SIGINT');
-  });
-}
 
 (async () => {
   fs.mkdirSync(work, { recursive: true });
-  const browser = await chromium.launch({
-    executablePath: '/usr/bin/chromium',
-    args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-           '--autoplay-policy=no-user-gesture-required'],
-  });
+  const browser = await lib.launchChromium(playwrightDir);
   try {
     const arcoPts = methodPoints('arco'), visionPts = methodPoints('vision');
 
@@ -407,6 +357,6 @@ function stopServer(server) {
   } finally {
     await browser.close();
   }
-  console.log(failures ? `${failures} check(s) FAILED; screenshots in ${work}` : `all checks passed; screenshots in ${work}`);
-  process.exit(failures ? 1 : 0);
+  console.log(failures() ? `${failures()} check(s) FAILED; screenshots in ${work}` : `all checks passed; screenshots in ${work}`);
+  process.exit(failures() ? 1 : 0);
 })();

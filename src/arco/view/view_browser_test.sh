@@ -11,22 +11,14 @@ work=$3
 rm -rf "$work"
 # Bad input, without a browser: one line "arco: error: ...", exit 1, nothing written.
 mkdir -p "$work"
-fail=0
-bad() {  # bad NAME PATTERN ARGS...
-  local name=$1 pattern=$2; shift 2
-  "$arco" "$@" >/dev/null 2>"$work/err"
-  local rc=$? line; line=$(cat "$work/err")
-  if [ $rc -ne 1 ] || [ "$(wc -l <"$work/err")" -ne 1 ] || [[ "$line" != "arco: error: "$pattern ]]; then
-    echo "FAILED: $name: exit $rc: $line"; fail=1
-  fi
-  if [ -e "$work/out" ]; then echo "FAILED: $name: $work/out was written"; fail=1; fi
-}
+source "$src/src/arco/cli/cli_test_lib.sh"
+SNAPSHOT_DIR=$work
 mkdir -p "$work/not_a_result"
-bad "no result.json" "*not_a_result/result.json: not found (not an arco result folder)" \
+expect_error "no result.json" "*not_a_result/result.json: not found (not an arco result folder)" \
   view "$work/not_a_result" --no-serve -o "$work/out"
-bad "--no-serve without -o" "*--no-serve needs -o DIR*" view "$work/not_a_result" --no-serve
-bad "-o without --no-serve" "*-o is for --no-serve*" view "$work/not_a_result" -o "$work/out"
-bad "port out of range" "*--port*" view "$work/not_a_result" --port 70000
+expect_error "--no-serve without -o" "*--no-serve needs -o DIR*" view "$work/not_a_result" --no-serve
+expect_error "-o without --no-serve" "*-o is for --no-serve*" view "$work/not_a_result" -o "$work/out"
+expect_error "port out of range" "*--port*" view "$work/not_a_result" --port 70000
 [ $fail -eq 0 ] || exit 1
 
 if [ ! -x /usr/bin/chromium ]; then

@@ -16,29 +16,15 @@
 'use strict';
 const fs = require('fs');
 const path = require('path');
-const { spawn } = require('child_process');
+const lib = require('./browser_test_lib.js');
 
 const [arco, result, pageDir, camera, work, playwrightDir] = process.argv.slice(2);
-const { chromium } = require(path.resolve(playwrightDir));
 const secondCamera = 'camera_21334209_1';  // no video: the overlay on black
 const scale = 0.25;
 const tipNames = ['thumb', 'index', 'middle', 'ring', 'little'].map((f) => `left_hand_${f}_tip`);
-let failures = 0;
-function check(ok, what) {
-  console.log((ok ? 'ok      ' : 'FAILED  ') + what);
-  if (!ok) failures += 1;
-}
+const { check, failures } = lib.makeChecker();
+const { readNpy, openPage, stopServer } = lib;
 
-function readNpy(file) {
-  const buf = fs.readFileSync(file);
-  const major = buf[6];
-  const headerLen = major === 1 ? buf.readUInt16LE(8) : buf.readUInt32LE(8);
-  const start = major === 1 ? 10 : 12;
-  const header = buf.toString('latin1', start, start + headerLen);
-  if (!/'descr': '<f8'/.test(header)) throw new Error(file + ': expected float64: ' + header);
-  const shape = header.match(/'shape': \(([^)]*)\)/)[1].split(',').filter((s) => s.trim()).map(Number);
-  return { shape, data: new Float64Array(buf.buffer.slice(buf.byteOffset + start + headerLen, buf.byteOffset + buf.length)) };
-}
 const resultJson = JSON.parse(fs.readFileSync(path.join(result, 'result.json'), 'utf8'));
 const capture = path.resolve(result, resultJson.capture);
 const captureJson = JSON.parse(fs.readFileSync(path.join(capture, 'capture.json'), 'utf8'));
@@ -74,16 +60,6 @@ function tipsAt(project, f) {
 const magenta = (rgb) => rgb[0] > 190 && rgb[1] < 90 && rgb[2] > 190;
 const dist = (a, b) => Math.hypot(a.x - b.x, a.y - b.y);
 
-async function openPage(browser, url) {
-  const page = await browser.newPage({ viewport: { width: 1280, height: 720 } });
-  const errors = [];
-  page.on('console', (m) => { if (m.type() === 'error') errors.push('console: ' + m.text()); });
-  page.on('pageerror', (e) => errors.push('page error: ' + e.message));
-  page.on('requestfailed', (r) => errors.push('request failed: ' + r.url()));
-  await page.goto(url);
-  await page.waitForFunction(() => window.arcoView && window.arcoView.ready, null, { timeout: 60000 });
-  return { page, errors };
-}
 async function videoReady(page) {
   await page.waitForFunction(() => {
     const v = window.arcoView.video();
@@ -138,35 +114,11 @@ async function checkFrames(page, label, cam, apart) {
   }
 }
 
-function startServer(args) {
-  return new Promise((resolve, reject) => {
-    const child = spawn(arco, ['view', result, '--port', '0', '--exit-after-s', '300', ...args]);
-    let out = '', err = '';
-    const start = Date.now();
-    child.stdout.on('data', (d) => {
-      out += d;
-      const m = out.match(/http:\/\/127\.0\.0\.1:\d+\//);
-      if (m) resolve({ child, url: m[0], out: () => out, seconds: (Date.now() - start) / 1000 });
-    });
-    child.stderr.on('data', (d) => { err += d; });
-    child.on('exit', (code) => reject(new Error('arco view exited ' + code + ': ' + err)));
-  });
-}
-function stopServer(server) {
-  return new Promise((resolve) => {
-    server.child.removeAllListeners('exit');
-    server.child.on('exit', (code) => resolve(code));
-    server.child.kill('SIGINT');
-  });
-}
+const startServer = (args) => lib.startServer(arco, result, args);
 
 (async () => {
   fs.mkdirSync(work, { recursive: true });
-  const browser = await chromium.launch({
-    executablePath: '/usr/bin/chromium',
-    args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-           '--autoplay-policy=no-user-gesture-required'],
-  });
+  const browser = await lib.launchChromium(playwrightDir);
   try {
     const server = await startServer(['--video-camera', camera, '--video-camera', secondCamera,
                                       '--video-scale', String(scale)]);
@@ -223,6 +175,6 @@ function stopServer(server) {
   } finally {
     await browser.close();
   }
-  console.log(failures ? `${failures} check(s) FAILED; screenshots in ${work}` : `all checks passed; screenshots in ${work}`);
-  process.exit(failures ? 1 : 0);
+  console.log(failures() ? `${failures()} check(s) FAILED; screenshots in ${work}` : `all checks passed; screenshots in ${work}`);
+  process.exit(failures() ? 1 : 0);
 })();
