@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "arco/geometry/rotation.h"
+#include "arco/util/parallel.h"
 #include "arco/util/stats.h"
 
 namespace arco::body {
@@ -181,10 +182,13 @@ Eigen::Matrix3d Exp(const std::array<double, 3>& d) {
   return Eigen::AngleAxisd(angle, v / angle).toRotationMatrix();
 }
 
-// Fits one group; fills `out` and `residuals`.
-void FitGroup(std::vector<Node>& nodes,
+// Fits one group on frames [start, end), started cold at `start`; fills frames
+// [write_from, end) of `out` and appends their residuals to `residuals`.
+void FitGroup(const std::vector<Node>& nodes,
               const Points& pts,
-              int64_t frames,
+              int64_t start,
+              int64_t write_from,
+              int64_t end,
               const SkeletonFitOptions& options,
               NpyArray<double>& out,
               std::vector<double>& residuals) {
@@ -200,7 +204,7 @@ void FitGroup(std::vector<Node>& nodes,
                   : Eigen::Vector3d(fk[nodes[i].parent] + r[nodes[i].parent] * nodes[i].offset);
     }
   };
-  for (int64_t f = 0; f < frames; ++f) {
+  for (int64_t f = start; f < end; ++f) {
     std::vector<int> observed;
     for (int i = 0; i < n; ++i) {
       if (nodes[i].keypoint >= 0 && pts.At(f, nodes[i].keypoint).allFinite()) observed.push_back(i);
@@ -263,18 +267,24 @@ void FitGroup(std::vector<Node>& nodes,
                                delta[j].data());
     }
     ceres::Solver::Options so;
-    so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+    // Each point's residual depends on the root and the rotations along its path only, so
+    // J^T J is mostly zeros: the sparse Cholesky took 25% less time than the dense one on
+    // the same iterates (58 s take, docs/performance.md). Tolerances 1e-8 instead of 1e-10
+    // took 8.6 instead of 12.7 iterations per frame and moved no joint by more than
+    // 0.05 mm (p99 0.002 mm; arco eval unchanged to 0.01 mm).
+    so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
     so.max_num_iterations = options.max_iterations;
     so.num_threads = 1;
-    so.function_tolerance = 1e-10;
-    so.gradient_tolerance = 1e-14;
-    so.parameter_tolerance = 1e-10;
+    so.function_tolerance = 1e-8;
+    so.gradient_tolerance = 1e-10;
+    so.parameter_tolerance = 1e-8;
     so.logging_type = ceres::SILENT;
     ceres::Solver::Summary summary;
     ceres::Solve(so, &problem, &summary);
     root += Eigen::Vector3d(dp[0], dp[1], dp[2]);
     for (int j = 0; j < n; ++j) rot[j] = rot[j] * Exp(delta[j]);
     forward(rot, root);
+    if (f < write_from) continue;  // a warm-up frame
     for (int i = 0; i < n; ++i) {
       const int k = nodes[i].keypoint;
       if (k < 0) continue;
@@ -293,6 +303,9 @@ Status SkeletonFitOptions::Validate() const {
     return Status::Error("rotation_prior_mm_per_rad must be >= 0");
   }
   if (max_iterations < 1) return Status::Error("max_iterations must be >= 1");
+  if (chunk_frames < 1) return Status::Error("chunk_frames must be >= 1");
+  if (warmup_frames < 0) return Status::Error("warmup_frames must be >= 0");
+  if (num_threads < 0) return Status::Error("num_threads must be >= 0 (0 = all cores)");
   return Status::Ok();
 }
 
@@ -317,6 +330,13 @@ StatusOr<SkeletonFitResult> FitSkeleton(const NpyArray<double>& points_mm,
   const std::vector<SkeletonJoint>& skeleton = WholeBodySkeleton();
   SkeletonFitResult result;
   result.points_mm = points_mm;
+  // The groups' subtrees and rest offsets (serial: medians over the whole take), then
+  // every (group, chunk) fitted independently.
+  struct Group {
+    JointGroup group;
+    std::vector<Node> nodes;
+  };
+  std::vector<Group> groups;
   for (JointGroup group : options.groups) {
     std::vector<Node> nodes;
     std::vector<int> index(skeleton.size(), -1);
@@ -348,10 +368,36 @@ StatusOr<SkeletonFitResult> FitSkeleton(const NpyArray<double>& points_mm,
       complete = RestOffsets(nodes, j, pts, frames);
     }
     if (!complete) continue;  // a bone never measured: the group stays raw
-    std::vector<double> residuals;
-    FitGroup(nodes, pts, frames, options, result.points_mm, residuals);
-    result.fitted_groups.push_back(group);
-    result.median_residual_mm.push_back(residuals.empty() ? 0.0 : Median(residuals));
+    groups.push_back({group, std::move(nodes)});
+  }
+  const int64_t chunk = options.chunk_frames;
+  const int64_t chunks = (frames + chunk - 1) / chunk;
+  const int64_t items = static_cast<int64_t>(groups.size()) * chunks;
+  std::vector<std::vector<double>> residuals(static_cast<size_t>(items));
+  // Each item writes only its group's keypoints on its own frames of result.points_mm.
+  ParallelFor(
+      items,
+      options.num_threads,
+      [&](int64_t item, int) {
+        const int64_t c = item % chunks;
+        FitGroup(groups[static_cast<size_t>(item / chunks)].nodes,
+                 pts,
+                 std::max<int64_t>(0, c * chunk - options.warmup_frames),
+                 c * chunk,
+                 std::min(frames, (c + 1) * chunk),
+                 options,
+                 result.points_mm,
+                 residuals[static_cast<size_t>(item)]);
+      },
+      1);
+  for (size_t g = 0; g < groups.size(); ++g) {
+    std::vector<double> all;
+    for (int64_t c = 0; c < chunks; ++c) {
+      const std::vector<double>& r = residuals[g * static_cast<size_t>(chunks) + c];
+      all.insert(all.end(), r.begin(), r.end());
+    }
+    result.fitted_groups.push_back(groups[g].group);
+    result.median_residual_mm.push_back(all.empty() ? 0.0 : Median(all));
   }
   return result;
 }

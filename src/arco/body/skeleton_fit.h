@@ -12,6 +12,15 @@
 // between forward kinematics and the measured points (Huber loss), warm-started from the
 // previous frame and pulled weakly towards it, so a joint missing in a frame (or a
 // rotation no point constrains, such as a bone's twist) keeps its previous pose.
+//
+// Parallel: the frames are cut into fixed chunks of chunk_frames, and the groups' chunks
+// are fitted on num_threads threads. The chunks do not depend on the thread count, so
+// neither do the results. Each chunk starts cold (from the tree fit, as the take's first
+// frame does) warmup_frames before its first frame and keeps only its own frames: a cold
+// start alone places a joint missing in that frame along its parent's bone (hundreds of
+// mm off), while after the warm-up it has the pose of its last measurement, as in one
+// pass over the take. Chunk boundaries then differ from one pass by the solver's
+// tolerance, except where a joint is missing for the whole warm-up (skeleton_fit_test).
 #pragma once
 
 #include <string>
@@ -33,6 +42,10 @@ struct SkeletonFitOptions {
   // Weight (mm per radian) of each rotation's pull towards the previous frame.
   double rotation_prior_mm_per_rad = 0.01;
   int max_iterations = 100;
+  // Frames per independently fitted chunk (see above); not a function of num_threads.
+  int chunk_frames = 120;
+  int warmup_frames = 30;  // fitted before a chunk's first frame and dropped
+  int num_threads = 1;  // 0 = all cores; results do not depend on it
 
   Status Validate() const;
 };
@@ -48,7 +61,7 @@ struct SkeletonFitResult {
 
 // points_mm: (F, P, 3) millimetres, NaN = missing, named by `names` (arco keypoint names);
 // weights: (F, P) per-point weights (a point with weight 0 is ignored) or empty for 1.
-// Deterministic (one thread, frames in order).
+// Deterministic: the same bits for any num_threads.
 StatusOr<SkeletonFitResult> FitSkeleton(const NpyArray<double>& points_mm,
                                         const std::vector<std::string>& names,
                                         const NpyArray<double>& weights,

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <random>
 
@@ -174,6 +175,56 @@ TEST(FitSkeleton, ExactOnExactPointsAndDeterministic) {
     worst = std::max(worst, std::abs(a->points_mm.data[i] - clean.data[i]));
   }
   EXPECT_LT(worst, 1e-6);
+}
+
+// Chunks fitted in parallel: the same bits for any thread count, and chunk starts (cold,
+// from the tree fit) that agree with one warm-started pass over the whole take.
+TEST(FitSkeleton, ChunksGiveTheSameBitsForAnyThreadCount) {
+  const Take t = MakeTake(60, 2.0, 5);
+  SkeletonFitOptions o;
+  o.chunk_frames = 7;  // 9 chunks, the last one short
+  o.num_threads = 1;
+  const StatusOr<SkeletonFitResult> one = FitSkeleton(t.noisy, t.names, {}, o);
+  ASSERT_TRUE(one.ok()) << one.status().message();
+  for (int threads : {2, 3, 0}) {
+    o.num_threads = threads;
+    const StatusOr<SkeletonFitResult> many = FitSkeleton(t.noisy, t.names, {}, o);
+    ASSERT_TRUE(many.ok());
+    EXPECT_TRUE(SameBits(one->points_mm, many->points_mm)) << threads << " threads";
+    EXPECT_EQ(one->median_residual_mm, many->median_residual_mm);
+  }
+  SkeletonFitOptions whole;
+  whole.chunk_frames = 60;
+  const StatusOr<SkeletonFitResult> warm = FitSkeleton(t.noisy, t.names, {}, whole);
+  ASSERT_TRUE(warm.ok());
+  EXPECT_FALSE(SameBits(one->points_mm, warm->points_mm));  // the chunks did start cold
+  // Measured joints agree. A filled (missing) joint is as undetermined as the pose it
+  // inherits (an elbow missing between a measured shoulder and wrist may swivel), so
+  // there the chunks must only be as close to the truth as one pass.
+  double worst_measured = 0;
+  std::vector<double> filled_chunks, filled_one_pass;
+  for (size_t i = 0; i < warm->points_mm.data.size(); i += 3) {
+    const double a = one->points_mm.data[i], b = warm->points_mm.data[i];
+    ASSERT_EQ(std::isnan(a), std::isnan(b)) << i;
+    if (std::isnan(a)) continue;
+    const Eigen::Map<const Eigen::Vector3d> chunks(&one->points_mm.data[i]),
+        pass(&warm->points_mm.data[i]), truth(&t.truth.data[i]);
+    if (std::isnan(t.noisy.data[i])) {
+      filled_chunks.push_back((chunks - truth).norm());
+      filled_one_pass.push_back((pass - truth).norm());
+    } else {
+      worst_measured = std::max(worst_measured, (chunks - pass).norm());
+    }
+  }
+  EXPECT_LT(worst_measured, 0.05) << "mm";
+  ASSERT_GT(filled_chunks.size(), 100u);
+  EXPECT_LT(Median(filled_chunks), 1.05 * Median(filled_one_pass) + 0.05)
+      << Median(filled_one_pass) << " mm in one pass";
+  o.chunk_frames = 0;
+  EXPECT_FALSE(FitSkeleton(t.noisy, t.names, {}, o).ok());
+  o.chunk_frames = 7;
+  o.num_threads = -1;
+  EXPECT_FALSE(FitSkeleton(t.noisy, t.names, {}, o).ok());
 }
 
 TEST(FitSkeleton, RejectsBadShapesAndLeavesUnmeasuredGroupsRaw) {

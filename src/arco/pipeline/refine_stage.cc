@@ -23,7 +23,7 @@ Status Expect(bool ok, const std::string& path, const std::string& what) {
 // reprojection RMS made the fit worse on the synthetic takes (body 7.02 -> 7.23 mm by
 // views alone, 7.43 mm with the RMS; docs/export.md), plausibly because the points are
 // temporally filtered after triangulation, so a frame's RMS no longer describes them.
-StatusOr<NpyArray<double>> FitBody(const RefineInputs& inputs) {
+StatusOr<NpyArray<double>> FitBody(const RefineInputs& inputs, int num_threads) {
   const KeypointLayout* layout =
       FindKeypointLayout(refine::SpdContactLayoutName(*inputs.instrument));
   const NpyArray<double>& base = inputs.spd.base_points_mm;
@@ -32,8 +32,9 @@ StatusOr<NpyArray<double>> FitBody(const RefineInputs& inputs) {
   }
   const std::vector<std::string> names(layout->names.begin(),
                                        layout->names.begin() + base.shape[1]);
-  ARCO_ASSIGN_OR_RETURN(body::SkeletonFitResult fit,
-                        body::FitSkeleton(base, names, {}, body::SkeletonFitOptions{}));
+  body::SkeletonFitOptions options;
+  options.num_threads = num_threads;
+  ARCO_ASSIGN_OR_RETURN(body::SkeletonFitResult fit, body::FitSkeleton(base, names, {}, options));
   return std::move(fit.points_mm);
 }
 
@@ -172,7 +173,7 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
     fitted.instrument = inputs.spd.instrument;
     fitted.hand_model = inputs.spd.hand_model;
     fitted.strings_in_world_mm = inputs.spd.strings_in_world_mm;
-    ARCO_ASSIGN_OR_RETURN(fitted.base_points_mm, FitBody(inputs));
+    ARCO_ASSIGN_OR_RETURN(fitted.base_points_mm, FitBody(inputs, options.num_threads));
     spd = &fitted;
   }
   out.points3d = refine::BuildSpdPoints(
