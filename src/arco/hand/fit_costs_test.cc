@@ -1,0 +1,97 @@
+// CompressedReprojectionCost against the block it stands for (HandCostFunction over all
+// observations): Levenberg-Marquardt sees a block only through |r|^2, J^T r and J^T J,
+// so those must agree, also when a finger is seen in no view (J^T J singular).
+#include "arco/hand/fit_costs.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "arco/hand/hand_test_util.h"
+#include "arco/hand/synthetic_rig.h"
+
+namespace arco::hand::internal {
+namespace {
+
+constexpr int kParams = CompressedReprojectionCost::kParams;
+using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+struct Normal {
+  double rr = 0;
+  Eigen::MatrixXd jtj;
+  Eigen::VectorXd jtr;
+};
+
+// |r|^2, J^T J, J^T r of a cost function with the (aa, t, angles) blocks.
+
+Normal Evaluate(const ceres::CostFunction& f, const double* aa, const double* t,
+                const double* angles) {
+  const int m = f.num_residuals();
+  Eigen::VectorXd r(m);
+  Mat j0(m, 3), j1(m, 3), j2(m, kNumJointDofs);
+  const double* x[3] = {aa, t, angles};
+  double* jac[3] = {j0.data(), j1.data(), j2.data()};
+  EXPECT_TRUE(f.Evaluate(x, r.data(), jac));
+  Eigen::MatrixXd j(m, kParams);
+  j << j0, j1, j2;
+  Normal n;
+  n.rr = r.squaredNorm();
+  n.jtj = j.transpose() * j;
+  n.jtr = j.transpose() * r;
+  Eigen::VectorXd cost_only(m);
+  EXPECT_TRUE(f.Evaluate(x, cost_only.data(), nullptr));
+  EXPECT_NEAR(cost_only.squaredNorm(), n.rr, 1e-9 * n.rr);
+  return n;
+}
+
+void ExpectSameNormalEquations(bool hide_a_finger) {
+  const HandModel model = HandModel::Default(HandSide::kLeft);
+  std::mt19937 rng(hide_a_finger ? 7 : 3);
+  const std::vector<Camera> cameras = testing::MakeRingRig(20, 2500, Eigen::Vector3d::Zero());
+  const HandPose truth = testing::RandomPose(model, rng, 0.1);
+  const auto views = testing::ProjectHand(cameras, ForwardKinematics(model, truth), 2.0, 0.1, rng);
+  std::vector<PixelObservation> observations;
+  for (size_t v = 0; v < views.size(); ++v) {
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      if (hide_a_finger && k >= 13 && k <= 16) continue;  // the ring finger, in every view
+      if (!views[v].pixels[k].allFinite()) continue;
+      observations.push_back({&cameras[v], static_cast<int>(v), k, views[v].pixels[k],
+                              std::sqrt(views[v].scores[k])});
+    }
+  }
+  // Evaluated away from the truth, as in the solver's first iterations.
+  HandPose start = truth;
+  start.wrist_in_world_mm += Eigen::Vector3d(4, -3, 5);
+  for (double& a : start.angles_rad) a += 0.05;
+  start = ClampToLimits(model, start);
+  const Eigen::Vector3d aa = start.WristAngleAxis();
+  const ReprojectionResiduals residuals{&model, &observations, 5.0 * 5.0};
+  const Normal full = Evaluate(HandCostFunction<ReprojectionResiduals>(residuals), aa.data(),
+                               start.wrist_in_world_mm.data(), start.angles_rad.data());
+  const Normal compressed = Evaluate(CompressedReprojectionCost(residuals), aa.data(),
+                                     start.wrist_in_world_mm.data(), start.angles_rad.data());
+  ASSERT_EQ(compressed.jtj.rows(), kParams);
+  EXPECT_NEAR(compressed.rr, full.rr, 1e-9 * full.rr);
+  const double scale = full.jtj.cwiseAbs().maxCoeff();
+  EXPECT_LT((compressed.jtj - full.jtj).cwiseAbs().maxCoeff(), 1e-10 * scale);
+  EXPECT_LT((compressed.jtr - full.jtr).cwiseAbs().maxCoeff(),
+            1e-9 * full.jtr.cwiseAbs().maxCoeff());
+  // The hidden finger's angles are unconstrained: J^T J is singular there.
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(full.jtj);
+  if (hide_a_finger) {
+    EXPECT_LT(eig.eigenvalues()[0], 1e-12 * eig.eigenvalues().maxCoeff());
+  } else {
+    EXPECT_GT(eig.eigenvalues()[0], 1e-9 * eig.eigenvalues().maxCoeff());
+  }
+}
+
+TEST(CompressedReprojectionCost, SameNormalEquationsAsTheFullBlock) {
+  ExpectSameNormalEquations(false);
+}
+
+TEST(CompressedReprojectionCost, SameNormalEquationsWhenAFingerIsSeenInNoView) {
+  ExpectSameNormalEquations(true);
+}
+
+}  // namespace
+}  // namespace arco::hand::internal
