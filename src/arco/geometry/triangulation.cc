@@ -1,5 +1,6 @@
 #include "arco/geometry/triangulation.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
@@ -24,6 +25,16 @@ std::optional<Eigen::Vector3d> SolveHomogeneous(const Eigen::Matrix4d& ata) {
   const Eigen::Vector4d h = solver.eigenvectors().col(0);
   if (!h.allFinite() || std::abs(h[3]) < 1e-12 * h.head<3>().norm()) return std::nullopt;
   return Eigen::Vector3d(h.head<3>() / h[3]);
+}
+
+// Least-squares point with the last homogeneous coordinate fixed to 1: the 3x3
+// normal equations A_3^T A_3 X = -A_3^T a_4 read off A^T A; empty when singular.
+std::optional<Eigen::Vector3d> SolveInhomogeneous(const Eigen::Matrix4d& ata) {
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(ata.topLeftCorner<3, 3>());
+  if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-13)) return std::nullopt;
+  const Eigen::Vector3d x = ldlt.solve(-ata.topRightCorner<3, 1>());
+  if (!x.allFinite()) return std::nullopt;
+  return x;
 }
 
 }  // namespace
@@ -64,7 +75,8 @@ std::optional<Eigen::Vector3d> TriangulateDltConditioned(const DltObservation* o
     ++used;
   }
   if (used < 2) return std::nullopt;
-  std::optional<Eigen::Vector3d> x = SolveHomogeneous(ata);
+  auto solve = options.inhomogeneous ? SolveInhomogeneous : SolveHomogeneous;
+  std::optional<Eigen::Vector3d> x = solve(ata);
   for (int iter = 0; x && iter < options.reweight_iterations; ++iter) {
     ata.setZero();
     const Eigen::Vector4d xh = x->homogeneous();
@@ -76,7 +88,7 @@ std::optional<Eigen::Vector3d> TriangulateDltConditioned(const DltObservation* o
       const double inv_depth = std::abs(depth) > 1e-12 ? 1.0 / std::abs(depth) : 1.0;
       AccumulateRows(o.projection, o.point, o.weight * inv_depth, &ata);
     }
-    std::optional<Eigen::Vector3d> next = SolveHomogeneous(ata);
+    std::optional<Eigen::Vector3d> next = solve(ata);
     if (!next) break;
     x = next;
   }

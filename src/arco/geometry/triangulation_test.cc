@@ -108,6 +108,32 @@ TEST(TriangulateDlt, FewerThanTwoWeightedViewsIsEmpty) {
   EXPECT_FALSE(TriangulateDlt(obs, ConditioningOf(cams)).has_value());
 }
 
+TEST(TriangulateDlt, InhomogeneousSolveMatchesTheEigenvectorOne) {
+  std::mt19937 rng(9);
+  DltOptions inhomogeneous;
+  inhomogeneous.inhomogeneous = true;
+  const auto cams = RingCameras(8, 3.0);
+  const auto cond = ConditioningOf(cams);
+  for (int i = 0; i < 20; ++i) {
+    const Eigen::Vector3d truth(0.3 * std::sin(i), 0.3 * std::cos(i), 0.02 * i - 0.2);
+    // Exact without noise, like the eigenvector solve.
+    const auto exact = TriangulateDlt(Observe(cams, truth, 0.0, &rng), cond, inhomogeneous);
+    ASSERT_TRUE(exact.has_value());
+    EXPECT_LT((*exact - truth).norm(), 1e-9);
+    // With noise (about 2 px) the two minimisers differ far below the 3D error itself.
+    const auto obs = Observe(cams, truth, 1e-3, &rng);
+    const auto a = TriangulateDlt(obs, cond);
+    const auto b = TriangulateDlt(obs, cond, inhomogeneous);
+    ASSERT_TRUE(a.has_value() && b.has_value());
+    EXPECT_LT((*a - *b).norm(), 1e-2 * (*a - truth).norm() + 1e-9);
+  }
+  // Two views of the same camera: the normal equations are singular.
+  auto obs = Observe(cams, Eigen::Vector3d(0.1, 0.2, 0.3), 0.0, &rng);
+  obs[1] = obs[0];
+  obs.resize(2);
+  EXPECT_FALSE(TriangulateDlt(obs, cond, inhomogeneous).has_value());
+}
+
 TEST(TriangulateTwoViews, MatchesDltOnTwoViewsAndRejectsParallelRays) {
   std::mt19937 rng(8);
   const auto cams = RingCameras(4, 3.0);
