@@ -41,6 +41,26 @@ TEST(Camera, ProjectThenUnprojectRoundTrips) {
   }
 }
 
+TEST(Camera, NewtonUndistortionMatchesTheGaussNewtonOne) {
+  Camera cam = MakeDistortedCamera();
+  std::mt19937 rng(7);
+  // Over the whole image, including the corners where distortion is strongest.
+  std::uniform_real_distribution<double> u(0, cam.width), v(0, cam.height);
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector2d pixel(u(rng), v(rng));
+    const Eigen::Vector2d n = cam.PixelToNormalizedNewton(pixel);
+    EXPECT_LT((n - cam.PixelToNormalized(pixel)).norm(), 1e-11);
+    double xd, yd;
+    cam.Distort(n.x(), n.y(), &xd, &yd);
+    EXPECT_LT(Eigen::Vector2d(cam.fx * xd + cam.skew * yd + cam.cx - pixel.x(),
+                              cam.fy * yd + cam.cy - pixel.y())
+                  .norm(),
+              1e-8);  // px
+  }
+  cam.distortion = Distortion();
+  EXPECT_EQ(cam.PixelToNormalizedNewton({1200, 100}), cam.PixelToNormalized({1200, 100}));
+}
+
 TEST(Camera, PointBehindCameraDoesNotProject) {
   const Camera cam = MakeDistortedCamera();
   Eigen::Vector3d behind = cam.CenterInWorld() - cam.cam_from_world_rotation.row(2).transpose();

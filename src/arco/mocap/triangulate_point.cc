@@ -89,7 +89,7 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
     if (!o.pixel.allFinite() || !(o.score >= options_.min_score)) continue;
     const Camera& cam = rig_.cameras[o.camera];
     s.views.push_back(
-        {o.camera, o.pixel, o.score, cam.PixelToNormalized(o.pixel), std::sqrt(cam.fx * cam.fy)});
+        {o.camera, o.pixel, o.score, cam.PixelToNormalizedNewton(o.pixel), std::sqrt(cam.fx * cam.fy)});
   }
   std::sort(s.views.begin(), s.views.end(), [](const auto& a, const auto& b) {
     if (a.score != b.score) return a.score > b.score;
