@@ -1,8 +1,6 @@
 #include "arco/geometry/triangulation.h"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 
@@ -30,11 +28,7 @@ std::optional<Eigen::Vector3d> SolveHomogeneous(const Eigen::Matrix4d& ata) {
 // Least-squares point with the last homogeneous coordinate fixed to 1: the 3x3
 // normal equations A_3^T A_3 X = -A_3^T a_4 read off A^T A; empty when singular.
 std::optional<Eigen::Vector3d> SolveInhomogeneous(const Eigen::Matrix4d& ata) {
-  const Eigen::LDLT<Eigen::Matrix3d> ldlt(ata.topLeftCorner<3, 3>());
-  if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-13)) return std::nullopt;
-  const Eigen::Vector3d x = ldlt.solve(-ata.topRightCorner<3, 1>());
-  if (!x.allFinite()) return std::nullopt;
-  return x;
+  return SolveSymmetric3x3(ata.topLeftCorner<3, 3>(), -ata.topRightCorner<3, 1>());
 }
 
 }  // namespace
@@ -106,6 +100,27 @@ std::optional<Eigen::Vector3d> TriangulateDlt(const std::vector<DltObservation>&
   return Eigen::Vector3d(conditioning.center + conditioning.scale * *x);
 }
 
+std::optional<Eigen::Vector3d> SolveSymmetric3x3(const Eigen::Matrix3d& a,
+                                                 const Eigen::Vector3d& b,
+                                                 double min_hadamard_ratio) {
+  // Cofactors of the symmetric matrix (the adjugate is symmetric too).
+  const double c00 = a(1, 1) * a(2, 2) - a(1, 2) * a(1, 2);
+  const double c01 = a(0, 2) * a(1, 2) - a(0, 1) * a(2, 2);
+  const double c02 = a(0, 1) * a(1, 2) - a(0, 2) * a(1, 1);
+  const double c11 = a(0, 0) * a(2, 2) - a(0, 2) * a(0, 2);
+  const double c12 = a(0, 1) * a(0, 2) - a(0, 0) * a(1, 2);
+  const double c22 = a(0, 0) * a(1, 1) - a(0, 1) * a(0, 1);
+  const double det = a(0, 0) * c00 + a(0, 1) * c01 + a(0, 2) * c02;
+  const double diagonal = a(0, 0) * a(1, 1) * a(2, 2);
+  if (!(diagonal > 0) || !(det > min_hadamard_ratio * diagonal)) return std::nullopt;
+  const Eigen::Vector3d x = Eigen::Vector3d(c00 * b[0] + c01 * b[1] + c02 * b[2],
+                                            c01 * b[0] + c11 * b[1] + c12 * b[2],
+                                            c02 * b[0] + c12 * b[1] + c22 * b[2]) /
+                            det;
+  if (!x.allFinite()) return std::nullopt;
+  return x;
+}
+
 std::optional<Eigen::Vector3d> TriangulateTwoViewsConditioned(const Matrix34d& p0,
                                                               const Eigen::Vector2d& x0,
                                                               const Matrix34d& p1,
@@ -121,11 +136,7 @@ std::optional<Eigen::Vector3d> TriangulateTwoViewsConditioned(const Matrix34d& p
   const Eigen::Matrix<double, 4, 3> m = a.leftCols<3>();
   const Eigen::Matrix3d mtm = m.transpose() * m;
   const Eigen::Vector3d rhs = -m.transpose() * a.col(3);
-  Eigen::FullPivLU<Eigen::Matrix3d> lu(mtm);
-  if (!lu.isInvertible() || lu.rcond() < 1e-13) return std::nullopt;
-  const Eigen::Vector3d x = lu.solve(rhs);
-  if (!x.allFinite()) return std::nullopt;
-  return x;
+  return SolveSymmetric3x3(mtm, rhs);
 }
 
 }  // namespace arco

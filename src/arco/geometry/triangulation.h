@@ -63,6 +63,17 @@ std::optional<Eigen::Vector3d> TriangulateDlt(const std::vector<DltObservation>&
                                               const WorldConditioning& conditioning,
                                               const DltOptions& options = DltOptions());
 
+// Solves the symmetric 3x3 system A x = b by the adjugate (Cramer's rule): a few
+// dozen flops where a pivoted factorisation spends most of its time in loop overhead.
+// For positive (semi)definite A (normal equations). Empty when A is numerically
+// singular: for a positive definite A,
+// 0 < det(A) <= A00 A11 A22 (Hadamard's inequality, equality when A is diagonal), so the
+// ratio det(A) / (A00 A11 A22) is a scale-free measure of how far A is from singular,
+// and the solve is refused below `min_hadamard_ratio`.
+std::optional<Eigen::Vector3d> SolveSymmetric3x3(const Eigen::Matrix3d& a,
+                                                 const Eigen::Vector3d& b,
+                                                 double min_hadamard_ratio = 1e-13);
+
 // Closed-form two-view triangulation (same as TriangulateDltConditioned on two
 // observations with unit weights); the RANSAC hypothesis generator.
 std::optional<Eigen::Vector3d> TriangulateTwoViewsConditioned(const Matrix34d& p0,

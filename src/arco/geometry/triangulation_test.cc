@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <random>
 
@@ -132,6 +133,29 @@ TEST(TriangulateDlt, InhomogeneousSolveMatchesTheEigenvectorOne) {
   obs[1] = obs[0];
   obs.resize(2);
   EXPECT_FALSE(TriangulateDlt(obs, cond, inhomogeneous).has_value());
+}
+
+TEST(SolveSymmetric3x3, MatchesCholeskyAndRefusesSingularSystems) {
+  std::mt19937 rng(10);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 100; ++i) {
+    Eigen::Matrix3d m;
+    for (int k = 0; k < 9; ++k) m.data()[k] = u(rng);
+    const double scale = std::pow(10.0, 6 * u(rng));  // any scale
+    const Eigen::Matrix3d a = scale * (m * m.transpose() + 0.1 * Eigen::Matrix3d::Identity());
+    const Eigen::Vector3d b(u(rng), u(rng), u(rng));
+    const auto x = SolveSymmetric3x3(a, b);
+    ASSERT_TRUE(x.has_value());
+    const Eigen::Vector3d expected = a.llt().solve(b);
+    EXPECT_LT((*x - expected).norm(), 1e-9 * expected.norm());
+  }
+  // Rank 2 (two equal rows and columns), zero, and negative definite.
+  Eigen::Matrix3d rank2;
+  rank2 << 2, 1, 1, 1, 3, 3, 1, 3, 3;
+  EXPECT_FALSE(SolveSymmetric3x3(rank2, Eigen::Vector3d(1, 2, 3)).has_value());
+  EXPECT_FALSE(SolveSymmetric3x3(Eigen::Matrix3d::Zero(), Eigen::Vector3d(1, 2, 3)).has_value());
+  EXPECT_FALSE(
+      SolveSymmetric3x3(-Eigen::Matrix3d::Identity(), Eigen::Vector3d(1, 2, 3)).has_value());
 }
 
 TEST(TriangulateTwoViews, MatchesDltOnTwoViewsAndRejectsParallelRays) {

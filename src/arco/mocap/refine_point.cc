@@ -1,9 +1,11 @@
 #include "arco/mocap/refine_point.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+
+#include "arco/geometry/triangulation.h"
 
 namespace arco {
 namespace {
@@ -20,7 +22,9 @@ struct Linearization {
 // Robustified residual r' = s(|r|^2) r with s = sqrt(rho(|r|^2) / |r|^2)
 // = sqrt(2 / (1 + q)), q = sqrt(1 + |r|^2 / b^2), so |r'|^2 = rho(|r|^2) and minimising
 // sum |r'|^2 minimises the robust cost (the scaling is smooth at r = 0). Its Jacobian
-// J' = s J + r (ds/d|r|^2) 2 r^T J with ds/d|r|^2 = -s^3 / (8 b^2 q).
+// J' = (s I + 2 (ds/d|r|^2) r r^T) J with ds/d|r|^2 = -s^3 / (8 b^2 q) and
+// J = sqrt(weight) d pixel / d point: a 2x2 matrix M w applied to the pixel Jacobian,
+// and only the upper triangle of the symmetric J'^T J' is summed.
 // False when the point is behind a view.
 bool Linearize(const RefinementView* views,
                int count,
@@ -28,26 +32,36 @@ bool Linearize(const RefinementView* views,
                const Eigen::Vector3d& x,
                Linearization* out) {
   double cost = 0;
-  Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
+  // Upper triangle of J^T J (symmetric), filled in below.
+  double h00 = 0, h01 = 0, h02 = 0, h11 = 0, h12 = 0, h22 = 0;
   Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
   for (int i = 0; i < count; ++i) {
     const RefinementView& v = views[i];
     Eigen::Vector2d pixel;
     Eigen::Matrix<double, 2, 3> d_pixel;
     if (!v.camera->ProjectWithJacobian(x, &pixel, &d_pixel)) return false;
-    const Eigen::Vector2d r = v.sqrt_weight * (pixel - v.pixel);
-    const Eigen::Matrix<double, 2, 3> dr = v.sqrt_weight * d_pixel;
-    const double q = std::sqrt(1 + r.squaredNorm() * inv_b2);
+    const double w = v.sqrt_weight;
+    const double rx = w * (pixel.x() - v.pixel.x()), ry = w * (pixel.y() - v.pixel.y());
+    const double q = std::sqrt(1 + (rx * rx + ry * ry) * inv_b2);
     const double s = std::sqrt(2 / (1 + q));
-    const double ds = -s * s * s * inv_b2 / (8 * q);
-    const Eigen::Matrix<double, 2, 3> j = s * dr + (2 * ds) * r * (r.transpose() * dr);
-    const Eigen::Vector2d rs = s * r;
-    cost += rs.squaredNorm();
-    jtj.noalias() += j.transpose() * j;
-    jtr.noalias() += j.transpose() * rs;
+    const double ds2 = -s * s * s * inv_b2 / (4 * q);  // 2 ds/d|r|^2
+    // M w, with M = s I + ds2 r r^T.
+    const double m00 = w * (s + ds2 * rx * rx), m01 = w * (ds2 * rx * ry),
+                 m11 = w * (s + ds2 * ry * ry);
+    const Eigen::RowVector3d j0 = m00 * d_pixel.row(0) + m01 * d_pixel.row(1);
+    const Eigen::RowVector3d j1 = m01 * d_pixel.row(0) + m11 * d_pixel.row(1);
+    const double r0 = s * rx, r1 = s * ry;
+    cost += r0 * r0 + r1 * r1;
+    h00 += j0[0] * j0[0] + j1[0] * j1[0];
+    h01 += j0[0] * j0[1] + j1[0] * j1[1];
+    h02 += j0[0] * j0[2] + j1[0] * j1[2];
+    h11 += j0[1] * j0[1] + j1[1] * j1[1];
+    h12 += j0[1] * j0[2] + j1[1] * j1[2];
+    h22 += j0[2] * j0[2] + j1[2] * j1[2];
+    jtr += (r0 * j0 + r1 * j1).transpose();
   }
   out->cost = cost;
-  out->jtj = jtj;
+  out->jtj << h00, h01, h02, h01, h11, h12, h02, h12, h22;
   out->jtr = jtr;
   return true;
 }
@@ -78,9 +92,9 @@ PointRefinementSummary RefinePointRobust(const RefinementView* views,
     ++summary.iterations;
     Eigen::Matrix3d a = at_x.jtj;
     for (int k = 0; k < 3; ++k) a(k, k) += mu * std::max(at_x.jtj(k, k), 1e-12);
-    const Eigen::LDLT<Eigen::Matrix3d> ldlt(a);
-    const Eigen::Vector3d dx = ldlt.solve(-at_x.jtr);
-    if (ldlt.info() != Eigen::Success || !dx.allFinite()) break;
+    const std::optional<Eigen::Vector3d> step = SolveSymmetric3x3(a, -at_x.jtr);
+    if (!step) break;
+    const Eigen::Vector3d& dx = *step;
     if (dx.norm() <= options.parameter_tolerance * (x.norm() + options.parameter_tolerance)) break;
     // Decrease the linearised model predicts, -2 dx^T J^T r - dx^T J^T J dx: when even
     // the model promises less than the tolerance, evaluating the step is not worth it.
