@@ -39,8 +39,8 @@ struct PointRefinementOptions {
 struct PointRefinementSummary {
   double initial_cost = 0;  // sum over views of rho(|r|^2), px^2; +inf when behind a view
   double final_cost = 0;
-  int iterations = 0;       // linear solves
-  int evaluations = 0;      // passes over the views
+  int iterations = 0;   // linear solves
+  int evaluations = 0;  // passes over the views
 };
 
 // Refines `point_in_world` in place. A trial step that puts the point behind any view

@@ -93,8 +93,7 @@ TEST(RefinePointRobust, StartBehindACameraIsLeftAlone) {
   // 10 m from the origin the point is behind the cameras on the other side of the ring.
   const Eigen::Vector3d start(10, 0, 1);
   Eigen::Vector3d x = start;
-  const auto summary =
-      RefinePointRobust(views.data(), views.size(), PointRefinementOptions(), &x);
+  const auto summary = RefinePointRobust(views.data(), views.size(), PointRefinementOptions(), &x);
   EXPECT_EQ(x, start);
   EXPECT_TRUE(std::isinf(summary.initial_cost));
   EXPECT_EQ(summary.iterations, 0);

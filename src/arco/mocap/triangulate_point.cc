@@ -14,13 +14,14 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Undistorted-image error (px) of a conditioned point in one view; +inf behind it.
-double GateErrorPx(const Matrix34d& conditioned_p,
-                   const Eigen::Vector3d& x_conditioned,
-                   const TriangulationScratch::View& v) {
+// Squared undistorted-image error (px^2) of a conditioned point in one view; +inf
+// behind it. Squared so the gate test and the MSAC cost need no square root.
+double GateErrorSquaredPx2(const Matrix34d& conditioned_p,
+                           const Eigen::Vector3d& x_conditioned,
+                           const TriangulationScratch::View& v) {
   const Eigen::Vector3d h = conditioned_p * x_conditioned.homogeneous();
   if (!(h.z() > 0)) return kInf;
-  return (h.head<2>() / h.z() - v.normalized).norm() * v.focal_px;
+  return (h.head<2>() / h.z() - v.normalized).squaredNorm() * (v.focal_px * v.focal_px);
 }
 
 }  // namespace
@@ -61,6 +62,7 @@ Triangulator::Triangulator(const Rig& rig, const TriangulationOptions& options)
   for (const Camera& c : rig_.cameras) centers.push_back(c.CenterInWorld());
   conditioning_ = ConditioningFromCameraCenters(centers);
   for (const Camera& c : rig_.cameras) {
+    focal_px_.push_back(std::sqrt(c.fx * c.fy));
     Matrix34d rt;
     rt.leftCols<3>() = c.cam_from_world_rotation;
     rt.col(3) = c.cam_from_world_translation;
@@ -81,32 +83,30 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
 
   // 1. Usable views, undistorted, in a camera-order independent order.
   s.views.clear();
+  s.camera_seen.assign(static_cast<size_t>(num_cameras), 0);
   for (const PointObservation& o : observations) {
     if (o.camera < 0 || o.camera >= num_cameras) {
       throw std::invalid_argument("Triangulate: camera index " + std::to_string(o.camera) +
                                   " outside the rig");
     }
     if (!o.pixel.allFinite() || !(o.score >= options_.min_score)) continue;
+    if (s.camera_seen[o.camera]++) {
+      throw std::invalid_argument("Triangulate: camera " + std::to_string(o.camera) +
+                                  " observed twice");
+    }
     const Camera& cam = rig_.cameras[o.camera];
     s.views.push_back(
-        {o.camera, o.pixel, o.score, cam.PixelToNormalizedNewton(o.pixel), std::sqrt(cam.fx * cam.fy)});
+        {o.camera, o.pixel, o.score, cam.PixelToNormalizedNewton(o.pixel), focal_px_[o.camera]});
   }
   std::sort(s.views.begin(), s.views.end(), [](const auto& a, const auto& b) {
     if (a.score != b.score) return a.score > b.score;
     if (a.pixel.x() != b.pixel.x()) return a.pixel.x() < b.pixel.x();
     return a.pixel.y() < b.pixel.y();
   });
-  for (size_t i = 1; i < s.views.size(); ++i) {
-    for (size_t j = 0; j < i; ++j) {
-      if (s.views[i].camera == s.views[j].camera) {
-        throw std::invalid_argument("Triangulate: camera " + std::to_string(s.views[i].camera) +
-                                    " observed twice");
-      }
-    }
-  }
   const int n = static_cast<int>(s.views.size());
   if (n < 2) return std::nullopt;
   const double gate = options_.max_reprojection_px;
+  const double gate2 = gate * gate;
   auto p_of = [&](int view) -> const Matrix34d& {
     return conditioned_cam_from_world_[s.views[view].camera];
   };
@@ -127,11 +127,11 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
     int count = 0;
     double cost = 0;
     for (int k = 0; k < n; ++k) {
-      const double e = GateErrorPx(p_of(k), *x, s.views[k]);
-      const bool in = e < gate;
+      const double e2 = GateErrorSquaredPx2(p_of(k), *x, s.views[k]);
+      const bool in = e2 < gate2;
       s.inlier[k] = in;
       count += in;
-      cost += in ? e * e : gate * gate;
+      cost += in ? e2 : gate2;
     }
     if (!s.inlier[a] || !s.inlier[b]) continue;  // behind a sampled camera or inconsistent
     if (count > best_count || (count == best_count && cost < best_cost)) {
@@ -163,7 +163,7 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
     int count = 0;
     bool changed = false;
     for (int k = 0; k < n; ++k) {
-      const bool in = GateErrorPx(p_of(k), *xc, s.views[k]) < gate;
+      const bool in = GateErrorSquaredPx2(p_of(k), *xc, s.views[k]) < gate2;
       s.inlier[k] = in;
       count += in;
       changed |= (in != static_cast<bool>(s.best_inlier[k]));
@@ -187,9 +187,8 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
     for (int k = 0; k < n; ++k) {
       if (!s.best_inlier[k]) continue;
       const auto& v = s.views[k];
-      s.refine.push_back({&rig_.cameras[v.camera],
-                          v.pixel,
-                          options_.weight_by_score ? std::sqrt(v.score) : 1.0});
+      s.refine.push_back(
+          {&rig_.cameras[v.camera], v.pixel, options_.weight_by_score ? std::sqrt(v.score) : 1.0});
     }
     PointRefinementOptions refine;
     refine.loss_scale_px = options_.robust_loss_scale_px;

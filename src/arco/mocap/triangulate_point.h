@@ -71,6 +71,7 @@ struct TriangulationScratch {
   };
   std::vector<View> views;
   std::vector<char> inlier, best_inlier;
+  std::vector<char> camera_seen;  // by rig camera: catches a camera observed twice
   std::vector<DltObservation> dlt;
   std::vector<RefinementView> refine;  // inlier views entering the refinement
 };
@@ -95,7 +96,8 @@ class Triangulator {
   Rig rig_;
   TriangulationOptions options_;
   WorldConditioning conditioning_;
-  std::vector<Matrix34d> conditioned_cam_from_world_;             // [R|t] in conditioned world
+  std::vector<Matrix34d> conditioned_cam_from_world_;  // [R|t] in conditioned world
+  std::vector<double> focal_px_;  // sqrt(fx fy): pixels per normalised unit, by camera
   std::vector<std::vector<std::pair<int, int>>> pair_schedules_;  // by usable view count
 };
 
