@@ -1,23 +1,8 @@
 #include "arco/camera/camera.h"
 
+#include "arco/camera/undistort.h"
+
 namespace arco {
-namespace {
-
-// Brown-Conrady distortion (x, y) -> (x', y') in DistortNormalized's order of
-// operations (so the values are bit-identical to it) and its Jacobian d(x', y')/d(x, y).
-inline void DistortWithJacobian(
-    const Distortion& d, double x, double y, double* xd, double* yd, Eigen::Matrix2d* jac) {
-  const double r2 = x * x + y * y;
-  const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
-  *xd = x * radial + 2.0 * d.p1 * x * y + d.p2 * (r2 + 2.0 * x * x);
-  *yd = y * radial + d.p1 * (r2 + 2.0 * y * y) + 2.0 * d.p2 * x * y;
-  const double dradial = d.k1 + r2 * (2.0 * d.k2 + 3.0 * d.k3 * r2);  // d radial / d r2
-  const double cross = 2.0 * x * y * dradial + 2.0 * d.p1 * x + 2.0 * d.p2 * y;
-  *jac << radial + 2.0 * x * x * dradial + 2.0 * d.p1 * y + 6.0 * d.p2 * x, cross,  //
-      cross, radial + 2.0 * y * y * dradial + 6.0 * d.p1 * y + 2.0 * d.p2 * x;
-}
-
-}  // namespace
 
 Eigen::Matrix3d Camera::K() const {
   Eigen::Matrix3d k;
@@ -122,29 +107,6 @@ Eigen::Vector2d Camera::PixelToNormalized(const Eigen::Vector2d& pixel) const {
     est -= step;
   }
   return est;
-}
-
-Eigen::Vector2d Camera::PixelToNormalizedNewton(const Eigen::Vector2d& pixel) const {
-  const double yd = (pixel.y() - cy) / fy;
-  const double xd = (pixel.x() - cx - skew * yd) / fx;
-  if (distortion.IsZero()) return {xd, yd};
-  // Newton on f(x, y) = distort(x, y) - (xd, yd): (x, y) -= J^-1 f, with the 2x2
-  // inverse written out (J is close to the identity for real lenses).
-  double x = xd, y = yd;
-  for (int iter = 0; iter < 20; ++iter) {
-    double fx0, fy0;
-    Eigen::Matrix2d j;
-    DistortWithJacobian(distortion, x, y, &fx0, &fy0, &j);
-    const double rx = fx0 - xd, ry = fy0 - yd;
-    if (rx * rx + ry * ry < 1e-24) break;
-    const double det = j(0, 0) * j(1, 1) - j(0, 1) * j(1, 0);
-    const double step_x = (j(1, 1) * rx - j(0, 1) * ry) / det;
-    const double step_y = (j(0, 0) * ry - j(1, 0) * rx) / det;
-    if (!std::isfinite(step_x) || !std::isfinite(step_y)) break;
-    x -= step_x;
-    y -= step_y;
-  }
-  return {x, y};
 }
 
 Eigen::Vector2d Camera::UndistortPixel(const Eigen::Vector2d& pixel) const {

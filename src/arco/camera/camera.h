@@ -98,12 +98,6 @@ struct Camera {
   // Removes distortion: pixel -> normalised image coordinates (x, y) with
   // X/Z = x, Y/Z = y. Iterative (Gauss-Newton on the forward model).
   Eigen::Vector2d PixelToNormalized(const Eigen::Vector2d& pixel) const;
-  // The same undistortion by Newton's method with the distortion's closed-form 2x2
-  // Jacobian: about a third of the cost (no finite differences, no LU), same stopping
-  // rule, so it lands on the same point to within ~1e-12 normalised units (1e-9 px) but
-  // not bit for bit. For hot loops (triangulation); PixelToNormalized stays as it is
-  // because synthetic data and earlier results were made with it.
-  Eigen::Vector2d PixelToNormalizedNewton(const Eigen::Vector2d& pixel) const;
   // Removes distortion but stays in pixels (ideal pinhole pixel with the same K).
   Eigen::Vector2d UndistortPixel(const Eigen::Vector2d& pixel) const;
   // Unit viewing ray through a pixel, in world coordinates.

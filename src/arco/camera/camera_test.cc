@@ -5,6 +5,8 @@
 
 #include <random>
 
+#include "arco/camera/undistort.h"
+
 namespace arco {
 namespace {
 
@@ -48,7 +50,7 @@ TEST(Camera, NewtonUndistortionMatchesTheGaussNewtonOne) {
   std::uniform_real_distribution<double> u(0, cam.width), v(0, cam.height);
   for (int i = 0; i < 500; ++i) {
     const Eigen::Vector2d pixel(u(rng), v(rng));
-    const Eigen::Vector2d n = cam.PixelToNormalizedNewton(pixel);
+    const Eigen::Vector2d n = PixelToNormalizedNewton(cam, pixel);
     EXPECT_LT((n - cam.PixelToNormalized(pixel)).norm(), 1e-11);
     double xd, yd;
     cam.Distort(n.x(), n.y(), &xd, &yd);
@@ -58,7 +60,7 @@ TEST(Camera, NewtonUndistortionMatchesTheGaussNewtonOne) {
               1e-8);  // px
   }
   cam.distortion = Distortion();
-  EXPECT_EQ(cam.PixelToNormalizedNewton({1200, 100}), cam.PixelToNormalized({1200, 100}));
+  EXPECT_EQ(PixelToNormalizedNewton(cam, {1200, 100}), cam.PixelToNormalized({1200, 100}));
 }
 
 TEST(Camera, PointBehindCameraDoesNotProject) {

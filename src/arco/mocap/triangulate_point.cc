@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "arco/camera/undistort.h"
 #include "arco/geometry/robust.h"
 #include "arco/mocap/refine_point.h"
 
@@ -96,7 +97,7 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
     }
     const Camera& cam = rig_.cameras[o.camera];
     s.views.push_back(
-        {o.camera, o.pixel, o.score, cam.PixelToNormalizedNewton(o.pixel), focal_px_[o.camera]});
+        {o.camera, o.pixel, o.score, PixelToNormalizedNewton(cam, o.pixel), focal_px_[o.camera]});
   }
   std::sort(s.views.begin(), s.views.end(), [](const auto& a, const auto& b) {
     if (a.score != b.score) return a.score > b.score;

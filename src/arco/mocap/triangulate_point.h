@@ -1,6 +1,6 @@
 // Robust multi-view triangulation of one keypoint:
 //   1. keep views with a finite pixel and score >= min_score, undistort them
-//      (Camera::PixelToNormalizedNewton);
+//      (PixelToNormalizedNewton, camera/undistort.h);
 //   2. RANSAC over view pairs (geometry/robust.h schedule: most confident pairs first,
 //      then seeded random pairs, at most max_ransac_trials, adaptive stop) with a pixel
 //      gate and a cheirality test (the point must lie in front of both cameras);
