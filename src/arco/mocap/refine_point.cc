@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <string>
 
 #include "arco/geometry/triangulation.h"
 
@@ -67,6 +68,18 @@ bool Linearize(const RefinementView* views,
 }
 
 }  // namespace
+
+Status PointRefinementOptions::Validate() const {
+  auto bad = [](const char* m) { return Status::Error(std::string("point refinement: ") + m); };
+  if (!(loss_scale_px > 0 && std::isfinite(loss_scale_px))) {
+    return bad("loss_scale_px must be a positive number");
+  }
+  if (max_iterations < 1) return bad("max_iterations must be >= 1");
+  if (!(parameter_tolerance >= 0) || !(function_tolerance_px2 >= 0)) {
+    return bad("tolerances must be >= 0");
+  }
+  return Status::Ok();
+}
 
 PointRefinementSummary RefinePointRobust(const RefinementView* views,
                                          int count,

@@ -7,14 +7,16 @@
 // 2n x 3 Jacobian: one pass over the views accumulates the robust cost, the 3x3
 // Gauss-Newton matrix J^T J and the gradient J^T r (closed-form Jacobians from
 // Camera::ProjectWithJacobian), and the pass that tests a trial step is also the
-// linearisation for the next one. It costs about a third of ceres::TinySolver on the
-// same problem (which evaluates every accepted point twice, stores J and forms J^T J
-// with a dynamic-size product) and reaches the same minimum. Does not allocate.
+// linearisation for the next one (ceres::TinySolver, used before, evaluated every
+// accepted point twice, stored J and formed J^T J with a dynamic-size product; with the
+// stopping rule below the refinement takes about a third of its CPU time in the
+// triangulation bench, docs/performance.md). Does not allocate.
 #pragma once
 
 #include <Eigen/Core>
 
 #include "arco/camera/camera.h"
+#include "arco/util/status.h"
 
 namespace arco {
 
@@ -34,6 +36,7 @@ struct PointRefinementOptions {
   // within a few micrometres of the minimum for an SPD-like rig (J^T J ~ 1e7 px^2/m^2),
   // far below the noise; the triangulation bench's errors move by 1e-4 mm.
   double function_tolerance_px2 = 1e-4;
+  Status Validate() const;  // readable message on a bad value
 };
 
 struct PointRefinementSummary {
@@ -43,7 +46,8 @@ struct PointRefinementSummary {
   int evaluations = 0;  // passes over the views
 };
 
-// Refines `point_in_world` in place. A trial step that puts the point behind any view
+// Refines `point_in_world` in place; `options` must pass Validate() (not re-checked per
+// point). A trial step that puts the point behind any view
 // is rejected (the cheirality the RANSAC stage established is kept). The cost never
 // increases: final_cost <= initial_cost.
 PointRefinementSummary RefinePointRobust(const RefinementView* views,

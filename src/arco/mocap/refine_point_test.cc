@@ -99,5 +99,18 @@ TEST(RefinePointRobust, StartBehindACameraIsLeftAlone) {
   EXPECT_EQ(summary.iterations, 0);
 }
 
+TEST(PointRefinementOptions, ValidateRejectsBadValues) {
+  EXPECT_TRUE(PointRefinementOptions().Validate().ok());
+  PointRefinementOptions o;
+  o.loss_scale_px = 0;
+  EXPECT_FALSE(o.Validate().ok());
+  o = PointRefinementOptions();
+  o.max_iterations = 0;
+  EXPECT_FALSE(o.Validate().ok());
+  o = PointRefinementOptions();
+  o.function_tolerance_px2 = -1;
+  EXPECT_FALSE(o.Validate().ok());
+}
+
 }  // namespace
 }  // namespace arco

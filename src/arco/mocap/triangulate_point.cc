@@ -193,7 +193,7 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
     }
     PointRefinementOptions refine;
     refine.loss_scale_px = options_.robust_loss_scale_px;
-    refine.max_iterations = options_.max_refine_iterations;
+    refine.max_iterations = options_.max_refine_iterations;  // both checked by Validate()
     Eigen::Vector3d x = x_world;
     const PointRefinementSummary summary =
         RefinePointRobust(s.refine.data(), static_cast<int>(s.refine.size()), refine, &x);
