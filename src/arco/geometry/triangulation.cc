@@ -1,6 +1,7 @@
 #include "arco/geometry/triangulation.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 
@@ -103,20 +104,11 @@ std::optional<Eigen::Vector3d> TriangulateDlt(const std::vector<DltObservation>&
 std::optional<Eigen::Vector3d> SolveSymmetric3x3(const Eigen::Matrix3d& a,
                                                  const Eigen::Vector3d& b,
                                                  double min_hadamard_ratio) {
-  // Cofactors of the symmetric matrix (the adjugate is symmetric too).
-  const double c00 = a(1, 1) * a(2, 2) - a(1, 2) * a(1, 2);
-  const double c01 = a(0, 2) * a(1, 2) - a(0, 1) * a(2, 2);
-  const double c02 = a(0, 1) * a(1, 2) - a(0, 2) * a(1, 1);
-  const double c11 = a(0, 0) * a(2, 2) - a(0, 2) * a(0, 2);
-  const double c12 = a(0, 1) * a(0, 2) - a(0, 0) * a(1, 2);
-  const double c22 = a(0, 0) * a(1, 1) - a(0, 1) * a(0, 1);
-  const double det = a(0, 0) * c00 + a(0, 1) * c01 + a(0, 2) * c02;
   const double diagonal = a(0, 0) * a(1, 1) * a(2, 2);
-  if (!(diagonal > 0) || !(det > min_hadamard_ratio * diagonal)) return std::nullopt;
-  const Eigen::Vector3d x = Eigen::Vector3d(c00 * b[0] + c01 * b[1] + c02 * b[2],
-                                            c01 * b[0] + c11 * b[1] + c12 * b[2],
-                                            c02 * b[0] + c12 * b[1] + c22 * b[2]) /
-                            det;
+  if (!(diagonal > 0)) return std::nullopt;
+  // Eigen's fixed-size 3x3 determinant and inverse are closed-form (cofactors).
+  if (!(a.determinant() > min_hadamard_ratio * diagonal)) return std::nullopt;
+  const Eigen::Vector3d x = a.inverse() * b;
   if (!x.allFinite()) return std::nullopt;
   return x;
 }

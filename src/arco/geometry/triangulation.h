@@ -63,8 +63,9 @@ std::optional<Eigen::Vector3d> TriangulateDlt(const std::vector<DltObservation>&
                                               const WorldConditioning& conditioning,
                                               const DltOptions& options = DltOptions());
 
-// Solves the symmetric 3x3 system A x = b by the adjugate (Cramer's rule): a few
-// dozen flops where a pivoted factorisation spends most of its time in loop overhead.
+// Solves the symmetric 3x3 system A x = b with Eigen's closed-form 3x3 inverse (the
+// adjugate): a few dozen flops where a pivoted factorisation spends most of its time in
+// loop overhead.
 // For positive (semi)definite A (normal equations). Empty when A is numerically
 // singular: for a positive definite A,
 // 0 < det(A) <= A00 A11 A22 (Hadamard's inequality, equality when A is diagonal), so the
