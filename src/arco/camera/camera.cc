@@ -1,5 +1,7 @@
 #include "arco/camera/camera.h"
 
+#include "arco/camera/undistort.h"
+
 namespace arco {
 
 Eigen::Matrix3d Camera::K() const {
@@ -62,18 +64,11 @@ bool Camera::ProjectWithJacobian(const Eigen::Vector3d& point_in_world,
   }
   if (!(p[2] > 0)) return false;
   const double x = p[0] / p[2], y = p[1] / p[2];
-  const Distortion& d = distortion;
-  const double r2 = x * x + y * y;
-  const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
-  const double xd = x * radial + 2.0 * d.p1 * x * y + d.p2 * (r2 + 2.0 * x * x);
-  const double yd = y * radial + d.p1 * (r2 + 2.0 * y * y) + 2.0 * d.p2 * x * y;
+  double xd, yd;
+  Eigen::Matrix2d dist;  // d(xd, yd) / d(x, y)
+  DistortWithJacobian(distortion, x, y, &xd, &yd, &dist);
   (*pixel)[0] = fx * xd + skew * yd + cx;
   (*pixel)[1] = fy * yd + cy;
-  const double dradial = d.k1 + r2 * (2.0 * d.k2 + 3.0 * d.k3 * r2);  // d radial / d r2
-  Eigen::Matrix2d dist;                                               // d(xd, yd) / d(x, y)
-  const double cross = 2.0 * x * y * dradial + 2.0 * d.p1 * x + 2.0 * d.p2 * y;
-  dist << radial + 2.0 * x * x * dradial + 2.0 * d.p1 * y + 6.0 * d.p2 * x, cross,  //
-      cross, radial + 2.0 * y * y * dradial + 6.0 * d.p1 * y + 2.0 * d.p2 * x;
   Eigen::Matrix2d k;
   k << fx, skew, 0.0, fy;
   const double iz = 1.0 / p[2];

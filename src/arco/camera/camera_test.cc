@@ -5,6 +5,8 @@
 
 #include <random>
 
+#include "arco/camera/undistort.h"
+
 namespace arco {
 namespace {
 
@@ -39,6 +41,26 @@ TEST(Camera, ProjectThenUnprojectRoundTrips) {
     Eigen::Vector3d to_point = (p_world - cam.CenterInWorld()).normalized();
     EXPECT_NEAR(ray.dot(to_point), 1.0, 1e-12);
   }
+}
+
+TEST(Camera, NewtonUndistortionMatchesTheGaussNewtonOne) {
+  Camera cam = MakeDistortedCamera();
+  std::mt19937 rng(7);
+  // Over the whole image, including the corners where distortion is strongest.
+  std::uniform_real_distribution<double> u(0, cam.width), v(0, cam.height);
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector2d pixel(u(rng), v(rng));
+    const Eigen::Vector2d n = PixelToNormalizedNewton(cam, pixel);
+    EXPECT_LT((n - cam.PixelToNormalized(pixel)).norm(), 1e-11);
+    double xd, yd;
+    cam.Distort(n.x(), n.y(), &xd, &yd);
+    EXPECT_LT(Eigen::Vector2d(cam.fx * xd + cam.skew * yd + cam.cx - pixel.x(),
+                              cam.fy * yd + cam.cy - pixel.y())
+                  .norm(),
+              1e-8);  // px
+  }
+  cam.distortion = Distortion();
+  EXPECT_EQ(PixelToNormalizedNewton(cam, {1200, 100}), cam.PixelToNormalized({1200, 100}));
 }
 
 TEST(Camera, PointBehindCameraDoesNotProject) {

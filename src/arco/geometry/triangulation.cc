@@ -26,6 +26,12 @@ std::optional<Eigen::Vector3d> SolveHomogeneous(const Eigen::Matrix4d& ata) {
   return Eigen::Vector3d(h.head<3>() / h[3]);
 }
 
+// Least-squares point with the last homogeneous coordinate fixed to 1: the 3x3
+// normal equations A_3^T A_3 X = -A_3^T a_4 read off A^T A; empty when singular.
+std::optional<Eigen::Vector3d> SolveInhomogeneous(const Eigen::Matrix4d& ata) {
+  return SolveSymmetric3x3(ata.topLeftCorner<3, 3>(), -ata.topRightCorner<3, 1>());
+}
+
 }  // namespace
 
 WorldConditioning ConditioningFromCameraCenters(const std::vector<Eigen::Vector3d>& centers) {
@@ -64,7 +70,8 @@ std::optional<Eigen::Vector3d> TriangulateDltConditioned(const DltObservation* o
     ++used;
   }
   if (used < 2) return std::nullopt;
-  std::optional<Eigen::Vector3d> x = SolveHomogeneous(ata);
+  auto solve = options.inhomogeneous ? SolveInhomogeneous : SolveHomogeneous;
+  std::optional<Eigen::Vector3d> x = solve(ata);
   for (int iter = 0; x && iter < options.reweight_iterations; ++iter) {
     ata.setZero();
     const Eigen::Vector4d xh = x->homogeneous();
@@ -76,7 +83,7 @@ std::optional<Eigen::Vector3d> TriangulateDltConditioned(const DltObservation* o
       const double inv_depth = std::abs(depth) > 1e-12 ? 1.0 / std::abs(depth) : 1.0;
       AccumulateRows(o.projection, o.point, o.weight * inv_depth, &ata);
     }
-    std::optional<Eigen::Vector3d> next = SolveHomogeneous(ata);
+    std::optional<Eigen::Vector3d> next = solve(ata);
     if (!next) break;
     x = next;
   }
@@ -94,6 +101,18 @@ std::optional<Eigen::Vector3d> TriangulateDlt(const std::vector<DltObservation>&
   return Eigen::Vector3d(conditioning.center + conditioning.scale * *x);
 }
 
+std::optional<Eigen::Vector3d> SolveSymmetric3x3(const Eigen::Matrix3d& a,
+                                                 const Eigen::Vector3d& b,
+                                                 double min_hadamard_ratio) {
+  const double diagonal = a(0, 0) * a(1, 1) * a(2, 2);
+  if (!(diagonal > 0)) return std::nullopt;
+  // Eigen's fixed-size 3x3 determinant and inverse are closed-form (cofactors).
+  if (!(a.determinant() > min_hadamard_ratio * diagonal)) return std::nullopt;
+  const Eigen::Vector3d x = a.inverse() * b;
+  if (!x.allFinite()) return std::nullopt;
+  return x;
+}
+
 std::optional<Eigen::Vector3d> TriangulateTwoViewsConditioned(const Matrix34d& p0,
                                                               const Eigen::Vector2d& x0,
                                                               const Matrix34d& p1,
@@ -109,11 +128,7 @@ std::optional<Eigen::Vector3d> TriangulateTwoViewsConditioned(const Matrix34d& p
   const Eigen::Matrix<double, 4, 3> m = a.leftCols<3>();
   const Eigen::Matrix3d mtm = m.transpose() * m;
   const Eigen::Vector3d rhs = -m.transpose() * a.col(3);
-  Eigen::FullPivLU<Eigen::Matrix3d> lu(mtm);
-  if (!lu.isInvertible() || lu.rcond() < 1e-13) return std::nullopt;
-  const Eigen::Vector3d x = lu.solve(rhs);
-  if (!x.allFinite()) return std::nullopt;
-  return x;
+  return SolveSymmetric3x3(mtm, rhs);
 }
 
 }  // namespace arco

@@ -42,6 +42,12 @@ struct DltOptions {
   // Extra solves that divide each view's rows by its depth (P X)_3 from the previous
   // estimate, so the minimised quantity approaches the image-plane error.
   int reweight_iterations = 1;
+  // Fix the homogeneous coordinate to 1 and solve the 3x3 normal equations by LDLT
+  // (H&Z sec. 12.2, "inhomogeneous method") instead of taking the smallest eigenvector
+  // of the 4x4 A^T A: several times cheaper, and in conditioned coordinates the same
+  // point to well below the noise for points at finite distance; not for points at or
+  // near infinity, which it reports as empty (ill-conditioned system).
+  bool inhomogeneous = false;
 };
 
 // Weighted DLT in conditioned coordinates: `observations` must already use
@@ -56,6 +62,18 @@ std::optional<Eigen::Vector3d> TriangulateDltConditioned(const DltObservation* o
 std::optional<Eigen::Vector3d> TriangulateDlt(const std::vector<DltObservation>& observations,
                                               const WorldConditioning& conditioning,
                                               const DltOptions& options = DltOptions());
+
+// Solves the symmetric 3x3 system A x = b with Eigen's closed-form 3x3 inverse (the
+// adjugate): a few dozen flops where a pivoted factorisation spends most of its time in
+// loop overhead.
+// For positive (semi)definite A (normal equations). Empty when A is numerically
+// singular: for a positive definite A,
+// 0 < det(A) <= A00 A11 A22 (Hadamard's inequality, equality when A is diagonal), so the
+// ratio det(A) / (A00 A11 A22) is a scale-free measure of how far A is from singular,
+// and the solve is refused below `min_hadamard_ratio`.
+std::optional<Eigen::Vector3d> SolveSymmetric3x3(const Eigen::Matrix3d& a,
+                                                 const Eigen::Vector3d& b,
+                                                 double min_hadamard_ratio = 1e-13);
 
 // Closed-form two-view triangulation (same as TriangulateDltConditioned on two
 // observations with unit weights); the RANSAC hypothesis generator.

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <random>
 
@@ -106,6 +107,55 @@ TEST(TriangulateDlt, FewerThanTwoWeightedViewsIsEmpty) {
   obs.resize(1);
   obs[0].weight = 1;
   EXPECT_FALSE(TriangulateDlt(obs, ConditioningOf(cams)).has_value());
+}
+
+TEST(TriangulateDlt, InhomogeneousSolveMatchesTheEigenvectorOne) {
+  std::mt19937 rng(9);
+  DltOptions inhomogeneous;
+  inhomogeneous.inhomogeneous = true;
+  const auto cams = RingCameras(8, 3.0);
+  const auto cond = ConditioningOf(cams);
+  for (int i = 0; i < 20; ++i) {
+    const Eigen::Vector3d truth(0.3 * std::sin(i), 0.3 * std::cos(i), 0.02 * i - 0.2);
+    // Exact without noise, like the eigenvector solve.
+    const auto exact = TriangulateDlt(Observe(cams, truth, 0.0, &rng), cond, inhomogeneous);
+    ASSERT_TRUE(exact.has_value());
+    EXPECT_LT((*exact - truth).norm(), 1e-9);
+    // With noise (about 2 px) the two minimisers differ far below the 3D error itself.
+    const auto obs = Observe(cams, truth, 1e-3, &rng);
+    const auto a = TriangulateDlt(obs, cond);
+    const auto b = TriangulateDlt(obs, cond, inhomogeneous);
+    ASSERT_TRUE(a.has_value() && b.has_value());
+    EXPECT_LT((*a - *b).norm(), 1e-2 * (*a - truth).norm() + 1e-9);
+  }
+  // Two views of the same camera: the normal equations are singular.
+  auto obs = Observe(cams, Eigen::Vector3d(0.1, 0.2, 0.3), 0.0, &rng);
+  obs[1] = obs[0];
+  obs.resize(2);
+  EXPECT_FALSE(TriangulateDlt(obs, cond, inhomogeneous).has_value());
+}
+
+TEST(SolveSymmetric3x3, MatchesCholeskyAndRefusesSingularSystems) {
+  std::mt19937 rng(10);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 100; ++i) {
+    Eigen::Matrix3d m;
+    for (int k = 0; k < 9; ++k) m.data()[k] = u(rng);
+    const double scale = std::pow(10.0, 6 * u(rng));  // any scale
+    const Eigen::Matrix3d a = scale * (m * m.transpose() + 0.1 * Eigen::Matrix3d::Identity());
+    const Eigen::Vector3d b(u(rng), u(rng), u(rng));
+    const auto x = SolveSymmetric3x3(a, b);
+    ASSERT_TRUE(x.has_value());
+    const Eigen::Vector3d expected = a.llt().solve(b);
+    EXPECT_LT((*x - expected).norm(), 1e-9 * expected.norm());
+  }
+  // Rank 2 (two equal rows and columns), zero, and negative definite.
+  Eigen::Matrix3d rank2;
+  rank2 << 2, 1, 1, 1, 3, 3, 1, 3, 3;
+  EXPECT_FALSE(SolveSymmetric3x3(rank2, Eigen::Vector3d(1, 2, 3)).has_value());
+  EXPECT_FALSE(SolveSymmetric3x3(Eigen::Matrix3d::Zero(), Eigen::Vector3d(1, 2, 3)).has_value());
+  EXPECT_FALSE(
+      SolveSymmetric3x3(-Eigen::Matrix3d::Identity(), Eigen::Vector3d(1, 2, 3)).has_value());
 }
 
 TEST(TriangulateTwoViews, MatchesDltOnTwoViewsAndRejectsParallelRays) {

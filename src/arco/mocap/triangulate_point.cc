@@ -1,125 +1,28 @@
 #include "arco/mocap/triangulate_point.h"
 
-// TinySolver::Solve reads its cost before checking the first evaluation, which GCC
-// flags; our cost functor always succeeds.
-#pragma GCC diagnostic push
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-#include <ceres/tiny_solver.h>
-#pragma GCC diagnostic pop
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
+#include "arco/camera/undistort.h"
 #include "arco/geometry/robust.h"
+#include "arco/mocap/refine_point.h"
 
 namespace arco {
 namespace {
 
-#if defined(__GNUC__) && !defined(__clang__)
-#define ARCO_FLATTEN __attribute__((flatten))
-#else
-#define ARCO_FLATTEN
-#endif
-
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Reprojection residuals of one point in several views, with distortion, scaled by
-// sqrt(weight) and robustified so that |r_i'|^2 = rho(|r_i|^2) for the soft-L1 loss
-// rho(s) = 2 b^2 (sqrt(1 + s / b^2) - 1) (the loss Ceres calls SoftLOneLoss):
-// r_i' = r_i sqrt(rho(s) / s) with rho(s) / s = 2 / (1 + sqrt(1 + s / b^2)), smooth at 0.
-// Minimising sum |r_i'|^2 by Levenberg-Marquardt minimises the robust cost.
-struct RobustReprojection {
-  const TriangulationScratch* scratch;  // views
-  const std::vector<int>* used;         // indices into scratch->views
-  const Rig* rig;
-  bool weight_by_score;
-  double inv_b2;
-
-  int NumResiduals() const { return 2 * static_cast<int>(used->size()); }
-
-  // flatten: GCC leaves the Jet operations of the projection out of line (a third of
-  // the refinement's time in calls); inlined, the same operations run in the same
-  // order, so results are unchanged bit for bit.
-  template <typename T>
-  ARCO_FLATTEN bool operator()(const T* point_in_world, T* residuals) const {
-    for (size_t i = 0; i < used->size(); ++i) {
-      const auto& v = scratch->views[(*used)[i]];
-      T projected[2];
-      if (!rig->cameras[v.camera].ProjectToPixel(point_in_world, projected)) {
-        // Behind the camera: a huge constant cost, so the solver rejects the step (the
-        // tiny solver ignores a false return when it evaluates a trial step).
-        residuals[2 * i] = residuals[2 * i + 1] = T(1e6);
-        continue;
-      }
-      const double sqrt_w = weight_by_score ? std::sqrt(v.score) : 1.0;
-      const T rx = T(sqrt_w) * (projected[0] - T(v.pixel.x()));
-      const T ry = T(sqrt_w) * (projected[1] - T(v.pixel.y()));
-      using std::sqrt;
-      const T scale = sqrt(T(2) / (T(1) + sqrt(T(1) + (rx * rx + ry * ry) * T(inv_b2))));
-      residuals[2 * i] = rx * scale;
-      residuals[2 * i + 1] = ry * scale;
-    }
-    return true;
-  }
-};
-
-// The same residuals with their 2x3 Jacobians in closed form, for ceres::TinySolver (the
-// Jet version costs about twice as much): Camera::ProjectWithJacobian, then the
-// soft-L1 scale s(q) = sqrt(2 / (1 + q)),
-// q = sqrt(1 + |r|^2 / b^2), with ds/d|r|^2 = -s^3 / (8 b^2 q).
-struct AnalyticRobustReprojection {
-  using Scalar = double;
-  enum { NUM_RESIDUALS = Eigen::Dynamic, NUM_PARAMETERS = 3 };
-  const RobustReprojection* cost;
-
-  int NumResiduals() const { return cost->NumResiduals(); }
-  int NumParameters() const { return 3; }
-
-  bool operator()(const double* point_in_world, double* residuals, double* jacobian) const {
-    if (jacobian == nullptr) return (*cost)(point_in_world, residuals);
-    const int m = NumResiduals();
-    const Eigen::Map<const Eigen::Vector3d> x_world(point_in_world);
-    for (size_t i = 0; i < cost->used->size(); ++i) {
-      const auto& v = cost->scratch->views[(*cost->used)[i]];
-      const int r0 = 2 * static_cast<int>(i), r1 = r0 + 1;
-      Eigen::Vector2d pixel;
-      Eigen::Matrix<double, 2, 3> d_pixel;
-      if (!cost->rig->cameras[v.camera].ProjectWithJacobian(x_world, &pixel, &d_pixel)) {
-        residuals[r0] = residuals[r1] = 1e6;
-        for (int c = 0; c < 3; ++c) jacobian[r0 + c * m] = jacobian[r1 + c * m] = 0;
-        continue;
-      }
-      const double sqrt_w = cost->weight_by_score ? std::sqrt(v.score) : 1.0;
-      const Eigen::Matrix<double, 2, 3> dr = sqrt_w * d_pixel;
-      const double rx = sqrt_w * (pixel.x() - v.pixel.x());
-      const double ry = sqrt_w * (pixel.y() - v.pixel.y());
-      const double q = std::sqrt(1 + (rx * rx + ry * ry) * cost->inv_b2);
-      const double scale = std::sqrt(2 / (1 + q));
-      const double dscale_ds = -scale * scale * scale * cost->inv_b2 / (8 * q);
-      const Eigen::RowVector3d ds = 2 * (rx * dr.row(0) + ry * dr.row(1));
-      residuals[r0] = rx * scale;
-      residuals[r1] = ry * scale;
-      for (int c = 0; c < 3; ++c) {
-        jacobian[r0 + c * m] = scale * dr(0, c) + rx * dscale_ds * ds[c];
-        jacobian[r1 + c * m] = scale * dr(1, c) + ry * dscale_ds * ds[c];
-      }
-    }
-    return true;
-  }
-};
-
-// Undistorted-image error (px) of a conditioned point in one view; +inf behind it.
-double GateErrorPx(const Matrix34d& conditioned_p,
-                   const Eigen::Vector3d& x_conditioned,
-                   const TriangulationScratch::View& v) {
+// Squared undistorted-image error (px^2) of a conditioned point in one view; +inf
+// behind it. Squared so the gate test and the MSAC cost need no square root.
+double GateErrorSquaredPx2(const Matrix34d& conditioned_p,
+                           const Eigen::Vector3d& x_conditioned,
+                           const TriangulationScratch::View& v) {
   const Eigen::Vector3d h = conditioned_p * x_conditioned.homogeneous();
   if (!(h.z() > 0)) return kInf;
-  return (h.head<2>() / h.z() - v.normalized).norm() * v.focal_px;
+  return (h.head<2>() / h.z() - v.normalized).squaredNorm() * (v.focal_px * v.focal_px);
 }
 
 }  // namespace
@@ -160,6 +63,7 @@ Triangulator::Triangulator(const Rig& rig, const TriangulationOptions& options)
   for (const Camera& c : rig_.cameras) centers.push_back(c.CenterInWorld());
   conditioning_ = ConditioningFromCameraCenters(centers);
   for (const Camera& c : rig_.cameras) {
+    focal_px_.push_back(std::sqrt(c.fx * c.fy));
     Matrix34d rt;
     rt.leftCols<3>() = c.cam_from_world_rotation;
     rt.col(3) = c.cam_from_world_translation;
@@ -180,32 +84,30 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
 
   // 1. Usable views, undistorted, in a camera-order independent order.
   s.views.clear();
+  s.camera_seen.assign(static_cast<size_t>(num_cameras), 0);
   for (const PointObservation& o : observations) {
     if (o.camera < 0 || o.camera >= num_cameras) {
       throw std::invalid_argument("Triangulate: camera index " + std::to_string(o.camera) +
                                   " outside the rig");
     }
     if (!o.pixel.allFinite() || !(o.score >= options_.min_score)) continue;
+    if (s.camera_seen[o.camera]++) {
+      throw std::invalid_argument("Triangulate: camera " + std::to_string(o.camera) +
+                                  " observed twice");
+    }
     const Camera& cam = rig_.cameras[o.camera];
     s.views.push_back(
-        {o.camera, o.pixel, o.score, cam.PixelToNormalized(o.pixel), std::sqrt(cam.fx * cam.fy)});
+        {o.camera, o.pixel, o.score, PixelToNormalizedNewton(cam, o.pixel), focal_px_[o.camera]});
   }
   std::sort(s.views.begin(), s.views.end(), [](const auto& a, const auto& b) {
     if (a.score != b.score) return a.score > b.score;
     if (a.pixel.x() != b.pixel.x()) return a.pixel.x() < b.pixel.x();
     return a.pixel.y() < b.pixel.y();
   });
-  for (size_t i = 1; i < s.views.size(); ++i) {
-    for (size_t j = 0; j < i; ++j) {
-      if (s.views[i].camera == s.views[j].camera) {
-        throw std::invalid_argument("Triangulate: camera " + std::to_string(s.views[i].camera) +
-                                    " observed twice");
-      }
-    }
-  }
   const int n = static_cast<int>(s.views.size());
   if (n < 2) return std::nullopt;
   const double gate = options_.max_reprojection_px;
+  const double gate2 = gate * gate;
   auto p_of = [&](int view) -> const Matrix34d& {
     return conditioned_cam_from_world_[s.views[view].camera];
   };
@@ -226,11 +128,11 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
     int count = 0;
     double cost = 0;
     for (int k = 0; k < n; ++k) {
-      const double e = GateErrorPx(p_of(k), *x, s.views[k]);
-      const bool in = e < gate;
+      const double e2 = GateErrorSquaredPx2(p_of(k), *x, s.views[k]);
+      const bool in = e2 < gate2;
       s.inlier[k] = in;
       count += in;
-      cost += in ? e * e : gate * gate;
+      cost += in ? e2 : gate2;
     }
     if (!s.inlier[a] || !s.inlier[b]) continue;  // behind a sampled camera or inconsistent
     if (count > best_count || (count == best_count && cost < best_cost)) {
@@ -253,14 +155,16 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
       const double w = (options_.weight_by_score ? s.views[k].score : 1.0) * s.views[k].focal_px;
       s.dlt.push_back({p_of(k), s.views[k].normalized, w});
     }
-    return TriangulateDltConditioned(s.dlt.data(), static_cast<int>(s.dlt.size()));
+    DltOptions dlt;
+    dlt.inhomogeneous = true;  // RANSAC's cheirality test keeps the points finite
+    return TriangulateDltConditioned(s.dlt.data(), static_cast<int>(s.dlt.size()), dlt);
   };
   std::optional<Eigen::Vector3d> xc = solve_inliers(s.best_inlier);
   for (int round = 0; round < 2 && xc; ++round) {
     int count = 0;
     bool changed = false;
     for (int k = 0; k < n; ++k) {
-      const bool in = GateErrorPx(p_of(k), *xc, s.views[k]) < gate;
+      const bool in = GateErrorSquaredPx2(p_of(k), *xc, s.views[k]) < gate2;
       s.inlier[k] = in;
       count += in;
       changed |= (in != static_cast<bool>(s.best_inlier[k]));
@@ -276,28 +180,23 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
   if (!xc) return std::nullopt;
   Eigen::Vector3d x_world = conditioning_.center + conditioning_.scale * *xc;
 
-  // 4. Robust Levenberg-Marquardt (Ceres' tiny solver: dense, allocation-light, 3
-  //    parameters) on the distorted reprojection error of the inliers.
+  // 4. Robust Levenberg-Marquardt on the distorted reprojection error of the inliers
+  //    (refine_point.h: 3 parameters, normal equations accumulated view by view).
   TriangulatedPoint result;
   if (options_.refine) {
-    s.used.clear();
+    s.refine.clear();
     for (int k = 0; k < n; ++k) {
-      if (s.best_inlier[k]) s.used.push_back(k);
+      if (!s.best_inlier[k]) continue;
+      const auto& v = s.views[k];
+      s.refine.push_back(
+          {&rig_.cameras[v.camera], v.pixel, options_.weight_by_score ? std::sqrt(v.score) : 1.0});
     }
-    const RobustReprojection cost{
-        &s,
-        &s.used,
-        &rig_,
-        options_.weight_by_score,
-        1.0 / (options_.robust_loss_scale_px * options_.robust_loss_scale_px)};
-    const AnalyticRobustReprojection function{&cost};
-    ceres::TinySolver<AnalyticRobustReprojection> solver;
-    solver.options.max_num_iterations = options_.max_refine_iterations;
-    solver.options.gradient_tolerance = 1e-12;
-    solver.options.parameter_tolerance = 1e-10;
-    solver.options.function_tolerance = 1e-8;  // absolute, in px^2
+    PointRefinementOptions refine;
+    refine.loss_scale_px = options_.robust_loss_scale_px;
+    refine.max_iterations = options_.max_refine_iterations;  // both checked by Validate()
     Eigen::Vector3d x = x_world;
-    const auto& summary = solver.Solve(function, &x);
+    const PointRefinementSummary summary =
+        RefinePointRobust(s.refine.data(), static_cast<int>(s.refine.size()), refine, &x);
     if (x.allFinite() && summary.final_cost <= summary.initial_cost) {
       x_world = x;
       result.refined = true;

@@ -1,12 +1,13 @@
 // Robust multi-view triangulation of one keypoint:
 //   1. keep views with a finite pixel and score >= min_score, undistort them
-//      (Camera::PixelToNormalized);
+//      (PixelToNormalizedNewton, camera/undistort.h);
 //   2. RANSAC over view pairs (geometry/robust.h schedule: most confident pairs first,
 //      then seeded random pairs, at most max_ransac_trials, adaptive stop) with a pixel
 //      gate and a cheirality test (the point must lie in front of both cameras);
 //   3. confidence-weighted, conditioned DLT on the inliers, re-gated once;
-//   4. Levenberg-Marquardt (ceres::TinySolver, autodiff through Camera::ProjectToPixel)
-//      on the distorted reprojection error of the inliers with a soft-L1 robust loss.
+//   4. Levenberg-Marquardt (refine_point.h, closed-form Jacobians through
+//      Camera::ProjectWithJacobian) on the distorted reprojection error of the inliers
+//      with a soft-L1 robust loss.
 // Deterministic: views are ordered by (score, pixel) so results do not depend on the
 // order of cameras in the rig, and the sampler is seeded.
 //
@@ -21,6 +22,7 @@
 
 #include "arco/camera/rig.h"
 #include "arco/geometry/triangulation.h"
+#include "arco/mocap/refine_point.h"
 #include "arco/util/json_io.h"
 #include "arco/util/status.h"
 
@@ -69,8 +71,9 @@ struct TriangulationScratch {
   };
   std::vector<View> views;
   std::vector<char> inlier, best_inlier;
+  std::vector<char> camera_seen;  // by rig camera: catches a camera observed twice
   std::vector<DltObservation> dlt;
-  std::vector<int> used;  // views entering the refinement
+  std::vector<RefinementView> refine;  // inlier views entering the refinement
 };
 
 // Immutable triangulation set-up for one rig: options are validated, projection
@@ -93,7 +96,8 @@ class Triangulator {
   Rig rig_;
   TriangulationOptions options_;
   WorldConditioning conditioning_;
-  std::vector<Matrix34d> conditioned_cam_from_world_;             // [R|t] in conditioned world
+  std::vector<Matrix34d> conditioned_cam_from_world_;  // [R|t] in conditioned world
+  std::vector<double> focal_px_;  // sqrt(fx fy): pixels per normalised unit, by camera
   std::vector<std::vector<std::pair<int, int>>> pair_schedules_;  // by usable view count
 };
 

@@ -27,6 +27,9 @@ StatusOr<SequenceTriangulation> TriangulateSequence(const Rig& rig,
     return Status::Error(source + ": 2D keypoints must have shape (frames, views, points, 3)");
   }
   const int64_t num_frames = shape[0], num_views = shape[1], num_points = shape[2];
+  if (static_cast<int64_t>(keypoints2d.data.size()) != num_frames * num_views * num_points * 3) {
+    return Status::Error(source + ": 2D keypoint data do not match the array's shape");
+  }
   if (static_cast<int64_t>(view_to_camera.size()) != num_views) {
     return Status::Error(source + ": " + std::to_string(num_views) + " views in the array but " +
                          std::to_string(view_to_camera.size()) + " cameras listed");
@@ -74,9 +77,10 @@ StatusOr<SequenceTriangulation> TriangulateSequence(const Rig& rig,
           obs.clear();
           int usable = 0;
           for (int64_t v = 0; v < num_views; ++v) {
-            const double x = keypoints2d.at(f, v, p, 0);
-            const double y = keypoints2d.at(f, v, p, 1);
-            const double score = keypoints2d.at(f, v, p, 2);
+            // keypoints2d.at(f, v, p, k) without the out-of-line call per value.
+            const double* kp =
+                &keypoints2d.data[static_cast<size_t>(((f * num_views + v) * num_points + p) * 3)];
+            const double x = kp[0], y = kp[1], score = kp[2];
             if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(score)) continue;
             obs.push_back({view_to_camera[v], Eigen::Vector2d(x, y), score});
             usable += score >= options.point.min_score;
