@@ -43,6 +43,11 @@ struct TrackStageOptions {
   // default and the bow's slots are kept.
   bool track_bow = false;
   track::BowTrackerOptions bow;  // its num_threads is num_threads above
+  // The right hand (keypoints2d.npy's right_hand slots from `arco detect`) is the bow's
+  // prior on the frog in a view when this many of its points score at least
+  // bow_hand_min_score (their mean pixel).
+  double bow_hand_min_score = 0.3;
+  int bow_hand_min_points = 3;
   Status Validate() const;
 };
 
@@ -68,10 +73,12 @@ struct TrackStageSummary {
   int64_t frames_without_pose = 0;            // the pose was the prediction
   bool bow_tracked = false;  // frog and tip labelled in two views: the bow slots written
   int64_t bow_frames_without_pose = 0;
+  int64_t bow_hand_frames = 0;  // frames read with the right hand in two views or more
   std::vector<TrackCameraSummary> cameras;
   std::vector<std::string> warnings;
   bool kept_other_points = false;  // body/hand slots kept from keypoints2d.npy
   double decode_s = 0, track_s = 0, wall_s = 0;
+  double bow_s = 0;  // of track_s, in the bow tracker (wall)
 };
 
 Json ToJson(const TrackStageSummary& summary);
