@@ -563,6 +563,7 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   report_summary.erase("decode_s");  // times differ between runs: left out
   report_summary.erase("track_s");
   report_summary.erase("wall_s");
+  report_summary.erase("bow_s");
   Json cameras_json = Json::array();
   for (const auto& in : inputs) cameras_json.push_back(in.camera);
   ARCO_RETURN_IF_ERROR(WriteJsonFile(report_tmp,

@@ -290,38 +290,114 @@ struct BowTracker::State {
     }
   }
 
-  // The stick's centre line in view v (ideal pixels: a point and a unit direction):
-  // total least squares through its segments' endpoints (weights: length), Huber
-  // reweighted by the endpoints' distance to the line. Both edges of the stick are
-  // segments, so the line runs between them. False without segments.
-  bool FitLine(View& view, Eigen::Vector2d* point, Eigen::Vector2d* direction) const {
-    if (view.segments.empty()) return false;
-    std::vector<double> weight;
-    for (const Segment& s : view.segments) weight.push_back(s.length);
-    for (int iteration = 0; iteration < 5; ++iteration) {
-      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  // The stick's centre line in view v (ideal pixels: a point and a unit direction) and
+  // its weight for step 4. The segments lie on the stick's two edges, a few pixels apart:
+  // a single robust line locks onto whichever edge has more segments (up to half the
+  // stick's width off the centre, measured 5-10 px on the unit test's 10 px stick). So:
+  // a total-least-squares line through all endpoints (weights: length) gives the
+  // direction; the segments' offsets across it split into two edges (the split with the
+  // largest between-edge variance, Otsu 1979, on the length-weighted offsets); with two
+  // edges apart by >= 2 px, each holding >= 15 % of the length, the line runs midway
+  // between their median offsets (weight 1) and the direction is refitted with each
+  // edge moved onto it; otherwise (one edge, or a stick too thin to split) through the
+  // median offset, weight 0.5. A segment's residual_px is to its own edge. False (weight
+  // 0) without segments.
+  bool FitLine(View& view,
+               Eigen::Vector2d* point,
+               Eigen::Vector2d* direction,
+               double* weight_out) const {
+    *weight_out = 0;
+    std::vector<Segment>& segs = view.segments;
+    if (segs.empty()) return false;
+    const size_t m = segs.size();
+    std::vector<double> shift(m, 0.0);  // each segment's edge offset, removed in the fit
+    std::vector<int> edge(m, 0);
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero(), t = Eigen::Vector2d::UnitX();
+    double centre = 0, weight = 0.5;
+    for (int pass = 0; pass < 2; ++pass) {
+      // Direction: TLS over the endpoints, each segment moved across by its shift.
+      const Eigen::Vector2d n0(-t.y(), t.x());
+      mean.setZero();
       double total = 0;
-      for (size_t i = 0; i < view.segments.size(); ++i) {
-        mean += weight[i] * (view.segments[i].a + view.segments[i].b);
-        total += 2 * weight[i];
+      for (size_t i = 0; i < m; ++i) {
+        mean += segs[i].length * (segs[i].a + segs[i].b - 2 * shift[i] * n0);
+        total += 2 * segs[i].length;
       }
-      if (!(total > 0)) return false;
       mean /= total;
       Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
-      for (size_t i = 0; i < view.segments.size(); ++i)
-        for (const Eigen::Vector2d& x : {view.segments[i].a, view.segments[i].b})
-          scatter += weight[i] * (x - mean) * (x - mean).transpose();
+      for (size_t i = 0; i < m; ++i)
+        for (const Eigen::Vector2d& x : {segs[i].a, segs[i].b}) {
+          const Eigen::Vector2d y = x - shift[i] * n0 - mean;
+          scatter += segs[i].length * y * y.transpose();
+        }
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(scatter);
-      *point = mean;
-      *direction = eig.eigenvectors().col(1);
-      const Eigen::Vector2d n(-direction->y(), direction->x());
-      for (size_t i = 0; i < view.segments.size(); ++i) {
-        Segment& s = view.segments[i];
-        s.residual_px =
-            std::sqrt(0.5 * (std::pow(n.dot(s.a - mean), 2) + std::pow(n.dot(s.b - mean), 2)));
-        weight[i] = s.length * std::min(1.0, options.huber_px / std::max(s.residual_px, 1e-9));
+      Eigen::Vector2d t_new = eig.eigenvectors().col(1);
+      if (pass > 0 && t_new.dot(t) < 0) t_new = -t_new;
+      t = t_new;
+      const Eigen::Vector2d n(-t.y(), t.x());
+      // Offsets across the line, sorted; the best two-edge split.
+      std::vector<std::pair<double, size_t>> offset(m);
+      for (size_t i = 0; i < m; ++i)
+        offset[i] = {n.dot(0.5 * (segs[i].a + segs[i].b) - mean), i};
+      std::sort(offset.begin(), offset.end());
+      double all_w = 0, all_wo = 0;
+      for (const auto& [o, i] : offset) {
+        all_w += segs[i].length;
+        all_wo += segs[i].length * o;
       }
+      double best = -1, w0 = 0, wo0 = 0;
+      size_t split = 0;
+      for (size_t k = 0; k + 1 < m; ++k) {
+        w0 += segs[offset[k].second].length;
+        wo0 += segs[offset[k].second].length * offset[k].first;
+        const double w1 = all_w - w0;
+        const double between = w0 * w1 * std::pow(wo0 / w0 - (all_wo - wo0) / w1, 2);
+        if (between > best) {
+          best = between;
+          split = k + 1;
+        }
+      }
+      // Weighted median offset of a range of the sorted offsets.
+      const auto median = [&](size_t from, size_t to, double* w) {
+        *w = 0;
+        for (size_t k = from; k < to; ++k) *w += segs[offset[k].second].length;
+        double acc = 0;
+        for (size_t k = from; k < to; ++k) {
+          acc += segs[offset[k].second].length;
+          if (acc >= 0.5 * *w) return offset[k].first;
+        }
+        return offset[to - 1].first;
+      };
+      double wa = 0, wb = 0;
+      const double oa = split > 0 ? median(0, split, &wa) : 0;
+      const double ob = split > 0 ? median(split, m, &wb) : 0;
+      if (split > 0 && ob - oa >= 2 && wa >= 0.15 * all_w && wb >= 0.15 * all_w) {
+        centre = 0.5 * (oa + ob);
+        weight = 1;
+        for (size_t k = 0; k < m; ++k) {
+          const size_t i = offset[k].second;
+          edge[i] = k < split ? 0 : 1;
+          shift[i] = (k < split ? oa : ob) - centre;
+        }
+      } else {
+        double w = 0;
+        centre = median(0, m, &w);
+        weight = 0.5;
+        std::fill(shift.begin(), shift.end(), 0.0);
+      }
+      // The line through the centre; shift (relative to it) moves each segment onto it
+      // in the next pass's TLS.
+      mean += centre * n;
     }
+    const Eigen::Vector2d n(-t.y(), t.x());
+    for (size_t i = 0; i < m; ++i) {
+      Segment& s = segs[i];
+      const double da = n.dot(s.a - mean) - shift[i], db = n.dot(s.b - mean) - shift[i];
+      s.residual_px = std::sqrt(0.5 * (da * da + db * db));
+    }
+    *point = mean;
+    *direction = t;
+    *weight_out = weight;
     return true;
   }
 
@@ -387,11 +463,12 @@ struct BowTracker::State {
   Refined Refine(const std::vector<cv::Mat>& images,
                  const std::vector<Eigen::Vector2d>& line_point,
                  const std::vector<Eigen::Vector2d>& line_direction,
-                 const std::vector<char>& has_line,
+                 const std::vector<double>& line_weight,
                  const Eigen::Vector3d& frog_p,
                  const Eigen::Vector3d& tip_p,
                  const std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& first,
-                 const std::optional<Eigen::Vector3d>& hand) {
+                 const std::optional<Eigen::Vector3d>& hand,
+                 bool motion_prior) {
     const int n = static_cast<int>(views.size());
     std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> sticks{{frog_p, tip_p}};
     if (first) sticks.push_back(*first);
@@ -416,11 +493,9 @@ struct BowTracker::State {
         const View& view = views[v];
         BowViewTerms t;
         t.camera = &view.camera;
-        if (has_line[v]) {
-          t.line_point = line_point[v];
-          t.line_direction = line_direction[v];
-          t.line_weight = 1;
-        }
+        t.line_point = line_point[v];
+        t.line_direction = line_direction[v];
+        t.line_weight = line_weight[v];
         if (!view.blurred.empty()) {
           const cv::Mat& b = view.blurred[l];
           t.image = b.ptr<float>(0);
@@ -444,8 +519,11 @@ struct BowTracker::State {
         }
         terms[l].push_back(std::move(t));
       }
-    std::vector<BowPointPrior> priors{{0, frog_p, options.motion_sigma_mm},
-                                      {length, tip_p, options.motion_sigma_mm}};
+    std::vector<BowPointPrior> priors;
+    if (motion_prior) {
+      priors.push_back({0, frog_p, options.motion_sigma_mm});
+      priors.push_back({length, tip_p, options.motion_sigma_mm});
+    }
     if (hand) priors.push_back({0, *hand, options.hand_sigma_mm});
     BowSolveOptions so;
     so.line_sigma_px = options.line_sigma_px;
@@ -611,6 +689,7 @@ TrackFrame BowTracker::Next(const std::vector<const media::Image*>& frames,
   // The right hand holds the frog: seen in two views, it re-places a prediction that
   // went astray (or follows a lost frame) and is a prior on the frog below.
   std::optional<Eigen::Vector3d> hand;
+  bool moved_to_hand = false;  // then the motion prior is no prior: left out
   if (right_hand != nullptr) hand = TriangulateRays(st.views, *right_hand);
   if (hand) {
     // The frog the hand implies, at its labelled-frame offset along the predicted axis.
@@ -619,6 +698,7 @@ TrackFrame BowTracker::Next(const std::vector<const media::Image*>& frames,
     if (!st.last_ok || (frog_p - *hand).norm() > st.options.hand_reacquire_mm) {
       tip_p += *hand - frog_p;
       frog_p = *hand;
+      moved_to_hand = true;
     }
   }
   std::vector<cv::Mat> images(n);
@@ -650,8 +730,9 @@ TrackFrame BowTracker::Next(const std::vector<const media::Image*>& frames,
   // coincide (its depth is then unknown).
   std::vector<Eigen::Vector2d> line_point(n), line_direction(n);
   std::vector<char> has_line(n, 0);
+  std::vector<double> line_weight(n, 0);
   for (int v = 0; v < n; ++v)
-    has_line[v] = st.FitLine(st.views[v], &line_point[v], &line_direction[v]);
+    has_line[v] = st.FitLine(st.views[v], &line_point[v], &line_direction[v], &line_weight[v]);
   // Per view: the profile's best shift (+-slide_search_mm around the prediction).
   const int range = st.slide;
   std::vector<double> view_ncc(n, 0), view_shift(n, 0);
@@ -733,11 +814,12 @@ TrackFrame BowTracker::Next(const std::vector<const media::Image*>& frames,
     ncc = ncc_sum / matched;
   }
   if (st.options.refine) {
-    const auto refined = st.Refine(images, line_point, line_direction, has_line, frog_p, tip_p,
+    const auto refined = st.Refine(images, line_point, line_direction, line_weight, frog_p, tip_p,
                                    ok ? std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>>(
                                             std::make_pair(frog, tip))
                                       : std::nullopt,
-                                   hand);
+                                   hand,
+                                   !moved_to_hand);
     if (refined.ok) {
       frog = refined.frog;
       tip = refined.tip;
