@@ -37,10 +37,11 @@ struct TrackStageOptions {
   track::InstrumentTrackerOptions tracker;  // its num_threads is num_threads below
   int num_threads = 0;                      // 0 = all cores; results do not depend on it
   // Experimental: the bow as a thin rigid body of fixed length from its frog and tip
-  // labels (track/bow_tracker.h: line segments, the profile along the stick). It holds
-  // on a bow lying on the picture (pipeline_track_plane_test) but misses issue 13's bound
-  // on a bow moving on its own (pipeline_track_bow_test, disabled), so it is off by
-  // default and the bow's slots are kept.
+  // labels (track/bow_tracker.h: line segments, the profile along the stick, the pose
+  // from all views at once, the right hand as the frog's prior). It meets issue 13's
+  // bound on synthetic scenes (pipeline_track_plane_test, pipeline_track_bow_test) but
+  // has not been measured on real footage, so it is off by default and the bow's slots
+  // are kept.
   bool track_bow = false;
   track::BowTrackerOptions bow;  // its num_threads is num_threads above
   // The right hand (keypoints2d.npy's right_hand slots from `arco detect`) is the bow's
