@@ -173,8 +173,8 @@ const BowScene& GetBowScene() {
       const double crossing = 10 * M_PI / 180 * std::sin(2 * M_PI * 0.35 * t);
       const Eigen::Quaterniond turn(Eigen::AngleAxisd(crossing, Eigen::Vector3d::UnitY()));
       const double stroke = 200 * std::sin(2 * M_PI * 0.7 * t);
-      poses.emplace_back(turn * rest,
-                         Eigen::Vector3d(0, -200, -150) + stroke * (turn * Eigen::Vector3d::UnitX()));
+      poses.emplace_back(
+          turn * rest, Eigen::Vector3d(0, -200, -150) + stroke * (turn * Eigen::Vector3d::UnitX()));
     }
     s.frog = synth::PlaneToWorld(poses[0], synth::TexturePixelToPlane(bow, {20, 11.5}));
     s.tip = synth::PlaneToWorld(poses[0], synth::TexturePixelToPlane(bow, {700, 11.5}));

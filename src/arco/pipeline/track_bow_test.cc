@@ -172,137 +172,138 @@ TEST(TrackBow, TheBowMovesOnItsOwn) {
   }
   const int hand_first = (*layout->Group("right_hand"))[0];
   const auto run = [&](const std::string& name, bool with_hand) {
-  SCOPED_TRACE(name);
-  c.output_dir = dir / name;
-  ASSERT_TRUE(CreateCapture(c).ok());
-  if (with_hand) {
-    // `arco detect`'s right hand: 21 points over the blob (uniform in a 12 px disc about
-    // its centre, then 2 px of noise), score 0.9; everything else NaN.
-    auto manifest = ReadCaptureManifest(c.output_dir);
-    ASSERT_TRUE(manifest.ok());
-    NpyArray<float> kp;
-    kp.shape = {kFrames, kCameras, static_cast<int64_t>(layout->names.size()), 3};
-    kp.data.assign(static_cast<size_t>(kFrames * kCameras * kp.shape[2] * 3), NAN);
-    std::mt19937 hand_rng(11);
-    std::uniform_real_distribution<double> unit(-1, 1);
-    std::normal_distribution<double> noise(0, 2);
-    for (int f = 0; f < kFrames; ++f)
-      for (int v = 0; v < kCameras; ++v) {
-        const auto centre = hand_centre(rig.cameras[v], f);
-        ASSERT_TRUE(centre);
-        for (int k = 0; k < 21; ++k) {
-          Eigen::Vector2d offset;
-          do offset = Eigen::Vector2d(unit(hand_rng), unit(hand_rng));
-          while (offset.norm() > 1);
-          const Eigen::Vector2d x =
-              *centre + 12 * offset + Eigen::Vector2d(noise(hand_rng), noise(hand_rng));
-          float* out =
-              &kp.data[static_cast<size_t>(((f * kCameras + v) * kp.shape[2] + hand_first + k) * 3)];
-          out[0] = static_cast<float>(x.x());
-          out[1] = static_cast<float>(x.y());
-          out[2] = 0.9f;
-        }
-      }
-    ASSERT_TRUE(WriteNpy(c.output_dir + "/keypoints2d.npy", kp).ok());
-    manifest->keypoints2d = "keypoints2d.npy";
-    manifest->layout = "spd_cello";
-    ASSERT_TRUE(WriteCaptureManifest(c.output_dir, *manifest).ok());
-  }
-  TrackStageOptions o;
-  o.capture_dir = c.output_dir;
-  o.num_threads = 2;
-  o.track_bow = true;
-  for (int v : kLabelViews) {
-    const Camera& cam = rig.cameras[v];
-    std::vector<std::string> names;
-    std::vector<Eigen::Vector2d> px;
-    for (size_t p = 0; p < slots.size(); ++p) {
-      names.push_back(layout->names[slots[p]]);
-      px.push_back(*synth::ProjectPlanePoint(cam, world_from_cello[0], cello, cello_px[p]));
-    }
-    names.push_back("frog");
-    px.push_back(*synth::ProjectPlanePoint(cam, world_from_bow[0], bow, frog_px));
-    names.push_back("tip_plate");
-    px.push_back(*synth::ProjectPlanePoint(cam, world_from_bow[0], bow, tip_px));
-    const std::string file = dir / (cam.name + ".json");
-    ASSERT_TRUE(AtomicWriteFile(file, LabelmeText(cam, names, px)).ok());
-    o.labels.push_back({cam.name, -1, file});
-  }
-  auto tracked = RunTrackStage(o);
-  ASSERT_TRUE(tracked.ok()) << tracked.status().message();
-  EXPECT_TRUE(tracked->bow_tracked);
-  EXPECT_EQ(tracked->bow_hand_frames, with_hand ? kFrames : 0);
-  std::printf("%s: bow tracker %.2f s for %d view-frames (%.1f ms each, wall)\n",
-              name.c_str(),
-              tracked->bow_s,
-              kFrames * kCameras,
-              1e3 * tracked->bow_s / (kFrames * kCameras));
-  TriangulateStageOptions t;
-  t.capture_dir = c.output_dir;
-  t.result_dir = dir / ("result_" + name);
-  ASSERT_TRUE(RunTriangulateStage(t).ok());
-  auto kp = ReadNpy<float>(c.output_dir + "/keypoints2d.npy");
-  auto p3 = ReadNpy<double>(t.result_dir + "/triangulation/points3d_raw.npy");
-  ASSERT_TRUE(kp.ok() && p3.ok());
-
-  // Errors: 2D in every view where the truth is in the image, 3D per frame.
-  const auto measure = [&](const std::vector<int>& which,
-                           const std::vector<Rigid3d>& poses,
-                           const synth::PlaneTexture& texture,
-                           const std::vector<Eigen::Vector2d>& texture_px,
-                           std::vector<double>* px_err,
-                           std::vector<double>* mm_err,
-                           int* missing) {
-    for (int f = 0; f < kFrames; ++f)
-      for (size_t p = 0; p < which.size(); ++p) {
+    SCOPED_TRACE(name);
+    c.output_dir = dir / name;
+    ASSERT_TRUE(CreateCapture(c).ok());
+    if (with_hand) {
+      // `arco detect`'s right hand: 21 points over the blob (uniform in a 12 px disc about
+      // its centre, then 2 px of noise), score 0.9; everything else NaN.
+      auto manifest = ReadCaptureManifest(c.output_dir);
+      ASSERT_TRUE(manifest.ok());
+      NpyArray<float> kp;
+      kp.shape = {kFrames, kCameras, static_cast<int64_t>(layout->names.size()), 3};
+      kp.data.assign(static_cast<size_t>(kFrames * kCameras * kp.shape[2] * 3), NAN);
+      std::mt19937 hand_rng(11);
+      std::uniform_real_distribution<double> unit(-1, 1);
+      std::normal_distribution<double> noise(0, 2);
+      for (int f = 0; f < kFrames; ++f)
         for (int v = 0; v < kCameras; ++v) {
-          const float* x =
-              &kp->data[static_cast<size_t>(((f * kCameras + v) * kp->shape[2] + which[p]) * 3)];
-          const auto truth =
-              synth::ProjectPlanePoint(rig.cameras[v], poses[f], texture, texture_px[p]);
-          if (!truth || !synth::InImage(rig.cameras[v], *truth)) continue;
-          if (std::isfinite(x[0])) px_err->push_back((Eigen::Vector2d(x[0], x[1]) - *truth).norm());
+          const auto centre = hand_centre(rig.cameras[v], f);
+          ASSERT_TRUE(centre);
+          for (int k = 0; k < 21; ++k) {
+            Eigen::Vector2d offset;
+            do offset = Eigen::Vector2d(unit(hand_rng), unit(hand_rng));
+            while (offset.norm() > 1);
+            const Eigen::Vector2d x =
+                *centre + 12 * offset + Eigen::Vector2d(noise(hand_rng), noise(hand_rng));
+            float* out = &kp.data[static_cast<size_t>(
+                ((f * kCameras + v) * kp.shape[2] + hand_first + k) * 3)];
+            out[0] = static_cast<float>(x.x());
+            out[1] = static_cast<float>(x.y());
+            out[2] = 0.9f;
+          }
         }
-        const double* x = &p3->data[static_cast<size_t>((f * p3->shape[1] + which[p]) * 3)];
-        if (!std::isfinite(x[0])) {
-          ++*missing;
-          continue;
-        }
-        const Eigen::Vector3d truth =
-            synth::PlaneToWorld(poses[f], synth::TexturePixelToPlane(texture, texture_px[p]));
-        mm_err->push_back((Eigen::Vector3d(x[0], x[1], x[2]) - truth).norm());
+      ASSERT_TRUE(WriteNpy(c.output_dir + "/keypoints2d.npy", kp).ok());
+      manifest->keypoints2d = "keypoints2d.npy";
+      manifest->layout = "spd_cello";
+      ASSERT_TRUE(WriteCaptureManifest(c.output_dir, *manifest).ok());
+    }
+    TrackStageOptions o;
+    o.capture_dir = c.output_dir;
+    o.num_threads = 2;
+    o.track_bow = true;
+    for (int v : kLabelViews) {
+      const Camera& cam = rig.cameras[v];
+      std::vector<std::string> names;
+      std::vector<Eigen::Vector2d> px;
+      for (size_t p = 0; p < slots.size(); ++p) {
+        names.push_back(layout->names[slots[p]]);
+        px.push_back(*synth::ProjectPlanePoint(cam, world_from_cello[0], cello, cello_px[p]));
       }
-  };
-  std::vector<double> bow_px, bow_mm, cello_err_px, cello_mm;
-  int bow_missing = 0, cello_missing = 0;
-  measure(bow_slots, world_from_bow, bow, {frog_px, tip_px}, &bow_px, &bow_mm, &bow_missing);
-  measure(slots, world_from_cello, cello, cello_px, &cello_err_px, &cello_mm, &cello_missing);
-  ASSERT_FALSE(bow_mm.empty());
-  ASSERT_FALSE(cello_mm.empty());
-  std::printf(
-      "| moving bow (%s): bow (frog, tip) | %.2f px | %.2f px | %.2f mm | %.2f mm | %d of %d "
-      "missing |\n",
-      name.c_str(),
-      Median(bow_px),
-      InterpolatedQuantile(bow_px, 0.95),
-      Median(bow_mm),
-      InterpolatedQuantile(bow_mm, 0.95),
-      bow_missing,
-      2 * kFrames);
-  std::printf(
-      "| moving bow (%s): instrument | %.2f px | %.2f px | %.2f mm | %.2f mm | %d of %d missing "
-      "|\n",
-      name.c_str(),
-      Median(cello_err_px),
-      InterpolatedQuantile(cello_err_px, 0.95),
-      Median(cello_mm),
-      InterpolatedQuantile(cello_mm, 0.95),
-      cello_missing,
-      7 * kFrames);
-  EXPECT_LE(Median(bow_mm), 8.0);
-  EXPECT_LE(bow_missing, 0.02 * 2 * kFrames);
-  EXPECT_LE(Median(cello_err_px), 2.0);
-  EXPECT_LE(Median(cello_mm), 4.0);
+      names.push_back("frog");
+      px.push_back(*synth::ProjectPlanePoint(cam, world_from_bow[0], bow, frog_px));
+      names.push_back("tip_plate");
+      px.push_back(*synth::ProjectPlanePoint(cam, world_from_bow[0], bow, tip_px));
+      const std::string file = dir / (cam.name + ".json");
+      ASSERT_TRUE(AtomicWriteFile(file, LabelmeText(cam, names, px)).ok());
+      o.labels.push_back({cam.name, -1, file});
+    }
+    auto tracked = RunTrackStage(o);
+    ASSERT_TRUE(tracked.ok()) << tracked.status().message();
+    EXPECT_TRUE(tracked->bow_tracked);
+    EXPECT_EQ(tracked->bow_hand_frames, with_hand ? kFrames : 0);
+    std::printf("%s: bow tracker %.2f s for %d view-frames (%.1f ms each, wall)\n",
+                name.c_str(),
+                tracked->bow_s,
+                kFrames * kCameras,
+                1e3 * tracked->bow_s / (kFrames * kCameras));
+    TriangulateStageOptions t;
+    t.capture_dir = c.output_dir;
+    t.result_dir = dir / ("result_" + name);
+    ASSERT_TRUE(RunTriangulateStage(t).ok());
+    auto kp = ReadNpy<float>(c.output_dir + "/keypoints2d.npy");
+    auto p3 = ReadNpy<double>(t.result_dir + "/triangulation/points3d_raw.npy");
+    ASSERT_TRUE(kp.ok() && p3.ok());
+
+    // Errors: 2D in every view where the truth is in the image, 3D per frame.
+    const auto measure = [&](const std::vector<int>& which,
+                             const std::vector<Rigid3d>& poses,
+                             const synth::PlaneTexture& texture,
+                             const std::vector<Eigen::Vector2d>& texture_px,
+                             std::vector<double>* px_err,
+                             std::vector<double>* mm_err,
+                             int* missing) {
+      for (int f = 0; f < kFrames; ++f)
+        for (size_t p = 0; p < which.size(); ++p) {
+          for (int v = 0; v < kCameras; ++v) {
+            const float* x =
+                &kp->data[static_cast<size_t>(((f * kCameras + v) * kp->shape[2] + which[p]) * 3)];
+            const auto truth =
+                synth::ProjectPlanePoint(rig.cameras[v], poses[f], texture, texture_px[p]);
+            if (!truth || !synth::InImage(rig.cameras[v], *truth)) continue;
+            if (std::isfinite(x[0]))
+              px_err->push_back((Eigen::Vector2d(x[0], x[1]) - *truth).norm());
+          }
+          const double* x = &p3->data[static_cast<size_t>((f * p3->shape[1] + which[p]) * 3)];
+          if (!std::isfinite(x[0])) {
+            ++*missing;
+            continue;
+          }
+          const Eigen::Vector3d truth =
+              synth::PlaneToWorld(poses[f], synth::TexturePixelToPlane(texture, texture_px[p]));
+          mm_err->push_back((Eigen::Vector3d(x[0], x[1], x[2]) - truth).norm());
+        }
+    };
+    std::vector<double> bow_px, bow_mm, cello_err_px, cello_mm;
+    int bow_missing = 0, cello_missing = 0;
+    measure(bow_slots, world_from_bow, bow, {frog_px, tip_px}, &bow_px, &bow_mm, &bow_missing);
+    measure(slots, world_from_cello, cello, cello_px, &cello_err_px, &cello_mm, &cello_missing);
+    ASSERT_FALSE(bow_mm.empty());
+    ASSERT_FALSE(cello_mm.empty());
+    std::printf(
+        "| moving bow (%s): bow (frog, tip) | %.2f px | %.2f px | %.2f mm | %.2f mm | %d of %d "
+        "missing |\n",
+        name.c_str(),
+        Median(bow_px),
+        InterpolatedQuantile(bow_px, 0.95),
+        Median(bow_mm),
+        InterpolatedQuantile(bow_mm, 0.95),
+        bow_missing,
+        2 * kFrames);
+    std::printf(
+        "| moving bow (%s): instrument | %.2f px | %.2f px | %.2f mm | %.2f mm | %d of %d missing "
+        "|\n",
+        name.c_str(),
+        Median(cello_err_px),
+        InterpolatedQuantile(cello_err_px, 0.95),
+        Median(cello_mm),
+        InterpolatedQuantile(cello_mm, 0.95),
+        cello_missing,
+        7 * kFrames);
+    EXPECT_LE(Median(bow_mm), 8.0);
+    EXPECT_LE(bow_missing, 0.02 * 2 * kFrames);
+    EXPECT_LE(Median(cello_err_px), 2.0);
+    EXPECT_LE(Median(cello_mm), 4.0);
   };
   run("capture", false);
   run("capture_hand", true);

@@ -37,7 +37,8 @@ struct LineResidual {
     const T xn = c[0] / c[2], yn = c[1] / c[2];
     const T px = T(camera->fx) * xn + T(camera->skew) * yn + T(camera->cx);
     const T py = T(camera->fy) * yn + T(camera->cy);
-    residual[0] = T(scale) * (T(normal.x()) * (px - T(point.x())) + T(normal.y()) * (py - T(point.y())));
+    residual[0] =
+        T(scale) * (T(normal.x()) * (px - T(point.x())) + T(normal.y()) * (py - T(point.y())));
     return true;
   }
 };
@@ -105,7 +106,8 @@ BowPose SolveBowPose(const std::vector<BowViewTerms>& views,
       }
     }
     if (view.image != nullptr && !view.u.empty()) {
-      grids.push_back(std::make_unique<ceres::Grid2D<float, 1>>(view.image, 0, view.rows, 0, view.cols));
+      grids.push_back(
+          std::make_unique<ceres::Grid2D<float, 1>>(view.image, 0, view.rows, 0, view.cols));
       interpolators.push_back(std::make_unique<Interpolator>(*grids.back()));
       problem.AddParameterBlock(&offsets[v], 1);
       for (size_t k = 0; k < view.u.size(); ++k) {

@@ -47,16 +47,16 @@ struct BowPointPrior {
 };
 
 struct BowSolveOptions {
-  double line_sigma_px = 1;       // the line term's scale (Huber at this)
-  double intensity_sigma = 8;     // grey levels (Huber at this)
-  int line_points = 9;            // points along the stick for the line term
+  double line_sigma_px = 1;    // the line term's scale (Huber at this)
+  double intensity_sigma = 8;  // grey levels (Huber at this)
+  int line_points = 9;         // points along the stick for the line term
   int max_iterations = 30;
 };
 
 struct BowPose {
   Eigen::Vector3d frog = Eigen::Vector3d::Zero();
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
-  double cost = 0;  // the final cost (Ceres' 1/2 sum of robustified squares)
+  double cost = 0;      // the final cost (Ceres' 1/2 sum of robustified squares)
   bool usable = false;  // the solver ran and the pose is finite
 };
 

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "arco/track/bow_line.h"
 #include "arco/track/bow_pose_solver.h"
 #include "arco/util/parallel.h"
 
@@ -44,18 +45,11 @@ std::optional<Eigen::Vector2d> IdealPixel(const Camera& cam, const Eigen::Vector
   return h.head<2>();
 }
 
-// A line segment in a view, in ideal (undistorted) pixels.
-struct Segment {
-  Eigen::Vector2d a, b;  // ideal pixels
-  double length = 0;
-  double residual_px = 0;  // to the fitted axis' projection
-};
-
 struct View {
   Camera camera;
   cv::Mat label_image;
   std::vector<double> profile;  // the labelled frame's, NaN where unseen
-  std::vector<Segment> segments;
+  std::vector<StickSegment> segments;
   std::vector<double> current;  // this frame's, slide_search_mm longer at both ends
   // Step 4: the labelled frame's intensities at State::u per blur level, and this frame's
   // blurred box (float) per level.
@@ -189,10 +183,11 @@ struct BowTracker::State {
     double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
     for (const auto& [f, t] : sticks)
       for (int i = -2; i <= 18; ++i) {
+        // Points i < 0 and i > 16: the slide search beyond frog and tip.
+        const double beyond = i < 0 ? -1.0 : (i > 16 ? 1.0 : 0.0);
         const Eigen::Vector3d d = (t - f).normalized();
-        const auto p = view.camera.Project(f + (t - f) * (i / 16.0) +
-                                           (i < 0 ? -1.0 : i > 16 ? 1.0 : 0.0) *
-                                               options.slide_search_mm * d);
+        const auto p = view.camera.Project(f + (t - f) * (std::clamp(i, 0, 16) / 16.0) +
+                                           beyond * options.slide_search_mm * d);
         if (!p) continue;
         x0 = std::min(x0, p->x());
         y0 = std::min(y0, p->y());
@@ -274,7 +269,7 @@ struct BowTracker::State {
       const Eigen::Vector2d p(l[0] + box.x - 0.5, l[1] + box.y - 0.5);
       const Eigen::Vector2d q(l[2] + box.x - 0.5, l[3] + box.y - 0.5);
       if ((q - p).norm() < options.min_segment_px) continue;
-      Segment s;
+      StickSegment s;
       s.a = cam.UndistortPixel(p);
       s.b = cam.UndistortPixel(q);
       s.length = (s.b - s.a).norm();
@@ -288,117 +283,6 @@ struct BowTracker::State {
       if (mid < -0.1 * extent || mid > 1.1 * extent) continue;
       view.segments.push_back(s);
     }
-  }
-
-  // The stick's centre line in view v (ideal pixels: a point and a unit direction) and
-  // its weight for step 4. The segments lie on the stick's two edges, a few pixels apart:
-  // a single robust line locks onto whichever edge has more segments (up to half the
-  // stick's width off the centre, measured 5-10 px on the unit test's 10 px stick). So:
-  // a total-least-squares line through all endpoints (weights: length) gives the
-  // direction; the segments' offsets across it split into two edges (the split with the
-  // largest between-edge variance, Otsu 1979, on the length-weighted offsets); with two
-  // edges apart by >= 2 px, each holding >= 15 % of the length, the line runs midway
-  // between their median offsets (weight 1) and the direction is refitted with each
-  // edge moved onto it; otherwise (one edge, or a stick too thin to split) through the
-  // median offset, weight 0.5. A segment's residual_px is to its own edge. False (weight
-  // 0) without segments.
-  bool FitLine(View& view,
-               Eigen::Vector2d* point,
-               Eigen::Vector2d* direction,
-               double* weight_out) const {
-    *weight_out = 0;
-    std::vector<Segment>& segs = view.segments;
-    if (segs.empty()) return false;
-    const size_t m = segs.size();
-    std::vector<double> shift(m, 0.0);  // each segment's edge offset, removed in the fit
-    std::vector<int> edge(m, 0);
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero(), t = Eigen::Vector2d::UnitX();
-    double centre = 0, weight = 0.5;
-    for (int pass = 0; pass < 2; ++pass) {
-      // Direction: TLS over the endpoints, each segment moved across by its shift.
-      const Eigen::Vector2d n0(-t.y(), t.x());
-      mean.setZero();
-      double total = 0;
-      for (size_t i = 0; i < m; ++i) {
-        mean += segs[i].length * (segs[i].a + segs[i].b - 2 * shift[i] * n0);
-        total += 2 * segs[i].length;
-      }
-      mean /= total;
-      Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
-      for (size_t i = 0; i < m; ++i)
-        for (const Eigen::Vector2d& x : {segs[i].a, segs[i].b}) {
-          const Eigen::Vector2d y = x - shift[i] * n0 - mean;
-          scatter += segs[i].length * y * y.transpose();
-        }
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(scatter);
-      Eigen::Vector2d t_new = eig.eigenvectors().col(1);
-      if (pass > 0 && t_new.dot(t) < 0) t_new = -t_new;
-      t = t_new;
-      const Eigen::Vector2d n(-t.y(), t.x());
-      // Offsets across the line, sorted; the best two-edge split.
-      std::vector<std::pair<double, size_t>> offset(m);
-      for (size_t i = 0; i < m; ++i)
-        offset[i] = {n.dot(0.5 * (segs[i].a + segs[i].b) - mean), i};
-      std::sort(offset.begin(), offset.end());
-      double all_w = 0, all_wo = 0;
-      for (const auto& [o, i] : offset) {
-        all_w += segs[i].length;
-        all_wo += segs[i].length * o;
-      }
-      double best = -1, w0 = 0, wo0 = 0;
-      size_t split = 0;
-      for (size_t k = 0; k + 1 < m; ++k) {
-        w0 += segs[offset[k].second].length;
-        wo0 += segs[offset[k].second].length * offset[k].first;
-        const double w1 = all_w - w0;
-        const double between = w0 * w1 * std::pow(wo0 / w0 - (all_wo - wo0) / w1, 2);
-        if (between > best) {
-          best = between;
-          split = k + 1;
-        }
-      }
-      // Weighted median offset of a range of the sorted offsets.
-      const auto median = [&](size_t from, size_t to, double* w) {
-        *w = 0;
-        for (size_t k = from; k < to; ++k) *w += segs[offset[k].second].length;
-        double acc = 0;
-        for (size_t k = from; k < to; ++k) {
-          acc += segs[offset[k].second].length;
-          if (acc >= 0.5 * *w) return offset[k].first;
-        }
-        return offset[to - 1].first;
-      };
-      double wa = 0, wb = 0;
-      const double oa = split > 0 ? median(0, split, &wa) : 0;
-      const double ob = split > 0 ? median(split, m, &wb) : 0;
-      if (split > 0 && ob - oa >= 2 && wa >= 0.15 * all_w && wb >= 0.15 * all_w) {
-        centre = 0.5 * (oa + ob);
-        weight = 1;
-        for (size_t k = 0; k < m; ++k) {
-          const size_t i = offset[k].second;
-          edge[i] = k < split ? 0 : 1;
-          shift[i] = (k < split ? oa : ob) - centre;
-        }
-      } else {
-        double w = 0;
-        centre = median(0, m, &w);
-        weight = 0.5;
-        std::fill(shift.begin(), shift.end(), 0.0);
-      }
-      // The line through the centre; shift (relative to it) moves each segment onto it
-      // in the next pass's TLS.
-      mean += centre * n;
-    }
-    const Eigen::Vector2d n(-t.y(), t.x());
-    for (size_t i = 0; i < m; ++i) {
-      Segment& s = segs[i];
-      const double da = n.dot(s.a - mean) - shift[i], db = n.dot(s.b - mean) - shift[i];
-      s.residual_px = std::sqrt(0.5 * (da * da + db * db));
-    }
-    *point = mean;
-    *direction = t;
-    *weight_out = weight;
-    return true;
   }
 
   // The distorted pixel of an ideal one.
@@ -483,7 +367,8 @@ struct BowTracker::State {
           if (images[v].empty()) return;
           view.box = RefineBox(view, sticks, images[v]);
           if (view.box.empty()) return;
-          for (const double sigma : sigmas) view.blurred.push_back(Blurred(images[v], view.box, sigma));
+          for (const double sigma : sigmas)
+            view.blurred.push_back(Blurred(images[v], view.box, sigma));
         },
         1);
     const Eigen::Vector3d d_p = (tip_p - frog_p).normalized();
@@ -507,7 +392,8 @@ struct BowTracker::State {
           const std::vector<double> at_prediction =
               SampleStick(view.camera, t.image, t.rows, t.cols, t.x0, t.y0, frog_p, d_p, u);
           for (size_t k = 0; k < u.size(); ++k) {
-            if (!std::isfinite(view.label_values[l][k]) || !std::isfinite(at_prediction[k])) continue;
+            if (!std::isfinite(view.label_values[l][k]) || !std::isfinite(at_prediction[k]))
+              continue;
             t.u.push_back(u[k]);
             t.value.push_back(view.label_values[l][k]);
           }
@@ -549,8 +435,8 @@ struct BowTracker::State {
     for (int v = 0; v < n; ++v) {
       const BowViewTerms& t = terms.back()[v];
       if (t.image == nullptr) continue;
-      const std::vector<double> now =
-          SampleStick(views[v].camera, t.image, t.rows, t.cols, t.x0, t.y0, out.frog, best->direction, u);
+      const std::vector<double> now = SampleStick(
+          views[v].camera, t.image, t.rows, t.cols, t.x0, t.y0, out.frog, best->direction, u);
       std::vector<double> a, b;
       for (size_t k = 0; k < u.size(); ++k) {
         if (!std::isfinite(now[k]) || !std::isfinite(views[v].label_values.back()[k])) continue;
@@ -582,7 +468,7 @@ struct BowTracker::State {
       report.tracked = static_cast<int>(v.segments.size());
       report.inliers = 0;
       double sum2 = 0;
-      for (const Segment& s : v.segments) {
+      for (const StickSegment& s : v.segments) {
         if (s.residual_px > 3 * options.huber_px) continue;
         ++report.inliers;
         sum2 += s.residual_px * s.residual_px;
@@ -664,15 +550,8 @@ TrackFrame BowTracker::Start(const std::vector<const media::Image*>& frames,
         const cv::Rect all(0, 0, view.label_image.cols, view.label_image.rows);
         for (const double sigma : st.BlurSigmas()) {
           const cv::Mat b = State::Blurred(view.label_image, all, sigma);
-          view.label_values.push_back(SampleStick(view.camera,
-                                                  b.ptr<float>(0),
-                                                  b.rows,
-                                                  b.cols,
-                                                  0,
-                                                  0,
-                                                  st.frog0,
-                                                  st.direction0,
-                                                  st.u));
+          view.label_values.push_back(SampleStick(
+              view.camera, b.ptr<float>(0), b.rows, b.cols, 0, 0, st.frog0, st.direction0, st.u));
         }
       },
       1);
@@ -732,7 +611,8 @@ TrackFrame BowTracker::Next(const std::vector<const media::Image*>& frames,
   std::vector<char> has_line(n, 0);
   std::vector<double> line_weight(n, 0);
   for (int v = 0; v < n; ++v)
-    has_line[v] = st.FitLine(st.views[v], &line_point[v], &line_direction[v], &line_weight[v]);
+    has_line[v] =
+        FitStickLine(&st.views[v].segments, &line_point[v], &line_direction[v], &line_weight[v]);
   // Per view: the profile's best shift (+-slide_search_mm around the prediction).
   const int range = st.slide;
   std::vector<double> view_ncc(n, 0), view_shift(n, 0);
@@ -814,12 +694,17 @@ TrackFrame BowTracker::Next(const std::vector<const media::Image*>& frames,
     ncc = ncc_sum / matched;
   }
   if (st.options.refine) {
-    const auto refined = st.Refine(images, line_point, line_direction, line_weight, frog_p, tip_p,
-                                   ok ? std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>>(
-                                            std::make_pair(frog, tip))
-                                      : std::nullopt,
-                                   hand,
-                                   !moved_to_hand);
+    const auto refined = st.Refine(
+        images,
+        line_point,
+        line_direction,
+        line_weight,
+        frog_p,
+        tip_p,
+        ok ? std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>>(std::make_pair(frog, tip))
+           : std::nullopt,
+        hand,
+        !moved_to_hand);
     if (refined.ok) {
       frog = refined.frog;
       tip = refined.tip;
