@@ -8,7 +8,9 @@
 // 3D positions (issue's bound: median 8 mm), the instrument's points against theirs.
 // Twice: without 2D keypoints, and with `arco detect`-like right-hand keypoints (21
 // points scattered over the hand blob, with noise) in keypoints2d.npy, which the bow
-// tracker uses as its prior on the frog: it must meet the bound too.
+// tracker uses as its prior on the frog: it must meet the bound too. And once more with
+// a plain stick (a real bow's: uniform wood, a black frog with a light eye, a white tip
+// plate), whose only cues along its length are its ends.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -69,7 +71,9 @@ void Disc(media::Image* image, const Eigen::Vector2d& centre, double radius, uin
       if ((Eigen::Vector2d(x, y) - centre).norm() <= radius) image->row(y)[x] = value;
 }
 
-TEST(TrackBow, TheBowMovesOnItsOwn) {
+// The scene with a random-block stick (plain_stick false) or a plain one; with_hand:
+// also the run with right-hand keypoints.
+void MovingBow(bool plain_stick, bool with_hand_too) {
   testing::TempDir dir;
   // The instrument: the photo, moving a little.
   const std::string data = ARCO_SHARED_DATA_DIR;
@@ -85,7 +89,9 @@ TEST(TrackBow, TheBowMovesOnItsOwn) {
   motion.max_translation_mm = 40;
   motion.max_rotation_deg = 4;
   const std::vector<Rigid3d> world_from_cello = synth::MakePlaneMotion(motion);
-  // The bow: random 6 mm blocks on a 720 x 24 mm strip; frog and tip on its axis.
+  // The bow: random 6 mm blocks on a 720 x 24 mm strip, or a plain stick (grey 120, the
+  // frog black over 60 mm with a light 10 mm eye, the last 25 mm white); frog and tip on
+  // its axis.
   synth::PlaneTexture bow;
   bow.image = media::MakeImage(720, 24, media::PixelFormat::kGray8);
   std::mt19937 rng(7);
@@ -96,6 +102,15 @@ TEST(TrackBow, TheBowMovesOnItsOwn) {
       for (int y = by; y < by + 6; ++y)
         for (int x = bx; x < bx + 6; ++x) bow.image.row(y)[x] = g;
     }
+  if (plain_stick) {
+    for (int y = 0; y < 24; ++y)
+      for (int x = 0; x < 720; ++x) {
+        uint8_t g = 120;
+        if (x < 60) g = (std::abs(x - 35) < 5 && std::abs(y - 12) < 5) ? 220 : 30;
+        if (x >= 695) g = 235;
+        bow.image.row(y)[x] = g;
+      }
+  }
   bow.width_mm = 720;
   bow.height_mm = 24;
   synth::BuildMipmaps(&bow);
@@ -305,8 +320,14 @@ TEST(TrackBow, TheBowMovesOnItsOwn) {
     EXPECT_LE(Median(cello_err_px), 2.0);
     EXPECT_LE(Median(cello_mm), 4.0);
   };
-  run("capture", false);
-  run("capture_hand", true);
+  run(plain_stick ? "plain_stick" : "capture", false);
+  if (with_hand_too) run("capture_hand", true);
+}
+
+TEST(TrackBow, TheBowMovesOnItsOwn) { MovingBow(/*plain_stick=*/false, /*with_hand_too=*/true); }
+
+TEST(TrackBow, APlainStickMovesOnItsOwn) {
+  MovingBow(/*plain_stick=*/true, /*with_hand_too=*/false);
 }
 
 }  // namespace
