@@ -4,9 +4,17 @@
 // on frame 1 in two views) for 20 frames with T threads, frames already decoded and in
 // memory (decoding is media::VideoReader's, timed by detect_bench's BM_DecodeFrame).
 // Counter ms_per_view_frame: track::InstrumentTracker::Next per view-frame.
+// BM_TrackBow/R tracks the moving bow of pipeline_track_bow_test (a 720 x 24 mm strip of
+// random 6 mm blocks, +-200 mm strokes at 0.7 Hz and +-10 degree string crossings, over
+// the photo at rest; same rig) for 20 frames on one thread: R = 1 with the all-view pose
+// (BowTrackerOptions::refine), R = 0 without. Counter cpu_ms_per_view_frame:
+// track::BowTracker::Next's process CPU time per view-frame (the machine may be shared:
+// CPU time, not wall).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <ctime>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -14,6 +22,7 @@
 #include "arco/mocap/labelme.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/synth/plane_scene.h"
+#include "arco/track/bow_tracker.h"
 #include "arco/track/instrument_tracker.h"
 
 namespace arco::track {
@@ -122,6 +131,104 @@ void BM_TrackInstrument(benchmark::State& state) {
   state.counters["ms_per_view_frame"] = 1e3 * next_s / std::max<int64_t>(1, view_frames);
 }
 BENCHMARK(BM_TrackInstrument)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+struct BowScene {
+  std::vector<Camera> cameras;
+  std::vector<std::vector<media::Image>> frames;  // [frame][view], gray
+  Eigen::Vector3d frog, tip;                      // frame 0's, exact
+  std::string error;
+};
+
+const BowScene& GetBowScene() {
+  static const BowScene scene = [] {
+    BowScene s;
+    const std::string data = ARCO_SHARED_DATA_DIR;
+    auto reader = media::VideoReader::Open(data + "/spd/example.jpg");
+    if (!reader.ok()) {
+      s.error = "../shared/data/spd/example.jpg is needed";
+      return s;
+    }
+    synth::PlaneTexture cello;
+    cello.image = *reader->ReadFrame(0);
+    cello.width_mm = cello.image.width * 0.778;
+    cello.height_mm = cello.image.height * 0.778;
+    synth::BuildMipmaps(&cello);
+    synth::PlaneTexture bow;
+    bow.image = media::MakeImage(720, 24, media::PixelFormat::kGray8);
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<int> grey(40, 220);
+    for (int by = 0; by < 24; by += 6)
+      for (int bx = 0; bx < 720; bx += 6) {
+        const uint8_t g = static_cast<uint8_t>(grey(rng));
+        for (int y = by; y < by + 6; ++y)
+          for (int x = bx; x < bx + 6; ++x) bow.image.row(y)[x] = g;
+      }
+    bow.width_mm = 720;
+    bow.height_mm = 24;
+    synth::BuildMipmaps(&bow);
+    std::vector<Rigid3d> poses;
+    const Eigen::Quaterniond rest = synth::PlaneRestPose().rotation;
+    for (int f = 0; f < kFrames; ++f) {
+      const double t = f / 30.0;
+      const double crossing = 10 * M_PI / 180 * std::sin(2 * M_PI * 0.35 * t);
+      const Eigen::Quaterniond turn(Eigen::AngleAxisd(crossing, Eigen::Vector3d::UnitY()));
+      const double stroke = 200 * std::sin(2 * M_PI * 0.7 * t);
+      poses.emplace_back(
+          turn * rest, Eigen::Vector3d(0, -200, -150) + stroke * (turn * Eigen::Vector3d::UnitX()));
+    }
+    s.frog = synth::PlaneToWorld(poses[0], synth::TexturePixelToPlane(bow, {20, 11.5}));
+    s.tip = synth::PlaneToWorld(poses[0], synth::TexturePixelToPlane(bow, {700, 11.5}));
+    synth::PlaneRigOptions rig;
+    rig.cameras = 6;
+    rig.width = 768;
+    rig.height = 886;
+    rig.focal_px = 760;
+    s.cameras = synth::MakePlaneRig(rig).cameras;
+    synth::PlaneRenderOptions render;
+    render.supersampling = 1;
+    render.threads = 2;
+    s.frames.resize(kFrames);
+    for (const Camera& cam : s.cameras) {
+      const synth::PlaneRenderer renderer(cam, render);
+      const media::Image background =
+          synth::MakeSolidImage(cam.width, cam.height, media::PixelFormat::kGray8, {90, 90, 90});
+      media::Image picture;
+      renderer.Render(synth::PlaneRestPose(), cello, background, &picture);
+      for (int f = 0; f < kFrames; ++f) {
+        media::Image out;
+        renderer.Render(poses[f], bow, picture, &out);
+        s.frames[f].push_back(std::move(out));
+      }
+    }
+    return s;
+  }();
+  return scene;
+}
+
+void BM_TrackBow(benchmark::State& state) {
+  const BowScene& s = GetBowScene();
+  if (!s.error.empty()) {
+    state.SkipWithError(s.error.c_str());
+    return;
+  }
+  BowTrackerOptions options;
+  options.num_threads = 1;
+  options.refine = state.range(0) != 0;
+  double cpu_s = 0;
+  int64_t view_frames = 0;
+  for (auto _ : state) {
+    BowTracker tracker(s.cameras, s.frog, s.tip, options);
+    tracker.Start(Pointers(s.frames[0]));
+    const std::clock_t start = std::clock();
+    for (int f = 1; f < kFrames; ++f) {
+      benchmark::DoNotOptimize(tracker.Next(Pointers(s.frames[f])));
+    }
+    cpu_s += static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC;
+    view_frames += static_cast<int64_t>(kFrames - 1) * s.cameras.size();
+  }
+  state.counters["cpu_ms_per_view_frame"] = 1e3 * cpu_s / std::max<int64_t>(1, view_frames);
+}
+BENCHMARK(BM_TrackBow)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace arco::track

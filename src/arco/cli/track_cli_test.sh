@@ -98,7 +98,9 @@ check 'grep -A1 "\"tracked_points\"" cap/track.json | grep -q "\"scroll_top\""' 
 check 'grep -q "the bow is not tracked (its frog and tip need labels in two views of frame 1)" err.txt' \
   "no warning for a bow labelled in one view: $(cat err.txt)"
 # The bow labelled in both views with --bow: tracked as its own thin body, no warning.
-"$arco" track cap --labels front=bowfront.json --labels side=bowside.json --bow >/dev/null 2>err.txt
+"$arco" track cap --labels front=bowfront.json --labels side=bowside.json --bow >out.txt 2>err.txt
 check '[ ! -s err.txt ] && grep -q "\"bow_tracked\": true" cap/track.json' \
   "the bow was not tracked: $(cat err.txt)"
+check 'grep -q "of which the bow .* ms per view-frame; the right hand seen in 0 frames" out.txt' \
+  "the bow's time is not printed: $(cat out.txt)"
 exit $fail

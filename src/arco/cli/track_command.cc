@@ -80,6 +80,11 @@ int RunTrack(const TrackArgs& a) {
               s.wall_s,
               view_frames > 0 ? 1e3 * (s.track_s - s.decode_s) / view_frames : 0.0,
               view_frames > 0 ? 1e3 * s.decode_s / view_frames : 0.0);
+  if (s.bow_tracked) {
+    std::printf("  of which the bow %.1f ms per view-frame; the right hand seen in %lld frames\n",
+                view_frames > 0 ? 1e3 * s.bow_s / view_frames : 0.0,
+                static_cast<long long>(s.bow_hand_frames));
+  }
   std::printf("wrote %s/keypoints2d.npy, track.json and capture.json\n",
               NormalizeOutputPath(a.o.capture_dir).c_str());
   return 0;
@@ -130,7 +135,8 @@ std::function<int()> SetupTrack(CLI::App& app) {
   sub->add_flag("--bow",
                 a->o.track_bow,
                 "Experimental: also track the bow from its frog and tip labels, as a thin line of "
-                "fixed length (10 mm median on a fast bow, over issue 13's 8 mm; docs/track.md)");
+                "fixed length posed from all views at once, the right hand (from `arco detect`) "
+                "as its frog's prior (tested on synthetic renders only; docs/track.md)");
   sub->parse_complete_callback([a] { ApplyAndValidate(*a); });
   return [a]() { return RunTrack(*a); };
 }

@@ -142,6 +142,8 @@ Status TrackStageOptions::Validate() const {
   t.num_threads = 1;
   ARCO_RETURN_IF_ERROR(t.Validate().WithContext("tracker"));
   ARCO_RETURN_IF_ERROR(bow.Validate().WithContext("bow"));
+  ARCO_RETURN_IF_ERROR(CheckInRange("bow_hand_min_score", bow_hand_min_score, Closed(0, 1)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("bow_hand_min_points", bow_hand_min_points, Closed(1, 21)));
   return Status::Ok();
 }
 
@@ -154,6 +156,8 @@ Json ToJson(const TrackStageOptions& o) {
               {"labels_frame", o.labels_frame},
               {"track_bow", o.track_bow},
               {"bow", ToJson(o.bow)},
+              {"bow_hand_min_score", o.bow_hand_min_score},
+              {"bow_hand_min_points", o.bow_hand_min_points},
               {"tracker", ToJson(o.tracker)}};
 }
 
@@ -178,11 +182,13 @@ Json ToJson(const TrackStageSummary& s) {
               {"frames_without_pose", s.frames_without_pose},
               {"bow_tracked", s.bow_tracked},
               {"bow_frames_without_pose", s.bow_frames_without_pose},
+              {"bow_hand_frames", s.bow_hand_frames},
               {"kept_other_points", s.kept_other_points},
               {"cameras", cameras},
               {"warnings", s.warnings},
               {"decode_s", s.decode_s},
               {"track_s", s.track_s},
+              {"bow_s", s.bow_s},
               {"wall_s", s.wall_s}};
 }
 
@@ -365,6 +371,31 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   const auto at = [&](int64_t f, int v, int64_t p) {
     return static_cast<size_t>(((f * views + v) * points + p) * 3);
   };
+  // The right hand per view in frame f (capture index): the mean pixel of its points that
+  // `arco detect` scored at least bow_hand_min_score, when enough did; NaN otherwise.
+  const std::vector<int>* hand_slots = layout->Group("right_hand");
+  const auto right_hand = [&](int64_t f, int64_t* frames_with_hand) {
+    std::vector<Eigen::Vector2d> px(views, Eigen::Vector2d::Constant(kNaN));
+    if (!summary.kept_other_points || hand_slots == nullptr) return px;
+    int seen = 0;
+    for (int v = 0; v < views; ++v) {
+      Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+      int count = 0;
+      for (int slot : *hand_slots) {
+        const float* x = &out.data[at(f, v, slot)];
+        if (!(std::isfinite(x[0]) && std::isfinite(x[1]) && x[2] >= options.bow_hand_min_score))
+          continue;
+        sum += Eigen::Vector2d(x[0], x[1]);
+        ++count;
+      }
+      if (count >= options.bow_hand_min_points) {
+        px[v] = sum / count;
+        ++seen;
+      }
+    }
+    *frames_with_hand += seen >= 2;
+    return px;
+  };
 
   OutputSet outputs;
   ARCO_ASSIGN_OR_RETURN(const std::string npy_tmp, outputs.AddFile(JoinPath(dir, kKeypointsFile)));
@@ -405,14 +436,26 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
           images[v] = &blanks[v];
         }
         r = tracker.Start(images);
-        if (bow_tracker) bow_r = bow_tracker->Start(images);
+        if (bow_tracker) {
+          const auto bow_start = std::chrono::steady_clock::now();
+          int64_t with_hand = 0;
+          const std::vector<Eigen::Vector2d> hand = right_hand(g - first, &with_hand);
+          if (step > 0) summary.bow_hand_frames += with_hand;
+          bow_r = bow_tracker->Start(images, &hand);
+          summary.bow_s += SecondsSince(bow_start);
+        }
       } else {
         const auto it = labelled.find(g);
         r = tracker.Next(images, it != labelled.end() ? &it->second : nullptr);
         if (bow_tracker) {
+          const auto bow_start = std::chrono::steady_clock::now();
           const auto bow_it = bow_labelled.find(g);
-          bow_r =
-              bow_tracker->Next(images, bow_it != bow_labelled.end() ? &bow_it->second : nullptr);
+          int64_t with_hand = 0;
+          const std::vector<Eigen::Vector2d> hand = right_hand(g - first, &with_hand);
+          bow_r = bow_tracker->Next(
+              images, bow_it != bow_labelled.end() ? &bow_it->second : nullptr, &hand);
+          summary.bow_s += SecondsSince(bow_start);
+          if (!done[static_cast<size_t>(g - first)]) summary.bow_hand_frames += with_hand;
         }
       }
       const size_t f = static_cast<size_t>(g - first);
@@ -520,6 +563,7 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   report_summary.erase("decode_s");  // times differ between runs: left out
   report_summary.erase("track_s");
   report_summary.erase("wall_s");
+  report_summary.erase("bow_s");
   Json cameras_json = Json::array();
   for (const auto& in : inputs) cameras_json.push_back(in.camera);
   ARCO_RETURN_IF_ERROR(WriteJsonFile(report_tmp,

@@ -37,12 +37,18 @@ struct TrackStageOptions {
   track::InstrumentTrackerOptions tracker;  // its num_threads is num_threads below
   int num_threads = 0;                      // 0 = all cores; results do not depend on it
   // Experimental: the bow as a thin rigid body of fixed length from its frog and tip
-  // labels (track/bow_tracker.h: line segments, the profile along the stick). It holds
-  // on a bow lying on the picture (pipeline_track_plane_test) but misses issue 13's bound
-  // on a bow moving on its own (pipeline_track_bow_test, disabled), so it is off by
-  // default and the bow's slots are kept.
+  // labels (track/bow_tracker.h: line segments, the profile along the stick, the pose
+  // from all views at once, the right hand as the frog's prior). It meets issue 13's
+  // bound on synthetic scenes (pipeline_track_plane_test, pipeline_track_bow_test) but
+  // has not been measured on real footage, so it is off by default and the bow's slots
+  // are kept.
   bool track_bow = false;
   track::BowTrackerOptions bow;  // its num_threads is num_threads above
+  // The right hand (keypoints2d.npy's right_hand slots from `arco detect`) is the bow's
+  // prior on the frog in a view when this many of its points score at least
+  // bow_hand_min_score (their mean pixel).
+  double bow_hand_min_score = 0.3;
+  int bow_hand_min_points = 3;
   Status Validate() const;
 };
 
@@ -68,10 +74,12 @@ struct TrackStageSummary {
   int64_t frames_without_pose = 0;            // the pose was the prediction
   bool bow_tracked = false;  // frog and tip labelled in two views: the bow slots written
   int64_t bow_frames_without_pose = 0;
+  int64_t bow_hand_frames = 0;  // frames read with the right hand in two views or more
   std::vector<TrackCameraSummary> cameras;
   std::vector<std::string> warnings;
   bool kept_other_points = false;  // body/hand slots kept from keypoints2d.npy
   double decode_s = 0, track_s = 0, wall_s = 0;
+  double bow_s = 0;  // of track_s, in the bow tracker (wall)
 };
 
 Json ToJson(const TrackStageSummary& summary);

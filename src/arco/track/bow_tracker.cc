@@ -9,6 +9,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "arco/track/bow_line.h"
+#include "arco/track/bow_pose_solver.h"
 #include "arco/util/parallel.h"
 
 namespace arco::track {
@@ -43,19 +45,17 @@ std::optional<Eigen::Vector2d> IdealPixel(const Camera& cam, const Eigen::Vector
   return h.head<2>();
 }
 
-// A line segment in a view, in ideal (undistorted) pixels.
-struct Segment {
-  Eigen::Vector2d a, b;  // ideal pixels
-  double length = 0;
-  double residual_px = 0;  // to the fitted axis' projection
-};
-
 struct View {
   Camera camera;
   cv::Mat label_image;
   std::vector<double> profile;  // the labelled frame's, NaN where unseen
-  std::vector<Segment> segments;
+  std::vector<StickSegment> segments;
   std::vector<double> current;  // this frame's, slide_search_mm longer at both ends
+  // Step 4: the labelled frame's intensities at State::u per blur level, and this frame's
+  // blurred box (float) per level.
+  std::vector<std::vector<double>> label_values;
+  std::vector<cv::Mat> blurred;
+  cv::Rect box;
   ViewTrackReport report;
   bool lost = false;
 };
@@ -82,6 +82,30 @@ double Ncc(const std::vector<double>& a, const std::vector<double>& b, int shift
   return (sab - sa * sb / count) / std::sqrt(va * vb);
 }
 
+// Least squares on the views' rays through their right-hand pixels (NaN: none); nullopt
+// with fewer than two views or rays that all but coincide.
+std::optional<Eigen::Vector3d> TriangulateRays(const std::vector<View>& views,
+                                               const std::vector<Eigen::Vector2d>& pixels) {
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  int used = 0;
+  for (size_t v = 0; v < views.size() && v < pixels.size(); ++v) {
+    if (!pixels[v].allFinite()) continue;
+    const Camera& cam = views[v].camera;
+    const Eigen::Vector3d r = cam.RayInWorld(pixels[v]);
+    const Eigen::Matrix3d m = Eigen::Matrix3d::Identity() - r * r.transpose();
+    a += m;
+    b += m * cam.CenterInWorld();
+    ++used;
+  }
+  if (used < 2) return std::nullopt;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(a);
+  if (!(eig.eigenvalues()(0) > 1e-3 * eig.eigenvalues()(2))) return std::nullopt;
+  const Eigen::Vector3d x = a.ldlt().solve(b);
+  if (!x.allFinite()) return std::nullopt;
+  return x;
+}
+
 }  // namespace
 
 Status BowTrackerOptions::Validate() const {
@@ -93,6 +117,14 @@ Status BowTrackerOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(CheckInRange("slide_search_mm", slide_search_mm, Closed(1, 1000)));
   ARCO_RETURN_IF_ERROR(CheckInRange("profile_margin", profile_margin, Closed(0, 0.5)));
   ARCO_RETURN_IF_ERROR(CheckInRange("min_ncc", min_ncc, Closed(-1, 1)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("coarse_blur_px", coarse_blur_px, AboveZero(20)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("fine_blur_px", fine_blur_px, AboveZero(20)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("sample_step_mm", sample_step_mm, Closed(0.25, 100)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("intensity_sigma", intensity_sigma, AboveZero(255)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("line_sigma_px", line_sigma_px, AboveZero(100)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("motion_sigma_mm", motion_sigma_mm, AboveZero(1e4)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("hand_sigma_mm", hand_sigma_mm, AboveZero(1e4)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("hand_reacquire_mm", hand_reacquire_mm, AboveZero(1e4)));
   ARCO_RETURN_IF_ERROR(CheckInRange("num_threads", num_threads, Closed(0, 1024)));
   return Status::Ok();
 }
@@ -105,7 +137,16 @@ Json ToJson(const BowTrackerOptions& o) {
               {"huber_px", o.huber_px},
               {"slide_search_mm", o.slide_search_mm},
               {"profile_margin", o.profile_margin},
-              {"min_ncc", o.min_ncc}};
+              {"min_ncc", o.min_ncc},
+              {"refine", o.refine},
+              {"coarse_blur_px", o.coarse_blur_px},
+              {"fine_blur_px", o.fine_blur_px},
+              {"sample_step_mm", o.sample_step_mm},
+              {"intensity_sigma", o.intensity_sigma},
+              {"line_sigma_px", o.line_sigma_px},
+              {"motion_sigma_mm", o.motion_sigma_mm},
+              {"hand_sigma_mm", o.hand_sigma_mm},
+              {"hand_reacquire_mm", o.hand_reacquire_mm}};
 }
 
 struct BowTracker::State {
@@ -116,6 +157,52 @@ struct BowTracker::State {
   Eigen::Vector3d frog, tip, frog_velocity = Eigen::Vector3d::Zero(),
                              tip_velocity = Eigen::Vector3d::Zero();
   int margin = 0, slide = 0, samples = 0;  // mm; samples per profile (1 mm apart)
+  std::vector<double> u;                   // step 4's samples along the stick (mm)
+  // The right hand at the labelled frame: frog + hand_along d + hand_across (world; the
+  // across part is not turned with the bow: the bow turns little, and the prior is weak).
+  double hand_along = 0;
+  Eigen::Vector3d hand_across = Eigen::Vector3d::Zero();
+  bool last_ok = true;
+
+  std::vector<double> BlurSigmas() const { return {options.coarse_blur_px, options.fine_blur_px}; }
+
+  // A box of the image, as floats, blurred (Gaussian, sigma px; the box's edges repeat).
+  static cv::Mat Blurred(const cv::Mat& image, const cv::Rect& box, double sigma) {
+    cv::Mat f, out;
+    image(box).convertTo(f, CV_32F);
+    cv::GaussianBlur(f, out, cv::Size(0, 0), sigma, sigma, cv::BORDER_REPLICATE);
+    return out;
+  }
+
+  // The box step 4 reads in a view: the projections of the stick at the prediction and
+  // at the first estimate, grown by the slide search and a margin; empty when the stick
+  // is not in the image.
+  cv::Rect RefineBox(const View& view,
+                     const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& sticks,
+                     const cv::Mat& image) const {
+    double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
+    for (const auto& [f, t] : sticks)
+      for (int i = -2; i <= 18; ++i) {
+        // Points i < 0 and i > 16: the slide search beyond frog and tip.
+        const double beyond = i < 0 ? -1.0 : (i > 16 ? 1.0 : 0.0);
+        const Eigen::Vector3d d = (t - f).normalized();
+        const auto p = view.camera.Project(f + (t - f) * (std::clamp(i, 0, 16) / 16.0) +
+                                           beyond * options.slide_search_mm * d);
+        if (!p) continue;
+        x0 = std::min(x0, p->x());
+        y0 = std::min(y0, p->y());
+        x1 = std::max(x1, p->x());
+        y1 = std::max(y1, p->y());
+      }
+    if (!(x1 >= x0)) return cv::Rect();
+    const double m = options.roi_margin_px + 3 * options.coarse_blur_px;
+    const cv::Rect box =
+        cv::Rect(
+            cv::Point(static_cast<int>(std::floor(x0 - m)), static_cast<int>(std::floor(y0 - m))),
+            cv::Point(static_cast<int>(std::ceil(x1 + m)), static_cast<int>(std::ceil(y1 + m)))) &
+        cv::Rect(0, 0, image.cols, image.rows);
+    return box.width >= 8 && box.height >= 8 ? box : cv::Rect();
+  }
 
   // The intensity along the line `origin + u d` for u = start, start + 1, ... (count
   // samples, mm), each the mean of three pixels across the line's image (1 px apart).
@@ -182,7 +269,7 @@ struct BowTracker::State {
       const Eigen::Vector2d p(l[0] + box.x - 0.5, l[1] + box.y - 0.5);
       const Eigen::Vector2d q(l[2] + box.x - 0.5, l[3] + box.y - 0.5);
       if ((q - p).norm() < options.min_segment_px) continue;
-      Segment s;
+      StickSegment s;
       s.a = cam.UndistortPixel(p);
       s.b = cam.UndistortPixel(q);
       s.length = (s.b - s.a).norm();
@@ -196,41 +283,6 @@ struct BowTracker::State {
       if (mid < -0.1 * extent || mid > 1.1 * extent) continue;
       view.segments.push_back(s);
     }
-  }
-
-  // The stick's centre line in view v (ideal pixels: a point and a unit direction):
-  // total least squares through its segments' endpoints (weights: length), Huber
-  // reweighted by the endpoints' distance to the line. Both edges of the stick are
-  // segments, so the line runs between them. False without segments.
-  bool FitLine(View& view, Eigen::Vector2d* point, Eigen::Vector2d* direction) const {
-    if (view.segments.empty()) return false;
-    std::vector<double> weight;
-    for (const Segment& s : view.segments) weight.push_back(s.length);
-    for (int iteration = 0; iteration < 5; ++iteration) {
-      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-      double total = 0;
-      for (size_t i = 0; i < view.segments.size(); ++i) {
-        mean += weight[i] * (view.segments[i].a + view.segments[i].b);
-        total += 2 * weight[i];
-      }
-      if (!(total > 0)) return false;
-      mean /= total;
-      Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
-      for (size_t i = 0; i < view.segments.size(); ++i)
-        for (const Eigen::Vector2d& x : {view.segments[i].a, view.segments[i].b})
-          scatter += weight[i] * (x - mean) * (x - mean).transpose();
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(scatter);
-      *point = mean;
-      *direction = eig.eigenvectors().col(1);
-      const Eigen::Vector2d n(-direction->y(), direction->x());
-      for (size_t i = 0; i < view.segments.size(); ++i) {
-        Segment& s = view.segments[i];
-        s.residual_px =
-            std::sqrt(0.5 * (std::pow(n.dot(s.a - mean), 2) + std::pow(n.dot(s.b - mean), 2)));
-        weight[i] = s.length * std::min(1.0, options.huber_px / std::max(s.residual_px, 1e-9));
-      }
-    }
-    return true;
   }
 
   // The distorted pixel of an ideal one.
@@ -282,6 +334,127 @@ struct BowTracker::State {
     }
   }
 
+  struct Refined {
+    bool ok = false;
+    Eigen::Vector3d frog, tip;
+    double ncc = 0;
+  };
+
+  // Step 4 (bow_pose_solver.h): the pose from all views at once, from the prediction and
+  // from step 3's estimate (`first`), coarse to fine; the lower final cost wins. The terms
+  // depend on the prediction only, so both starts solve the same problem. ok: the
+  // texture at the result matches the labelled frame's (NCC >= min_ncc) in two views.
+  Refined Refine(const std::vector<cv::Mat>& images,
+                 const std::vector<Eigen::Vector2d>& line_point,
+                 const std::vector<Eigen::Vector2d>& line_direction,
+                 const std::vector<double>& line_weight,
+                 const Eigen::Vector3d& frog_p,
+                 const Eigen::Vector3d& tip_p,
+                 const std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& first,
+                 const std::optional<Eigen::Vector3d>& hand,
+                 bool motion_prior) {
+    const int n = static_cast<int>(views.size());
+    std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> sticks{{frog_p, tip_p}};
+    if (first) sticks.push_back(*first);
+    const std::vector<double> sigmas = BlurSigmas();
+    ParallelFor(
+        n,
+        options.num_threads,
+        [&](int64_t v, int) {
+          View& view = views[v];
+          view.blurred.clear();
+          view.box = cv::Rect();
+          if (images[v].empty()) return;
+          view.box = RefineBox(view, sticks, images[v]);
+          if (view.box.empty()) return;
+          for (const double sigma : sigmas)
+            view.blurred.push_back(Blurred(images[v], view.box, sigma));
+        },
+        1);
+    const Eigen::Vector3d d_p = (tip_p - frog_p).normalized();
+    std::vector<std::vector<BowViewTerms>> terms(sigmas.size());
+    for (size_t l = 0; l < sigmas.size(); ++l)
+      for (int v = 0; v < n; ++v) {
+        const View& view = views[v];
+        BowViewTerms t;
+        t.camera = &view.camera;
+        t.line_point = line_point[v];
+        t.line_direction = line_direction[v];
+        t.line_weight = line_weight[v];
+        if (!view.blurred.empty()) {
+          const cv::Mat& b = view.blurred[l];
+          t.image = b.ptr<float>(0);
+          t.rows = b.rows;
+          t.cols = b.cols;
+          t.x0 = view.box.x;
+          t.y0 = view.box.y;
+          // Samples seen in the labelled frame and, at the prediction, inside the box.
+          const std::vector<double> at_prediction =
+              SampleStick(view.camera, t.image, t.rows, t.cols, t.x0, t.y0, frog_p, d_p, u);
+          for (size_t k = 0; k < u.size(); ++k) {
+            if (!std::isfinite(view.label_values[l][k]) || !std::isfinite(at_prediction[k]))
+              continue;
+            t.u.push_back(u[k]);
+            t.value.push_back(view.label_values[l][k]);
+          }
+          if (t.u.size() < u.size() / 4) {
+            t.image = nullptr;
+            t.u.clear();
+            t.value.clear();
+          }
+        }
+        terms[l].push_back(std::move(t));
+      }
+    std::vector<BowPointPrior> priors;
+    if (motion_prior) {
+      priors.push_back({0, frog_p, options.motion_sigma_mm});
+      priors.push_back({length, tip_p, options.motion_sigma_mm});
+    }
+    if (hand) priors.push_back({0, *hand, options.hand_sigma_mm});
+    BowSolveOptions so;
+    so.line_sigma_px = options.line_sigma_px;
+    so.intensity_sigma = options.intensity_sigma;
+    std::optional<BowPose> best;
+    for (const auto& [f, t] : sticks) {
+      BowPose pose;
+      pose.frog = f;
+      pose.direction = (t - f).normalized();
+      for (size_t l = 0; l < sigmas.size(); ++l) {
+        pose = SolveBowPose(terms[l], priors, length, pose, so);
+        if (!pose.usable) break;
+      }
+      if (pose.usable && (!best || pose.cost < best->cost)) best = pose;
+    }
+    Refined out;
+    if (!best) return out;
+    out.frog = best->frog;
+    out.tip = best->frog + length * best->direction;
+    // The check: the fine level's texture at the result against the labelled frame's.
+    double sum = 0;
+    int matched = 0;
+    for (int v = 0; v < n; ++v) {
+      const BowViewTerms& t = terms.back()[v];
+      if (t.image == nullptr) continue;
+      const std::vector<double> now = SampleStick(
+          views[v].camera, t.image, t.rows, t.cols, t.x0, t.y0, out.frog, best->direction, u);
+      std::vector<double> a, b;
+      for (size_t k = 0; k < u.size(); ++k) {
+        if (!std::isfinite(now[k]) || !std::isfinite(views[v].label_values.back()[k])) continue;
+        a.push_back(views[v].label_values.back()[k]);
+        b.push_back(now[k]);
+      }
+      int count = 0;
+      const double c = Ncc(a, b, 0, &count);
+      if (count >= static_cast<int>(u.size() / 4) && c >= options.min_ncc) {
+        sum += c;
+        ++matched;
+      }
+    }
+    out.ok = matched >= 2;
+    out.ncc = matched > 0 ? sum / matched : 0;
+    return out;
+  }
+
   TrackFrame Output(bool ok, double ncc) {
     TrackFrame r;
     r.pose_ok = ok;
@@ -295,7 +468,7 @@ struct BowTracker::State {
       report.tracked = static_cast<int>(v.segments.size());
       report.inliers = 0;
       double sum2 = 0;
-      for (const Segment& s : v.segments) {
+      for (const StickSegment& s : v.segments) {
         if (s.residual_px > 3 * options.huber_px) continue;
         ++report.inliers;
         sum2 += s.residual_px * s.residual_px;
@@ -342,6 +515,7 @@ BowTracker::BowTracker(std::vector<Camera> cameras,
   st.margin = static_cast<int>(std::ceil(st.options.profile_margin * st.length));
   st.slide = static_cast<int>(std::ceil(options.slide_search_mm));
   st.samples = static_cast<int>(std::floor(st.length)) + 1 + 2 * st.margin;
+  for (double u = 0; u <= st.length + 1e-9; u += options.sample_step_mm) st.u.push_back(u);
   for (Camera& c : cameras) {
     View v;
     v.camera = std::move(c);
@@ -352,8 +526,17 @@ BowTracker::BowTracker(std::vector<Camera> cameras,
 BowTracker::~BowTracker() = default;
 BowTracker::BowTracker(BowTracker&&) noexcept = default;
 
-TrackFrame BowTracker::Start(const std::vector<const media::Image*>& frames) {
+TrackFrame BowTracker::Start(const std::vector<const media::Image*>& frames,
+                             const std::vector<Eigen::Vector2d>* right_hand) {
   State& st = *state_;
+  st.hand_along = 0;
+  st.hand_across = Eigen::Vector3d::Zero();
+  if (right_hand != nullptr) {
+    if (const auto hand = TriangulateRays(st.views, *right_hand)) {
+      st.hand_along = (*hand - st.frog0).dot(st.direction0);
+      st.hand_across = *hand - st.frog0 - st.hand_along * st.direction0;
+    }
+  }
   const int n = static_cast<int>(st.views.size());
   ParallelFor(
       n,
@@ -363,17 +546,40 @@ TrackFrame BowTracker::Start(const std::vector<const media::Image*>& frames) {
         view.label_image = AsMat(*frames[v]).clone();
         st.Profile(
             view, view.label_image, st.frog0, st.direction0, -st.margin, st.samples, &view.profile);
+        view.label_values.clear();
+        const cv::Rect all(0, 0, view.label_image.cols, view.label_image.rows);
+        for (const double sigma : st.BlurSigmas()) {
+          const cv::Mat b = State::Blurred(view.label_image, all, sigma);
+          view.label_values.push_back(SampleStick(
+              view.camera, b.ptr<float>(0), b.rows, b.cols, 0, 0, st.frog0, st.direction0, st.u));
+        }
       },
       1);
   return st.Output(true, 1);
 }
 
 TrackFrame BowTracker::Next(const std::vector<const media::Image*>& frames,
-                            const std::vector<std::vector<Eigen::Vector2d>>* labels) {
+                            const std::vector<std::vector<Eigen::Vector2d>>* labels,
+                            const std::vector<Eigen::Vector2d>* right_hand) {
   State& st = *state_;
   const int n = static_cast<int>(st.views.size());
-  const Eigen::Vector3d frog_p = st.frog + st.frog_velocity;
-  const Eigen::Vector3d tip_p = st.tip + st.tip_velocity;
+  Eigen::Vector3d frog_p = st.frog + st.frog_velocity;
+  Eigen::Vector3d tip_p = st.tip + st.tip_velocity;
+  // The right hand holds the frog: seen in two views, it re-places a prediction that
+  // went astray (or follows a lost frame) and is a prior on the frog below.
+  std::optional<Eigen::Vector3d> hand;
+  bool moved_to_hand = false;  // then the motion prior is no prior: left out
+  if (right_hand != nullptr) hand = TriangulateRays(st.views, *right_hand);
+  if (hand) {
+    // The frog the hand implies, at its labelled-frame offset along the predicted axis.
+    const Eigen::Vector3d d = (tip_p - frog_p).normalized();
+    *hand -= st.hand_along * d + st.hand_across;
+    if (!st.last_ok || (frog_p - *hand).norm() > st.options.hand_reacquire_mm) {
+      tip_p += *hand - frog_p;
+      frog_p = *hand;
+      moved_to_hand = true;
+    }
+  }
   std::vector<cv::Mat> images(n);
   for (int v = 0; v < n; ++v)
     if (frames[v] != nullptr) images[v] = AsMat(*frames[v]);
@@ -403,8 +609,10 @@ TrackFrame BowTracker::Next(const std::vector<const media::Image*>& frames,
   // coincide (its depth is then unknown).
   std::vector<Eigen::Vector2d> line_point(n), line_direction(n);
   std::vector<char> has_line(n, 0);
+  std::vector<double> line_weight(n, 0);
   for (int v = 0; v < n; ++v)
-    has_line[v] = st.FitLine(st.views[v], &line_point[v], &line_direction[v]);
+    has_line[v] =
+        FitStickLine(&st.views[v].segments, &line_point[v], &line_direction[v], &line_weight[v]);
   // Per view: the profile's best shift (+-slide_search_mm around the prediction).
   const int range = st.slide;
   std::vector<double> view_ncc(n, 0), view_shift(n, 0);
@@ -485,6 +693,29 @@ TrackFrame BowTracker::Next(const std::vector<const media::Image*>& frames,
     ok = true;
     ncc = ncc_sum / matched;
   }
+  if (st.options.refine) {
+    const auto refined = st.Refine(
+        images,
+        line_point,
+        line_direction,
+        line_weight,
+        frog_p,
+        tip_p,
+        ok ? std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>>(std::make_pair(frog, tip))
+           : std::nullopt,
+        hand,
+        !moved_to_hand);
+    if (refined.ok) {
+      frog = refined.frog;
+      tip = refined.tip;
+      ok = true;
+      ncc = refined.ncc;
+    } else {
+      ok = false;
+      frog = frog_p;
+      tip = tip_p;
+    }
+  }
   // Labels of this frame (two views) override the estimate.
   if (labels != nullptr) {
     FrameLabels l{{"frog", "tip"}, *labels};
@@ -508,6 +739,7 @@ TrackFrame BowTracker::Next(const std::vector<const media::Image*>& frames,
   }
   st.frog = frog;
   st.tip = tip;
+  st.last_ok = ok;
   return st.Output(ok, ncc);
 }
 
