@@ -89,16 +89,16 @@ check 'grep -q "warning: label \"chin\" is not a point of the cello" err.txt' "n
 check '[ -f cap/keypoints2d.npy ] && grep -q "arco-track-report" cap/track.json' "outputs missing"
 check 'grep -q "keypoints2d.npy" cap/capture.json && grep -q "spd_cello" cap/capture.json' \
   "capture.json does not name the keypoints"
-"$arco" track cap --labels front=front.json --labels side=far.json >/dev/null 2>err.txt
-check '! grep -q tip_plate err.txt && grep -q "the bow is not tracked (experimental: --bow)" err.txt' \
+"$arco" track cap --labels front=front.json --labels side=far.json --no-bow >/dev/null 2>err.txt
+check '! grep -q tip_plate err.txt && grep -q "the bow is not tracked (--no-bow)" err.txt' \
   "the bow's label was warned about: $(cat err.txt)"
 check 'grep -A1 "\"tracked_points\"" cap/track.json | grep -q "\"scroll_top\""' \
   "track.json lacks the tracked points"
-"$arco" track cap --labels front=front.json --labels side=far.json --bow >/dev/null 2>err.txt
+"$arco" track cap --labels front=front.json --labels side=far.json >/dev/null 2>err.txt
 check 'grep -q "the bow is not tracked (its frog and tip need labels in two views of frame 1)" err.txt' \
   "no warning for a bow labelled in one view: $(cat err.txt)"
-# The bow labelled in both views with --bow: tracked as its own thin body, no warning.
-"$arco" track cap --labels front=bowfront.json --labels side=bowside.json --bow >out.txt 2>err.txt
+# The bow labelled in both views: tracked (the default) as its own thin body, no warning.
+"$arco" track cap --labels front=bowfront.json --labels side=bowside.json >out.txt 2>err.txt
 check '[ ! -s err.txt ] && grep -q "\"bow_tracked\": true" cap/track.json' \
   "the bow was not tracked: $(cat err.txt)"
 check 'grep -q "of which the bow .* ms per view-frame; the right hand seen in 0 frames" out.txt' \

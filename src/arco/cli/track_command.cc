@@ -18,7 +18,7 @@ namespace {
 
 inline constexpr FieldFlag kTrackFlags[] = {{"num_threads", "--threads"},
                                             {"labels_frame", "--labels-frame"},
-                                            {"track_bow", "--bow"},
+                                            {"track_bow off", "--no-bow"},
                                             {"max_features_per_view", "--max-features"},
                                             {"keyframe_interval", "--keyframe-interval"},
                                             {"inlier_px", "--inlier-px"}};
@@ -132,11 +132,12 @@ std::function<int()> SetupTrack(CLI::App& app) {
             "A tracked corner farther than this from the pose's projection is an outlier",
             AboveZero(1000))
       ->capture_default_str();
-  sub->add_flag("--bow",
+  sub->add_flag("--bow,!--no-bow",
                 a->o.track_bow,
-                "Experimental: also track the bow from its frog and tip labels, as a thin line of "
-                "fixed length posed from all views at once, the right hand (from `arco detect`) "
-                "as its frog's prior (tested on synthetic renders only; docs/track.md)");
+                "Track the bow from its frog and tip labels (the default when both are labelled "
+                "in two views), as a thin line of fixed length posed from all views at once, "
+                "the right hand (from `arco detect`) as its frog's prior; --no-bow keeps the "
+                "bow's slots as they were (docs/track.md)");
   sub->parse_complete_callback([a] { ApplyAndValidate(*a); });
   return [a]() { return RunTrack(*a); };
 }

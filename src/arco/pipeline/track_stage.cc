@@ -341,7 +341,7 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   std::optional<track::RigidTemplate> bow_body;
   if (!bow_names.empty() && !options.track_bow) {
     summary.warnings.push_back(
-        "the bow is not tracked (experimental: track_bow): its points are kept as they were");
+        "the bow is not tracked (track_bow off): its points are kept as they were");
   } else if (!bow_names.empty()) {
     track::FrameLabels bow_frame_labels{bow_names, bow_labelled[template_frame]};
     auto bow = track::TriangulateTemplate(cameras, bow_frame_labels, 10, /*thin=*/true);

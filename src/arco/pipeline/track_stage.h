@@ -36,13 +36,13 @@ struct TrackStageOptions {
   int64_t labels_frame = -1;                // -1: the capture's first frame
   track::InstrumentTrackerOptions tracker;  // its num_threads is num_threads below
   int num_threads = 0;                      // 0 = all cores; results do not depend on it
-  // Experimental: the bow as a thin rigid body of fixed length from its frog and tip
-  // labels (track/bow_tracker.h: line segments, the profile along the stick, the pose
-  // from all views at once, the right hand as the frog's prior). It meets issue 13's
-  // bound on synthetic scenes (pipeline_track_plane_test, pipeline_track_bow_test) but
-  // has not been measured on real footage, so it is off by default and the bow's slots
-  // are kept.
-  bool track_bow = false;
+  // The bow as a thin rigid body of fixed length from its frog and tip labels
+  // (track/bow_tracker.h: line segments, the profile along the stick, the pose from all
+  // views at once, the right hand as the frog's prior), when both are labelled in two
+  // views. Measured on synthetic renders (pipeline_track_plane_test,
+  // pipeline_track_bow_test: 0.24 mm median against issue 13's 8 mm), not yet on real
+  // footage (docs/track.md). false: the bow's slots keep what the file held.
+  bool track_bow = true;
   track::BowTrackerOptions bow;  // its num_threads is num_threads above
   // The right hand (keypoints2d.npy's right_hand slots from `arco detect`) is the bow's
   // prior on the frog in a view when this many of its points score at least
