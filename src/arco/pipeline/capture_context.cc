@@ -40,4 +40,11 @@ StatusOr<CaptureContext> OpenCapture(const std::string& capture_dir) {
   return c;
 }
 
+StatusOr<std::shared_ptr<const NpyArray<double>>> ReadKeypoints2d(const CaptureContext& capture) {
+  if (capture.keypoints2d) return capture.keypoints2d;
+  ARCO_ASSIGN_OR_RETURN(NpyArray<double> k,
+                        ReadCaptureKeypoints2d(capture.capture_dir, capture.manifest));
+  return std::make_shared<const NpyArray<double>>(std::move(k));
+}
+
 }  // namespace arco::pipeline

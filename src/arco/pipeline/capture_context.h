@@ -8,6 +8,7 @@
 #include "arco/instrument/instrument_model.h"
 #include "arco/mocap/capture.h"
 #include "arco/registry/keypoint_layout.h"
+#include "arco/util/npy.h"
 #include "arco/util/status.h"
 
 namespace arco::pipeline {
@@ -17,7 +18,14 @@ struct CaptureContext {
   CaptureManifest manifest;
   KeypointLayout layout;
   std::shared_ptr<const InstrumentModel> instrument;
+  // keypoints2d.npy as doubles, once read (PreflightRun reads it, and `arco run`'s stages
+  // use it instead of reading the file again: 2 x 59 MB for a one-minute 20-camera take);
+  // null: not read yet (ReadKeypoints2d reads the file).
+  std::shared_ptr<const NpyArray<double>> keypoints2d;
 };
+
+// capture.keypoints2d when set, else the file read (ReadCaptureKeypoints2d).
+StatusOr<std::shared_ptr<const NpyArray<double>>> ReadKeypoints2d(const CaptureContext& capture);
 
 // Errors name capture.json: an unreadable manifest, no instrument ("none"), a layout
 // without the instrument's points or without whole-body hands.

@@ -72,7 +72,9 @@ StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
     camera.cam_from_world_translation /= s;
     cameras.push_back(camera);
   }
-  ARCO_ASSIGN_OR_RETURN(NpyArray<double> k2d, ReadCaptureKeypoints2d(capture.capture_dir, m));
+  ARCO_ASSIGN_OR_RETURN(const std::shared_ptr<const NpyArray<double>> k2d_read,
+                        ReadKeypoints2d(capture));
+  const NpyArray<double>& k2d = *k2d_read;
   const int64_t frames = points.shape[0];
   const int64_t views = static_cast<int64_t>(cameras.size());
   std::vector<hand::HandPointsMm> left(static_cast<size_t>(frames));

@@ -138,7 +138,9 @@ Status CheckTriangulationFilters(const TriangulateStageOptions& options,
 
 Status CheckCaptureInstrumentPoints(const CaptureContext& capture) {
   const CaptureManifest& m = capture.manifest;
-  ARCO_ASSIGN_OR_RETURN(const NpyArray<double> k, ReadCaptureKeypoints2d(capture.capture_dir, m));
+  ARCO_ASSIGN_OR_RETURN(const std::shared_ptr<const NpyArray<double>> read,
+                        ReadKeypoints2d(capture));
+  const NpyArray<double>& k = *read;
   const InstrumentModel& model = *capture.instrument;
   std::vector<int> ends;
   for (const int i : {model.nut_l(), model.nut_r(), model.bridge_l(), model.bridge_r()}) {
@@ -174,6 +176,8 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
   const CaptureManifest& m = capture.manifest;
   ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(options.capture_dir, m));
   ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(options.capture_dir, m));
+  // Read once here; the stages of the run use it (CaptureContext::keypoints2d).
+  ARCO_ASSIGN_OR_RETURN(capture.keypoints2d, ReadKeypoints2d(capture));
   ARCO_RETURN_IF_ERROR(CheckCaptureInstrumentPoints(capture));
   ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(
       options.ForTriangulate(), capture.layout, m.fps, ManifestPath(options.capture_dir)));

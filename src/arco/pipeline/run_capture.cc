@@ -1,6 +1,7 @@
 #include "arco/pipeline/run_capture.h"
 
 #include <chrono>
+#include <utility>
 
 #include "arco/pipeline/capture_context.h"
 #include "arco/pipeline/preflight.h"
@@ -91,7 +92,7 @@ namespace {
 
 // Every stage, in order, into options.result_dir.
 StatusOr<RunSummary> RunStages(const RunOptions& options,
-                               const CaptureContext& capture,
+                               CaptureContext capture,
                                Progress& progress) {
   RunSummary summary;
   auto stage = [&](int index, const char* name) {
@@ -101,7 +102,7 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
 
   auto start = stage(1, "triangulate");
   ARCO_ASSIGN_OR_RETURN(summary.triangulate,
-                        RunTriangulateStage(options.ForTriangulate(), progress));
+                        RunTriangulateStage(options.ForTriangulate(), progress, capture.keypoints2d));
   summary.timings.push_back({"triangulate", SecondsSince(start)});
 
   start = stage(2, "instrument");
@@ -113,6 +114,7 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
   start = stage(3, "hands");
   ARCO_ASSIGN_OR_RETURN(summary.hands, RunHandStage(options.ForHands(), capture, progress));
   summary.timings.push_back({"hands", SecondsSince(start)});
+  capture.keypoints2d.reset();  // the last stage that reads the 2D keypoints
   Append(&summary.warnings, summary.hands.warnings);
 
   start = stage(4, "pitch");
@@ -144,7 +146,7 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
 
 StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
   // Every input checked before the first stage (and before the result folder exists).
-  ARCO_ASSIGN_OR_RETURN(const CaptureContext capture, PreflightRun(options));
+  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, PreflightRun(options));
   // The stages fill a hidden temporary result folder, moved into place once all are done:
   // a failed run leaves no result folder and an old one as it was.
   RunSummary summary;
@@ -152,7 +154,7 @@ StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
       options.result_dir, options.Replace(), [&](const std::string& tmp_dir) -> Status {
         RunOptions staged = options;
         staged.result_dir = tmp_dir;
-        StatusOr<RunSummary> ran = RunStages(staged, capture, progress);
+        StatusOr<RunSummary> ran = RunStages(staged, std::move(capture), progress);
         if (!ran.ok()) {
           // Messages name the result folder the user gave, not its temporary.
           std::string message = ran.status().message();

@@ -26,8 +26,10 @@ Json ToJson(const TriangulateStageOptions& o) {
   return j;
 }
 
-StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOptions& o,
-                                                      Progress& progress) {
+StatusOr<TriangulateStageSummary> RunTriangulateStage(
+    const TriangulateStageOptions& o,
+    Progress& progress,
+    std::shared_ptr<const NpyArray<double>> keypoints2d) {
   ARCO_RETURN_IF_ERROR(o.Validate());
   ARCO_RETURN_IF_ERROR(ResultFolder(o.result_dir).CheckWritable());  // before the work
   ARCO_ASSIGN_OR_RETURN(CaptureManifest manifest, ReadCaptureManifest(o.capture_dir));
@@ -48,8 +50,11 @@ StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOpti
   ARCO_ASSIGN_OR_RETURN(
       const std::vector<int> view_to_camera,
       MatchCaptureCameras(o.capture_dir, manifest, calibration->rig, calibration_path));
-  ARCO_ASSIGN_OR_RETURN(NpyArray<double> keypoints,
-                        ReadCaptureKeypoints2d(o.capture_dir, manifest));
+  if (!keypoints2d) {
+    ARCO_ASSIGN_OR_RETURN(NpyArray<double> read, ReadCaptureKeypoints2d(o.capture_dir, manifest));
+    keypoints2d = std::make_shared<const NpyArray<double>>(std::move(read));
+  }
+  const NpyArray<double>& keypoints = *keypoints2d;
   progress.SetTotal(manifest.frame_count);
   ARCO_ASSIGN_OR_RETURN(
       SequenceTriangulation raw,

@@ -2,6 +2,7 @@
 // RESULT_DIR/triangulation/ (pipeline/result_folder.h). Also `arco triangulate CAPTURE`.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "arco/mocap/triangulate_sequence.h"
 #include "arco/pipeline/summaries.h"
 #include "arco/util/json_io.h"
+#include "arco/util/npy.h"
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
 
@@ -30,8 +32,11 @@ struct TriangulateStageOptions {
 Json ToJson(const TriangulateStageOptions& options);
 
 // Reads CAPTURE_DIR, triangulates every frame, filters, writes RESULT_DIR. Progress: the
-// total is the frame count, advanced per frame from worker threads.
-StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOptions& options,
-                                                      Progress& progress = NoProgress());
+// total is the frame count, advanced per frame from worker threads. keypoints2d: the
+// capture's keypoints2d.npy already read (`arco run` reads it once); null: read here.
+StatusOr<TriangulateStageSummary> RunTriangulateStage(
+    const TriangulateStageOptions& options,
+    Progress& progress = NoProgress(),
+    std::shared_ptr<const NpyArray<double>> keypoints2d = nullptr);
 
 }  // namespace arco::pipeline
