@@ -14,13 +14,13 @@
 
 #include <chrono>
 #include <ctime>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "arco/media/video_reader.h"
 #include "arco/mocap/labelme.h"
 #include "arco/registry/keypoint_layout.h"
+#include "arco/synth/plane_bow.h"
 #include "arco/synth/plane_scene.h"
 #include "arco/track/bow_tracker.h"
 #include "arco/track/instrument_tracker.h"
@@ -153,31 +153,10 @@ const BowScene& GetBowScene() {
     cello.width_mm = cello.image.width * 0.778;
     cello.height_mm = cello.image.height * 0.778;
     synth::BuildMipmaps(&cello);
-    synth::PlaneTexture bow;
-    bow.image = media::MakeImage(720, 24, media::PixelFormat::kGray8);
-    std::mt19937 rng(7);
-    std::uniform_int_distribution<int> grey(40, 220);
-    for (int by = 0; by < 24; by += 6)
-      for (int bx = 0; bx < 720; bx += 6) {
-        const uint8_t g = static_cast<uint8_t>(grey(rng));
-        for (int y = by; y < by + 6; ++y)
-          for (int x = bx; x < bx + 6; ++x) bow.image.row(y)[x] = g;
-      }
-    bow.width_mm = 720;
-    bow.height_mm = 24;
-    synth::BuildMipmaps(&bow);
-    std::vector<Rigid3d> poses;
-    const Eigen::Quaterniond rest = synth::PlaneRestPose().rotation;
-    for (int f = 0; f < kFrames; ++f) {
-      const double t = f / 30.0;
-      const double crossing = 10 * M_PI / 180 * std::sin(2 * M_PI * 0.35 * t);
-      const Eigen::Quaterniond turn(Eigen::AngleAxisd(crossing, Eigen::Vector3d::UnitY()));
-      const double stroke = 200 * std::sin(2 * M_PI * 0.7 * t);
-      poses.emplace_back(
-          turn * rest, Eigen::Vector3d(0, -200, -150) + stroke * (turn * Eigen::Vector3d::UnitX()));
-    }
-    s.frog = synth::PlaneToWorld(poses[0], synth::TexturePixelToPlane(bow, {20, 11.5}));
-    s.tip = synth::PlaneToWorld(poses[0], synth::TexturePixelToPlane(bow, {700, 11.5}));
+    const synth::PlaneTexture bow = synth::MakeBowTexture();
+    const std::vector<Rigid3d> poses = synth::MakeBowingMotion(kFrames);
+    s.frog = synth::PlaneToWorld(poses[0], synth::TexturePixelToPlane(bow, synth::kBowFrogPx));
+    s.tip = synth::PlaneToWorld(poses[0], synth::TexturePixelToPlane(bow, synth::kBowTipPx));
     synth::PlaneRigOptions rig;
     rig.cameras = 6;
     rig.width = 768;

@@ -29,6 +29,7 @@
 #include "arco/pipeline/track_stage.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/registry/keypoint_layout.h"
+#include "arco/synth/plane_bow.h"
 #include "arco/synth/plane_scene.h"
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
@@ -89,42 +90,11 @@ void MovingBow(bool plain_stick, bool with_hand_too) {
   motion.max_translation_mm = 40;
   motion.max_rotation_deg = 4;
   const std::vector<Rigid3d> world_from_cello = synth::MakePlaneMotion(motion);
-  // The bow: random 6 mm blocks on a 720 x 24 mm strip, or a plain stick (grey 120, the
-  // frog black over 60 mm with a light 10 mm eye, the last 25 mm white); frog and tip on
-  // its axis.
-  synth::PlaneTexture bow;
-  bow.image = media::MakeImage(720, 24, media::PixelFormat::kGray8);
-  std::mt19937 rng(7);
-  std::uniform_int_distribution<int> grey(40, 220);
-  for (int by = 0; by < 24; by += 6)
-    for (int bx = 0; bx < 720; bx += 6) {
-      const uint8_t g = static_cast<uint8_t>(grey(rng));
-      for (int y = by; y < by + 6; ++y)
-        for (int x = bx; x < bx + 6; ++x) bow.image.row(y)[x] = g;
-    }
-  if (plain_stick) {
-    for (int y = 0; y < 24; ++y)
-      for (int x = 0; x < 720; ++x) {
-        uint8_t g = 120;
-        if (x < 60) g = (std::abs(x - 35) < 5 && std::abs(y - 12) < 5) ? 220 : 30;
-        if (x >= 695) g = 235;
-        bow.image.row(y)[x] = g;
-      }
-  }
-  bow.width_mm = 720;
-  bow.height_mm = 24;
-  synth::BuildMipmaps(&bow);
-  const Eigen::Vector2d frog_px(20, 11.5), tip_px(700, 11.5);
-  std::vector<Rigid3d> world_from_bow;
-  const Eigen::Quaterniond rest = synth::PlaneRestPose().rotation;
-  for (int f = 0; f < kFrames; ++f) {
-    const double t = f / 30.0;
-    const double crossing = 10 * M_PI / 180 * std::sin(2 * M_PI * 0.35 * t);
-    const Eigen::Quaterniond turn(Eigen::AngleAxisd(crossing, Eigen::Vector3d::UnitY()));
-    const Eigen::Vector3d axis = turn * Eigen::Vector3d::UnitX();
-    const double stroke = 200 * std::sin(2 * M_PI * 0.7 * t);
-    world_from_bow.emplace_back(turn * rest, Eigen::Vector3d(0, -200, -150) + stroke * axis);
-  }
+  // The bow (synth/plane_bow.h): random 6 mm blocks on a 720 x 24 mm strip, or a plain
+  // stick; frog and tip on its axis; bowing strokes and string crossings.
+  const synth::PlaneTexture bow = synth::MakeBowTexture(plain_stick);
+  const Eigen::Vector2d frog_px = synth::kBowFrogPx, tip_px = synth::kBowTipPx;
+  const std::vector<Rigid3d> world_from_bow = synth::MakeBowingMotion(kFrames);
 
   // The right hand: a dark blob around the frog end, moving with the bow (its centre per
   // view and frame).
