@@ -142,7 +142,7 @@ std::function<int()> SetupView(CLI::App& app) {
             view::kViewVideoScaleRange)
       ->capture_default_str();
   a->options.cache_dir = view::DefaultVideoCacheDir();
-  cmd->add_option("--cache-dir",
+  auto* cache_dir = cmd->add_option("--cache-dir",
                   a->options.cache_dir,
                   "Cache of the encoded videos, reused while their inputs are unchanged "
                   "(default: $XDG_CACHE_HOME/arco/view, else ~/.cache/arco/view)");
@@ -153,7 +153,7 @@ std::function<int()> SetupView(CLI::App& app) {
             "Size of the video cache; the least recently used videos beyond it are removed",
             view::kViewCacheMaxGbRange)
       ->capture_default_str();
-  cmd->parse_complete_callback([a] {
+  cmd->parse_complete_callback([a, cache_dir] {
     if (a->no_serve && a->output.empty()) {
       throw CLI::ValidationError("--no-serve needs -o DIR");
     }
@@ -164,6 +164,9 @@ std::function<int()> SetupView(CLI::App& app) {
       throw CLI::ValidationError("--no-videos and --video-camera contradict each other");
     }
     a->options.videos = !a->no_videos;
+    if (a->no_cache && cache_dir->count() > 0) {
+      throw CLI::ValidationError("--no-cache and --cache-dir contradict each other");
+    }
     if (a->no_cache) a->options.cache_dir.clear();
     if (!a->no_cache && a->options.cache_dir.empty() && a->options.videos) {
       throw CLI::ValidationError(

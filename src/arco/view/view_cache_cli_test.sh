@@ -6,7 +6,7 @@
 # --video-scale, the source video) encodes again; a truncated entry or one without its
 # sidecar is encoded again; --no-cache writes no cache; --cache-max-gb 0 removes every
 # entry but the one in use; the default folder is $XDG_CACHE_HOME/arco/view; the result
-# folder is never written to. Bad cache options: one line "arco: error: ...", exit 1,
+# folder is never written to. Bad cache options (also --no-cache with --cache-dir): one line "arco: error: ...", exit 1,
 # nothing written. Skips (77) without ffmpeg unless CI is set.
 # usage: view_cache_cli_test.sh ARCO_BINARY SOURCE_DIR
 set -uo pipefail
@@ -77,7 +77,7 @@ key=$(ls "$cache" | grep '\.webm$' | sed 's/\.webm$//')
 
 # --no-cache: encoded, the cache untouched.
 cache_before=$(SNAPSHOT_DIR=$cache snapshot)
-view_page 1 0 "--no-cache" --cache-dir "$cache" --no-cache
+XDG_CACHE_HOME=$cache view_page 1 0 "--no-cache" --no-cache
 check 'grep -q "(no cache)" "$tmp/out"' "--no-cache: the summary names a cache"
 check '[ "$(SNAPSHOT_DIR=$cache snapshot)" = "$cache_before" ]' "--no-cache: the cache changed"
 # The default folder: $XDG_CACHE_HOME/arco/view.
@@ -129,6 +129,8 @@ bad "--cache-max-gb negative" "--cache-max-gb" view "$tmp/res" --no-serve -o "$t
   --cache-max-gb -1
 bad_at "unwritable cache" "/proc/arco-cache" view "$tmp/res" --no-serve -o "$tmp/w/out" \
   --cache-dir /proc/arco-cache
+bad "--no-cache with --cache-dir" "--no-cache and --cache-dir contradict" view "$tmp/res" \
+  --no-serve -o "$tmp/w/out" --no-cache --cache-dir "$tmp/w/cache"
 HOME= XDG_CACHE_HOME= bad "no cache folder" "--cache-dir: no cache folder" view "$tmp/res" \
   --no-serve -o "$tmp/w/out"
 exit $fail
