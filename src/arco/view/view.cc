@@ -373,8 +373,12 @@ StatusOr<std::vector<ViewVideo>> WriteVideos(const ViewOptions& options,
     const std::string path = JoinPath(dir, file);
     const auto start = std::chrono::steady_clock::now();
     ViewVideo video;
-    if (cache) {
-      ARCO_ASSIGN_OR_RETURN(const std::string key, VideoKey(options, header, capture, v, method));
+    // An input the key cannot read (a missing calibration or video): encoded uncached,
+    // so that the overlay itself reports what is wrong with the capture.
+    const StatusOr<std::string> keyed =
+        cache ? VideoKey(options, header, capture, v, method) : StatusOr<std::string>("");
+    if (cache && keyed.ok()) {
+      const std::string& key = *keyed;
       used.insert(key);
       std::optional<ViewVideo> hit = TakeCached(options.cache_dir, key, path);
       if (hit.has_value()) {

@@ -5,7 +5,7 @@
 # or --no-serve; a changed input that the overlay draws or encodes (points3d.npy, notes.csv,
 # --video-scale, the source video) encodes again; a truncated entry or one without its
 # sidecar is encoded again; --no-cache writes no cache; --cache-max-gb 0 removes every
-# entry but the one in use; the default folder is $XDG_CACHE_HOME/arco/view; the result
+# entry but the one in use; a missing source video is the overlay's own error; the default folder is $XDG_CACHE_HOME/arco/view; the result
 # folder is never written to. Bad cache options (also --no-cache with --cache-dir): one line "arco: error: ...", exit 1,
 # nothing written. Skips (77) without ffmpeg unless CI is set.
 # usage: view_cache_cli_test.sh ARCO_BINARY SOURCE_DIR
@@ -123,6 +123,17 @@ view_page 0 1 "--cache-max-gb 0" --cache-dir "$cache" --cache-max-gb 0
 check '[ "$(entries)" -eq 1 ] && [ "$before" -gt 1 ]' "--cache-max-gb 0: $before then $(entries) entries"
 check 'grep -q "$((before - 1)) cache entries removed" "$tmp/out"' "--cache-max-gb 0: $(grep videos: "$tmp/out")"
 view_page 0 1 "after eviction" --cache-dir "$cache"
+
+# A missing source video: the overlay's own error, as without the cache, nothing cached.
+mv "$tmp/cap/$cam.mp4" "$tmp/moved.mp4"
+before=$(SNAPSHOT_DIR=$cache snapshot)
+with=$("$arco" view "$tmp/res" --no-serve -o "$tmp/w/out" --cache-dir "$cache" 2>&1 >/dev/null)
+without=$("$arco" view "$tmp/res" --no-serve -o "$tmp/w/out" --no-cache 2>&1 >/dev/null)
+check '[[ "$with" == "arco: error: "*"$cam.mp4"* ]] && [ "$with" = "$without" ]' \
+  "missing video: '$with' with the cache, '$without' without"
+check '[ "$(SNAPSHOT_DIR=$cache snapshot)" = "$before" ] && [ ! -e "$tmp/w/out" ]' \
+  "missing video: something was written"
+mv "$tmp/moved.mp4" "$tmp/cap/$cam.mp4"
 
 # Bad cache options: one error line, nothing written.
 bad "--cache-max-gb negative" "--cache-max-gb" view "$tmp/res" --no-serve -o "$tmp/w/out" \
