@@ -142,10 +142,11 @@ std::function<int()> SetupView(CLI::App& app) {
             view::kViewVideoScaleRange)
       ->capture_default_str();
   a->options.cache_dir = view::DefaultVideoCacheDir();
-  auto* cache_dir = cmd->add_option("--cache-dir",
-                  a->options.cache_dir,
-                  "Cache of the encoded videos, reused while their inputs are unchanged "
-                  "(default: $XDG_CACHE_HOME/arco/view, else ~/.cache/arco/view)");
+  auto* cache_dir =
+      cmd->add_option("--cache-dir",
+                      a->options.cache_dir,
+                      "Cache of the encoded videos, reused while their inputs are unchanged "
+                      "(default: $XDG_CACHE_HOME/arco/view, else ~/.cache/arco/view)");
   cmd->add_flag("--no-cache", a->no_cache, "Encode the videos again and cache nothing");
   AddNumber(cmd,
             "--cache-max-gb",

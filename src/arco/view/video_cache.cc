@@ -63,7 +63,9 @@ Status HashWholeFile(Sha256& hash, const std::string& label, const std::string& 
 namespace {
 
 // Size, first and last `sample` bytes of one file.
-Status HashFileEnds(Sha256& hash, const std::string& label, const std::string& path,
+Status HashFileEnds(Sha256& hash,
+                    const std::string& label,
+                    const std::string& path,
                     int64_t sample) {
   std::ifstream in(path, std::ios::binary);
   std::error_code ec;

@@ -4,8 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <set>
 
@@ -208,16 +208,18 @@ StatusOr<std::string> VideoKey(const ViewOptions& options,
   char scale[40];
   std::snprintf(scale, sizeof(scale), "%.17g", options.video_scale);
   hash.AddField("scale", scale);
-  for (const std::string& sub : {std::string(), std::string(pipeline::kTriangulationStage),
-                                 std::string(pipeline::kInstrumentStage), method}) {
+  for (const std::string& sub : {std::string(),
+                                 std::string(pipeline::kTriangulationStage),
+                                 std::string(pipeline::kInstrumentStage),
+                                 method}) {
     const std::string dir = sub.empty() ? options.result_dir : JoinPath(options.result_dir, sub);
     for (const auto& file : FilesOf(dir, !sub.empty())) {
       ARCO_RETURN_IF_ERROR(
           HashWholeFile(hash, "result/" + JoinPath(sub, file), JoinPath(dir, file)));
     }
   }
-  ARCO_RETURN_IF_ERROR(HashWholeFile(
-      hash, "capture.json", JoinPath(header.capture_dir, kCaptureManifestName)));
+  ARCO_RETURN_IF_ERROR(
+      HashWholeFile(hash, "capture.json", JoinPath(header.capture_dir, kCaptureManifestName)));
   ARCO_RETURN_IF_ERROR(HashWholeFile(
       hash, "calibration", ResolveCapturePath(header.capture_dir, capture.calibration)));
   const std::string& video = capture.cameras[v].video;
@@ -288,8 +290,7 @@ StatusOr<ViewVideo> EncodeIntoCache(const exporter::OverlayOptions& overlay,
   const VideoCacheEntry entry = CacheEntryPaths(cache_dir, key);
   // Hidden (never taken as an entry) and this process's own: two viewers encoding the
   // same key each write their temporary and the last rename wins, with the same bytes.
-  const std::string tmp =
-      JoinPath(cache_dir, "." + key + "-" + std::to_string(getpid()) + ".webm");
+  const std::string tmp = JoinPath(cache_dir, "." + key + "-" + std::to_string(getpid()) + ".webm");
   auto written = exporter::WriteOverlay(overlay, tmp, entry.video);
   std::error_code ec;
   if (!written.ok()) {
@@ -655,9 +656,9 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
   }
   if (!overlay_method.empty()) {
     ARCO_ASSIGN_OR_RETURN(
-        summary.videos,
-        WriteVideos(options, header, overlay_method, dir, &summary.cache_evicted));
-    for (const auto& v : summary.videos) ++(v.cached ? summary.videos_cached : summary.videos_encoded);
+        summary.videos, WriteVideos(options, header, overlay_method, dir, &summary.cache_evicted));
+    for (const auto& v : summary.videos)
+      ++(v.cached ? summary.videos_cached : summary.videos_encoded);
   } else if (!options.video_cameras.empty()) {
     return Status::Error(folder.ManifestPath() +
                          ": no refined method (arco, paper, vision) to draw over the videos");

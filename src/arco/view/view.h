@@ -60,8 +60,8 @@ struct ViewVideo {
   std::string method;  // whose overlay is drawn
   int width = 0, height = 0;
   int64_t frames = 0;
-  double seconds = 0;  // the time it took to write
-  bool cached = false;  // copied from the cache (not encoded)
+  double seconds = 0;     // the time it took to write
+  bool cached = false;    // copied from the cache (not encoded)
   std::string cache_key;  // the SHA-256 key ("" : no cache)
 };
 

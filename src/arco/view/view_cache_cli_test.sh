@@ -2,12 +2,13 @@
 # `arco view`'s video cache (docs/view.md, "Video cache") on a synthetic capture given a
 # small video for one camera: a second start with the same inputs takes the cached WebM
 # (the summary line counts 0 encoded, 1 from the cache; the bytes are the first's), served
-# or --no-serve; a changed input that the overlay draws or encodes (points3d.npy, notes.csv,
-# --video-scale, the source video) encodes again; a truncated entry or one without its
-# sidecar is encoded again; --no-cache writes no cache; --cache-max-gb 0 removes every
-# entry but the one in use; a missing source video is the overlay's own error; the default folder is $XDG_CACHE_HOME/arco/view; the result
-# folder is never written to. Bad cache options (also --no-cache with --cache-dir): one line "arco: error: ...", exit 1,
-# nothing written. Skips (77) without ffmpeg unless CI is set.
+# or --no-serve; a changed input that the overlay draws or encodes (points3d.npy,
+# notes.csv, --video-scale, the source video) encodes again; a truncated entry or one
+# without its sidecar is encoded again; --no-cache writes no cache; --cache-max-gb 0
+# removes every entry but the one in use; a missing source video is the overlay's own
+# error; the default folder is $XDG_CACHE_HOME/arco/view; the result folder is never
+# written to. Bad cache options (also --no-cache with --cache-dir): one line
+# "arco: error: ...", exit 1, nothing written. Skips (77) without ffmpeg unless CI is set.
 # usage: view_cache_cli_test.sh ARCO_BINARY SOURCE_DIR
 set -uo pipefail
 arco=$1
