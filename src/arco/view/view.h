@@ -16,7 +16,8 @@
 // Videos: the capture's camera videos, each written with the overlay of the page's first
 // method (exporter::WriteOverlay: skeleton, strings, contact, finger numbers, note) as
 // video_<camera index>.webm (VP8, which every browser plays), one frame per result frame
-// at the capture's fps, so frame k of the page is the video's k / fps too.
+// at the capture's fps, so frame k of the page is the video's k / fps too. Each is taken
+// from the cache (video_cache.h) when its inputs are those of an earlier encode.
 #pragma once
 
 #include <cstdint>
