@@ -8,6 +8,7 @@
 #include "arco/cli/number_option.h"
 #include "arco/util/output_set.h"
 #include "arco/view/server.h"
+#include "arco/view/video_cache.h"
 #include "arco/view/view.h"
 
 namespace arco::cli {
@@ -20,6 +21,7 @@ struct Args {
   bool no_serve = false;
   bool overwrite = false;
   bool no_videos = false;
+  bool no_cache = false;
   std::string output;
 };
 
@@ -39,14 +41,22 @@ void PrintShown(const Args& a, const view::ViewSummary& summary) {
               summary.audio.empty() ? "none" : summary.audio.c_str(),
               summary.bytes / 1e6);
   for (const auto& v : summary.videos) {
-    std::printf("arco view: video of %s (%dx%d, %lld frames, %s overlay, %s) written in %.1f s\n",
+    std::printf("arco view: video of %s (%dx%d, %lld frames, %s overlay, %s) %s in %.1f s\n",
                 v.camera.c_str(),
                 v.width,
                 v.height,
                 static_cast<long long>(v.frames),
                 v.method.c_str(),
                 v.source.empty() ? "no video: black" : v.source.c_str(),
+                v.cached ? "taken from the cache" : "encoded",
                 v.seconds);
+  }
+  if (!summary.videos.empty()) {
+    std::printf("arco view: videos: %d encoded, %d from the cache (%s), %d cache entries removed\n",
+                summary.videos_encoded,
+                summary.videos_cached,
+                a.options.cache_dir.empty() ? "no cache" : a.options.cache_dir.c_str(),
+                summary.cache_evicted);
   }
 }
 
@@ -131,7 +141,20 @@ std::function<int()> SetupView(CLI::App& app) {
             "Size of the videos as a fraction of the calibration's image size",
             view::kViewVideoScaleRange)
       ->capture_default_str();
-  cmd->parse_complete_callback([a] {
+  a->options.cache_dir = view::DefaultVideoCacheDir();
+  auto* cache_dir =
+      cmd->add_option("--cache-dir",
+                      a->options.cache_dir,
+                      "Cache of the encoded videos, reused while their inputs are unchanged "
+                      "(default: $XDG_CACHE_HOME/arco/view, else ~/.cache/arco/view)");
+  cmd->add_flag("--no-cache", a->no_cache, "Encode the videos again and cache nothing");
+  AddNumber(cmd,
+            "--cache-max-gb",
+            a->options.cache_max_gb,
+            "Size of the video cache; the least recently used videos beyond it are removed",
+            view::kViewCacheMaxGbRange)
+      ->capture_default_str();
+  cmd->parse_complete_callback([a, cache_dir] {
     if (a->no_serve && a->output.empty()) {
       throw CLI::ValidationError("--no-serve needs -o DIR");
     }
@@ -142,6 +165,15 @@ std::function<int()> SetupView(CLI::App& app) {
       throw CLI::ValidationError("--no-videos and --video-camera contradict each other");
     }
     a->options.videos = !a->no_videos;
+    if (a->no_cache && cache_dir->count() > 0) {
+      throw CLI::ValidationError("--no-cache and --cache-dir contradict each other");
+    }
+    if (a->no_cache) a->options.cache_dir.clear();
+    if (!a->no_cache && a->options.cache_dir.empty() && a->options.videos) {
+      throw CLI::ValidationError(
+          "--cache-dir: no cache folder (HOME and XDG_CACHE_HOME are unset): give one or "
+          "--no-cache");
+    }
     ThrowIfInvalid(a->options.Validate());
   });
   return [a] { return a->no_serve ? WriteFolder(*a) : Serve(*a); };

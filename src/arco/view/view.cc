@@ -4,8 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <optional>
+#include <set>
 
 #include "arco/export/export.h"
 #include "arco/export/overlay.h"
@@ -17,6 +19,12 @@
 #include "arco/util/check.h"
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
+#include "arco/view/video_cache.h"
+
+extern "C" {
+#include <libavcodec/avcodec.h>
+}
+#include <unistd.h>
 
 #ifndef ARCO_VIEW_WEB_DIR
 #define ARCO_VIEW_WEB_DIR ""
@@ -156,13 +164,170 @@ FrameErrors ErrorsAgainstTruth(const exporter::ExportData& data,
   return out;
 }
 
-// The camera videos with the overlay of `method` (exporter::WriteOverlay), as WebM VP8.
+// The regular files of `dir` (not hidden: no temporaries), sorted; with `recursive`, those
+// of its subfolders too, as paths relative to `dir`.
+std::vector<std::string> FilesOf(const std::string& dir, bool recursive) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> out;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return out;
+  if (recursive) {
+    for (const auto& e : fs::recursive_directory_iterator(dir, ec)) {
+      const std::string rel = fs::relative(e.path(), dir, ec).string();
+      if (e.is_regular_file() && e.path().filename().string()[0] != '.') out.push_back(rel);
+    }
+  } else {
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+      const std::string name = e.path().filename().string();
+      if (e.is_regular_file() && name[0] != '.') out.push_back(name);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// The cache key of camera `v`'s video (docs/view.md, "Video cache"): what the overlay
+// reads and draws, and how it is encoded. The result's files in full: its top-level files
+// (result.json: frames, units, stages; pitch.csv, notes.csv) and every file of the
+// drawn method's, the instrument's and the triangulation's folders (a superset of what
+// exporter::LoadExportData and WriteOverlay read: a change anywhere there encodes again).
+// The capture's capture.json (cameras, rotations, video paths) and calibration in full;
+// its video by size and ends (HashVideoSource): not its path or mtime, so a capture moved
+// or copied keeps its cache.
+StatusOr<std::string> VideoKey(const ViewOptions& options,
+                               const pipeline::ResultHeader& header,
+                               const CaptureManifest& capture,
+                               int v,
+                               const std::string& method) {
+  Sha256 hash;
+  hash.AddField("arco-view-video", std::to_string(kVideoCacheVersion));
+  hash.AddField("libavcodec", std::to_string(avcodec_version()));
+  hash.AddField("codec", "webm-vp8");
+  hash.AddField("method", method);
+  hash.AddField("camera", std::to_string(v) + "/" + capture.cameras[v].name);
+  char scale[40];
+  std::snprintf(scale, sizeof(scale), "%.17g", options.video_scale);
+  hash.AddField("scale", scale);
+  for (const std::string& sub : {std::string(),
+                                 std::string(pipeline::kTriangulationStage),
+                                 std::string(pipeline::kInstrumentStage),
+                                 method}) {
+    const std::string dir = sub.empty() ? options.result_dir : JoinPath(options.result_dir, sub);
+    for (const auto& file : FilesOf(dir, !sub.empty())) {
+      ARCO_RETURN_IF_ERROR(
+          HashWholeFile(hash, "result/" + JoinPath(sub, file), JoinPath(dir, file)));
+    }
+  }
+  ARCO_RETURN_IF_ERROR(
+      HashWholeFile(hash, "capture.json", JoinPath(header.capture_dir, kCaptureManifestName)));
+  ARCO_RETURN_IF_ERROR(HashWholeFile(
+      hash, "calibration", ResolveCapturePath(header.capture_dir, capture.calibration)));
+  const std::string& video = capture.cameras[v].video;
+  hash.AddField("has_video", video.empty() ? "0" : "1");
+  if (!video.empty()) {
+    ARCO_RETURN_IF_ERROR(
+        HashVideoSource(hash, "video", ResolveCapturePath(header.capture_dir, video)));
+  }
+  return hash.HexDigest();
+}
+
+Json SidecarOf(const ViewVideo& video, int64_t bytes) {
+  return {{"format", "arco-view-video-cache"},
+          {"bytes", bytes},
+          {"camera", video.camera},
+          {"source", video.source},
+          {"method", video.method},
+          {"width", video.width},
+          {"height", video.height},
+          {"frames", video.frames}};
+}
+
+// The cached video of `key` copied to `dest`, or nullopt when there is no whole entry: no
+// sidecar, one that does not parse, or a video whose size is not the sidecar's.
+std::optional<ViewVideo> TakeCached(const std::string& cache_dir,
+                                    const std::string& key,
+                                    const std::string& dest) {
+  namespace fs = std::filesystem;
+  const VideoCacheEntry entry = CacheEntryPaths(cache_dir, key);
+  std::error_code ec;
+  if (!fs::exists(entry.sidecar, ec)) return std::nullopt;
+  auto side = ReadJsonFile(entry.sidecar);
+  const auto size = fs::file_size(entry.video, ec);
+  if (!side.ok() || ec || !side->is_object() || !side->contains("bytes") ||
+      side->value("bytes", int64_t{-1}) != static_cast<int64_t>(size)) {
+    return std::nullopt;
+  }
+  ViewVideo video;
+  try {
+    video.camera = side->at("camera").get<std::string>();
+    video.source = side->at("source").get<std::string>();
+    video.method = side->at("method").get<std::string>();
+    video.width = side->at("width").get<int>();
+    video.height = side->at("height").get<int>();
+    video.frames = side->at("frames").get<int64_t>();
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (!fs::copy_file(entry.video, dest, fs::copy_options::overwrite_existing, ec) || ec) {
+    return std::nullopt;
+  }
+  // Least recently used: the entry's mtime is its last use.
+  const auto now = fs::file_time_type::clock::now();
+  fs::last_write_time(entry.video, now, ec);
+  fs::last_write_time(entry.sidecar, now, ec);
+  video.cached = true;
+  video.cache_key = key;
+  return video;
+}
+
+// Encodes camera `overlay.camera`'s video into the cache (a hidden temporary renamed to
+// the entry, then the sidecar) and copies it to `dest`.
+StatusOr<ViewVideo> EncodeIntoCache(const exporter::OverlayOptions& overlay,
+                                    const std::string& cache_dir,
+                                    const std::string& key,
+                                    const std::string& dest) {
+  namespace fs = std::filesystem;
+  const VideoCacheEntry entry = CacheEntryPaths(cache_dir, key);
+  // Hidden (never taken as an entry) and this process's own: two viewers encoding the
+  // same key each write their temporary and the last rename wins, with the same bytes.
+  const std::string tmp = JoinPath(cache_dir, "." + key + "-" + std::to_string(getpid()) + ".webm");
+  auto written = exporter::WriteOverlay(overlay, tmp, entry.video);
+  std::error_code ec;
+  if (!written.ok()) {
+    fs::remove(tmp, ec);
+    return written.status();
+  }
+  ViewVideo video;
+  video.camera = written->camera;
+  video.source = written->video;
+  video.method = overlay.method;
+  video.width = written->width;
+  video.height = written->height;
+  video.frames = written->frames;
+  video.cache_key = key;
+  const auto bytes = fs::file_size(tmp, ec);
+  if (!ec) fs::rename(tmp, entry.video, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    return Status::Error(entry.video + ": cannot write to the video cache (--no-cache skips it)");
+  }
+  ARCO_RETURN_IF_ERROR(
+      AtomicWriteFile(entry.sidecar, SidecarOf(video, static_cast<int64_t>(bytes)).dump(1) + "\n"));
+  if (!fs::copy_file(entry.video, dest, fs::copy_options::overwrite_existing, ec) || ec) {
+    return Status::Error(dest + ": cannot copy the cached video");
+  }
+  return video;
+}
+
+// The camera videos with the overlay of `method` (exporter::WriteOverlay), as WebM VP8,
+// taken from the cache when it has them (options.cache_dir).
 // The cameras: the options' (each must be one of the capture's), else the first camera
 // with a video; none when the capture has no video (not an error).
 StatusOr<std::vector<ViewVideo>> WriteVideos(const ViewOptions& options,
                                              const pipeline::ResultHeader& header,
                                              const std::string& method,
-                                             const std::string& dir) {
+                                             const std::string& dir,
+                                             int* evicted) {
   std::vector<ViewVideo> out;
   if (!options.videos || header.capture_dir.empty()) return out;
   auto read = ReadCaptureManifest(header.capture_dir);
@@ -190,26 +355,60 @@ StatusOr<std::vector<ViewVideo>> WriteVideos(const ViewOptions& options,
       }
     }
   }
+  const bool cache = !options.cache_dir.empty() && !views.empty();
+  if (cache) {
+    const Status made = MakeDirectories(options.cache_dir);
+    if (!made.ok()) {
+      return Status::Error(options.cache_dir +
+                           ": cannot create the video cache (--no-cache skips it)");
+    }
+  }
+  std::set<std::string> used;
   for (const int v : views) {
     exporter::OverlayOptions overlay;
     overlay.result_dir = options.result_dir;
     overlay.camera = capture.cameras[v].name;
     overlay.method = method;
     overlay.scale = options.video_scale;
-    ViewVideo video;
-    video.file = "video_" + std::to_string(v) + ".webm";
+    const std::string file = "video_" + std::to_string(v) + ".webm";
+    const std::string path = JoinPath(dir, file);
     const auto start = std::chrono::steady_clock::now();
-    const std::string path = JoinPath(dir, video.file);
-    ARCO_ASSIGN_OR_RETURN(const exporter::OverlaySummary written,
-                          exporter::WriteOverlay(overlay, path, path));
+    ViewVideo video;
+    // An input the key cannot read (a missing calibration or video): encoded uncached,
+    // so that the overlay itself reports what is wrong with the capture.
+    const StatusOr<std::string> keyed =
+        cache ? VideoKey(options, header, capture, v, method) : StatusOr<std::string>("");
+    if (cache && keyed.ok()) {
+      const std::string& key = *keyed;
+      used.insert(key);
+      std::optional<ViewVideo> hit = TakeCached(options.cache_dir, key, path);
+      if (hit.has_value()) {
+        video = *hit;
+        // The capture may have moved since: name the video where it is now.
+        if (!capture.cameras[v].video.empty()) {
+          video.source = ResolveCapturePath(header.capture_dir, capture.cameras[v].video);
+        }
+      } else {
+        ARCO_ASSIGN_OR_RETURN(video, EncodeIntoCache(overlay, options.cache_dir, key, path));
+      }
+    } else {
+      ARCO_ASSIGN_OR_RETURN(const exporter::OverlaySummary written,
+                            exporter::WriteOverlay(overlay, path, path));
+      video.camera = written.camera;
+      video.source = written.video;
+      video.method = method;
+      video.width = written.width;
+      video.height = written.height;
+      video.frames = written.frames;
+    }
+    video.file = file;
     video.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    video.camera = written.camera;
-    video.source = written.video;
-    video.method = method;
-    video.width = written.width;
-    video.height = written.height;
-    video.frames = written.frames;
     out.push_back(video);
+  }
+  if (cache) {
+    ARCO_ASSIGN_OR_RETURN(
+        *evicted,
+        EvictVideoCache(options.cache_dir, static_cast<int64_t>(options.cache_max_gb * 1e9), used));
   }
   return out;
 }
@@ -219,6 +418,7 @@ StatusOr<std::vector<ViewVideo>> WriteVideos(const ViewOptions& options,
 Status ViewOptions::Validate() const {
   if (result_dir.empty()) return Status::Error("result_dir is empty");
   ARCO_RETURN_IF_ERROR(CheckInRange("video_scale", video_scale, kViewVideoScaleRange));
+  ARCO_RETURN_IF_ERROR(CheckInRange("cache_max_gb", cache_max_gb, kViewCacheMaxGbRange));
   if (!videos && !video_cameras.empty()) {
     return Status::Error("video cameras are named but videos are off");
   }
@@ -455,7 +655,10 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
     }
   }
   if (!overlay_method.empty()) {
-    ARCO_ASSIGN_OR_RETURN(summary.videos, WriteVideos(options, header, overlay_method, dir));
+    ARCO_ASSIGN_OR_RETURN(
+        summary.videos, WriteVideos(options, header, overlay_method, dir, &summary.cache_evicted));
+    for (const auto& v : summary.videos)
+      ++(v.cached ? summary.videos_cached : summary.videos_encoded);
   } else if (!options.video_cameras.empty()) {
     return Status::Error(folder.ManifestPath() +
                          ": no refined method (arco, paper, vision) to draw over the videos");

@@ -16,7 +16,8 @@
 // Videos: the capture's camera videos, each written with the overlay of the page's first
 // method (exporter::WriteOverlay: skeleton, strings, contact, finger numbers, note) as
 // video_<camera index>.webm (VP8, which every browser plays), one frame per result frame
-// at the capture's fps, so frame k of the page is the video's k / fps too.
+// at the capture's fps, so frame k of the page is the video's k / fps too. Each is taken
+// from the cache (video_cache.h) when its inputs are those of an earlier encode.
 #pragma once
 
 #include <cstdint>
@@ -29,6 +30,7 @@
 namespace arco::view {
 
 inline constexpr NumberRange kViewVideoScaleRange = Closed(0.05, 1);
+inline constexpr NumberRange kViewCacheMaxGbRange = Closed(0, 1e6);
 
 struct ViewOptions {
   std::string result_dir;   // an `arco run` result folder (result.json)
@@ -43,6 +45,11 @@ struct ViewOptions {
   bool videos = true;
   std::vector<std::string> video_cameras;
   double video_scale = 0.5;
+  // The cache of encoded videos (view/video_cache.h, docs/view.md "Video cache"): "" = no
+  // cache (every video encoded); the CLI's default is DefaultVideoCacheDir(). Entries
+  // beyond cache_max_gb (10^9 bytes) are removed, least recently used first.
+  std::string cache_dir;
+  double cache_max_gb = 5;
   Status Validate() const;
 };
 
@@ -54,7 +61,9 @@ struct ViewVideo {
   std::string method;  // whose overlay is drawn
   int width = 0, height = 0;
   int64_t frames = 0;
-  double seconds = 0;  // the time it took to write
+  double seconds = 0;     // the time it took to write
+  bool cached = false;    // copied from the cache (not encoded)
+  std::string cache_key;  // the SHA-256 key ("" : no cache)
 };
 
 // A stage the page cannot show, and what writes it.
@@ -71,6 +80,8 @@ struct ViewSummary {
   std::string audio;  // the audio file copied ("" when none)
   int64_t bytes = 0;  // of the data arrays
   std::vector<ViewVideo> videos;
+  int videos_encoded = 0, videos_cached = 0;
+  int cache_evicted = 0;  // entries removed to keep the cache within cache_max_gb
 };
 
 // The stages a complete result has and the command that writes each (the page and the

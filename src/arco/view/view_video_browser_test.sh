@@ -14,6 +14,8 @@ src=$2
 work=$3
 rm -rf "$work"
 mkdir -p "$work"
+# The video cache (docs/view.md, "Video cache") in the work folder, not the user's.
+export XDG_CACHE_HOME=$work/cache
 if [ ! -x /usr/bin/chromium ] || ! command -v ffmpeg >/dev/null || ! command -v ffprobe >/dev/null; then
   echo "SKIPPED: /usr/bin/chromium or ffmpeg/ffprobe is not installed (scripts/setup)"
   exit 77
