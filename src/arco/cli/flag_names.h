@@ -56,6 +56,9 @@ inline constexpr FieldFlag kSynthFlags[] = {{"overwrite", "--overwrite"},
                                             {"occlusion_rate", "--occlusion-rate"},
                                             {"finger_bias_mm", "--finger-bias-mm"},
                                             {"jitter_mm", "--jitter-mm"},
+                                            {"finger_offset_mm", "--finger-offset-mm"},
+                                            {"hand_back_max_deg", "--hand-back-deg"},
+                                            {"finger_confusion_rate", "--finger-confusion-rate"},
                                             {"mm_per_unit", "--mm-per-unit"}};
 
 // `text` with every whole-word field name of `names` replaced by its flag. A name quoted

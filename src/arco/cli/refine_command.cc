@@ -91,6 +91,14 @@ std::function<int()> SetupRefine(CLI::App& app) {
             "(mm); beyond it the contact is rejected",
             Closed(0, 1000))
       ->capture_default_str();
+  sub->add_flag("!--reject-unreachable",
+                r.ik.keep_unreachable,
+                "arco: reject a contact the finger cannot reach even after the hand's move "
+                "(uncertain, out_of_reach) instead of keeping the decoded note and finger");
+  sub->add_flag("!--whole-hand-shift",
+                r.ik.detected_hand_shift,
+                "arco: move the whole hand by all of the offset its finger cannot reach (the "
+                "former rule), not only as far as the triangulated palm says the fit is off");
   AddNumber(sub,
             "--lift-max-mm",
             r.ik.lift_max_distance_mm,

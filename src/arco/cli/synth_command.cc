@@ -13,6 +13,8 @@
 #include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
 #include "arco/synth/capture_writer.h"
+#include "arco/synth/error_model.h"
+#include "arco/synth/motion.h"
 #include "arco/synth/synth.h"
 
 #ifndef ARCO_SHARED_DATA_DIR
@@ -54,7 +56,81 @@ struct Args {
   bool no_audio = false, no_sample_tuning = false, no_vibrato = false,
        no_geometric_occlusion = false;
   bool list_pieces = false;
+  // Re-capture of a recorded take (synth/motion.h).
+  std::string motion, audio, error_model = "synth", cameras;
+  bool list_error_models = false;
+  // The detection flags, to tell the ones given (they override the error model's preset).
+  std::vector<std::pair<CLI::Option*, double synth::DetectionOptions::*>> detection_flags;
 };
+
+// The error model's preset with the detection flags the user gave applied over it.
+StatusOr<synth::DetectionOptions> DetectionFor(const Args& a) {
+  ARCO_ASSIGN_OR_RETURN(synth::DetectionOptions o, synth::ErrorModelOptions(a.error_model));
+  for (const auto& [option, field] : a.detection_flags)
+    if (option->count() > 0) o.*field = a.o.detection.*field;
+  if (a.no_geometric_occlusion) o.geometric_occlusion = false;
+  return o;
+}
+
+// `arco synth --motion`: a recorded take re-captured in the rig.
+int RunMotion(Args& a) {
+  synth::MotionOptions m;
+  m.motion_path = a.motion;
+  m.audio_path = a.audio;
+  m.instrument = a.o.instrument;
+  m.fps = a.o.fps;
+  m.max_duration_s = a.o.max_duration_s;
+  m.a4_hz = a.o.a4_hz;
+  m.seed = a.o.seed;
+  m.num_threads = a.o.num_threads;
+  m.stage = a.o.stage;
+  m.error_model = a.error_model;
+  m.cameras = a.cameras;
+  auto detection = DetectionFor(a);
+  if (!detection.ok()) return PrintError("--error-model: " + detection.status().message());
+  m.detection = *detection;
+  const Status valid = m.Validate();
+  if (!valid.ok()) return PrintError(WithFlagNames(valid.message(), kSynthFlags));
+  const Status writable = synth::CheckCaptureOutput(a.output, a.w);
+  if (!writable.ok()) return PrintError(writable.message());
+  const auto start = std::chrono::steady_clock::now();
+  auto calibration = LoadCalibration(a.calibration);
+  if (!calibration.ok()) return PrintError(calibration.status().message());
+  auto capture = synth::GenerateFromMotion(calibration->rig, m);
+  if (!capture.ok()) {
+    const std::string msg = capture.status().message();
+    // Messages about the motion or the audio name their file; the rest is the rig's.
+    const bool named = msg.rfind(a.motion, 0) == 0 || msg.rfind(a.audio, 0) == 0;
+    return PrintError(named ? msg : a.calibration + ": " + msg);
+  }
+  synth::WriteSummary ws;
+  const Status written = synth::WriteCapture(*capture, a.output, a.w, &ws);
+  if (!written.ok()) return PrintError(WithFlagNames(written.message(), kSynthFlags));
+  const double total_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const auto& c = *capture;
+  std::printf("arco synth: %s re-captured, error model %s, seed %llu\n",
+              a.motion.c_str(),
+              a.error_model.c_str(),
+              static_cast<unsigned long long>(c.options.seed));
+  std::printf("  calibration   %s (%zu cameras, %.1f mm per unit)\n",
+              a.calibration.c_str(),
+              c.rig_mm.cameras.size(),
+              c.stage.mm_per_unit);
+  std::printf("  motion        %d frames at %g fps (%.2f s), %d with a pressed note\n",
+              c.num_frames,
+              c.options.fps,
+              c.num_frames / c.options.fps,
+              c.pressed_frames);
+  std::string folder = a.output;
+  while (folder.size() > 1 && folder.back() == '/') folder.pop_back();
+  std::printf("  wrote         %s/ (%.1f MB) and %s/truth/ in %.1f s\n",
+              folder.c_str(),
+              ws.bytes / 1e6,
+              folder.c_str(),
+              total_s);
+  return 0;
+}
 
 int Run(Args& a) {
   if (a.list_pieces) {
@@ -63,10 +139,26 @@ int Run(Args& a) {
     }
     return 0;
   }
+  if (a.list_error_models) {
+    for (const auto& m : synth::ErrorModels())
+      std::printf("%-10s %s\n", m.name.c_str(), m.description.c_str());
+    return 0;
+  }
   if (a.output.empty()) return PrintError("synth: -o OUT_DIR is required");
   if (a.calibration.empty()) a.calibration = DefaultCalibration();
+  if (!a.cameras.empty() && a.motion.empty()) return PrintError("synth: --cameras needs --motion");
+  if (!a.motion.empty() || !a.audio.empty()) {
+    if (a.motion.empty()) return PrintError("synth: --audio needs --motion");
+    if (a.audio.empty()) return PrintError("synth: --motion needs --audio (the take's recording)");
+    a.w.calibration_source = a.calibration;
+    return RunMotion(a);
+  }
+  {
+    auto detection = DetectionFor(a);
+    if (!detection.ok()) return PrintError("--error-model: " + detection.status().message());
+    a.o.detection = *detection;
+  }
   a.o.expression.vibrato = !a.no_vibrato;
-  a.o.detection.geometric_occlusion = !a.no_geometric_occlusion;
   a.w.audio = !a.no_audio;
   a.w.audio_render.tune_soundfont = !a.no_sample_tuning;
   a.w.calibration_source = a.calibration;
@@ -204,41 +296,46 @@ std::function<int()> SetupSynth(CLI::App& app) {
             "extent, 12; --no-vibrato for none)",
             Closed(12, 100))
       ->capture_default_str();
-  AddNumber(cmd,
+  a->detection_flags.emplace_back(AddNumber(cmd,
             "--noise-px",
             a->o.detection.noise_px,
             "2D detection noise per axis (px)",
             NumberRange{0, 200, false, true})
-      ->capture_default_str();
-  AddNumber(cmd,
+      ->capture_default_str(),
+      &synth::DetectionOptions::noise_px);
+  a->detection_flags.emplace_back(AddNumber(cmd,
             "--outlier-rate",
             a->o.detection.outlier_rate,
             "Gross outliers per keypoint, and hand swaps per view and frame (fraction)",
             kFractionRange)
-      ->capture_default_str();
-  AddNumber(cmd,
+      ->capture_default_str(),
+      &synth::DetectionOptions::outlier_rate);
+  a->detection_flags.emplace_back(AddNumber(cmd,
             "--occlusion-rate",
             a->o.detection.occlusion_rate,
             "Random detector drop-outs per keypoint (fraction), on top of geometric occlusion",
             kFractionRange)
-      ->capture_default_str();
+      ->capture_default_str(),
+      &synth::DetectionOptions::occlusion_rate);
   cmd->add_flag("--no-geometric-occlusion",
                 a->no_geometric_occlusion,
                 "Do not occlude points hidden by the instrument body or the torso");
-  AddNumber(
+  a->detection_flags.emplace_back(AddNumber(
       cmd,
       "--finger-bias-mm",
       a->o.detection.finger_bias_mm,
       "3D offset of the playing fingertip off the string as the detector sees it (mm; DIP half)",
       NumberRange{0, 200, false, true})
-      ->capture_default_str();
-  AddNumber(cmd,
+      ->capture_default_str(),
+      &synth::DetectionOptions::finger_bias_mm);
+  a->detection_flags.emplace_back(AddNumber(cmd,
             "--jitter-mm",
             a->o.detection.jitter_mm,
             "View-consistent 3D detector error per axis for hand points (mm; body x1.5, "
             "instrument x0.3)",
             NumberRange{0, 100, false, true})
-      ->capture_default_str();
+      ->capture_default_str(),
+      &synth::DetectionOptions::jitter_mm);
   AddNumber(cmd,
             "--mm-per-unit",
             a->o.stage.mm_per_unit,
@@ -246,6 +343,46 @@ std::function<int()> SetupSynth(CLI::App& app) {
             "rig's camera distance)",
             Closed(0, 1e6))
       ->capture_default_str();
+  a->detection_flags.emplace_back(
+      AddNumber(cmd,
+                "--finger-offset-mm",
+                a->o.detection.finger_offset_mm,
+                "Smooth per-finger 3D offset of the left hand shared by all views, at the tip "
+                "(mm per axis; error models shared, harsh)",
+                NumberRange{0, 100, false, true}),
+      &synth::DetectionOptions::finger_offset_mm);
+  a->detection_flags.emplace_back(
+      AddNumber(cmd,
+                "--hand-back-deg",
+                a->o.detection.hand_back_max_deg,
+                "Hide the left fingers in views within this angle of the back of the hand "
+                "(degrees, 0 = off; error models behind, harsh)",
+                Closed(0, 90)),
+      &synth::DetectionOptions::hand_back_max_deg);
+  a->detection_flags.emplace_back(
+      AddNumber(cmd,
+                "--finger-confusion-rate",
+                a->o.detection.finger_confusion_rate,
+                "Neighbouring left fingers swapped per view and frame (fraction; error models "
+                "confusion, harsh)",
+                kFractionRange),
+      &synth::DetectionOptions::finger_confusion_rate);
+  cmd->add_option("--error-model",
+                  a->error_model,
+                  "Detector error model (see --list-error-models); the detection flags given "
+                  "override its values")
+      ->capture_default_str();
+  cmd->add_flag(
+      "--list-error-models", a->list_error_models, "List the detector error models and exit");
+  cmd->add_option("--motion",
+                  a->motion,
+                  "Re-capture a recorded take: released 3D results (frames, points, 3) in mm in "
+                  "the instrument's spd_*_contact layout (docs/synth.md)");
+  cmd->add_option("--audio", a->audio, "The recorded take's audio (with --motion), frame 0 at 0 s");
+  cmd->add_option("--cameras",
+                  a->cameras,
+                  "With --motion: the cameras that film the take, a count (spread around the "
+                  "performer) or names separated by commas (default: all)");
   cmd->add_flag("--no-audio", a->no_audio, "Skip rendering audio.wav");
   cmd->add_option("--soundfont", a->w.audio_render.soundfont, "SoundFont for fluidsynth")
       ->capture_default_str();

@@ -217,6 +217,12 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
   }
   if (!options.limits) options.limits = DefaultLeftHandLimits();
   options.joint_limit_tolerance_deg = r.joint_limit_tolerance_deg;
+  // The truth's own hand against arco's limits: a real hand (a recorded take) should violate
+  // none; a count here says the limits are too narrow for real players.
+  if (kLeftHandFirst + kNumHand <= truth.num_points) {
+    report.truth_joint_limit_violations = CountJointLimitViolations(
+        truth, kLeftHandFirst, true, *options.limits, options.joint_limit_tolerance_deg);
+  }
   report.contact_frames = 0;
   for (int f = 0; f < truth_contact.num_frames(); ++f)
     report.contact_frames += truth_contact.pressed(f);
@@ -288,13 +294,20 @@ Json EvalReport::ToJson(const EvalOptions& options) const {
   j["truth"] = {{"kind", truth_kind},
                 {"frames", truth_frames},
                 {"contact_frames", contact_frames},
+                {"joint_limit_violations",
+                 truth_joint_limit_violations < 0 ? Json(nullptr)
+                                                  : Json(truth_joint_limit_violations)},
                 {"units", units}};
   j["protocol"] = {
       {"hand", "left hand, 20 joints after aligning the wrists by translation (Jin et al. 2024)"},
       {"contact_frames",
        "frames whose truth presses a note (rests, open strings, unvoiced excluded)"},
       {"contact_deviation",
-       "playing fingertip (truth's finger) to the truth contact point, world frame"}};
+       "playing fingertip (truth's finger) to the truth contact point, world frame"},
+      {"left_hand_world",
+       "left hand joints to the truth in the world, no alignment; by group: wrist, base (thumb "
+       "CMC, MCPs), middle (thumb MCP, PIPs), distal (thumb IP, DIPs), tip; playing_tip: the "
+       "truth's playing fingertip on contact frames"}};
   j["methods"] = Json::object();
   for (const MethodMetrics& m : methods) {
     Json mj;
@@ -316,6 +329,12 @@ Json EvalReport::ToJson(const EvalOptions& options) const {
     mj["instrument_error_mm"] = JsonFromDouble(m.instrument_error_mm);
     mj["string_error_mm"] = JsonFromDouble(m.string_error_mm);
     mj["missing_hand_fraction"] = m.missing_hand_fraction;
+    mj["left_hand_world_mm"] = JsonFromDouble(m.left_hand_world_mm);
+    static const char* kGroups[5] = {"wrist", "base", "middle", "distal", "tip"};
+    for (int g = 0; g < 5; ++g)
+      mj["left_group_world_mm"][kGroups[g]] = JsonFromDouble(m.left_group_world_mm[g]);
+    mj["playing_tip_world_mm"] = JsonFromDouble(m.playing_tip_world_mm);
+    mj["contact_point_error_mm"] = JsonFromDouble(m.contact_point_error_mm);
     j["methods"][m.method] = mj;
   }
   if (pitch) {

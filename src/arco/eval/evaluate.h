@@ -46,6 +46,7 @@ struct EvalReport {
   std::string truth_kind;  // "synthetic" or "labels"
   int truth_frames = 0;    // frames with truth
   int contact_frames = 0;
+  int truth_joint_limit_violations = -1;  // the truth's left hand against arco's limits
   std::string units;
   std::vector<MethodMetrics> methods;
   std::optional<PitchMetrics> pitch;

@@ -145,13 +145,17 @@ TEST(DefaultLeftHandLimits, TruthHandsHaveNoViolationsAndBentFingersDo) {
   s.xyz = truth->data;
   const HandJointLimitsDeg limits = DefaultLeftHandLimits();
   EXPECT_EQ(CountJointLimitViolations(s, kLeftHandFirst, true, limits, 5.0), 0);
-  // Reflect every index tip across the PIP->DIP line within its plane: the DIP
-  // flexion f becomes -f, a hyperextension beyond the limit for curled fingers.
+  // Bend every (curled) index tip back within its plane to a 60 degree DIP hyperextension,
+  // beyond the limit (real players hyperextend the DIP, but not that far).
   for (int f = 0; f < s.num_frames; ++f) {
     const Eigen::Vector3d pip = s.at(f, kLeftHandFirst + 6), dip = s.at(f, kLeftHandFirst + 7),
                           tip = s.at(f, kLeftHandFirst + 8);
     const Eigen::Vector3d u = (dip - pip).normalized();
-    s.set(f, kLeftHandFirst + 8, 2 * (dip + (tip - dip).dot(u) * u) - tip);
+    const Eigen::Vector3d palmar = (tip - dip) - (tip - dip).dot(u) * u;
+    if (palmar.norm() < 1e-3) continue;  // a straight finger: no plane
+    const Eigen::Vector3d w = palmar.normalized();
+    const double length = (tip - dip).norm();
+    s.set(f, kLeftHandFirst + 8, dip + length * (0.5 * u - std::sqrt(0.75) * w));
   }
   EXPECT_GT(CountJointLimitViolations(s, kLeftHandFirst, true, limits, 5.0), s.num_frames / 2);
 }

@@ -127,6 +127,7 @@ MethodMetrics EvaluateMethod(const std::string& method,
   const int num_points = std::min(truth.num_points, result.num_points);
   MethodMetrics m;
   m.method = method;
+  std::vector<double> world_hand_err, world_group_err[5], playing_tip_err, contact_point_err;
   std::vector<double> hand_err, finger_err, contact_err, body_err, instrument_err, string_err;
   std::vector<int> pck_hits(options.pck_thresholds_mm.size(), 0);
   int hand_truth_valid = 0, hand_missing = 0, string_hits = 0, finger_hits = 0;
@@ -142,8 +143,15 @@ MethodMetrics EvaluateMethod(const std::string& method,
       if (!truth.valid(fr, p)) continue;
       if (result.valid(fr, p)) body_err.push_back((truth.at(fr, p) - result.at(fr, p)).norm());
     }
-    // Left hand after aligning the wrists by translation (the paper's protocol).
+    // Left hand in the world, by joint group (k = 0 wrist, then 1 + 4 finger + joint).
     const int w = kLeftHandFirst;
+    for (int k = 0; k < kNumHand && w + k < num_points; ++k) {
+      if (!truth.valid(fr, w + k) || !result.valid(fr, w + k)) continue;
+      const double e = (truth.at(fr, w + k) - result.at(fr, w + k)).norm();
+      world_hand_err.push_back(e);
+      world_group_err[k == 0 ? 0 : 1 + (k - 1) % 4].push_back(e);
+    }
+    // Left hand after aligning the wrists by translation (the paper's protocol).
     const bool wrists = w < num_points && truth.valid(fr, w) && result.valid(fr, w);
     const Eigen::Vector3d shift =
         wrists ? Eigen::Vector3d(truth.at(fr, w) - result.at(fr, w)) : Eigen::Vector3d::Zero();
@@ -184,6 +192,8 @@ MethodMetrics EvaluateMethod(const std::string& method,
     ++m.contact_frames;
     const int finger = truth_contact.finger[static_cast<size_t>(fr)];
     const int tip = w + HandJoint(finger, 3);
+    if (tip < num_points && result.valid(fr, tip) && truth.valid(fr, tip))
+      playing_tip_err.push_back((result.at(fr, tip) - truth.at(fr, tip)).norm());
     if (tip < num_points && result.valid(fr, tip)) {
       contact_err.push_back(
           (result.at(fr, tip) - truth_contact.point_mm[static_cast<size_t>(fr)]).norm());
@@ -200,10 +210,17 @@ MethodMetrics EvaluateMethod(const std::string& method,
     if (result_contact) {
       const size_t i = static_cast<size_t>(fr);
       string_hits += result_contact->string[i] == truth_contact.string[i];
+      if (result_contact->pressed(fr) && result_contact->point_mm[i].allFinite())
+        contact_point_err.push_back(
+            (result_contact->point_mm[i] - truth_contact.point_mm[i]).norm());
       finger_hits += result_contact->finger[i] == truth_contact.finger[i];
     }
   }
   m.mpjpe_hand_mm = Mean(hand_err);
+  m.left_hand_world_mm = Mean(world_hand_err);
+  for (int g = 0; g < 5; ++g) m.left_group_world_mm[g] = Mean(world_group_err[g]);
+  m.playing_tip_world_mm = Mean(playing_tip_err);
+  m.contact_point_error_mm = Mean(contact_point_err);
   m.mpjpe_note_finger_mm = Mean(finger_err);
   m.contact_deviation_mm = Mean(contact_err);
   m.contact_deviation_median_mm = Median(contact_err);

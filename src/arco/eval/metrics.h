@@ -95,6 +95,16 @@ struct MethodMetrics {
   double instrument_error_mm = NAN;
   double string_error_mm = NAN;
   double missing_hand_fraction = 0;  // truth-valid hand joints the method left NaN
+  // The left hand in the world, no alignment (where a user's animation puts it): all 21
+  // joints, and by joint group: wrist, then the five fingers' base joints (thumb CMC, MCPs),
+  // middle joints (thumb MCP, PIPs), distal joints (thumb IP, DIPs) and tips; and the truth's
+  // playing fingertip on contact frames.
+  double left_hand_world_mm = NAN;
+  double left_group_world_mm[5] = {NAN, NAN, NAN, NAN, NAN};
+  double playing_tip_world_mm = NAN;
+  // The method's own contact point to the truth's, on frames where both press (needs a
+  // contact annotation with points).
+  double contact_point_error_mm = NAN;
   // Per frame (NaN where not measured): wrist-aligned left-hand error and
   // contact deviation, for plots.
   std::vector<double> frame_hand_mm, frame_contact_mm;

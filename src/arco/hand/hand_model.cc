@@ -89,8 +89,12 @@ JointLimitsDeg DefaultJointLimitsDeg() {
     const Finger finger = static_cast<Finger>(f);
     limits[DofIndex(finger, FingerDof::kBaseFlex)] = {-30, 90};    // MCP, 30 hyperextension
     limits[DofIndex(finger, FingerDof::kBaseAbd)] = {-20, 20};     // MCP abduction
-    limits[DofIndex(finger, FingerDof::kMiddleFlex)] = {0, 110};   // PIP
-    limits[DofIndex(finger, FingerDof::kDistalFlex)] = {-10, 90};  // DIP, little hyperext.
+    // PIP and DIP: real players hyperextend them when a fingertip presses a string (the
+    // DIP collapses under the string's force). On SPD's real cello01 take, the former
+    // {0, 110} and {-10, 90} were violated by 131 (frame, joint) pairs; these ranges by
+    // none (docs/hand.md, "Joint limits on a real hand").
+    limits[DofIndex(finger, FingerDof::kMiddleFlex)] = {-10, 110};  // PIP
+    limits[DofIndex(finger, FingerDof::kDistalFlex)] = {-30, 90};   // DIP
   }
   return limits;
 }

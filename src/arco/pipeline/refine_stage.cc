@@ -103,6 +103,18 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
       for (int c = 0; c < 3; ++c) base_mm.at(f, kNumWholeBody + k, c) = placed.at(f, k, c);
     }
   }
+  // The left hand as triangulated (before the model fit): how far arco's IK may move the
+  // fitted hand (refine.h, RefineInput::detected_left_hand).
+  out.input.detected_left_hand.resize(static_cast<size_t>(frames));
+  for (int64_t f = 0; f < frames; ++f) {
+    hand::HandPointsMm points;
+    for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
+      const int64_t p = wholebody::kLeftHandFirst + k;
+      points[static_cast<size_t>(k)] =
+          Eigen::Vector3d(base_mm.at(f, p, 0), base_mm.at(f, p, 1), base_mm.at(f, p, 2));
+    }
+    out.input.detected_left_hand[static_cast<size_t>(f)] = points;
+  }
   std::vector<std::vector<StringSegment>> seg(static_cast<size_t>(frames));
   for (int64_t f = 0; f < frames; ++f) {
     std::vector<StringSegment> frame_strings;

@@ -1,5 +1,6 @@
 #include "arco/refine/finger_ik.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "arco/hand/kinematics.h"
@@ -79,12 +80,51 @@ FrameIk SolveArcoFrame(const DecodeContext& context,
   return Solve(context, c, f, ik, start);
 }
 
+// The whole-hand move toward an unreachable contact on frame f (ArcoIkOptions::
+// detected_hand_shift): the remaining offset r may only be taken where the cameras say
+// the fitted hand is off. d = the detected palm's displacement from the fitted palm (the
+// per-axis median over wrist, thumb CMC and four MCPs of triangulated minus fitted); the
+// hand moves by the part of r along d, at most d itself:
+//   shift = d * clamp(r . d / |d|^2, 0, 1).
+// A fit that lags a fast shift (the triangulated palm already moved toward the contact)
+// follows it; a hand the cameras and the fit agree on stays, whatever the finger cannot
+// reach (a real hand is not arco's model). Without a detected hand: the whole offset
+// (the fitted wrist is assumed wrong, the former rule).
+Eigen::Vector3d HandShift(const DecodeContext& context,
+                          const ArcoIkOptions& options,
+                          int f,
+                          const Eigen::Vector3d& r) {
+  const auto& detected = context.input->detected_left_hand;
+  if (!options.detected_hand_shift || detected.empty()) return r;
+  const auto& seen = detected[static_cast<size_t>(f)];
+  const auto& fitted = context.vision_points[static_cast<size_t>(f)];
+  if (!seen || !fitted) return Eigen::Vector3d::Zero();
+  std::vector<double> axis[3];
+  for (int k : {0, 1, 5, 9, 13, 17}) {  // wrist, thumb CMC, index..little MCP
+    const Eigen::Vector3d& a = (*seen)[static_cast<size_t>(k)];
+    if (!a.allFinite()) continue;
+    const Eigen::Vector3d d = a - (*fitted)[static_cast<size_t>(k)];
+    for (int c = 0; c < 3; ++c) axis[c].push_back(d[c]);
+  }
+  if (axis[0].size() < 3) return Eigen::Vector3d::Zero();  // the palm is hardly seen
+  Eigen::Vector3d d;
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double>& v = axis[c];
+    std::sort(v.begin(), v.end());
+    d[c] = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  }
+  const double dd = d.squaredNorm();
+  if (dd < 1e-12) return Eigen::Vector3d::Zero();
+  return d * std::clamp(r.dot(d) / dd, 0.0, 1.0);
+}
+
 // Takes an arco IK result for one frame: the refined pose when the tip is within
 // max_residual_mm, the whole hand shifted when within max_hand_shift_mm, otherwise the
 // contact is rejected (kOutOfReach) and `hand` left alone. True when taken.
 bool ApplyArcoIk(const DecodeContext& context,
                  const ArcoIkOptions& options,
                  const FrameIk& s,
+                 int f,
                  FrameContact* c,
                  std::optional<hand::HandPose>* hand_out) {
   hand::HandPose pose = s.pose;
@@ -93,17 +133,28 @@ bool ApplyArcoIk(const DecodeContext& context,
   if (distance > options.max_residual_mm) {
     if (distance > options.max_hand_shift_mm) {
       c->tip_distance_refined_mm = distance;
-      c->state = ContactState::kUncertain;  // lift test: unreachable within the limits
       c->reason = ContactReason::kOutOfReach;
+      if (!options.keep_unreachable) {
+        c->state = ContactState::kUncertain;  // lift test: unreachable within the limits
+        return false;
+      }
+      // The note is played whether or not arco's hand reaches it: the decision stands and
+      // the finger goes as near as its joints allow; the hand stays where the cameras put
+      // it (a real hand is not arco's model).
+      *hand_out = pose;
       return false;
     }
     const Eigen::Vector3d tip = hand::FingertipInWorld(context.input->hand_model, pose, finger);
-    pose.wrist_in_world_mm += c->point_in_world_mm - tip;  // the whole hand, rigidly
+    // The whole hand, rigidly, by its share of the offset.
+    const Eigen::Vector3d shift = HandShift(context, options, f, c->point_in_world_mm - tip);
+    pose.wrist_in_world_mm += shift;
     distance =
         (hand::FingertipInWorld(context.input->hand_model, pose, finger) - c->point_in_world_mm)
             .norm();
-    // A timing annotation (before_onset, note_boundary) says more than the shift.
-    if (c->reason == ContactReason::kNone) c->reason = ContactReason::kHandShifted;
+    // A timing annotation (before_onset, note_boundary) says more than the shift; a shift
+    // below half a millimetre is none.
+    if (c->reason == ContactReason::kNone && shift.norm() >= 0.5)
+      c->reason = ContactReason::kHandShifted;
   }
   c->tip_distance_refined_mm = distance;
   *hand_out = pose;
@@ -185,8 +236,12 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
     const FrameIk& s = final_ik[static_cast<size_t>(f)];
     if (!s.solved) continue;
     Accumulate(s, stats);
-    ApplyArcoIk(
-        context, options, s, &(*contacts)[static_cast<size_t>(f)], &hands[static_cast<size_t>(f)]);
+    ApplyArcoIk(context,
+                options,
+                s,
+                f,
+                &(*contacts)[static_cast<size_t>(f)],
+                &hands[static_cast<size_t>(f)]);
   }
 
   // The fitted hand lags fast shifts: a frame the lift test rejected inside a note whose
@@ -246,7 +301,7 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
       alt.state = ContactState::kPressed;
       alt.reason = ContactReason::kNone;
       std::optional<hand::HandPose> pose = hands[static_cast<size_t>(f)];
-      if (!ApplyArcoIk(context, options, retry_ik[r], &alt, &pose)) continue;
+      if (!ApplyArcoIk(context, options, retry_ik[r], f, &alt, &pose)) continue;
       alt.reason = ContactReason::kHandShifted;  // moved with its neighbours
       (*contacts)[static_cast<size_t>(f)] = alt;
       hands[static_cast<size_t>(f)] = pose;
@@ -286,7 +341,7 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
     if (!s.solved) continue;
     Accumulate(s, stats);
     std::optional<hand::HandPose> pose = hands[static_cast<size_t>(f)];
-    if (!ApplyArcoIk(context, options, s, &alt, &pose)) continue;
+    if (!ApplyArcoIk(context, options, s, f, &alt, &pose)) continue;
     if (alt.reason == ContactReason::kNone) alt.reason = ContactReason::kBeforeOnset;
     c = alt;
     hands[static_cast<size_t>(f)] = pose;

@@ -105,6 +105,10 @@ Status RefineInput::Validate() const {
                            std::to_string(instrument->num_strings()));
     }
   }
+  if (!detected_left_hand.empty() && detected_left_hand.size() != n) {
+    return Status::Error("refine input: " + std::to_string(detected_left_hand.size()) +
+                         " detected hand frames for " + std::to_string(n) + " frames");
+  }
   if (!(fps > 0 && Finite(fps))) return Status::Error("refine input: fps must be > 0");
   if (!(a4_hz > 0 && Finite(a4_hz))) return Status::Error("refine input: a4_hz must be > 0");
   if (!Finite(start_s)) return Status::Error("refine input: start_s must be finite");
@@ -309,6 +313,8 @@ Json ToJson(const RefineOptions& o) {
             {"lift_max_distance_mm", o.ik.lift_max_distance_mm},
             {"max_residual_mm", o.ik.max_residual_mm},
             {"max_hand_shift_mm", o.ik.max_hand_shift_mm},
+            {"detected_hand_shift", o.ik.detected_hand_shift},
+            {"keep_unreachable", o.ik.keep_unreachable},
             {"neighbour_shift_frames", o.ik.neighbour_shift_frames},
             {"max_iterations", o.ik.max_iterations}}}};
 }

@@ -22,6 +22,7 @@
 
 #include "arco/hand/hand_model.h"
 #include "arco/hand/ik.h"
+#include "arco/hand/kinematics.h"
 #include "arco/instrument/instrument_model.h"
 #include "arco/instrument/strings.h"
 #include "arco/refine/contact_annotation.h"
@@ -50,6 +51,11 @@ struct RefineInput {
   // (note_boundaries.h); empty: by each frame's own pitch only.
   std::vector<AudioNote> audio_notes;
   double start_s = 0;
+  // Per frame (empty, or one per frame): the left hand as the cameras triangulated it (21
+  // points, world mm, NaN where missing), before any model fit. arco's IK moves the whole
+  // hand toward a contact its joints cannot reach only as far as this detected hand says
+  // the fitted one may be off (ArcoIkOptions::contact_sigma_mm). Empty: unknown.
+  std::vector<std::optional<hand::HandPointsMm>> detected_left_hand;
 
   // Errors: no instrument, a right-hand model, sizes that differ, fps <= 0, a strings entry
   // with a wrong string count or non-finite ends.
@@ -132,6 +138,17 @@ struct ArcoIkOptions {
   // wrist is off: e.g. a hand fit lagging a shift); otherwise the contact is rejected.
   double max_residual_mm = 3.0;
   double max_hand_shift_mm = 15.0;
+  // How far the hand follows: the remaining offset r is taken only where the detected
+  // (triangulated) palm says the fitted hand is off, along that displacement d and at most
+  // d: shift = d clamp(r.d / |d|^2, 0, 1) (finger_ik.cc, HandShift). A fit that lags a fast
+  // shift follows the contact; a hand the cameras and the fit agree on stays where they put
+  // it. false, or no detected hand: the whole offset (the former rule).
+  bool detected_hand_shift = true;
+  // A contact still farther than max_hand_shift_mm after the IK and the hand's move: true
+  // keeps the decoded note, string and finger (state pressed, reason out_of_reach) with the
+  // finger as near as its joints reach; false rejects the contact (state uncertain) and
+  // leaves the fitted hand, the former lift test.
+  bool keep_unreachable = true;
   // A frame the lift test rejected inside a note starts from the fitted hand moved by the
   // whole-hand shift of its nearest accepted frames of the same note, string and finger
   // within this many frames (the fitted hand lags fast shifts); 0: off.

@@ -50,10 +50,21 @@ TruthFolder MakeTruthFolder(const SyntheticCapture& c,
   m.fingering_string_crossings = c.fingering.num_string_crossings;
   m.fingering_total_cost = c.fingering.total_cost;
   m.sample_median_offset_cents = s.audio.key_offset_cents;
+  m.motion_source = c.motion_source;
+  m.audio_source = c.audio_source;
+  m.error_model = c.error_model;
+  const bool recorded = !c.motion_source.empty();
+  if (recorded) {
+    m.piece = c.motion_source;
+    m.hand_model = "none (recorded motion: no hand pose truth)";
+  }
 
   t.points3d = c.points3d;
+  const size_t frames = static_cast<size_t>(c.num_frames);
   t.left_hand.assign(c.left_hand.begin(), c.left_hand.end());
   t.right_hand.assign(c.right_hand.begin(), c.right_hand.end());
+  t.left_hand.resize(frames);  // no hand pose truth: NaN rows
+  t.right_hand.resize(frames);
   t.world_from_instrument = c.world_from_instrument;
   for (int f = 0; f < c.num_frames; ++f) {
     const ContactTruth& truth = c.contact[static_cast<size_t>(f)];
@@ -82,6 +93,7 @@ TruthFolder MakeTruthFolder(const SyntheticCapture& c,
     n.vibrato_extent_cents = p.vibrato_extent_cents;
     t.notes.push_back(n);
   }
+  if (recorded) return t;  // the recording's pitch is not known: no pitch.csv truth
   // Confidence marks what a pitch evaluation should score: 0 for the first
   // 60 ms of a note (the sample speaks) and for release tails (0.7 s after a
   // note's end, the rendered sample still rings), 1 elsewhere.
@@ -110,7 +122,16 @@ Status WriteAll(const SyntheticCapture& c,
   ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, "keypoints2d.npy"), c.keypoints2d));
   // Audio.
   CaptureManifest m;
-  if (w.audio) {
+  if (!c.audio_source.empty()) {
+    // A recording's own audio, copied as it is (its format and rate kept).
+    std::string extension = fs::path(c.audio_source).extension().string();
+    if (extension.empty()) extension = ".wav";
+    const std::string name = "audio" + extension;
+    std::error_code ec;
+    fs::copy_file(c.audio_source, JoinPath(dir, name), ec);
+    if (ec) return Status::Error(c.audio_source + ": cannot copy into the capture: " + ec.message());
+    m.audio = name;
+  } else if (w.audio) {
     ARCO_RETURN_IF_ERROR(RenderPerformanceAudio(c.performance,
                                                 GmProgramFor(c.instrument_kind),
                                                 w.audio_render,
@@ -122,8 +143,10 @@ Status WriteAll(const SyntheticCapture& c,
     m.audio = "audio.wav";
   }
   m.name = "synth " + c.options.instrument + " " +
-           (c.options.midi_path.empty() ? c.options.piece : c.options.midi_path) + " seed " +
-           std::to_string(c.options.seed);
+           (!c.motion_source.empty() ? fs::path(c.motion_source).filename().string()
+            : c.options.midi_path.empty() ? c.options.piece
+                                          : c.options.midi_path) +
+           " seed " + std::to_string(c.options.seed);
   m.instrument = InstrumentKindName(c.instrument_kind);
   m.fps = c.options.fps;
   m.frame_first = 1;

@@ -61,6 +61,16 @@ Status DetectionOptions::Validate() const {
   if (!(instrument_noise_scale >= 0) || !(bow_noise_scale >= 0)) {
     return Status::Error("noise scales must be >= 0");
   }
+  if (!(finger_offset_mm >= 0 && finger_offset_mm < 100) ||
+      !(finger_offset_time_s >= 0 && finger_offset_time_s < 1e6)) {
+    return Status::Error("finger_offset_mm must be in [0, 100) and finger_offset_time_s >= 0");
+  }
+  if (!(hand_back_max_deg >= 0 && hand_back_max_deg <= 90)) {
+    return Status::Error("hand_back_max_deg must be in [0, 90]");
+  }
+  if (!(finger_confusion_rate >= 0 && finger_confusion_rate <= 1)) {
+    return Status::Error("finger_confusion_rate must be in [0, 1]");
+  }
   return Status::Ok();
 }
 
@@ -104,10 +114,40 @@ NpyArray<float> EmulateDetections(const Rig& rig,
     }
   }
 
+  // 7. Per-finger offset of the left hand, AR(1) per finger and axis, shared by all views.
+  // finger_offset[fr * 5 + finger] at the tip; joint j (0 = MCP .. 3 = tip) gets (j+1)/4.
+  std::vector<Eigen::Vector3d> finger_offset;
+  if (o.finger_offset_mm > 0) {
+    finger_offset.assign(static_cast<size_t>(num_frames) * 5, Eigen::Vector3d::Zero());
+    Rng rng = Rng::Stream(seed, 997);
+    const double a =
+        o.finger_offset_time_s > 0 ? std::exp(-1.0 / (fps * o.finger_offset_time_s)) : 0.0;
+    const double b = std::sqrt(1 - a * a);
+    for (int finger = 0; finger < 5; ++finger) {
+      Eigen::Vector3d state(rng.Normal(), rng.Normal(), rng.Normal());
+      for (int fr = 0; fr < num_frames; ++fr) {
+        if (fr > 0)
+          state = a * state + b * Eigen::Vector3d(rng.Normal(), rng.Normal(), rng.Normal());
+        finger_offset[static_cast<size_t>(fr) * 5 + static_cast<size_t>(finger)] =
+            o.finger_offset_mm * state;
+      }
+    }
+  }
+  // Left-hand keypoint k (1..20) -> finger 0..4 and joint 0..3; the wrist is -1.
+  auto left_finger_joint = [&](int p, int* finger, int* joint) {
+    const int k = p - layout.left_hand_first;
+    if (k < 1 || k >= wholebody::kNumHandPoints) return false;
+    *finger = (k - 1) / 4;
+    *joint = (k - 1) % 4;
+    return true;
+  };
+  const double back_cos = std::cos(o.hand_back_max_deg * kPi / 180.0);
+
   ParallelFor(num_views, num_threads, [&](int64_t view, int) {
     const Camera& cam = rig.cameras[static_cast<size_t>(view)];
     const Eigen::Vector3d centre = cam.CenterInWorld();
     Rng rng = Rng::Stream(seed, 1000 + static_cast<uint64_t>(view));
+    Rng confusion_rng = Rng::Stream(seed, 5000 + static_cast<uint64_t>(view));
     for (int fr = 0; fr < num_frames; ++fr) {
       const DetectionFrame& f = frames[static_cast<size_t>(fr)];
       auto slot = [&](int p) {
@@ -131,6 +171,16 @@ NpyArray<float> EmulateDetections(const Rig& rig,
                     static_cast<size_t>(p)];
         if (p == f.bias_tip) x += o.finger_bias_mm * f.bias_direction;
         if (p == f.bias_dip) x += 0.5 * o.finger_bias_mm * f.bias_direction;
+        int finger = -1, joint = -1;
+        const bool left_finger_point = left_finger_joint(p, &finger, &joint);
+        if (left_finger_point && !finger_offset.empty()) {
+          x += (joint + 1) / 4.0 *
+               finger_offset[static_cast<size_t>(fr) * 5 + static_cast<size_t>(finger)];
+        }
+        // 8. Seen from behind: the back of the hand faces the camera.
+        const bool behind_hand = o.hand_back_max_deg > 0 && left_finger_point && joint >= 1 &&
+                                 f.left_hand_back.squaredNorm() > 0.5 &&
+                                 f.left_hand_back.dot((centre - x).normalized()) > back_cos;
         const auto pixel = cam.Project(x);
         if (!pixel || pixel->x() < -0.5 || pixel->y() < -0.5 || pixel->x() > cam.width - 0.5 ||
             pixel->y() > cam.height - 0.5) {
@@ -150,7 +200,7 @@ NpyArray<float> EmulateDetections(const Rig& rig,
         if (outlier) {
           err = far_px * Eigen::Vector2d(std::cos(angle), std::sin(angle));
           score = outlier_score;
-        } else if (occluded || dropout) {
+        } else if (occluded || dropout || behind_hand) {
           err = 4 * err + occl_px * Eigen::Vector2d(std::cos(angle), std::sin(angle));
           score = occl_score;
         } else {
@@ -161,6 +211,18 @@ NpyArray<float> EmulateDetections(const Rig& rig,
         s[0] = static_cast<float>(pixel->x() + err.x());
         s[1] = static_cast<float>(pixel->y() + err.y());
         s[2] = static_cast<float>(score);
+      }
+      // 9. Neighbouring fingers of the left hand trade PIP, DIP and tip.
+      if (o.finger_confusion_rate > 0) {
+        const bool swap = confusion_rng.Bernoulli(o.finger_confusion_rate);
+        const int pair = std::min(2, static_cast<int>(confusion_rng.Uniform(0, 3)));
+        if (swap) {
+          for (int j = 1; j < 4; ++j) {
+            float* a = slot(layout.left_hand_first + 1 + 4 * (1 + pair) + j);
+            float* b = slot(layout.left_hand_first + 1 + 4 * (2 + pair) + j);
+            for (int c = 0; c < 3; ++c) std::swap(a[c], b[c]);
+          }
+        }
       }
       // Left/right hand swap for this view and frame.
       if (rng.Bernoulli(o.outlier_rate)) {

@@ -27,6 +27,22 @@
 //     jittered, within [0.5, 1]: the score correlates with the error.
 //  6. Hand swaps: with probability `outlier_rate` per view and frame the left and
 //     right hand detections trade places.
+// Three further errors of real hand detectors, off by default (the named error models of
+// synth/error_model.h switch them on). Each draws from its own seeded streams, so switching
+// one on leaves every other draw, and today's captures, unchanged:
+//  7. Per-finger offset (before projection, in 3D, shared by all views): each left-hand
+//     finger carries one smooth offset (first-order autoregressive, `finger_offset_time_s`),
+//     `finger_offset_mm` per axis at the tip, 3/4 at the DIP, 1/2 at the PIP, 1/4 at the
+//     MCP: the detector's systematic error on fingers pressing strings (a finger drawn too
+//     straight or too bent in every view), which triangulation cannot remove.
+//  8. The hand seen from behind: in a view that looks at the back of the left hand (the
+//     angle between the line of sight and the hand's back normal, DetectionFrame::
+//     left_hand_back, below `hand_back_max_deg`) the fingers' PIP, DIP and tips are
+//     hidden behind the hand; the detector guesses them as for an occluded point
+//     (4 noise_px + up to 25 px, score 0.05-0.45).
+//  9. Finger confusions: with probability `finger_confusion_rate` per view and frame two
+//     neighbouring fingers of the left hand (index-middle, middle-ring, ring-little) trade
+//     their PIP, DIP and tip detections.
 #pragma once
 
 #include <Eigen/Core>
@@ -50,6 +66,10 @@ struct DetectionOptions {
   double instrument_noise_scale = 0.5;  // instrument points (tracked, TAPIR-like)
   double bow_noise_scale = 1.5;         // frog and tip (a dedicated detector)
   bool geometric_occlusion = true;
+  double finger_offset_mm = 0;        // 7. per-finger shared 3D offset at the tip (0 = off)
+  double finger_offset_time_s = 0.6;  // its correlation time
+  double hand_back_max_deg = 0;       // 8. back-of-hand view cone half-angle (0 = off)
+  double finger_confusion_rate = 0;   // 9. neighbouring-finger swaps per view and frame
   Status Validate() const;
 };
 
@@ -58,6 +78,9 @@ struct DetectionFrame {
   std::vector<Eigen::Vector3d> points;  // truth keypoints of the capture layout
   int bias_tip = -1, bias_dip = -1;     // keypoint indices biased this frame (-1: none)
   Eigen::Vector3d bias_direction = Eigen::Vector3d::Zero();  // unit, world
+  // Unit normal of the back of the left hand (away from the palm); zero: unknown (no
+  // back-of-hand occlusion this frame).
+  Eigen::Vector3d left_hand_back = Eigen::Vector3d::Zero();
   // Instrument body ellipse: centre, unit axes, semi-axes (mm).
   Eigen::Vector3d body_centre, body_axis_x, body_axis_y;
   double body_half_x = 0, body_half_y = 0;

@@ -24,6 +24,7 @@
 #include "arco/synth/performance.h"
 #include "arco/synth/score.h"
 #include "arco/synth/stage.h"
+#include "arco/util/json_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/status.h"
 
@@ -83,6 +84,11 @@ struct SyntheticCapture {
   NpyArray<float> keypoints2d;                         // (frames, views, capture points, 3)
   double max_residual_shift_mm = 0;  // largest whole-hand correction the IK needed
   int pressed_frames = 0;
+  // A re-captured recording (motion.h): the motion and the audio it came from (the audio is
+  // copied, not rendered; the performance, score and hand poses are empty) and the
+  // detector error model applied (error_model.h). Empty for a generated performance.
+  std::string motion_source, audio_source;
+  Json error_model;
 };
 
 // Errors: invalid options, unknown instrument/piece, MIDI problems, a rig with

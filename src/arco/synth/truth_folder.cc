@@ -60,6 +60,9 @@ Json ManifestJson(const TruthManifest& m) {
                     {"open_strings", m.fingering_open_strings},
                     {"string_crossings", m.fingering_string_crossings},
                     {"total_cost", m.fingering_total_cost}};
+  if (!m.motion_source.empty()) j["motion_source"] = m.motion_source;
+  if (!m.audio_source.empty()) j["audio_source"] = m.audio_source;
+  if (!m.error_model.is_null()) j["error_model"] = m.error_model;
   Json offsets = Json::object();
   for (const auto& [key, cents] : m.sample_median_offset_cents)
     offsets[std::to_string(key)] = cents;
@@ -115,6 +118,9 @@ StatusOr<TruthManifest> ManifestFromJson(const Json& j, const std::string& path)
   get(j, "units", &m.units);
   get(j, "calibration_source", &m.calibration_source);
   get(j, "hand_model", &m.hand_model);
+  get(j, "motion_source", &m.motion_source);
+  get(j, "audio_source", &m.audio_source);
+  if (j.contains("error_model")) m.error_model = j["error_model"];
   const Json empty = Json::object();
   const Json& stage = j.contains("stage") && j["stage"].is_object() ? j["stage"] : empty;
   get(stage, "mm_per_unit", &m.mm_per_unit);
@@ -262,7 +268,9 @@ Status WriteTruthFolder(const std::string& dir, const TruthFolder& t) {
   ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, kInstrumentPoseFile), poses));
   ARCO_RETURN_IF_ERROR(AtomicWriteFile(JoinPath(dir, kContactFile), ContactCsv(t)));
   ARCO_RETURN_IF_ERROR(AtomicWriteFile(JoinPath(dir, kNotesFile), NotesCsv(t.notes)));
-  ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(JoinPath(dir, kPitchFile), t.pitch));
+  // A recording's pitch is not known: no pitch.csv (eval reports pitch absent).
+  if (t.manifest.motion_source.empty())
+    ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(JoinPath(dir, kPitchFile), t.pitch));
   return WriteJsonFile(JoinPath(dir, kManifestFile), ManifestJson(t.manifest));
 }
 

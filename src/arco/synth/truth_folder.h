@@ -29,6 +29,7 @@
 #include "arco/hand/hand_model.h"
 #include "arco/refine/contacts_csv.h"
 #include "arco/util/npy.h"
+#include "arco/util/json_io.h"
 #include "arco/util/status.h"
 
 namespace arco::synth {
@@ -60,6 +61,11 @@ struct TruthManifest {
   int fingering_shifts = 0, fingering_open_strings = 0, fingering_string_crossings = 0;
   double fingering_total_cost = 0;
   std::map<int, double> sample_median_offset_cents;  // per MIDI key of the rendered samples
+  // A re-captured recording (synth/motion.h): the motion and audio it came from ("" for a
+  // generated performance) and the detector error model with every parameter
+  // (synth/error_model.h; null when not recorded).
+  std::string motion_source, audio_source;
+  Json error_model;
 };
 
 // One row of notes.csv.
