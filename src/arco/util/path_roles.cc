@@ -73,19 +73,19 @@ Status PathRoles::Check() const {
     for (size_t i = 0; i < inputs_.size(); ++i) {
       if (SamePath(outputs[o], inputs[i])) {
         return Status::Error(shown + ": " + out.label + " is the input " + inputs_[i].label +
-                             Where(inputs_[i].path, out.path) + kReplaces);
+                             Where(NormalizeOutputPath(inputs_[i].path), shown) + kReplaces);
       }
     }
     for (size_t i = 0; i < inputs_.size(); ++i) {
       const Entry& in = inputs_[i];
       if (!in.owned && PathIsInside(outputs[o], inputs[i])) {
         return Status::Error(shown + ": " + out.label + " is inside the input folder " +
-                             in.label + Where(in.path, out.path) +
+                             in.label + Where(NormalizeOutputPath(in.path), shown) +
                              "; an output never goes into an input (choose a path outside it)");
       }
       if (PathIsInside(inputs[i], outputs[o])) {
         return Status::Error(shown + ": " + out.label + " contains the input " + in.label +
-                             Where(in.path, out.path) + kReplaces);
+                             Where(NormalizeOutputPath(in.path), shown) + kReplaces);
       }
     }
     for (size_t k = 0; k < o; ++k) {
