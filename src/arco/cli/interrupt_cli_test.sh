@@ -11,15 +11,24 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 
-# start DIR ARGS...: runs `arco ARGS` in the background ($pid) and waits until it has a
-# temporary in DIR (at most 60 s), then a little longer, so that it is inside its work;
-# with DIR "-", waits 0.5 s (a command still computing, before it writes).
+# handles_sigint PID: the process has installed its SIGINT handler (SigCgt bit 2 in
+# /proc/PID/status). Before that a background job of a script ignores SIGINT, as bash
+# starts it with SIGINT ignored.
+handles_sigint() {
+  local caught; caught=$(awk '/^SigCgt:/ {print $2}' "/proc/$1/status" 2>/dev/null)
+  [ -n "$caught" ] && (( (0x$caught & 2) != 0 ))
+}
+
+# start DIR ARGS...: runs `arco ARGS` in the background ($pid), waits until it handles
+# SIGINT and has a temporary in DIR (at most 60 s), then a little longer, so that it is
+# inside its work; with DIR "-", only 0.2 s after the handler (still computing).
 start() {
   local dir=$1; shift
   "$arco" "$@" >"$tmp/out" 2>"$tmp/err" &
   pid=$!
-  if [ "$dir" = - ]; then sleep 0.5; return; fi
   local waited=0
+  until handles_sigint "$pid" || [ $waited -ge 1200 ]; do sleep 0.05; waited=$((waited + 1)); done
+  if [ "$dir" = - ]; then sleep 0.2; return; fi
   until [ -n "$(find "$dir" -maxdepth 1 -name ".tmp-$pid.*" 2>/dev/null)" ] || [ $waited -ge 1200 ]; do
     sleep 0.05; waited=$((waited + 1))
   done
