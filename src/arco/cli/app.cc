@@ -5,6 +5,8 @@
 #include <exception>
 
 #include "arco/cli/command.h"
+#include "arco/util/interrupt.h"
+#include "arco/util/output_set.h"
 
 namespace arco::cli {
 
@@ -14,6 +16,7 @@ std::vector<CommandEntry>& CommandRegistry() {
 }
 
 int PrintError(const std::string& message) {
+  WaitIfInterrupted();  // an error caused by the cleanup removing a temporary is not news
   std::fprintf(stderr, "arco: error: %s\n", message.c_str());
   return 1;
 }
@@ -32,11 +35,23 @@ App BuildApp() {
                    [](const CommandEntry& a, const CommandEntry& b) { return a.order < b.order; });
   for (auto& entry : registry) {
     const size_t before = app.get_subcommands({}).size();
-    auto run = entry.setup(app);
+    CommandRun command = entry.setup(app);
     auto subs = app.get_subcommands({});
-    if (subs.size() > before) built.commands.emplace_back(subs.back(), run);
+    if (subs.size() > before) {
+      built.commands.emplace_back(subs.back(), [command] { return RunCommand(command); });
+    }
   }
   return built;
+}
+
+int RunCommand(const CommandRun& command) {
+  if (command.paths) {
+    const PathRoles roles = command.paths();
+    const Status distinct = roles.Check();
+    if (!distinct.ok()) return PrintError(distinct.message());
+    for (const std::string& output : roles.output_paths()) RemoveStaleTemporaries(output);
+  }
+  return command.run();
 }
 
 void App::Parse(std::vector<std::string> args) {
@@ -158,6 +173,7 @@ std::string OptionsMarkdown(const App& app) {
 }
 
 int Main(int argc, char** argv) {
+  InstallInterruptCleanup();  // Ctrl-C removes what is being written, exit 130
   App app = BuildApp();
   if (argc > 1) {
     const Status known = CheckCommandNames(app, std::vector<std::string>(argv + 1, argv + argc));
@@ -171,7 +187,9 @@ int Main(int argc, char** argv) {
   } catch (const std::exception& e) {  // a bug (the fuzzer looks for these): one line still
     return PrintError(e.what());
   }
-  return app.Run();
+  const int status = app.Run();
+  WaitIfInterrupted();  // the cleanup thread sets the exit status (130)
+  return status;
 }
 
 }  // namespace arco::cli

@@ -123,7 +123,7 @@ int RunBatch(const BatchOptions& o) {
   return PrintError(o.snakemake + ": cannot run: " + std::strerror(error));
 }
 
-std::function<int()> SetupBatch(CLI::App& app) {
+CommandRun SetupBatch(CLI::App& app) {
   auto o = std::make_shared<BatchOptions>();
   auto* cmd = app.add_subcommand(
       "batch",
@@ -146,7 +146,13 @@ std::function<int()> SetupBatch(CLI::App& app) {
                   "Folder of the Snakefile (default: $ARCO_WORKFLOW_DIR, else the source "
                   "tree's workflow/)");
   cmd->add_option("--snakemake", o->snakemake, "Snakemake executable")->capture_default_str();
-  return [o] { return RunBatch(*o); };
+  return CommandRun([o] { return RunBatch(*o); },
+                    [o] {
+                      PathRoles roles;
+                      roles.AddInput("TAKES", o->takes_dir);
+                      roles.AddOutput("-o", o->output_dir);
+                      return roles;
+                    });
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include "arco/calibration/calibrate.h"
 #include "arco/cli/command.h"
+#include "arco/cli/command_paths.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
@@ -215,7 +216,7 @@ void ApplyAndValidate(CalibrateArgs& a,
   if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kCalibrateFlags)));
 }
 
-std::function<int()> SetupCalibrate(CLI::App& app) {
+CommandRun SetupCalibrate(CLI::App& app) {
   auto a = std::make_shared<CalibrateArgs>();
   calibration::CalibrateOptions& o = a->options;
   auto* cmd = app.add_subcommand(
@@ -429,7 +430,29 @@ std::function<int()> SetupCalibrate(CLI::App& app) {
   });
   cmd->parse_complete_callback(
       [a, cmd, check, refine] { ApplyAndValidate(*a, *cmd, *check, *refine); });
-  return [a, c, r, json, check, refine] {
+  // calibrate check writes nothing; calibrate and calibrate refine write a calibration and
+  // its report beside it.
+  auto paths = [a, r, check, refine] {
+    PathRoles roles;
+    if (refine->parsed()) {
+      AddCaptureInputs(&roles, "CAPTURE", r->capture_dir);
+      roles.AddInput("--calibration", r->calibration);
+      roles.AddOutput("-o", r->output);
+      if (!r->output.empty()) {
+        roles.AddOutput("-o's report", calibration::ReportPath(r->output));
+      }
+    } else if (!check->parsed()) {
+      for (const std::string& v : a->videos) roles.AddInput("--video", AssignedPath(v));
+      for (const std::string& v : a->images) roles.AddInput("--images", AssignedPath(v));
+      roles.AddInput("--intrinsics", a->options.intrinsics);
+      roles.AddOutput("-o", a->options.output);
+      if (!a->options.output.empty()) {
+        roles.AddOutput("-o's report", calibration::ReportPath(a->options.output));
+      }
+    }
+    return roles;
+  };
+  return CommandRun([a, c, r, json, check, refine] {
     if (check->parsed()) return RunCheck(*c, *json);
     if (refine->parsed()) return RunRefine(*r);
     ProgressBar bar("calibrate");
@@ -438,7 +461,7 @@ std::function<int()> SetupCalibrate(CLI::App& app) {
     if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kCalibrateFlags));
     std::fputs(FormatReport(*result, a->options.output).c_str(), stdout);
     return 0;
-  };
+  }, paths);
 }
 
 }  // namespace

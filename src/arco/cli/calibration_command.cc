@@ -109,7 +109,7 @@ int RunCalibrationConvert(const CalibrationConvertOptions& o) {
   return 0;
 }
 
-std::function<int()> SetupCalibration(CLI::App& app) {
+CommandRun SetupCalibration(CLI::App& app) {
   auto* cmd = app.add_subcommand("calibration", "Show or convert a camera calibration");
   cmd->require_subcommand(1);
   auto show_options = std::make_shared<CalibrationShowOptions>();
@@ -137,11 +137,21 @@ std::function<int()> SetupCalibration(CLI::App& app) {
                    convert_options->format,
                    "Output format instead of the extension: yaml, opencv-xml, spd, arco")
       ->check(CLI::IsMember({"yaml", "opencv-xml", "spd", "arco"}));
-  return [show, show_options, convert, convert_options]() {
-    if (show->parsed()) return RunCalibrationShow(*show_options);
-    if (convert->parsed()) return RunCalibrationConvert(*convert_options);
-    return PrintError("calibration: give a subcommand (show, convert)");
+  auto paths = [convert, convert_options] {
+    PathRoles roles;
+    if (convert->parsed()) {
+      roles.AddInput("INPUT", convert_options->input);
+      roles.AddOutput("OUTPUT", convert_options->output);
+    }
+    return roles;
   };
+  return CommandRun(
+      [show, show_options, convert, convert_options]() {
+        if (show->parsed()) return RunCalibrationShow(*show_options);
+        if (convert->parsed()) return RunCalibrationConvert(*convert_options);
+        return PrintError("calibration: give a subcommand (show, convert)");
+      },
+      paths);
 }
 
 }  // namespace

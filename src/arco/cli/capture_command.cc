@@ -10,9 +10,11 @@
 #include <vector>
 
 #include "arco/cli/command.h"
+#include "arco/cli/command_paths.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
 #include "arco/pipeline/capture_new.h"
+#include "arco/mocap/capture.h"
 #include "arco/pipeline/import_keypoints.h"
 
 namespace arco::cli {
@@ -155,7 +157,7 @@ int RunImportKeypoints(const pipeline::ImportKeypointsOptions& o) {
   return 0;
 }
 
-std::function<int()> SetupCapture(CLI::App& app) {
+CommandRun SetupCapture(CLI::App& app) {
   auto* cmd = app.add_subcommand("capture", "Make a capture folder from videos, or fill one");
   cmd->require_subcommand(1);
 
@@ -249,11 +251,37 @@ std::function<int()> SetupCapture(CLI::App& app) {
   if (!valid.ok()) throw CLI::ValidationError(WithFlagNames(valid.message(), kCaptureFlags));
 });
 
-return [create, n, import, k]() {
-  if (create->parsed()) return RunCaptureNew(n->options);
-  if (import->parsed()) return RunImportKeypoints(k->options);
-  return PrintError("capture: give a subcommand (new, import-keypoints)");
-};
+  auto paths = [create, n, import, k] {
+    PathRoles roles;
+    if (create->parsed()) {
+      roles.AddInput("--calibration", n->options.calibration);
+      for (const std::string& v : n->videos) roles.AddInput("--video", AssignedPath(v));
+      for (const std::string& v : n->images) roles.AddInput("--images", AssignedPath(v));
+      roles.AddInput("--audio", n->options.audio);
+      roles.AddInput("--spd-summary", n->options.spd_summary);
+      roles.AddOutput("-o", n->options.output_dir);
+    }
+    if (import->parsed()) {
+      // The capture is the command's own: its keypoints and manifest are written in place.
+      const std::string& capture = k->options.capture_dir;
+      roles.AddOwnedFolder("CAPTURE", capture);
+      for (const std::string& c : k->cameras) roles.AddInput("--camera", AssignedPath(c));
+      auto manifest = ReadCaptureManifest(capture);
+      const std::string keypoints = manifest.ok() && !manifest->keypoints2d.empty()
+                                        ? manifest->keypoints2d
+                                        : "keypoints2d.npy";
+      roles.AddOutput("CAPTURE", ResolveCapturePath(capture, keypoints));
+      roles.AddOutput("CAPTURE", ResolveCapturePath(capture, "capture.json"));
+    }
+    return roles;
+  };
+  return CommandRun(
+      [create, n, import, k]() {
+        if (create->parsed()) return RunCaptureNew(n->options);
+        if (import->parsed()) return RunImportKeypoints(k->options);
+        return PrintError("capture: give a subcommand (new, import-keypoints)");
+      },
+      paths);
 }  // namespace
 
 }  // namespace arco::cli

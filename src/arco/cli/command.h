@@ -5,15 +5,39 @@
 
 #include <functional>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
+#include "arco/util/path_roles.h"
+
 namespace arco::cli {
 
-// Adds a subcommand to `app`; the returned callback runs it after parsing and
-// returns the process exit code (0 ok, 1 error already printed).
-using CommandSetup = std::function<std::function<int()>(CLI::App& app)>;
+// What a command's setup returns: `run` runs it after parsing and returns the process exit
+// code (0 ok, 1 error already printed); `paths` (for a command that writes files the user
+// names) lists, from the parsed options, every file and folder it reads and writes
+// (util/path_roles.h, cli/command_paths.h). The app checks them before `run`: an output
+// that is an input, lies inside an input folder or contains one is one error line, and
+// nothing is read or written; then the leftovers of interrupted commands beside each
+// output go (RemoveStaleTemporaries). docs/architecture.md, "Outputs".
+struct CommandRun {
+  std::function<int()> run;
+  std::function<PathRoles()> paths;
+
+  template <typename F, typename = std::enable_if_t<std::is_invocable_r_v<int, F>>>
+  CommandRun(F run_function) : run(std::move(run_function)) {}  // NOLINT: a command's lambda
+  CommandRun(std::function<int()> run_function, std::function<PathRoles()> path_function)
+      : run(std::move(run_function)), paths(std::move(path_function)) {}
+};
+
+// Adds a subcommand to `app` and returns how to run it.
+using CommandSetup = std::function<CommandRun(CLI::App& app)>;
+
+// Runs a parsed command: its paths checked (an output is never an input), the stale
+// temporaries beside its outputs removed, then `run`.
+int RunCommand(const CommandRun& command);
 
 struct CommandEntry {
   std::string name;
@@ -29,7 +53,8 @@ struct CommandRegistrar {
   }
 };
 
-// Prints "arco: error: <message>" on stderr; returns 1.
+// Prints "arco: error: <message>" on stderr; returns 1. After an interrupt (SIGINT,
+// SIGTERM: util/interrupt.h) it prints nothing and waits for the cleanup to exit with 130.
 int PrintError(const std::string& message);
 
 }  // namespace arco::cli

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "arco/cli/command.h"
+#include "arco/cli/command_paths.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
 #include "arco/eval/evaluate.h"
@@ -63,7 +64,7 @@ int Run(Args& a) {
   return 0;
 }
 
-std::function<int()> SetupEval(CLI::App& app) {
+CommandRun SetupEval(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "eval", "Score a result folder against truth (synthetic truth/ or labelled views)");
   auto a = std::make_shared<Args>();
@@ -101,7 +102,16 @@ std::function<int()> SetupEval(CLI::App& app) {
     const Status valid = a->r.Validate();
     if (!valid.ok()) throw CLI::ValidationError(WithFlagNames(valid.message(), kEvalFlags));
   });
-  return [a] { return Run(*a); };
+  return CommandRun([a] { return Run(*a); },
+                    [a] {
+                      PathRoles roles;
+                      AddResultInputs(&roles, "RESULT_DIR", a->r.result_dir);
+                      for (const std::string& truth : a->truths) roles.AddInput("--truth", truth);
+                      roles.AddInput("--pitch", a->r.pitch_csv);
+                      roles.AddOutput("-o", a->output);
+                      roles.AddOutput("--plot", a->plot);
+                      return roles;
+                    });
 }
 
 }  // namespace

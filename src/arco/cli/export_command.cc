@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "arco/cli/command.h"
+#include "arco/cli/command_paths.h"
 #include "arco/cli/flag_names.h"
 #include "arco/export/export.h"
 #include "arco/util/output_set.h"
@@ -54,7 +55,7 @@ int Run(const Args& a) {
   return 0;
 }
 
-std::function<int()> SetupExport(CLI::App& app) {
+CommandRun SetupExport(CLI::App& app) {
   auto* cmd = app.add_subcommand("export",
                                  "Write a result's 3D points as CSV, TRC, C3D, glTF (.glb) or BVH");
   auto a = std::make_shared<Args>();
@@ -72,7 +73,13 @@ std::function<int()> SetupExport(CLI::App& app) {
     const Status valid = a->options.Validate();
     if (!valid.ok()) throw CLI::ValidationError(WithFlagNames(valid.message(), kExportFlags));
   });
-  return [a] { return Run(*a); };
+  return CommandRun([a] { return Run(*a); },
+                    [a] {
+                      PathRoles roles;
+                      AddResultInputs(&roles, "RESULT_DIR", a->options.result_dir);
+                      roles.AddOutput("-o", a->output);
+                      return roles;
+                    });
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 namespace arco::cli {
 namespace {
 
-std::function<int()> Setup(CLI::App& app) {
+CommandRun Setup(CLI::App& app) {
   auto o = std::make_shared<pipeline::ImportSpdOptions>();
   CLI::App* sub = app.add_subcommand(
       "import-spd",
@@ -55,7 +55,17 @@ std::function<int()> Setup(CLI::App& app) {
                   "Capture folder to create (must not exist, unless --overwrite)")
       ->required();
   sub->add_flag("--overwrite", o->overwrite, "Replace an existing capture folder");
-  return [o]() {
+  auto paths = [o] {
+    PathRoles roles;
+    roles.AddInput("--calibration", o->calibration);
+    roles.AddInput("--human", o->human_dir);
+    roles.AddInput("--instrument-points", o->instrument_dir);
+    roles.AddInput("--summary", o->summary);
+    roles.AddInput("--audio", o->audio);
+    roles.AddOutput("-o", o->output_dir);
+    return roles;
+  };
+  return CommandRun([o]() {
     auto r = pipeline::ImportSpdCapture(*o);
     if (!r.ok()) return PrintError(r.status().message());
     std::printf(
@@ -70,7 +80,7 @@ std::function<int()> Setup(CLI::App& app) {
         o->output_dir.c_str());
     for (const std::string& w : r->warnings) std::printf("warning: %s\n", w.c_str());
     return 0;
-  };
+  }, paths);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 #include <cstdio>
 
 #include "arco/cli/command.h"
+#include "arco/cli/command_paths.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/frame_range.h"
 #include "arco/cli/number_option.h"
@@ -52,7 +53,7 @@ int Run(const Args& a) {
   return 0;
 }
 
-std::function<int()> SetupOverlay(CLI::App& app) {
+CommandRun SetupOverlay(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "overlay",
       "Draw a result (skeleton, strings, contact, fingers, note) into one camera's video");
@@ -81,7 +82,13 @@ std::function<int()> SetupOverlay(CLI::App& app) {
     const Status valid = a->options.Validate();
     if (!valid.ok()) throw CLI::ValidationError(WithFlagNames(valid.message(), kOverlayFlags));
   });
-  return [a] { return Run(*a); };
+  return CommandRun([a] { return Run(*a); },
+                    [a] {
+                      PathRoles roles;
+                      AddResultInputs(&roles, "RESULT_DIR", a->options.result_dir);
+                      roles.AddOutput("-o", a->output);
+                      return roles;
+                    });
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include "arco/cli/audio_report.h"
 #include "arco/cli/command.h"
+#include "arco/cli/command_paths.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
@@ -11,7 +12,7 @@
 namespace arco::cli {
 namespace {
 
-std::function<int()> SetupPitch(CLI::App& app) {
+CommandRun SetupPitch(CLI::App& app) {
   auto o = std::make_shared<pipeline::PitchRunOptions>();
   auto* cmd = app.add_subcommand(
       "pitch", "Pitch (f0) at video-frame times: pitch.csv with one row per frame");
@@ -77,14 +78,24 @@ std::function<int()> SetupPitch(CLI::App& app) {
     const Status valid = o->Validate();
     if (!valid.ok()) throw CLI::ValidationError(WithFlagNames(valid.message(), kPitchFlags));
   });
-  return [o] {
+  auto paths = [o] {
+    PathRoles roles;
+    roles.AddInput("INPUT", o->input);
+    AddCaptureInputs(&roles, "--capture", o->capture_dir);
+    roles.AddOutput("-o", o->output);
+    roles.AddOutput("--fine", o->fine_output);
+    roles.AddOutput("--notes", o->notes_output);
+    roles.AddOutput("--midi", o->midi_output);
+    return roles;
+  };
+  return CommandRun([o] {
     ProgressBar bar("pitch");  // the bar starts at TrackPitch's SetTotal
     auto result = pipeline::RunPitch(*o, bar);
     bar.Finish();
     if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kPitchFlags));
     std::fputs(FormatPitchReport(*o, *result).c_str(), stdout);
     return 0;
-  };
+  }, paths);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 #include <cstdio>
 
 #include "arco/cli/command.h"
+#include "arco/cli/command_paths.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
 #include "arco/export/plot.h"
@@ -46,7 +47,7 @@ int Run(const Args& a) {
   return 0;
 }
 
-std::function<int()> SetupPlot(CLI::App& app) {
+CommandRun SetupPlot(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "plot", "Plot a result: pitch and notes, the fingerboard map, errors (SVG and PNG)");
   auto a = std::make_shared<Args>();
@@ -63,7 +64,13 @@ std::function<int()> SetupPlot(CLI::App& app) {
     const Status valid = a->options.Validate();
     if (!valid.ok()) throw CLI::ValidationError(WithFlagNames(valid.message(), kPlotFlags));
   });
-  return [a] { return Run(*a); };
+  return CommandRun([a] { return Run(*a); },
+                    [a] {
+                      PathRoles roles;
+                      AddResultInputs(&roles, "RESULT_DIR", a->options.result_dir);
+                      roles.AddOutput("-o", a->output);
+                      return roles;
+                    });
 }
 
 }  // namespace

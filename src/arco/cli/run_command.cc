@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "arco/cli/command.h"
+#include "arco/cli/command_paths.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
@@ -44,7 +45,7 @@ int RunRun(const RunArgs& a) {
   return 0;
 }
 
-std::function<int()> SetupRun(CLI::App& app) {
+CommandRun SetupRun(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "run", "Run every stage on a capture: triangulate, fit hands, pitch, refine, write");
   auto a = std::make_shared<RunArgs>();
@@ -68,7 +69,13 @@ std::function<int()> SetupRun(CLI::App& app) {
     const Status valid = a->o.Validate();
     if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kRefineFlags)));
   });
-  return [a]() { return RunRun(*a); };
+  return CommandRun([a]() { return RunRun(*a); },
+                    [a] {
+                      PathRoles roles;
+                      AddCaptureInputs(&roles, "CAPTURE", a->o.capture_dir);
+                      roles.AddOutput("-o", a->o.result_dir);
+                      return roles;
+                    });
 }
 
 }  // namespace

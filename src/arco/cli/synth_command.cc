@@ -243,7 +243,7 @@ int Run(Args& a) {
   return 0;
 }
 
-std::function<int()> SetupSynth(CLI::App& app) {
+CommandRun SetupSynth(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "synth", "Synthesise a string performance with exact truth (docs/synth.md)");
   auto a = std::make_shared<Args>();
@@ -406,7 +406,16 @@ std::function<int()> SetupSynth(CLI::App& app) {
     const Status valid = a->o.Validate();  // combinations the ranges above cannot see
     if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kSynthFlags)));
   });
-  return [a] { return Run(*a); };
+  return CommandRun([a] { return Run(*a); },
+                    [a] {
+                      PathRoles roles;
+                      roles.AddInput("--calibration",
+                                     a->calibration.empty() ? DefaultCalibration() : a->calibration);
+                      roles.AddInput("--midi", a->o.midi_path);
+                      if (!a->no_audio) roles.AddInput("--soundfont", a->w.audio_render.soundfont);
+                      roles.AddOutput("-o", a->output);
+                      return roles;
+                    });
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "arco/cli/command.h"
+#include "arco/cli/command_paths.h"
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
 #include "arco/cli/report.h"
@@ -102,7 +103,7 @@ int RunCaptureFolder(const Args& a) {
   return 0;
 }
 
-std::function<int()> Setup(CLI::App& app) {
+CommandRun Setup(CLI::App& app) {
   auto a = std::make_shared<Args>();
   CLI::App* sub = app.add_subcommand(
       "triangulate",
@@ -169,7 +170,15 @@ std::function<int()> Setup(CLI::App& app) {
             Closed(0, 1000000))
       ->capture_default_str();
   sub->parse_complete_callback([a] { ThrowIfInvalid(a->t.Validate()); });
-  return [a]() {
+  auto paths = [a] {
+    PathRoles roles;
+    AddCaptureInputs(&roles, "CAPTURE_DIR", a->capture_dir);
+    roles.AddInput("--calibration", a->calibration);
+    for (const std::string& v : a->views) roles.AddInput("--view", AssignedPath(v));
+    roles.AddOutput("-o", a->output);
+    return roles;
+  };
+  return CommandRun([a]() {
     a->t.refine = !a->no_refine;
     const bool views_mode = !a->views.empty() || !a->calibration.empty();
     if (views_mode && !a->capture_dir.empty()) {
@@ -185,7 +194,7 @@ std::function<int()> Setup(CLI::App& app) {
     }
     if (!a->scale_instrument.empty()) return PrintError("--scale-to applies to labelled views");
     return RunCaptureFolder(*a);
-  };
+  }, paths);
 }
 
 }  // namespace

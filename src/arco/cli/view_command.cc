@@ -5,7 +5,9 @@
 #include <filesystem>
 
 #include "arco/cli/command.h"
+#include "arco/cli/command_paths.h"
 #include "arco/cli/number_option.h"
+#include "arco/util/interrupt.h"
 #include "arco/util/output_set.h"
 #include "arco/view/server.h"
 #include "arco/view/video_cache.h"
@@ -83,6 +85,7 @@ int Serve(const Args& a) {
   std::string pattern = (std::filesystem::temp_directory_path() / "arco-view-XXXXXX").string();
   if (mkdtemp(pattern.data()) == nullptr) return PrintError(pattern + ": cannot create");
   const std::string dir = pattern;
+  TrackTemporary(dir);  // an interrupt before the server listens removes it too
   auto summary = view::WriteViewFolder(a.options, dir);
   int rc = 0;
   if (!summary.ok()) {
@@ -103,10 +106,11 @@ int Serve(const Args& a) {
   }
   std::error_code ignored;
   std::filesystem::remove_all(dir, ignored);
+  UntrackTemporary(dir);
   return rc;
 }
 
-std::function<int()> SetupView(CLI::App& app) {
+CommandRun SetupView(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "view", "See and hear a result: 3D, audio, pitch, contacts in a local web page");
   auto a = std::make_shared<Args>();
@@ -176,7 +180,13 @@ std::function<int()> SetupView(CLI::App& app) {
     }
     ThrowIfInvalid(a->options.Validate());
   });
-  return [a] { return a->no_serve ? WriteFolder(*a) : Serve(*a); };
+  return CommandRun([a] { return a->no_serve ? WriteFolder(*a) : Serve(*a); },
+                    [a] {
+                      PathRoles roles;
+                      AddResultInputs(&roles, "RESULT_DIR", a->options.result_dir);
+                      if (a->no_serve) roles.AddOutput("-o", a->output);
+                      return roles;
+                    });
 }
 
 }  // namespace

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <system_error>
 
+#include "arco/util/interrupt.h"
+
 namespace arco {
 namespace fs = std::filesystem;
 namespace {
@@ -42,17 +44,15 @@ bool IsEmptyFolder(const std::string& path) {
   return fs::is_empty(path, ec) && !ec;
 }
 
-// ".tmp-PID.NAME" / ".old-PID.NAME" of `name`: the PID, or -1 for any other name.
-long TemporaryOwner(const std::string& entry, const std::string& what, const std::string& name) {
+// ".tmp-PID.NAME" / ".old-PID.NAME": the PID (NAME in *name), or -1 for any other entry.
+long TemporaryOwner(const std::string& entry, const std::string& what, std::string* name) {
   const std::string prefix = "." + what + "-";
   if (entry.compare(0, prefix.size(), prefix) != 0) return -1;
   const size_t dot = entry.find('.', prefix.size());
-  if (dot == std::string::npos || dot == prefix.size() ||
-      entry.compare(dot + 1, std::string::npos, name) != 0) {
-    return -1;
-  }
+  if (dot == std::string::npos || dot == prefix.size() || dot + 1 == entry.size()) return -1;
   const std::string digits = entry.substr(prefix.size(), dot - prefix.size());
   if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) return -1;
+  *name = entry.substr(dot + 1);
   return std::stol(digits);
 }
 
@@ -60,24 +60,31 @@ bool ProcessAlive(long pid) { return ::kill(static_cast<pid_t>(pid), 0) == 0 || 
 
 }  // namespace
 
-void RemoveStaleTemporaries(const std::string& given) {
+int RemoveStaleTemporaries(const std::string& given) {
   const std::string path = NormalizeOutputPath(given);
   const fs::path p(path);
   const std::string name = p.filename().string();
-  if (name.empty() || name == "." || name == "..") return;
+  if (name.empty() || name == "." || name == "..") return 0;
+  const fs::path parent = ParentOf(path);
+  int removed = 0;
   std::error_code ec;
-  for (fs::directory_iterator it(ParentOf(path), ec), end; !ec && it != end; it.increment(ec)) {
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string entry = it->path().filename().string();
     for (const char* what : {"tmp", "old"}) {
-      const long pid = TemporaryOwner(entry, what, name);
+      std::string of;
+      const long pid = TemporaryOwner(entry, what, &of);
       if (pid <= 0 || pid == ::getpid() || ProcessAlive(pid)) continue;
       // An old output moved aside is deleted only once the new one is in place: otherwise
       // it may be the only copy (a command killed mid-commit), and is left for the user.
-      if (std::string(what) == "old" && !fs::exists(fs::symlink_status(path, ec))) continue;
+      std::error_code missing;
+      if (std::string(what) == "old" && !fs::exists(fs::symlink_status(parent / of, missing))) {
+        continue;
+      }
       std::error_code ignored;
-      fs::remove_all(it->path(), ignored);
+      if (fs::remove_all(it->path(), ignored) > 0 && !ignored) ++removed;
     }
   }
+  return removed;
 }
 
 std::string NormalizeOutputPath(const std::string& path) {
@@ -98,7 +105,10 @@ std::string HiddenSibling(const std::string& path, const std::string& what) {
 OutputSet::~OutputSet() {
   if (done_) return;
   std::error_code ec;
-  for (const Output& o : outputs_) fs::remove_all(o.tmp, ec);
+  for (const Output& o : outputs_) {
+    fs::remove_all(o.tmp, ec);
+    UntrackTemporary(o.tmp);
+  }
 }
 
 std::vector<std::string> OutputSet::paths() const {
@@ -172,9 +182,11 @@ StatusOr<std::string> OutputSet::AddFile(const std::string& given) {
   RemoveStaleTemporaries(path);
   std::error_code ec;
   fs::remove_all(o.tmp, ec);
+  TrackTemporary(o.tmp);  // removed if the process is interrupted (util/interrupt.h)
   const int fd = ::open(o.tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd < 0) {
     const int err = errno;
+    UntrackTemporary(o.tmp);
     return Status::Error(path + ": cannot write: " + std::strerror(err));
   }
   ::close(fd);
@@ -193,8 +205,12 @@ StatusOr<std::string> OutputSet::AddFolder(const std::string& given, const Folde
   RemoveStaleTemporaries(path);
   std::error_code ec;
   fs::remove_all(o.tmp, ec);
+  TrackTemporary(o.tmp);  // removed if the process is interrupted (util/interrupt.h)
   fs::create_directory(o.tmp, ec);
-  if (ec) return Status::Error(path + ": cannot create a folder beside it: " + ec.message());
+  if (ec) {
+    UntrackTemporary(o.tmp);
+    return Status::Error(path + ": cannot create a folder beside it: " + ec.message());
+  }
   outputs_.push_back(o);
   return o.tmp;
 }
@@ -202,6 +218,15 @@ StatusOr<std::string> OutputSet::AddFolder(const std::string& given, const Folde
 Status OutputSet::Commit() {
   if (done_) return Status::Error("output set committed twice");
   done_ = true;
+  // An interrupt waits until every output is in place or rolled back (util/interrupt.h);
+  // the temporaries are untracked once gone (moved in or removed).
+  struct Untrack {
+    const std::vector<Output>& outputs;
+    ~Untrack() {
+      for (const Output& o : outputs) UntrackTemporary(o.tmp);
+    }
+  } untrack{outputs_};
+  const std::unique_lock<std::mutex> no_interrupt = HoldOffInterrupts();
   std::error_code ec;
   std::vector<bool> had_old(outputs_.size(), false);
   // Undoes outputs [0, n): the new one out, the old one back.

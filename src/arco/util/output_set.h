@@ -37,6 +37,8 @@ class OutputSet {
   OutputSet(const OutputSet&) = delete;
   OutputSet& operator=(const OutputSet&) = delete;
   ~OutputSet();  // removes the temporaries of an uncommitted set
+  // While they exist, the temporaries are also removed by an interrupt (SIGINT, SIGTERM)
+  // when the process installed util/interrupt.h's cleanup.
 
   // Declares the file `path` and returns the temporary path to write it to (created
   // empty now, which proves the folder writable). Errors, naming `path`: an existing
@@ -69,10 +71,12 @@ class OutputSet {
 // The hidden sibling of `path` used for its temporary (".<what>-<pid>.NAME").
 std::string HiddenSibling(const std::string& path, const std::string& what);
 
-// Removes what a killed command left beside `path`: every ".tmp-PID.NAME" of `path`'s
-// NAME whose process PID no longer exists, and its ".old-PID.NAME" when `path` itself
-// exists (else the old one may be the only copy and is left alone). Temporaries of live
-// processes and of other names are never touched. OutputSet::AddFile / AddFolder call it.
-void RemoveStaleTemporaries(const std::string& path);
+// Removes what killed commands left in `path`'s parent folder: every ".tmp-PID.NAME" whose
+// process PID no longer exists (any NAME: a temporary is never anyone's output), and a
+// dead process's ".old-PID.NAME" when NAME itself exists (else the old one may be the only
+// copy and is left alone). Temporaries of live processes are never touched. Returns how
+// many entries went. OutputSet::AddFile / AddFolder call it, and the CLI for every output
+// a command declares (cli/command.h), so a new start cleans up after an interrupted one.
+int RemoveStaleTemporaries(const std::string& path);
 
 }  // namespace arco

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <string>
 
@@ -234,8 +235,9 @@ long DeadPid() {
 }
 
 // What a killed command leaves (its temporary, or its old output moved aside after the new
-// one was in) goes the next time an output of that name is written; a live process's
-// temporaries, other names, and an old output whose new one never arrived stay.
+// one was in) goes the next time an output is written into that folder, whatever its
+// name; a live process's temporaries, entries that only look alike, and an old output
+// whose new one never arrived stay.
 TEST(OutputSet, StaleTemporariesOfDeadProcessesAreRemoved) {
   testing::TempDir tmp;
   const std::string dead = std::to_string(DeadPid());
@@ -245,23 +247,46 @@ TEST(OutputSet, StaleTemporariesOfDeadProcessesAreRemoved) {
                                   ".tmp-" + live + ".result",
                                   ".tmp-" + dead + ".other",
                                   ".old-" + dead + ".gone",
-                                  std::string(".tmp-x1.result")}) {
+                                  ".old-" + dead + ".kept",
+                                  std::string(".tmp-x1.result"),
+                                  ".tmp-" + dead,
+                                  ".tmp-" + dead + "."}) {
     ASSERT_TRUE(MakeDirectories(tmp / name).ok());
   }
   ASSERT_TRUE(MakeDirectories(tmp / "result").ok());
+  ASSERT_TRUE(MakeDirectories(tmp / "kept").ok());
   ASSERT_TRUE(
       AtomicWriteDirectory(tmp / "result", FolderReplace{true, "", "folder"}, WriteNew).ok());
   EXPECT_EQ(Entries(tmp.path()),
             (std::set<std::string>{"result",
+                                   "kept",
                                    ".tmp-" + live + ".result",
-                                   ".tmp-" + dead + ".other",
                                    ".old-" + dead + ".gone",
-                                   ".tmp-x1.result"}));
+                                   ".tmp-x1.result",
+                                   ".tmp-" + dead,
+                                   ".tmp-" + dead + "."}));
   // The same for a file output.
   ASSERT_TRUE(AtomicWriteFile(tmp / ".tmp-" + dead + ".p.csv", "partial").ok());
   ASSERT_TRUE(AtomicWriteFile(tmp / "p.csv", "whole").ok());
   EXPECT_FALSE(fs::exists(tmp / ".tmp-" + dead + ".p.csv"));
   EXPECT_EQ(Read(tmp / "p.csv"), "whole");
+}
+
+// RemoveStaleTemporaries alone (the CLI calls it for every declared output at start):
+// counts what it removed, and leaves the output itself and its siblings alone.
+TEST(RemoveStaleTemporaries, CleansTheParentFolderOfDeadProcessesOnly) {
+  testing::TempDir tmp;
+  const std::string dead = std::to_string(DeadPid());
+  const std::string live = std::to_string(::getpid());
+  // Written directly: an OutputSet would clean the folder itself.
+  std::ofstream(tmp / ".tmp-" + dead + ".a.npy") << "partial";
+  ASSERT_TRUE(MakeDirectories(tmp / (".tmp-" + dead + ".cap") + "/truth").ok());
+  std::ofstream(tmp / ".tmp-" + live + ".mine") << "in progress";
+  std::ofstream(tmp / "m.wav") << "recording";
+  EXPECT_EQ(RemoveStaleTemporaries(tmp / "out.csv"), 2);
+  EXPECT_EQ(Entries(tmp.path()), (std::set<std::string>{".tmp-" + live + ".mine", "m.wav"}));
+  EXPECT_EQ(RemoveStaleTemporaries(tmp / "out.csv"), 0);
+  EXPECT_EQ(RemoveStaleTemporaries(tmp / "missing/out.csv"), 0);  // no such folder
 }
 
 }  // namespace
