@@ -7,15 +7,19 @@
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME arco)
 set(CPACK_PACKAGE_VENDOR arco)
-set(CPACK_PACKAGE_CONTACT "arco <arco@localhost>")
+set(ARCO_PACKAGE_CONTACT "arco <arco@localhost>" CACHE STRING
+    "The .deb's Maintainer: (set a real address for a package that is distributed)")
+set(CPACK_PACKAGE_CONTACT "${ARCO_PACKAGE_CONTACT}")
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY
     "audio-guided markerless motion capture of string-instrument performance")
+# Lines under 80 characters (Debian policy for the extended description).
 set(CPACK_PACKAGE_DESCRIPTION
-    "arco triangulates the performer, the instrument, its strings and the bow from many
-calibrated cameras, and uses the sound of the performance to correct what the cameras
-get wrong. It reports 3D motion, the fingering of every note and how accurate it is.
-This package holds the arco command, its man pages and bash completion, the viewer's
-web page, the detector models (when the build had them) and the Python module arco.")
+    "arco triangulates the performer, the instrument, its strings and the bow
+from many calibrated cameras, and uses the sound of the performance to
+correct what the cameras get wrong. It reports 3D motion, the fingering of
+every note and how accurate it is. This package holds the arco command,
+its man pages and bash completion, the viewer's web page, the detector
+models (when the build had them) and the Python module arco.")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)  # arco_0.1.0_amd64.deb
 set(CPACK_DEBIAN_PACKAGE_SECTION science)

@@ -1,6 +1,6 @@
 // arco_manual OUT_DIR: writes the `arco` manual generated from the commands' definitions
 // (cli/manual.h) at build time: OUT_DIR/man1/*.1 (the folder replaced whole, so a removed
-// command leaves no page) and OUT_DIR/completions/arco (bash).
+// command leaves no page; the build then compresses them) and OUT_DIR/completions/arco.
 #include <cstdio>
 #include <filesystem>
 #include <string>
