@@ -8,7 +8,7 @@ ASAN_BUILD ?= build-asan
 FUZZ_BUILD ?= build-fuzz
 CMAKE_GEN := -G Ninja
 
-.PHONY: setup setup-demo build build-arco build-bench test test-unit test-asan test-fuzz fuzz-long demo bench format clean
+.PHONY: setup setup-demo build build-arco build-bench test test-unit test-asan test-fuzz fuzz-long demo bench package format clean
 
 setup:
 	@bash scripts/setup
@@ -54,6 +54,11 @@ demo: build-arco
 
 bench: build-bench
 	bash bench/run_all.sh $(BUILD)
+
+# The Debian package $(BUILD)/arco_VERSION_amd64.deb (CPack: cmake/packaging.cmake,
+# docs/install.md); `cmake --install $(BUILD) --prefix DIR` installs the same files.
+package: setup $(BUILD)/build.ninja
+	cmake --build $(BUILD) -j $(JOBS) --target package
 
 format:
 	find src bench fuzz -name '*.h' -o -name '*.cc' | xargs clang-format -i

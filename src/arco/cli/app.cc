@@ -2,9 +2,14 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
+#include <filesystem>
 
+#include "arco/cli/build_info.h"
 #include "arco/cli/command.h"
+#include "arco/cli/manual.h"
+#include "arco/util/data_dir.h"
 #include "arco/util/interrupt.h"
 #include "arco/util/output_set.h"
 
@@ -28,7 +33,11 @@ App BuildApp() {
       "Run `arco <command> --help` for a command's options (units, ranges and defaults).");
   CLI::App& app = *built.app;
   app.require_subcommand(1);
-  app.set_version_flag("--version", "arco 0.1.0");
+  app.set_version_flag("--version", VersionLine(), "Print the version and the source revision");
+  app.add_option("--data-dir",
+                 *built.data_dir,
+                 "Folder of arco's data (viewer page, three.js, detector models, workflow); "
+                 "default: $ARCO_DATA_DIR, else ../share/arco beside the executable's folder");
   auto registry = CommandRegistry();
   std::stable_sort(registry.begin(),
                    registry.end(),
@@ -60,6 +69,21 @@ void App::Parse(std::vector<std::string> args) {
 }
 
 int App::Run() {
+  // --data-dir as $ARCO_DATA_DIR, which every lookup (util/data_dir.h) and every arco this
+  // one starts (arco batch's workflow) reads.
+  if (!data_dir->empty()) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(*data_dir, ec)) {
+      return PrintError(*data_dir + ": no such folder (--data-dir)");
+    }
+    setenv(kDataDirEnv, data_dir->c_str(), 1);
+  }
+  // `arco batch` finds its Snakefile through $ARCO_WORKFLOW_DIR: the data folder's.
+  const std::string data = DataDir();
+  const char* workflow = std::getenv("ARCO_WORKFLOW_DIR");
+  if (!data.empty() && (workflow == nullptr || *workflow == '\0')) {
+    setenv("ARCO_WORKFLOW_DIR", (std::filesystem::path(data) / "workflow").c_str(), 1);
+  }
   try {
     for (auto& [sub, run] : commands) {
       if (sub->parsed()) return run();
@@ -120,27 +144,12 @@ std::string Escape(std::string text) {
 
 void AppendCommand(const CLI::App& command, const std::string& path, std::string* out) {
   std::string rows;
-  for (const CLI::Option* o : command.get_options()) {
-    if (o->get_name() == "--help") continue;
-    const std::string type_name = o->get_type_name();
-    const size_t colon = type_name.find(':');
-    std::string type = type_name.substr(0, colon);
-    if (o->get_type_size_max() == 0 || type.empty()) type = "flag";
-    const std::string check = colon == std::string::npos ? "" : type_name.substr(colon + 1);
+  for (const OptionDoc& o : DocumentedOptions(command)) {
     std::string names;
-    if (o->nonpositional()) {
-      const std::string all = o->get_name(false, true);
-      for (size_t start = 0; start < all.size();) {
-        const size_t comma = std::min(all.find(',', start), all.size());
-        names += (names.empty() ? "`" : ", `") + all.substr(start, comma - start) + "`";
-        start = comma + 1;
-      }
-    } else {
-      names = "`" + o->get_name(true) + "`";
-    }
-    rows += "| " + names + " | " + type + (o->get_required() ? ", required" : "") + " | " +
-            Escape(check) + " | " + Escape(o->get_default_str()) + " | " +
-            Escape(o->get_description()) + " |\n";
+    for (const std::string& name : o.names) names += (names.empty() ? "`" : ", `") + name + "`";
+    rows += "| " + names + " | " + o.type + (o.required ? ", required" : "") + " | " +
+            Escape(o.check) + " | " + Escape(o.default_value) + " | " + Escape(o.description) +
+            " |\n";
   }
   if (!rows.empty()) {
     *out += "\n## arco " + path + "\n\n" + Escape(command.get_description()) +

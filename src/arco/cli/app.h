@@ -23,11 +23,14 @@ struct App {
   std::unique_ptr<CLI::App> app;
   // Each command's subcommand and the function that runs it after a successful parse.
   std::vector<std::pair<CLI::App*, std::function<int()>>> commands;
+  // `arco --data-dir DIR`: Run() makes it $ARCO_DATA_DIR (util/data_dir.h). Shared so the
+  // option's storage stays put when the App moves.
+  std::shared_ptr<std::string> data_dir = std::make_shared<std::string>();
 
   // Throws CLI::ParseError (CallForHelp and CallForVersion included) and nothing else for
   // any argv. args excludes the program name.
   void Parse(std::vector<std::string> args);
-  // The parsed command's exit code (0 ok, 1 error printed).
+  // The parsed command's exit code (0 ok, 1 error printed). Applies --data-dir first.
   int Run();
 };
 

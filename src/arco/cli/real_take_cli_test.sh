@@ -66,4 +66,7 @@ bad_at "audio shorter than the motion" "$wav" synth --motion "$tmp/long.npy" --a
 bad "no audio" "--motion needs --audio" synth --motion "$take" -o "$tmp/bad"
 bad "unknown error model" "unknown error model 'gentle'" synth --motion "$take" --audio "$wav" --error-model gentle -o "$tmp/bad"
 bad "unknown camera" "no camera 'cam99'" synth --motion "$take" --audio "$wav" --cameras cam1,cam99 -o "$tmp/bad"
+# An output is never an input: the capture folder around the take's own files.
+mkdir -p "$tmp/in" && cp "$wav" "$tmp/in/take.wav"
+bad "output holds the audio" "an output never" synth --motion "$take" --audio "$tmp/in/take.wav" -o "$tmp/in" --overwrite
 exit $fail

@@ -412,7 +412,9 @@ CommandRun SetupSynth(CLI::App& app) {
                       roles.AddInput("--calibration",
                                      a->calibration.empty() ? DefaultCalibration() : a->calibration);
                       roles.AddInput("--midi", a->o.midi_path);
-                      if (!a->no_audio) roles.AddInput("--soundfont", a->w.audio_render.soundfont);
+                      roles.AddInput("--motion", a->motion);
+                      roles.AddInput("--audio", a->audio);
+                      if (!a->no_audio && a->motion.empty()) roles.AddInput("--soundfont", a->w.audio_render.soundfont);
                       roles.AddOutput("-o", a->output);
                       return roles;
                     });

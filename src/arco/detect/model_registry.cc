@@ -3,6 +3,8 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "arco/util/data_dir.h"
+
 #ifndef ARCO_MODELS_DIR
 #error "ARCO_MODELS_DIR must be defined by the build (src/arco/detect/CMakeLists.txt)"
 #endif
@@ -143,7 +145,7 @@ StatusOr<ModelId> ParseModelName(const std::string& name) {
 std::string DefaultModelsDir() {
   const char* env = std::getenv("ARCO_MODELS_DIR");
   if (env != nullptr && env[0] != '\0') return env;
-  return ARCO_MODELS_DIR;
+  return DataPath("models", ARCO_MODELS_DIR);
 }
 
 std::string ModelPath(ModelId id, const std::string& models_dir) {

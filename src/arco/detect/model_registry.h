@@ -55,8 +55,9 @@ const ModelInfo& GetModelInfo(ModelId id);
 // "pose_landmark_full" -> kPoseLandmarkFull; an error naming the known models otherwise.
 StatusOr<ModelId> ParseModelName(const std::string& name);
 
-// The models folder: $ARCO_MODELS_DIR when set, else the repository's models/ folder
-// (where scripts/setup puts them; fixed at configure time).
+// The models folder: $ARCO_MODELS_DIR when set, else the data folder's models/ (an
+// installed arco, util/data_dir.h), else the repository's models/ folder (where
+// scripts/setup puts them; fixed at configure time).
 std::string DefaultModelsDir();
 std::string ModelPath(ModelId id, const std::string& models_dir = DefaultModelsDir());
 

@@ -17,6 +17,7 @@
 #include "arco/registry/keypoint_layout.h"
 #include "arco/synth/truth_folder.h"
 #include "arco/util/check.h"
+#include "arco/util/data_dir.h"
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
 #include "arco/view/video_cache.h"
@@ -477,8 +478,23 @@ StatusOr<ViewSummary> WriteViewFolder(const ViewOptions& options, const std::str
   }
   ARCO_ASSIGN_OR_RETURN(const pipeline::ResultHeader header, folder.ReadHeader());
   ARCO_ASSIGN_OR_RETURN(const Json result, folder.ReadManifest());
-  const std::string web_dir = options.web_dir.empty() ? ARCO_VIEW_WEB_DIR : options.web_dir;
-  const std::string three_js = options.three_js.empty() ? ARCO_VIEW_THREE_JS : options.three_js;
+  // The page's own files: an installed arco's data folder, else the source tree's
+  // (util/data_dir.h); checked before any work, naming the file that is missing.
+  const std::string web_dir =
+      options.web_dir.empty() ? DataPath("view/web", ARCO_VIEW_WEB_DIR) : options.web_dir;
+  const std::string three_js = options.three_js.empty()
+                                   ? DataPath("view/three.min.js", ARCO_VIEW_THREE_JS)
+                                   : options.three_js;
+  for (const char* file : kWebFiles) {
+    if (!FileExists(JoinPath(web_dir, file))) {
+      return Status::Error(JoinPath(web_dir, file) + ": the viewer's page is missing (" +
+                           DataDirHint() + ")");
+    }
+  }
+  if (!FileExists(three_js)) {
+    return Status::Error(three_js + ": three.js not found (" + DataDirHint() +
+                         "; in a source tree scripts/fetch_view_tools installs it)");
+  }
 
   ViewSummary summary;
   summary.missing = MissingStages(options.result_dir);

@@ -35,8 +35,9 @@ inline constexpr NumberRange kViewCacheMaxGbRange = Closed(0, 1e6);
 struct ViewOptions {
   std::string result_dir;   // an `arco run` result folder (result.json)
   bool embed_data = false;  // also write data.js, for pages opened from disk
-  // Where the page's own files and three.min.js are; "" = the paths compiled in
-  // (ARCO_VIEW_WEB_DIR, ARCO_VIEW_THREE_JS).
+  // Where the page's own files and three.min.js are; "" = the data folder's view/web and
+  // view/three.min.js (util/data_dir.h), else, for a build-tree arco, the source tree's
+  // paths compiled in (ARCO_VIEW_WEB_DIR, ARCO_VIEW_THREE_JS).
   std::string web_dir;
   std::string three_js;
   // The camera videos with the overlay: the cameras (names or serials; empty: the first
