@@ -106,6 +106,9 @@ TEST(RunCapture, EveryStageAndThreeMethodsThatEvalScores) {
   EXPECT_LT(m["arco"].contact_deviation_mm, 0.3 * m["vision"].contact_deviation_mm);
   EXPECT_LT(m["arco"].mpjpe_note_finger_mm, 0.85 * m["vision"].mpjpe_note_finger_mm);
   EXPECT_LE(m["arco"].mpjpe_hand_mm, m["vision"].mpjpe_hand_mm);
+  // In the world too: the hand moves only as far as the triangulated palm says (issue 23).
+  EXPECT_LE(m["arco"].left_hand_world_mm, m["vision"].left_hand_world_mm);
+  EXPECT_LE(m["arco"].left_group_world_mm[0], m["vision"].left_group_world_mm[0] + 0.05);
   EXPECT_GE(m["arco"].string_accuracy, 0.95);
   EXPECT_GE(m["arco"].finger_accuracy, 0.95);
   EXPECT_EQ(m["arco"].joint_limit_violations, 0);
