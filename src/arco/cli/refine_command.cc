@@ -91,6 +91,10 @@ std::function<int()> SetupRefine(CLI::App& app) {
             "(mm); beyond it the contact is rejected",
             Closed(0, 1000))
       ->capture_default_str();
+  sub->add_flag("!--no-distal-first",
+                r.ik.distal_first,
+                "arco: solve MCP flexion, PIP and DIP together from the start, not PIP and DIP "
+                "first (the MCP freed only when they cannot reach)");
   sub->add_flag("!--reject-unreachable",
                 r.ik.keep_unreachable,
                 "arco: reject a contact the finger cannot reach even after the hand's move "

@@ -77,6 +77,19 @@ FrameIk SolveArcoFrame(const DecodeContext& context,
     ik.previous_pose = prev->pose;
     ik.previous_weight_mm_per_rad = options.temporal_weight_mm_per_rad;
   }
+  // The distal joints first: when PIP and DIP alone bring the tip within max_residual_mm,
+  // the MCP (and with it the PIP keypoint, which the cameras see well) keeps its fitted
+  // angle; only a tip they cannot bring there frees the MCP's flexion too.
+  if (options.distal_first && ik.joints == hand::FingerIkJoints::kMcpFlexPipDip) {
+    hand::FingerIkOptions distal = ik;
+    distal.joints = hand::FingerIkJoints::kPipDip;
+    FrameIk first = Solve(context, c, f, distal, start);
+    if (first.solved && first.distance_mm <= options.max_residual_mm) return first;
+    FrameIk second = Solve(context, c, f, ik, start);
+    second.solves += first.solves;
+    second.iterations += first.iterations;
+    return second;
+  }
   return Solve(context, c, f, ik, start);
 }
 

@@ -315,6 +315,7 @@ Json ToJson(const RefineOptions& o) {
             {"max_hand_shift_mm", o.ik.max_hand_shift_mm},
             {"detected_hand_shift", o.ik.detected_hand_shift},
             {"keep_unreachable", o.ik.keep_unreachable},
+            {"distal_first", o.ik.distal_first},
             {"neighbour_shift_frames", o.ik.neighbour_shift_frames},
             {"max_iterations", o.ik.max_iterations}}}};
 }

@@ -123,6 +123,10 @@ struct ArcoIkOptions {
   // the string. Abduction is seen well (the MCP-PIP direction) and, when left free, takes
   // the redundancy and drifts to its limits (docs/accuracy.md, the IK ablation).
   hand::FingerIkJoints joints = hand::FingerIkJoints::kMcpFlexPipDip;
+  // With kMcpFlexPipDip: solve PIP and DIP alone first and free the MCP's flexion only when
+  // they cannot bring the tip within max_residual_mm (the MCP moves the PIP keypoint, which
+  // the cameras see well; on a real hand that move made the PIP worse than vision's).
+  bool distal_first = true;
   // false: one regularised solve: the priors spread the change over the joints (least
   // change) and leave a small residual (sub-millimetre at these weights); true: the hand
   // IK's exact reach, where the priors only pick among exact solutions and drift along
