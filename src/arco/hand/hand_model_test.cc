@@ -174,13 +174,13 @@ TEST(HandModel, CountAndClampLimitViolations) {
   const HandModel model = HandModel::Default(HandSide::kRight);
   HandPose pose;
   EXPECT_EQ(CountLimitViolations(model, pose), 0);
-  pose.angle_rad(Finger::kIndex, FingerDof::kMiddleFlex) = -0.1;  // PIP hyperextension
+  pose.angle_rad(Finger::kIndex, FingerDof::kMiddleFlex) = -0.3;  // PIP beyond -10 degrees
   pose.angle_rad(Finger::kRing, FingerDof::kBaseAbd) = 1.0;
   pose.angle_rad(Finger::kThumb, FingerDof::kBaseFlex) = std::nan("");
   EXPECT_EQ(CountLimitViolations(model, pose), 3);
   const HandPose clamped = ClampToLimits(model, pose);
   EXPECT_EQ(CountLimitViolations(model, clamped), 0);
-  EXPECT_EQ(clamped.angle_rad(Finger::kIndex, FingerDof::kMiddleFlex), 0.0);
+  EXPECT_NEAR(clamped.angle_rad(Finger::kIndex, FingerDof::kMiddleFlex), -10 * kDeg, 1e-15);
   EXPECT_NEAR(clamped.angle_rad(Finger::kRing, FingerDof::kBaseAbd), 20 * kDeg, 1e-15);
   EXPECT_EQ(clamped.angle_rad(Finger::kThumb, FingerDof::kBaseFlex), 0.0);
 }
