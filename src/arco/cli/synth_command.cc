@@ -63,6 +63,17 @@ struct Args {
   std::vector<std::pair<CLI::Option*, double synth::DetectionOptions::*>> detection_flags;
 };
 
+// The summary's last line. "cap/" and "cap" name the same folder: printed once, without
+// the slash.
+void PrintWritten(std::string folder, int64_t bytes, double total_s) {
+  while (folder.size() > 1 && folder.back() == '/') folder.pop_back();
+  std::printf("  wrote         %s/ (%.1f MB) and %s/truth/ in %.1f s\n",
+              folder.c_str(),
+              bytes / 1e6,
+              folder.c_str(),
+              total_s);
+}
+
 // The error model's preset with the detection flags the user gave applied over it.
 StatusOr<synth::DetectionOptions> DetectionFor(const Args& a) {
   ARCO_ASSIGN_OR_RETURN(synth::DetectionOptions o, synth::ErrorModelOptions(a.error_model));
@@ -122,13 +133,7 @@ int RunMotion(Args& a) {
               c.options.fps,
               c.num_frames / c.options.fps,
               c.pressed_frames);
-  std::string folder = a.output;
-  while (folder.size() > 1 && folder.back() == '/') folder.pop_back();
-  std::printf("  wrote         %s/ (%.1f MB) and %s/truth/ in %.1f s\n",
-              folder.c_str(),
-              ws.bytes / 1e6,
-              folder.c_str(),
-              total_s);
+  PrintWritten(a.output, ws.bytes, total_s);
   return 0;
 }
 
@@ -232,14 +237,7 @@ int Run(Args& a) {
         ws.audio.key_offset_cents.size(),
         worst);
   }
-  // "cap/" and "cap" name the same folder: print it once, without the slash.
-  std::string folder = a.output;
-  while (folder.size() > 1 && folder.back() == '/') folder.pop_back();
-  std::printf("  wrote         %s/ (%.1f MB) and %s/truth/ in %.1f s\n",
-              folder.c_str(),
-              ws.bytes / 1e6,
-              folder.c_str(),
-              total_s);
+  PrintWritten(a.output, ws.bytes, total_s);
   return 0;
 }
 
