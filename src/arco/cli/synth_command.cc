@@ -295,44 +295,47 @@ CommandRun SetupSynth(CLI::App& app) {
             Closed(12, 100))
       ->capture_default_str();
   a->detection_flags.emplace_back(AddNumber(cmd,
-            "--noise-px",
-            a->o.detection.noise_px,
-            "2D detection noise per axis (px)",
-            NumberRange{0, 200, false, true})
-      ->capture_default_str(),
-      &synth::DetectionOptions::noise_px);
-  a->detection_flags.emplace_back(AddNumber(cmd,
-            "--outlier-rate",
-            a->o.detection.outlier_rate,
-            "Gross outliers per keypoint, and hand swaps per view and frame (fraction)",
-            kFractionRange)
-      ->capture_default_str(),
+                                            "--noise-px",
+                                            a->o.detection.noise_px,
+                                            "2D detection noise per axis (px)",
+                                            NumberRange{0, 200, false, true})
+                                      ->capture_default_str(),
+                                  &synth::DetectionOptions::noise_px);
+  a->detection_flags.emplace_back(
+      AddNumber(cmd,
+                "--outlier-rate",
+                a->o.detection.outlier_rate,
+                "Gross outliers per keypoint, and hand swaps per view and frame (fraction)",
+                kFractionRange)
+          ->capture_default_str(),
       &synth::DetectionOptions::outlier_rate);
-  a->detection_flags.emplace_back(AddNumber(cmd,
-            "--occlusion-rate",
-            a->o.detection.occlusion_rate,
-            "Random detector drop-outs per keypoint (fraction), on top of geometric occlusion",
-            kFractionRange)
-      ->capture_default_str(),
+  a->detection_flags.emplace_back(
+      AddNumber(cmd,
+                "--occlusion-rate",
+                a->o.detection.occlusion_rate,
+                "Random detector drop-outs per keypoint (fraction), on top of geometric occlusion",
+                kFractionRange)
+          ->capture_default_str(),
       &synth::DetectionOptions::occlusion_rate);
   cmd->add_flag("--no-geometric-occlusion",
                 a->no_geometric_occlusion,
                 "Do not occlude points hidden by the instrument body or the torso");
-  a->detection_flags.emplace_back(AddNumber(
-      cmd,
-      "--finger-bias-mm",
-      a->o.detection.finger_bias_mm,
-      "3D offset of the playing fingertip off the string as the detector sees it (mm; DIP half)",
-      NumberRange{0, 200, false, true})
-      ->capture_default_str(),
-      &synth::DetectionOptions::finger_bias_mm);
   a->detection_flags.emplace_back(AddNumber(cmd,
-            "--jitter-mm",
-            a->o.detection.jitter_mm,
-            "View-consistent 3D detector error per axis for hand points (mm; body x1.5, "
-            "instrument x0.3)",
-            NumberRange{0, 100, false, true})
-      ->capture_default_str(),
+                                            "--finger-bias-mm",
+                                            a->o.detection.finger_bias_mm,
+                                            "3D offset of the playing fingertip off the string as "
+                                            "the detector sees it (mm; DIP half)",
+                                            NumberRange{0, 200, false, true})
+                                      ->capture_default_str(),
+                                  &synth::DetectionOptions::finger_bias_mm);
+  a->detection_flags.emplace_back(
+      AddNumber(cmd,
+                "--jitter-mm",
+                a->o.detection.jitter_mm,
+                "View-consistent 3D detector error per axis for hand points (mm; body x1.5, "
+                "instrument x0.3)",
+                NumberRange{0, 100, false, true})
+          ->capture_default_str(),
       &synth::DetectionOptions::jitter_mm);
   AddNumber(cmd,
             "--mm-per-unit",
@@ -407,12 +410,14 @@ CommandRun SetupSynth(CLI::App& app) {
   return CommandRun([a] { return Run(*a); },
                     [a] {
                       PathRoles roles;
-                      roles.AddInput("--calibration",
-                                     a->calibration.empty() ? DefaultCalibration() : a->calibration);
+                      roles.AddInput(
+                          "--calibration",
+                          a->calibration.empty() ? DefaultCalibration() : a->calibration);
                       roles.AddInput("--midi", a->o.midi_path);
                       roles.AddInput("--motion", a->motion);
                       roles.AddInput("--audio", a->audio);
-                      if (!a->no_audio && a->motion.empty()) roles.AddInput("--soundfont", a->w.audio_render.soundfont);
+                      if (!a->no_audio && a->motion.empty())
+                        roles.AddInput("--soundfont", a->w.audio_render.soundfont);
                       roles.AddOutput("-o", a->output);
                       return roles;
                     });

@@ -291,13 +291,13 @@ Json EvalReport::ToJson(const EvalOptions& options) const {
   Json j;
   j["format"] = "arco-eval";
   j["version"] = 1;
-  j["truth"] = {{"kind", truth_kind},
-                {"frames", truth_frames},
-                {"contact_frames", contact_frames},
-                {"joint_limit_violations",
-                 truth_joint_limit_violations < 0 ? Json(nullptr)
-                                                  : Json(truth_joint_limit_violations)},
-                {"units", units}};
+  j["truth"] = {
+      {"kind", truth_kind},
+      {"frames", truth_frames},
+      {"contact_frames", contact_frames},
+      {"joint_limit_violations",
+       truth_joint_limit_violations < 0 ? Json(nullptr) : Json(truth_joint_limit_violations)},
+      {"units", units}};
   j["protocol"] = {
       {"hand", "left hand, 20 joints after aligning the wrists by translation (Jin et al. 2024)"},
       {"contact_frames",

@@ -4,7 +4,8 @@ namespace arco::synth {
 
 const std::vector<ErrorModelInfo>& ErrorModels() {
   static const std::vector<ErrorModelInfo> models = {
-      {"synth", "today's defaults: noise, outliers, drop-outs, occlusion, finger lift, shared jitter"},
+      {"synth",
+       "today's defaults: noise, outliers, drop-outs, occlusion, finger lift, shared jitter"},
       {"clean", "1 px noise only"},
       {"shared", "synth + a smooth per-finger 3D offset shared by all views (5 mm at the tip)"},
       {"behind", "synth + fingers hidden in views that see the back of the left hand"},

@@ -97,9 +97,9 @@ StatusOr<Rig> SelectCameras(const Rig& rig,
     for (size_t k = 0; k < direction.size(); ++k) {
       double nearest = INFINITY;
       for (int c : chosen)
-        nearest = std::min(nearest,
-                           std::acos(std::clamp(
-                               direction[k].dot(direction[static_cast<size_t>(c)]), -1.0, 1.0)));
+        nearest = std::min(
+            nearest,
+            std::acos(std::clamp(direction[k].dot(direction[static_cast<size_t>(c)]), -1.0, 1.0)));
       if (nearest > best_angle) best_angle = nearest, best = static_cast<int>(k);
     }
     chosen.push_back(best);
@@ -178,9 +178,9 @@ StatusOr<SyntheticCapture> GenerateFromMotion(const Rig& rig, const MotionOption
     for (int p = 0; p < num_capture + 8; ++p) {
       for (int c = 0; c < 3; ++c) {
         if (!std::isfinite(recorded.at(f, p, c))) {
-          const std::string name =
-              p < num_capture ? layout->names[static_cast<size_t>(p)]
-                              : "string end " + std::to_string(p - num_capture);
+          const std::string name = p < num_capture
+                                       ? layout->names[static_cast<size_t>(p)]
+                                       : "string end " + std::to_string(p - num_capture);
           return Status::Error(path + ": frame " + std::to_string(f) + ": point " +
                                std::to_string(p) + " (" + name +
                                ") is not finite (only the contact point and the playing finger "
@@ -341,7 +341,8 @@ StatusOr<SyntheticCapture> GenerateFromMotion(const Rig& rig, const MotionOption
       ct.finger = finger;
       ct.point_mm = contact;
       ++cap.pressed_frames;
-      df.bias_tip = wholebody::kLeftHandFirst + hand::TipKeypoint(static_cast<hand::Finger>(finger));
+      df.bias_tip =
+          wholebody::kLeftHandFirst + hand::TipKeypoint(static_cast<hand::Finger>(finger));
       df.bias_dip = df.bias_tip - 1;
       df.bias_direction = world_from_instrument.rotation.col(2);
     }
@@ -361,9 +362,11 @@ StatusOr<SyntheticCapture> GenerateFromMotion(const Rig& rig, const MotionOption
     // nearest point under the hand's MCP centre to that centre.
     Eigen::Vector3d mcp = Eigen::Vector3d::Zero();
     for (int g = 1; g <= 4; ++g)
-      mcp += point(f, wholebody::kLeftHandFirst + hand::KeypointIndex(static_cast<hand::Finger>(g), 0));
+      mcp += point(
+          f, wholebody::kLeftHandFirst + hand::KeypointIndex(static_cast<hand::Finger>(g), 0));
     mcp /= 4;
-    const Eigen::Vector3d mid_nut = 0.5 * (point(f, num_capture) + point(f, num_capture + 2 * n_strings - 2));
+    const Eigen::Vector3d mid_nut =
+        0.5 * (point(f, num_capture) + point(f, num_capture + 2 * n_strings - 2));
     const Eigen::Vector3d mid_bridge =
         0.5 * (point(f, num_capture + 1) + point(f, num_capture + 2 * n_strings - 1));
     const Eigen::Vector3d axis = (mid_bridge - mid_nut).normalized();

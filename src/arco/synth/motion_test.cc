@@ -1,6 +1,8 @@
 // Re-capture of a recorded take (motion.h) on SPD's real cello01 (first 11 s): the truth is
 // the recording moved rigidly into the rig, contacts read from the annotation, the audio
 // copied, the error models applied; bad input refused with one line naming the file.
+#include "arco/synth/motion.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,7 +14,6 @@
 #include "arco/registry/keypoint_layout.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/error_model.h"
-#include "arco/synth/motion.h"
 #include "arco/synth/truth_folder.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
@@ -55,8 +56,8 @@ TEST(Motion, TruthIsTheRecordingMovedRigidly) {
   EXPECT_EQ(cap->truth_layout, "spd_cello_contact");
   // Distances between any two points are kept (a rigid move), across frames too.
   for (int f : {0, 45, 89}) {
-    for (auto [p, q] : {std::pair{9, 99}, std::pair{91, 134}, std::pair{140, 141},
-                        std::pair{0, 138}}) {
+    for (auto [p, q] :
+         {std::pair{9, 99}, std::pair{91, 134}, std::pair{140, 141}, std::pair{0, 138}}) {
       EXPECT_NEAR((At(cap->points3d, f, p) - At(cap->points3d, 0, q)).norm(),
                   (At(*recorded, f, p) - At(*recorded, 0, q)).norm(),
                   1e-6);
@@ -118,8 +119,8 @@ TEST(Motion, ContactsFromTheAnnotation) {
     ++pressed;
     // The playing finger's four joints are the left hand's joints of that finger.
     for (int j = 0; j < 4; ++j) {
-      const int k = wholebody::kLeftHandFirst +
-                    hand::KeypointIndex(static_cast<hand::Finger>(c.finger), j);
+      const int k =
+          wholebody::kLeftHandFirst + hand::KeypointIndex(static_cast<hand::Finger>(c.finger), j);
       EXPECT_LT((At(cap->points3d, f, k) - At(cap->points3d, f, 151 + j)).norm(), 1e-9);
     }
     // The first half of cello01 is played on the A string (string 1).
