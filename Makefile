@@ -5,7 +5,6 @@
 JOBS ?= $(shell nproc)
 BUILD ?= build
 ASAN_BUILD ?= build-asan
-FUZZ_BUILD ?= build-fuzz
 CMAKE_GEN := -G Ninja
 
 .PHONY: setup setup-demo build build-arco build-bench test test-unit test-asan test-fuzz fuzz-long demo bench package format clean
@@ -33,19 +32,19 @@ build-bench: setup $(BUILD)/build.ninja
 test-unit: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
-# AddressSanitizer + UndefinedBehaviorSanitizer build of the unit tests.
+# AddressSanitizer + UndefinedBehaviorSanitizer build (clang) of the unit tests and the
+# libFuzzer harnesses: one build serves both (scripts/configure-sanitized says why).
 test-asan: setup
-	cmake -S . -B $(ASAN_BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Debug -DARCO_BUILD_BENCH=OFF \
-	  -DARCO_SANITIZE=address,undefined -DCMAKE_CXX_FLAGS="-O1"
+	bash scripts/configure-sanitized $(ASAN_BUILD)
 	cmake --build $(ASAN_BUILD) -j $(JOBS)
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1 ctest --output-on-failure -j $(JOBS) -LE slow
 
-# libFuzzer harnesses (clang), each run for a short bounded time on its corpus.
+# libFuzzer harnesses, each run for a short bounded time on its corpus, in the same build.
 test-fuzz: setup
-	bash scripts/fuzz $(FUZZ_BUILD) 20
+	bash scripts/fuzz $(ASAN_BUILD) 20
 
 fuzz-long: setup
-	bash scripts/fuzz $(FUZZ_BUILD) 600
+	bash scripts/fuzz $(ASAN_BUILD) 600
 
 test: test-unit test-asan test-fuzz
 
@@ -64,4 +63,4 @@ format:
 	find src bench fuzz -name '*.h' -o -name '*.cc' | xargs clang-format -i
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD)

@@ -17,7 +17,7 @@ struct RefineArgs {
   // Bound to the flags directly: the defaults shown by --help are the library's.
   pipeline::RefineStageOptions o;
   std::string mode = "arco";
-  std::string joints = "mcp_flex_pip_dip";
+  std::string joints = hand::FingerIkJointsName(refine::ArcoIkOptions{}.joints);
   bool exact_reach = false;
   bool no_audio_onsets = false;
 };
@@ -95,6 +95,18 @@ std::function<int()> SetupRefine(CLI::App& app) {
                 r.ik.distal_first,
                 "arco: solve MCP flexion, PIP and DIP together from the start, not PIP and DIP "
                 "first (the MCP freed only when they cannot reach)");
+  AddNumber(sub,
+            "--pip-weight",
+            r.ik.pip_weight,
+            "arco: weight of the playing finger's PIP keypoint (the mean of its fitted and "
+            "triangulated positions) relative to the tip's in the IK (0 = off)",
+            refine::kCostWeightRange)
+      ->capture_default_str();
+  sub->add_flag("--move-hand",
+                r.ik.move_hand,
+                "arco: move the output hand by the whole-hand shift that makes a contact "
+                "reachable (otherwise the shift only decides reachability; the hand stays "
+                "where the cameras put it)");
   sub->add_flag("!--reject-unreachable",
                 r.ik.keep_unreachable,
                 "arco: reject a contact the finger cannot reach even after the hand's move "

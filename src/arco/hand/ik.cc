@@ -18,8 +18,9 @@ constexpr double kActiveTolRad = 1e-6;
 // Grid levels per free joint for restarts, by number of free joints (<= 1296 points).
 constexpr int kAutoSeedLevels[5] = {2, 33, 17, 9, 6};
 
-// Tip position error (mm, world) as a function of the N free angles of a finger;
-// the other dofs stay at their reference values.
+// Tip position error (mm, world) as a function of the N free angles of a finger, and
+// pip_weight times the PIP keypoint's error toward pip_target (zero residuals when the
+// weight is 0); the other dofs stay at their reference values.
 template <int N>
 struct TipCost {
   const HandModel* model;
@@ -29,6 +30,8 @@ struct TipCost {
   Eigen::Matrix3d rotation;     // world_from_wrist
   Eigen::Vector3d translation;  // wrist in world
   Eigen::Vector3d target;
+  double pip_weight = 0;
+  Eigen::Vector3d pip_target = Eigen::Vector3d::Zero();
 
   template <typename T>
   bool operator()(const T* x, T* residual) const {
@@ -38,7 +41,11 @@ struct TipCost {
     Eigen::Matrix<T, 3, 1> p[4];
     FingerPointsInWrist(*model, finger, dof, p);
     const Eigen::Matrix<T, 3, 1> tip = rotation.cast<T>() * p[3] + translation.cast<T>();
-    for (int r = 0; r < 3; ++r) residual[r] = tip[r] - T(target[r]);
+    const Eigen::Matrix<T, 3, 1> pip = rotation.cast<T>() * p[1] + translation.cast<T>();
+    for (int r = 0; r < 3; ++r) {
+      residual[r] = tip[r] - T(target[r]);
+      residual[3 + r] = T(pip_weight) * (pip[r] - T(pip_target[r]));
+    }
     return true;
   }
 };
@@ -77,7 +84,7 @@ struct SolveOutcome {
 
 template <int N>
 ceres::CostFunction* MakeTipCost(const TipCost<N>& functor) {
-  return new ceres::AutoDiffCostFunction<TipCost<N>, 3, N>(new TipCost<N>(functor));
+  return new ceres::AutoDiffCostFunction<TipCost<N>, 6, N>(new TipCost<N>(functor));
 }
 
 struct IkProblemSpec {
@@ -89,6 +96,8 @@ struct IkProblemSpec {
   bool has_prev = false;
   Eigen::Matrix3d rotation;
   Eigen::Vector3d translation, target;
+  double pip_weight = 0;  // FingerIkOptions::pip_weight (0 without a PIP target)
+  Eigen::Vector3d pip_target = Eigen::Vector3d::Zero();
 };
 
 double TipDistance(const IkProblemSpec& s, const std::vector<double>& x) {
@@ -97,6 +106,16 @@ double TipDistance(const IkProblemSpec& s, const std::vector<double>& x) {
   Eigen::Vector3d p[4];
   FingerPointsInWrist(*s.model, s.finger, dof.data(), p);
   return (s.rotation * p[3] + s.translation - s.target).norm();
+}
+
+// pip_weight times the PIP keypoint's distance from pip_target (0 without a target).
+double PipTerm(const IkProblemSpec& s, const std::vector<double>& x) {
+  if (s.pip_weight <= 0) return 0.0;
+  std::array<double, 4> dof = s.reference;
+  for (size_t i = 0; i < s.slots.size(); ++i) dof[s.slots[i]] = x[i];
+  Eigen::Vector3d p[4];
+  FingerPointsInWrist(*s.model, s.finger, dof.data(), p);
+  return s.pip_weight * (s.rotation * p[1] + s.translation - s.pip_target).norm();
 }
 
 // One bounded trust-region solve from x (in place) with the given weights.
@@ -117,6 +136,8 @@ void SolveOnce(const IkProblemSpec& s,
     functor.rotation = s.rotation;
     functor.translation = s.translation;
     functor.target = s.target;
+    functor.pip_weight = s.pip_weight;
+    functor.pip_target = s.pip_target;
     return MakeTipCost(functor);
   };
   switch (n) {
@@ -173,7 +194,9 @@ std::vector<double> CostGradient(const IkProblemSpec& s,
   FingerPointsInWrist(*s.model, s.finger, dof, p);
   const Eigen::Matrix<Jet, 3, 1> r =
       s.rotation.cast<Jet>() * p[3] + (s.translation - s.target).cast<Jet>();
-  const Jet cost = r.squaredNorm();
+  const Eigen::Matrix<Jet, 3, 1> r_pip =
+      s.rotation.cast<Jet>() * p[1] + (s.translation - s.pip_target).cast<Jet>();
+  const Jet cost = r.squaredNorm() + s.pip_weight * s.pip_weight * r_pip.squaredNorm();
   std::vector<double> g(x.size());
   for (size_t i = 0; i < x.size(); ++i) {
     g[i] = cost.v[i] + 2 * w_ref * w_ref * (x[i] - s.ref_free[i]);
@@ -256,6 +279,7 @@ SolveOutcome SolveFrom(const IkProblemSpec& s,
   for (size_t i = 0; i < x.size(); ++i) x[i] = std::clamp(x[i], s.lower[i], s.upper[i]);
   out.x = x;
   out.distance_mm = TipDistance(s, x);
+  out.regularisation = std::pow(PipTerm(s, x), 2);
   for (size_t i = 0; i < x.size(); ++i) {
     out.regularisation += std::pow(o.reference_weight_mm_per_rad * (x[i] - s.ref_free[i]), 2);
     if (s.has_prev) {
@@ -308,6 +332,10 @@ Status FingerIkOptions::Validate() const {
   if (!(previous_weight_mm_per_rad >= 0) || !std::isfinite(previous_weight_mm_per_rad))
     return bad("previous_weight_mm_per_rad must be finite and >= 0");
   if (!(max_change_deg > 0)) return bad("max_change_deg must be > 0");
+  if (!(pip_weight >= 0) || !std::isfinite(pip_weight))
+    return bad("pip_weight must be finite and >= 0");
+  if (pip_target_in_world_mm && !pip_target_in_world_mm->allFinite())
+    return bad("pip_target_in_world_mm must be finite");
   if (seed_levels < 0 || seed_levels == 1 || seed_levels > 32) {
     return bad("seed_levels must be 0 (auto) or in [2, 32]");
   }
@@ -354,6 +382,10 @@ FingerIkResult SolveFingertipIk(const HandModel& model,
   s.rotation = reference.world_from_wrist_rotation;
   s.translation = reference.wrist_in_world_mm;
   s.target = target_in_world_mm;
+  if (options.pip_target_in_world_mm && options.pip_weight > 0) {
+    s.pip_weight = options.pip_weight;
+    s.pip_target = *options.pip_target_in_world_mm;
+  }
   s.has_prev = options.previous_pose.has_value() && options.previous_weight_mm_per_rad > 0;
   const double max_change_rad = options.max_change_deg * kDegToRad;
   for (FingerDof slot : FreeDofs(options.joints)) {

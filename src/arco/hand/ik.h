@@ -5,7 +5,10 @@
 // paper's Eq. 3 adjusts PIP and DIP of the note-playing finger: kPipDip).
 //
 // Cost over the free angles x (rad) of one finger:
-//   |tip(x) - target|^2 + w_ref^2 |x - x_ref|^2 + w_prev^2 |x - x_prev|^2
+//   |tip(x) - target|^2 + w_pip^2 |pip(x) - pip_target|^2
+//     + w_ref^2 |x - x_ref|^2 + w_prev^2 |x - x_prev|^2
+// (the PIP term only with a pip_target: where the PIP keypoint is seen, in position space,
+// so the MCP's angles explain the tip's residual only as far as the PIP allows).
 // subject to  max(min_k, x_ref,k - max_change) <= x_k <= min(max_k, x_ref,k + max_change).
 // With exact_reach, a second solve with the weights scaled by 1e-4 starts from
 // the first: the regularisation picks the solution (redundant dofs, unreachable
@@ -37,6 +40,10 @@ struct FingerIkOptions {
   double previous_weight_mm_per_rad = 0.0;
   // Largest change of any free angle from the reference ("small steps"), deg.
   double max_change_deg = 360.0;
+  // Optional observation of the finger's PIP keypoint (world, mm) and its weight relative
+  // to the tip's (0 = none). Moves only with the MCP's angles free.
+  std::optional<Eigen::Vector3d> pip_target_in_world_mm;
+  double pip_weight = 0.0;
   bool exact_reach = true;  // see the header comment
   // When the tip ends farther than reach_tolerance_mm, evaluate a grid of
   // seed_levels values per free joint over its bounds (0 = automatic: 33, 17, 9

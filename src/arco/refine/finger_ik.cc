@@ -73,22 +73,49 @@ FrameIk SolveArcoFrame(const DecodeContext& context,
   // max_residual_mm (a local minimum on a limit), not for the regularised solve's small
   // residual.
   ik.reach_tolerance_mm = options.max_residual_mm;
+  if (options.pip_weight > 0) {
+    const hand::Finger finger = static_cast<hand::Finger>(c.finger);
+    const size_t pip = static_cast<size_t>(hand::KeypointIndex(finger, 1));
+    const auto& fitted = context.vision_points[static_cast<size_t>(f)];
+    if (fitted && (*fitted)[pip].allFinite()) {
+      Eigen::Vector3d target = (*fitted)[pip];
+      const auto& detected = context.input->detected_left_hand;
+      if (!detected.empty() && detected[static_cast<size_t>(f)] &&
+          (*detected[static_cast<size_t>(f)])[pip].allFinite()) {
+        target = 0.5 * (target + (*detected[static_cast<size_t>(f)])[pip]);
+      }
+      ik.pip_target_in_world_mm = target;
+      ik.pip_weight = options.pip_weight;
+    }
+  }
   if (options.temporal_weight_mm_per_rad > 0 && prev != nullptr && prev->solved) {
     ik.previous_pose = prev->pose;
     ik.previous_weight_mm_per_rad = options.temporal_weight_mm_per_rad;
   }
   // The distal joints first: when PIP and DIP alone bring the tip within max_residual_mm,
   // the MCP (and with it the PIP keypoint, which the cameras see well) keeps its fitted
-  // angle; only a tip they cannot bring there frees the MCP's flexion too.
-  if (options.distal_first && ik.joints == hand::FingerIkJoints::kMcpFlexPipDip) {
-    hand::FingerIkOptions distal = ik;
-    distal.joints = hand::FingerIkJoints::kPipDip;
-    FrameIk first = Solve(context, c, f, distal, start);
-    if (first.solved && first.distance_mm <= options.max_residual_mm) return first;
-    FrameIk second = Solve(context, c, f, ik, start);
-    second.solves += first.solves;
-    second.iterations += first.iterations;
-    return second;
+  // angles; only a tip they cannot bring there frees the MCP's flexion, and only one that
+  // still stays farther frees its abduction too, up to options.joints.
+  if (options.distal_first && ik.joints != hand::FingerIkJoints::kPipDip) {
+    FrameIk best;
+    int solves = 0, iterations = 0;
+    for (hand::FingerIkJoints stage : {hand::FingerIkJoints::kPipDip,
+                                       hand::FingerIkJoints::kMcpFlexPipDip,
+                                       hand::FingerIkJoints::kAll}) {
+      hand::FingerIkOptions staged = ik;
+      staged.joints = stage;
+      FrameIk s = Solve(context, c, f, staged, start);
+      solves += s.solves;
+      iterations += s.iterations;
+      // A later stage replaces an earlier one only when it comes nearer.
+      if (s.solved && (!best.solved || s.distance_mm < best.distance_mm)) best = s;
+      if ((best.solved && best.distance_mm <= options.max_residual_mm) || stage == ik.joints) {
+        break;
+      }
+    }
+    best.solves = solves;
+    best.iterations = iterations;
+    return best;
   }
   return Solve(context, c, f, ik, start);
 }
@@ -139,7 +166,8 @@ bool ApplyArcoIk(const DecodeContext& context,
                  const FrameIk& s,
                  int f,
                  FrameContact* c,
-                 std::optional<hand::HandPose>* hand_out) {
+                 std::optional<hand::HandPose>* hand_out,
+                 Eigen::Vector3d* shift_out = nullptr) {
   hand::HandPose pose = s.pose;
   double distance = s.distance_mm;
   const hand::Finger finger = static_cast<hand::Finger>(c->finger);
@@ -158,12 +186,17 @@ bool ApplyArcoIk(const DecodeContext& context,
       return false;
     }
     const Eigen::Vector3d tip = hand::FingertipInWorld(context.input->hand_model, pose, finger);
-    // The whole hand, rigidly, by its share of the offset.
+    // The whole hand, rigidly, by its share of the offset: the contact is taken as
+    // reachable by a hand where the cameras saw it. The output hand moves only with
+    // move_hand (ArcoIkOptions).
     const Eigen::Vector3d shift = HandShift(context, options, f, c->point_in_world_mm - tip);
-    pose.wrist_in_world_mm += shift;
-    distance =
-        (hand::FingertipInWorld(context.input->hand_model, pose, finger) - c->point_in_world_mm)
-            .norm();
+    if (shift_out != nullptr) *shift_out = shift;
+    if (options.move_hand) {
+      pose.wrist_in_world_mm += shift;
+      distance =
+          (hand::FingertipInWorld(context.input->hand_model, pose, finger) - c->point_in_world_mm)
+              .norm();
+    }
     // A timing annotation (before_onset, note_boundary) says more than the shift; a shift
     // below half a millimetre is none.
     if (c->reason == ContactReason::kNone && shift.norm() >= 0.5)
@@ -245,6 +278,8 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
       1);
 
   std::vector<std::optional<hand::HandPose>> hands = VisionHands(context);
+  // Each frame's whole-hand move of the first pass (zero where none was needed).
+  std::vector<Eigen::Vector3d> shifts(static_cast<size_t>(n), Eigen::Vector3d::Zero());
   for (int f = 0; f < n; ++f) {
     const FrameIk& s = final_ik[static_cast<size_t>(f)];
     if (!s.solved) continue;
@@ -254,7 +289,8 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
                 s,
                 f,
                 &(*contacts)[static_cast<size_t>(f)],
-                &hands[static_cast<size_t>(f)]);
+                &hands[static_cast<size_t>(f)],
+                &shifts[static_cast<size_t>(f)]);
   }
 
   // The fitted hand lags fast shifts: a frame the lift test rejected inside a note whose
@@ -292,8 +328,7 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
               !context.input->vision_hand[static_cast<size_t>(g)]) {
             continue;
           }
-          sum += first_hands[static_cast<size_t>(g)]->wrist_in_world_mm -
-                 context.input->vision_hand[static_cast<size_t>(g)]->wrist_in_world_mm;
+          sum += shifts[static_cast<size_t>(g)];
           ++count;
           break;
         }
@@ -316,6 +351,18 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
       std::optional<hand::HandPose> pose = hands[static_cast<size_t>(f)];
       if (!ApplyArcoIk(context, options, retry_ik[r], f, &alt, &pose)) continue;
       alt.reason = ContactReason::kHandShifted;  // moved with its neighbours
+      if (!options.move_hand) {
+        // Reachable with its neighbours' move; the hand stays where the cameras put it, with
+        // the finger solved from there (the first pass's solution, or a new one for a frame
+        // the decoder had already left unsolved).
+        const FrameIk& first = final_ik[static_cast<size_t>(f)];
+        const FrameIk from_fit =
+            first.solved ? first : SolveArcoFrame(context, alt, f, options, nullptr);
+        if (!from_fit.solved) continue;
+        if (!first.solved) Accumulate(from_fit, stats);
+        pose = from_fit.pose;
+        alt.tip_distance_refined_mm = from_fit.distance_mm;
+      }
       (*contacts)[static_cast<size_t>(f)] = alt;
       hands[static_cast<size_t>(f)] = pose;
     }

@@ -229,7 +229,14 @@ TEST(ArcoIk, ARejectedFrameStartsFromItsNeighboursHandShift) {
     scene.input.vision_hand[static_cast<size_t>(f)]->wrist_in_world_mm -=
         (f == 30 ? 22.0 : 12.0) * toward_nut;
   }
-  const RefineResult r = Refine(scene.input, Arco());
+  // The flexion chain only: with the MCP's abduction free too, frame 30's finger comes
+  // within the hand's move on its own and needs no neighbour.
+  RefineOptions flexion = Arco();
+  flexion.ik.joints = hand::FingerIkJoints::kMcpFlexPipDip;
+  // With the move applied to the hand (ArcoIkOptions::move_hand), the tip reaches.
+  RefineOptions moved = flexion;
+  moved.ik.move_hand = true;
+  const RefineResult r = Refine(scene.input, moved);
   const FrameContact& c = r.contacts[30];
   EXPECT_TRUE(c.pressed());
   EXPECT_EQ(c.reason, ContactReason::kHandShifted);
@@ -237,7 +244,19 @@ TEST(ArcoIk, ARejectedFrameStartsFromItsNeighboursHandShift) {
   EXPECT_LT(c.tip_distance_refined_mm, 3.0);
   EXPECT_LT((c.point_in_world_mm - scene.truth_contact[30]).norm(), 1e-6);
   EXPECT_EQ(r.summary.joint_limit_violations, 0);
-  RefineOptions off = Arco();
+  // By default the same decision, and every hand stays where the fit put it (the frame 30
+  // path solves the finger from the fitted hand).
+  const RefineResult d = Refine(scene.input, flexion);
+  EXPECT_TRUE(d.contacts[30].pressed());
+  EXPECT_EQ(d.contacts[30].reason, ContactReason::kHandShifted);
+  EXPECT_EQ(d.contacts[30].finger, 1);
+  EXPECT_GT(d.contacts[30].tip_distance_refined_mm, 3.0);
+  for (size_t f = 0; f < d.hand.size(); ++f) {
+    if (!d.hand[f]) continue;
+    EXPECT_EQ(d.hand[f]->wrist_in_world_mm, scene.input.vision_hand[f]->wrist_in_world_mm)
+        << "frame " << f;
+  }
+  RefineOptions off = flexion;
   off.ik.neighbour_shift_frames = 0;
   const RefineResult o = Refine(scene.input, off);
   EXPECT_EQ(o.contacts[30].reason, ContactReason::kOutOfReach);

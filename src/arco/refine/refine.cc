@@ -155,8 +155,8 @@ Status ArcoDecodeOptions::Validate() const {
       {"infeasible_cost", infeasible_cost},
       {"onset_lead_margin_mm", onset_lead_margin_mm}};
   for (const auto& [name, value] : values) {
-    ARCO_RETURN_IF_ERROR(CheckInRange(name, value, kCostWeightRange)
-                             .WithContext("arco decode options"));
+    ARCO_RETURN_IF_ERROR(
+        CheckInRange(name, value, kCostWeightRange).WithContext("arco decode options"));
   }
   if (!(handover_margin_mm >= 0)) {
     return Status::Error("arco decode options: handover_margin_mm must be >= 0 (infinity: off)");
@@ -192,6 +192,8 @@ Status ArcoIkOptions::Validate() const {
   if (!(max_hand_shift_mm >= 0 && Finite(max_hand_shift_mm))) {
     return Status::Error("arco IK options: max_hand_shift_mm must be >= 0");
   }
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("pip_weight", pip_weight, kCostWeightRange).WithContext("arco IK options"));
   if (max_iterations < 1) return Status::Error("arco IK options: max_iterations must be >= 1");
   if (neighbour_shift_frames < 0) {
     return Status::Error("arco IK options: neighbour_shift_frames must be >= 0");
@@ -314,8 +316,10 @@ Json ToJson(const RefineOptions& o) {
             {"max_residual_mm", o.ik.max_residual_mm},
             {"max_hand_shift_mm", o.ik.max_hand_shift_mm},
             {"detected_hand_shift", o.ik.detected_hand_shift},
+            {"move_hand", o.ik.move_hand},
             {"keep_unreachable", o.ik.keep_unreachable},
             {"distal_first", o.ik.distal_first},
+            {"pip_weight", o.ik.pip_weight},
             {"neighbour_shift_frames", o.ik.neighbour_shift_frames},
             {"max_iterations", o.ik.max_iterations}}}};
 }

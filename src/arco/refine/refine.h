@@ -119,19 +119,28 @@ struct ArcoDecodeOptions {
 
 // arco's IK (finger_ik.h).
 struct ArcoIkOptions {
-  // MCP flexion, PIP and DIP: the flexion chain that brings a lifted fingertip down onto
-  // the string. Abduction is seen well (the MCP-PIP direction) and, when left free, takes
-  // the redundancy and drifts to its limits (docs/accuracy.md, the IK ablation).
-  hand::FingerIkJoints joints = hand::FingerIkJoints::kMcpFlexPipDip;
-  // With kMcpFlexPipDip: solve PIP and DIP alone first and free the MCP's flexion only when
-  // they cannot bring the tip within max_residual_mm (the MCP moves the PIP keypoint, which
-  // the cameras see well; on a real hand that move made the PIP worse than vision's).
+  // The largest set of the playing finger's joints the IK may free. With distal_first
+  // (below) they are freed in stages: PIP and DIP first; the MCP's flexion only when they
+  // cannot bring the tip within max_residual_mm; its abduction only when that still cannot
+  // (a finger that left the string across it). Each later stage moves the PIP keypoint,
+  // which the cameras see well, so pip_weight holds it there. Without the staging and the
+  // PIP term, free abduction takes the redundancy and drifts to its limits
+  // (docs/accuracy.md, the IK ablation).
+  hand::FingerIkJoints joints = hand::FingerIkJoints::kAll;
   bool distal_first = true;
   // false: one regularised solve: the priors spread the change over the joints (least
   // change) and leave a small residual (sub-millimetre at these weights); true: the hand
   // IK's exact reach, where the priors only pick among exact solutions and drift along
   // them (worse joints, docs/accuracy.md).
   bool exact_reach = false;
+  // The playing finger's PIP keypoint, in position space, toward the mean of its fitted
+  // and its triangulated position (the fitted one alone where it is not triangulated),
+  // with this weight relative to the tip's (0 = off). A detector's error on a pressing
+  // finger is largest at the tip and DIP, and the fit spreads it up the finger; the PIP
+  // is what the cameras still see well, so the MCP's angles explain the tip's residual
+  // only as far as the PIP allows (docs/refine.md). Acts only with the MCP free
+  // (joints other than pip_dip, and not decided by distal_first's first solve).
+  double pip_weight = 1.0;
   double reference_weight_mm_per_rad = 1.0;  // prior toward the fitted (vision) pose
   double temporal_weight_mm_per_rad = 4.0;   // toward the previous frame's solution
   // Lift test: a contact farther than this from the fitted fingertip is rejected (0 = the
@@ -148,6 +157,12 @@ struct ArcoIkOptions {
   // shift follows the contact; a hand the cameras and the fit agree on stays where they put
   // it. false, or no detected hand: the whole offset (the former rule).
   bool detected_hand_shift = true;
+  // Whether that move is applied to the output hand. false: the move only decides that the
+  // contact is reachable by a hand where the cameras saw it (the note, string and finger
+  // stand, reason hand_shifted); the hand stays where the fit put it and the finger goes
+  // as near as its joints reach. On the real take the move made the wrist, the MCPs and
+  // the other fingers worse than vision (docs/accuracy.md, "A real take").
+  bool move_hand = false;
   // A contact still farther than max_hand_shift_mm after the IK and the hand's move: true
   // keeps the decoded note, string and finger (state pressed, reason out_of_reach) with the
   // finger as near as its joints reach; false rejects the contact (state uncertain) and

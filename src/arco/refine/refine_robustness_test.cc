@@ -76,10 +76,26 @@ TEST(Refine, NeverViolatesAJointLimitEvenOnHarshInput) {
         }
       }
       if (mode == RefineMode::kArco) {
-        for (const FrameContact& c : r.contacts) {
+        // By default the hand stays where the fit put it (ArcoIkOptions::move_hand) and each
+        // pressed frame reports the distance its tip really ends from the contact.
+        for (size_t f = 0; f < r.contacts.size(); ++f) {
+          const FrameContact& c = r.contacts[f];
+          if (!r.hand[f]) continue;
+          EXPECT_EQ(r.hand[f]->wrist_in_world_mm, scene.input.vision_hand[f]->wrist_in_world_mm);
           if (!c.pressed() || !std::isfinite(c.tip_distance_refined_mm)) continue;
-          // A contact the finger cannot reach even with the hand's move keeps its decision
-          // (ArcoIkOptions::keep_unreachable) and says so; every other reaches it.
+          const Eigen::Vector3d tip = hand::FingertipInWorld(
+              scene.input.hand_model, *r.hand[f], static_cast<hand::Finger>(c.finger));
+          EXPECT_NEAR(c.tip_distance_refined_mm, (tip - c.point_in_world_mm).norm(), 1e-6);
+        }
+        // With the move applied: a contact the finger cannot reach even with the hand's move
+        // keeps its decision (ArcoIkOptions::keep_unreachable) and says so; every other
+        // reaches it.
+        RefineOptions moved = o;
+        moved.ik.move_hand = true;
+        const RefineResult m = Refine(scene.input, moved);
+        EXPECT_EQ(m.summary.joint_limit_violations, 0);
+        for (const FrameContact& c : m.contacts) {
+          if (!c.pressed() || !std::isfinite(c.tip_distance_refined_mm)) continue;
           if (c.reason == ContactReason::kOutOfReach) {
             EXPECT_GT(c.tip_distance_refined_mm, o.ik.max_hand_shift_mm);
           } else {
