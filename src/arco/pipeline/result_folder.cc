@@ -292,6 +292,9 @@ StatusOr<std::vector<RecordedInput>> RecordedInputs(const Json& manifest,
       out.push_back({role, ResolveCapturePath(capture_dir, input.file), input.fingerprint});
     }
   }
+  // The manifest first: a replaced capture is named by its capture.json.
+  std::stable_partition(
+      out.begin(), out.end(), [](const RecordedInput& r) { return r.role == kManifestInput; });
   return out;
 }
 
