@@ -21,8 +21,8 @@
 //
 // hand_params.npy rows: the left wrist rotation as an angle-axis (3, rad), the wrist
 // position (3, mm), the 20 joint angles (rad, hand/hand_model.h); a NaN row is no hand.
-// Each writer writes its files and its entry in result.json (keeping the other stages')
-// as one transaction (util/output_set.h): all of them or none.
+// Each writer writes its files and its entry in result.json (keeping the earlier stages',
+// removing the later ones) as one transaction (util/output_set.h): all of them or none.
 //
 // Tied to the capture (docs/architecture.md, "Results are tied to their inputs"): every
 // stage records the fingerprints of the capture files it read (capture_inputs.h) in its
