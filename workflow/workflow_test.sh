@@ -2,7 +2,8 @@
 # The Snakemake workflow (workflow/Snakefile, docs/workflow.md) on three synthetic takes
 # with 2 cores: results, eval and the summary of each; a re-run does nothing; a changed
 # input redoes only its take; a broken take fails alone, named with its stage, while the
-# others complete (--keep-going); `arco batch`; the command lines rendered for a video
+# others complete (--keep-going); a failed take is run again (never a finished target);
+# `arco batch`; the command lines rendered for a video
 # session and an SPD session, and an SPD session made from a synthetic take run for real;
 # the Slurm profile's submissions (a mock sbatch that runs the job itself).
 # Without snakemake it skips (exit 77) unless CI is set.
@@ -108,6 +109,30 @@ check '[ "$(column take3 status)" = failed ] && [ "$(column take3 stage)" = run 
 check '[ "$(column take1 status)" = ok ] && [ "$(column take2 status)" = ok ] &&
        [ "$(stat -c %Y out/take1/eval.json)" != "$before1" ]' \
   "take1/take2 rows: $(grep "take[12]" out/summary.tsv)"
+
+# A failed take is never a finished target: the table `onerror` writes is no proof of
+# work, so `arco batch` run again runs the take again and fails while it fails (it used
+# to say "Nothing to be done" and exit 0 with the take's outputs missing), and once the
+# take is fixed the re-run completes it.
+mkdir -p ftakes && cp -r takes/take1 ftakes/late
+cp ftakes/late/capture.json late-capture.json
+echo '{"format": "arco-capture", "version": 1, "fps": ' > ftakes/late/capture.json
+batch() { "$arco" batch ftakes -o fout --cores 2 --keep-going --workflow "$here" > "$1" 2>&1; }
+batch fail1.txt
+rc=$?
+check '[ $rc -ne 0 ] && [ -f fout/summary.tsv ] && [ ! -e fout/late/result ]' \
+  "the failed take: exit $rc, $(ls fout fout/late 2>&1 | tr '\n' ' ')"
+batch fail2.txt
+rc=$?
+check '[ $rc -ne 0 ] && ! grep -q "Nothing to be done" fail2.txt &&
+       grep -q "arco workflow: take late failed at stage run: " fail2.txt' \
+  "arco batch after a failed take: exit $rc: $(tail -5 fail2.txt)"
+cp late-capture.json ftakes/late/capture.json
+batch fail3.txt
+rc=$?
+check '[ $rc -eq 0 ] && [ -f fout/late/result/result.json ] && [ -f fout/late/eval.json ] &&
+       [ "$(tail -1 fout/summary.tsv | cut -f1-2)" = "$(printf "late\tok")" ]' \
+  "the fixed take: exit $rc: $(tail -5 fail3.txt) $(cat fout/summary.tsv)"
 
 # Video and SPD sessions: what would run (inputs as empty stand-ins).
 mkdir -p sessions/video1/videos sessions/video1/labels sessions/spd1/human/21334181 \

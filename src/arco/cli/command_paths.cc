@@ -26,7 +26,7 @@ void AddCaptureInputs(PathRoles* roles, const std::string& label, const std::str
 void AddResultInputs(PathRoles* roles, const std::string& label, const std::string& result_dir) {
   if (result_dir.empty()) return;
   roles->AddInput(label, result_dir);
-  auto header = pipeline::ResultFolder(result_dir).ReadHeader();
+  auto header = pipeline::ResultFolder(result_dir).ReadHeader(pipeline::InputCheck::kSkip);
   if (header.ok()) AddCaptureInputs(roles, "the capture of " + label, header->capture_dir);
 }
 

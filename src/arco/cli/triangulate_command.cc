@@ -100,6 +100,15 @@ int RunCaptureFolder(const Args& a) {
       seconds,
       seconds > 0 ? s.points / seconds : 0.0,
       a.output.c_str());
+  if (!summary->removed_stages.empty()) {
+    // They were made from the triangulation just replaced (docs/architecture.md).
+    std::string names;
+    for (const std::string& n : summary->removed_stages) names += (names.empty() ? "" : ", ") + n;
+    std::printf(
+        "removed the later stages made from the old triangulation: %s (arco run redoes "
+        "them)\n",
+        names.c_str());
+  }
   return 0;
 }
 

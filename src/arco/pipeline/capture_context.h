@@ -7,6 +7,7 @@
 
 #include "arco/instrument/instrument_model.h"
 #include "arco/mocap/capture.h"
+#include "arco/pipeline/capture_inputs.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/npy.h"
 #include "arco/util/status.h"
@@ -22,6 +23,9 @@ struct CaptureContext {
   // use it instead of reading the file again: 2 x 59 MB for a one-minute 20-camera take);
   // null: not read yet (ReadKeypoints2d reads the file).
   std::shared_ptr<const NpyArray<double>> keypoints2d;
+  // The fingerprints of the capture's files as checked and read (PreflightRun): what the
+  // stages record in result.json and compare with the triangulation's (capture_inputs.h).
+  CaptureInputs inputs;
 };
 
 // capture.keypoints2d when set, else the file read (ReadCaptureKeypoints2d).

@@ -57,6 +57,8 @@ StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
   ARCO_RETURN_IF_ERROR(options.Validate());
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   const ResultFolder result(options.result_dir);
+  // The stages read here must come from the capture given.
+  ARCO_RETURN_IF_ERROR(result.CheckInputsMatch(capture.inputs));
   ARCO_ASSIGN_OR_RETURN(const double s, result.ReadWorldUnitsPerMm());
   ARCO_ASSIGN_OR_RETURN(NpyArray<double> points, result.ReadPoints3d(kTriangulationStage));
   const CaptureManifest& m = capture.manifest;
@@ -153,6 +155,8 @@ StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
     record.bone_lengths_mm[static_cast<size_t>(k)] = k == 0 ? 0.0 : model.bone_length_mm(k);
   }
   record.summary = summary;
+  record.inputs =
+      SelectInputs(capture.inputs, {kManifestInput, kCalibrationInput, kKeypoints2dInput});
   ARCO_RETURN_IF_ERROR(result.WriteHand(record));
   return summary;
 }

@@ -60,6 +60,8 @@ StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions
                                                     Progress& /*progress*/) {
   ARCO_RETURN_IF_ERROR(options.Validate());
   const ResultFolder result(options.result_dir);
+  // The triangulation read here must come from the capture given.
+  ARCO_RETURN_IF_ERROR(result.CheckInputsMatch(capture.inputs));
   ARCO_ASSIGN_OR_RETURN(Json manifest, result.ReadManifest());
   ARCO_ASSIGN_OR_RETURN(NpyArray<double> points, result.ReadPoints3d(kTriangulationStage));
   const InstrumentModel& model = *capture.instrument;
@@ -137,6 +139,7 @@ StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions
   record.world_units_per_mm = s;
   record.keypoint_names = model.keypoint_names();
   record.summary = summary;
+  record.inputs = SelectInputs(capture.inputs, {kManifestInput});
   ARCO_RETURN_IF_ERROR(result.WriteInstrument(record));
   return summary;
 }

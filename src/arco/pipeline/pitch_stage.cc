@@ -18,6 +18,8 @@ StatusOr<PitchStageSummary> RunPitchStage(const PitchStageOptions& options,
                                           const CaptureContext& capture,
                                           Progress& progress) {
   ARCO_RETURN_IF_ERROR(options.Validate());
+  // The result it joins must come from the capture given.
+  ARCO_RETURN_IF_ERROR(ResultFolder(options.result_dir).CheckInputsMatch(capture.inputs));
   const CaptureManifest& m = capture.manifest;
   PitchStageSummary summary;
   if (m.audio.empty()) {
@@ -61,6 +63,7 @@ StatusOr<PitchStageSummary> RunPitchStage(const PitchStageOptions& options,
   summary.notes = static_cast<int64_t>(record.notes.notes.size());
   record.a4_hz = m.tuning_a4_hz;
   record.summary = summary;
+  record.inputs = SelectInputs(capture.inputs, {kManifestInput, kAudioInput});
   ARCO_RETURN_IF_ERROR(ResultFolder(options.result_dir).WritePitch(record));
   return summary;
 }

@@ -182,6 +182,12 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
   ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(
       options.ForTriangulate(), capture.layout, m.fps, ManifestPath(options.capture_dir)));
   ARCO_RETURN_IF_ERROR(CheckCaptureAudio(options.capture_dir, m).status());
+  // After the checks, so that a bad file gets its own message rather than the hash's.
+  ARCO_ASSIGN_OR_RETURN(capture.inputs,
+                        FingerprintCaptureInputs(
+                            options.capture_dir,
+                            m,
+                            {kManifestInput, kCalibrationInput, kKeypoints2dInput, kAudioInput}));
   return capture;
 }
 

@@ -1,9 +1,11 @@
 #include "arco/pipeline/result_folder.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <type_traits>
@@ -51,6 +53,74 @@ Status WriteFingeringCsv(const std::string& path, const std::vector<refine::Note
 
 Status Expect(bool ok, const std::string& path, const std::string& what) {
   return ok ? Status::Ok() : Status::Error(path + ": " + what);
+}
+
+// result.json keys of the ties to the capture (docs/formats.md).
+constexpr char kInputsKey[] = "inputs";
+constexpr char kRemovedStagesKey[] = "removed_stages";
+
+Json InputsToJson(const CaptureInputs& inputs) {
+  Json j = Json::object();
+  for (const auto& [role, input] : inputs) {
+    j[role] = {{"file", input.file},
+               {"size_bytes", input.fingerprint.size_bytes},
+               {"murmur3", input.fingerprint.murmur3}};
+  }
+  return j;
+}
+
+// "inputs" of result.json (`field`: "inputs" or "stages.<stage>.inputs"); errors name
+// the manifest and the field.
+StatusOr<CaptureInputs> InputsFromJson(const Json& j,
+                                       const std::string& manifest_path,
+                                       const std::string& field) {
+  auto bad = [&](const std::string& what) {
+    return Status::Error(manifest_path + ": \"" + field + "\" " + what);
+  };
+  if (!j.is_object()) return bad("is not an object");
+  CaptureInputs out;
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const Json& e = it.value();
+    const std::string where = "entry '" + it.key() + "' ";
+    if (!e.is_object() || !e.contains("file") || !e["file"].is_string() ||
+        e["file"].get<std::string>().empty()) {
+      return bad(where + "has no \"file\"");
+    }
+    if (!e.contains("size_bytes") || !e["size_bytes"].is_number_integer() ||
+        e["size_bytes"].get<int64_t>() < 0) {
+      return bad(where + "has no \"size_bytes\" (an integer >= 0)");
+    }
+    if (!e.contains("murmur3") || !e["murmur3"].is_string()) {
+      return bad(where + "has no \"murmur3\" (a string)");
+    }
+    out[it.key()] = {e["file"].get<std::string>(),
+                     {e["size_bytes"].get<int64_t>(), e["murmur3"].get<std::string>()}};
+  }
+  return out;
+}
+
+// The capture folder result.json names, resolved against the result folder ("" when
+// absent).
+std::string CaptureDirOf(const Json& manifest, const std::string& result_dir) {
+  if (!manifest.contains("capture") || !manifest["capture"].is_string()) return "";
+  const std::string capture = manifest["capture"].get<std::string>();
+  if (capture.empty()) return "";
+  // Relative to the result folder (absolute stays absolute).
+  return NormalizeOutputPath(ResolveCapturePath(result_dir, capture));
+}
+
+// Where a stage stands in kStageOrder (the method folders after all of it).
+int StageRank(const std::string& stage) {
+  for (size_t i = 0; i < std::size(kStageOrder); ++i) {
+    if (stage == kStageOrder[i]) return static_cast<int>(i);
+  }
+  return static_cast<int>(std::size(kStageOrder));
+}
+
+// A file or folder name inside the result folder, never a path that leaves it: a stage
+// entry's "dir" and "files" decide what is removed.
+bool PlainName(const std::string& name) {
+  return !name.empty() && name != "." && name != ".." && name.find('/') == std::string::npos;
 }
 
 }  // namespace
@@ -172,7 +242,8 @@ StatusOr<Json> ResultFolder::ReadManifest() const {
   return j;
 }
 
-StatusOr<ResultHeader> ResultFolder::ReadHeader() const {
+StatusOr<ResultHeader> ResultFolder::ReadHeader(InputCheck check) const {
+  if (check == InputCheck::kCompare) ARCO_RETURN_IF_ERROR(CheckInputs());
   ARCO_ASSIGN_OR_RETURN(const Json result, ReadManifest());
   ResultHeader h;
   if (result.contains("keypoint_names"))
@@ -183,12 +254,87 @@ StatusOr<ResultHeader> ResultFolder::ReadHeader() const {
     h.frame_first = result["frames"].value("first", int64_t{1});
     h.frame_count = result["frames"].value("count", int64_t{0});
   }
-  // "capture" is relative to the result folder (absolute stays absolute).
-  if (result.contains("capture") && result["capture"].is_string()) {
-    const std::string capture = result["capture"].get<std::string>();
-    if (!capture.empty()) h.capture_dir = NormalizeOutputPath(ResolveCapturePath(dir_, capture));
-  }
+  h.capture_dir = CaptureDirOf(result, dir_);
   return h;
+}
+
+namespace {
+
+// One capture file result.json records, with the path it names now.
+struct RecordedInput {
+  std::string role;
+  std::string path;
+  Fingerprint fingerprint;
+};
+
+// Every input of result.json "inputs" and of each stage's "inputs".
+StatusOr<std::vector<RecordedInput>> RecordedInputs(const Json& manifest,
+                                                    const std::string& result_dir,
+                                                    const std::string& manifest_path) {
+  std::vector<std::pair<std::string, const Json*>> lists;
+  if (manifest.contains(kInputsKey)) lists.push_back({kInputsKey, &manifest[kInputsKey]});
+  if (manifest.contains("stages") && manifest["stages"].is_object()) {
+    for (auto it = manifest["stages"].begin(); it != manifest["stages"].end(); ++it) {
+      if (it.value().is_object() && it.value().contains(kInputsKey)) {
+        lists.push_back({"stages." + it.key() + "." + kInputsKey, &it.value()[kInputsKey]});
+      }
+    }
+  }
+  std::vector<RecordedInput> out;
+  if (lists.empty()) return out;  // a result of an older arco: nothing recorded
+  const std::string capture_dir = CaptureDirOf(manifest, result_dir);
+  if (capture_dir.empty()) {
+    return Status::Error(manifest_path + ": \"inputs\" recorded but no \"capture\" folder");
+  }
+  for (const auto& [field, list] : lists) {
+    ARCO_ASSIGN_OR_RETURN(const CaptureInputs inputs, InputsFromJson(*list, manifest_path, field));
+    for (const auto& [role, input] : inputs) {
+      out.push_back({role, ResolveCapturePath(capture_dir, input.file), input.fingerprint});
+    }
+  }
+  // The manifest first: a replaced capture is named by its capture.json.
+  std::stable_partition(
+      out.begin(), out.end(), [](const RecordedInput& r) { return r.role == kManifestInput; });
+  return out;
+}
+
+}  // namespace
+
+Status ResultFolder::CheckInputs() const {
+  ARCO_ASSIGN_OR_RETURN(const Json manifest, ReadManifest());
+  ARCO_ASSIGN_OR_RETURN(const std::vector<RecordedInput> recorded,
+                        RecordedInputs(manifest, dir_, ManifestPath()));
+  std::map<std::string, Fingerprint> now;  // each file hashed once
+  for (const RecordedInput& r : recorded) {
+    auto it = now.find(r.path);
+    if (it == now.end()) {
+      if (!FileExists(r.path)) {
+        return Status::Error(r.path + " changed since the result " + dir_ +
+                             " was made (it is gone; re-run `arco run`)");
+      }
+      ARCO_ASSIGN_OR_RETURN(Fingerprint f, FingerprintFile(r.path));
+      it = now.emplace(r.path, std::move(f)).first;
+    }
+    if (it->second != r.fingerprint) {
+      return Status::Error(r.path + " changed since the result " + dir_ +
+                           " was made (re-run `arco run`)");
+    }
+  }
+  return Status::Ok();
+}
+
+Status ResultFolder::CheckInputsMatch(const CaptureInputs& capture) const {
+  ARCO_ASSIGN_OR_RETURN(const Json manifest, ReadManifest());
+  ARCO_ASSIGN_OR_RETURN(const std::vector<RecordedInput> recorded,
+                        RecordedInputs(manifest, dir_, ManifestPath()));
+  for (const RecordedInput& r : recorded) {
+    auto it = capture.find(r.role);
+    if (it != capture.end() && it->second.fingerprint != r.fingerprint) {
+      return Status::Error(r.path + " changed since the result " + dir_ +
+                           " was made (re-run `arco run`)");
+    }
+  }
+  return Status::Ok();
 }
 
 StatusOr<bool> ResultFolder::HasStage(const std::string& stage) const {
@@ -245,19 +391,89 @@ Status ResultFolder::CheckWritable() const {
   return CheckOutputFolder(dir_, r);
 }
 
+StatusOr<std::vector<std::string>> ResultFolder::RemoveLaterStages(const std::string& stage,
+                                                                   OutputSet* outputs,
+                                                                   Json* manifest) const {
+  std::vector<std::string> removed;
+  if (!manifest->contains("stages") || !(*manifest)["stages"].is_object()) return removed;
+  Json& stages = (*manifest)["stages"];
+  for (auto it = stages.begin(); it != stages.end(); ++it) {
+    if (StageRank(it.key()) <= StageRank(stage)) continue;
+    const Json& e = it.value();
+    const std::string dir = e.is_object() && e.contains("dir") && e["dir"].is_string()
+                                ? e["dir"].get<std::string>()
+                                : it.key();
+    std::vector<std::string> names;
+    if (dir == ".") {  // files in the folder itself (pitch.csv, notes.csv)
+      if (e.is_object() && e.contains("files") && e["files"].is_object()) {
+        for (const Json& f : e["files"]) {
+          if (f.is_string()) names.push_back(f.get<std::string>());
+        }
+      }
+    } else {
+      names.push_back(dir);
+    }
+    for (const std::string& name : names) {
+      if (!PlainName(name)) {
+        return Status::Error(ManifestPath() + ": stage '" + it.key() + "' names '" + name +
+                             "': not a name inside the result folder");
+      }
+      ARCO_RETURN_IF_ERROR(outputs->AddRemoval(JoinPath(dir_, name)));
+    }
+    removed.push_back(it.key());
+  }
+  // In the order of the stages (the manifest's keys are alphabetical).
+  std::stable_sort(removed.begin(), removed.end(), [](const std::string& a, const std::string& b) {
+    return StageRank(a) < StageRank(b);
+  });
+  for (const std::string& name : removed) stages.erase(name);
+  if (!removed.empty()) {
+    Json& names = (*manifest)[kRemovedStagesKey];
+    if (!names.is_array()) names = Json::array();
+    for (const std::string& name : removed) {
+      if (std::find(names.begin(), names.end(), Json(name)) == names.end()) names.push_back(name);
+    }
+  }
+  return removed;
+}
+
+namespace {
+
+// `manifest` with `stage` written from `inputs`: its entry's "inputs", merged into the
+// result's, and its name no longer among "removed_stages".
+void RecordStageInputs(Json* manifest, const std::string& stage, const CaptureInputs& inputs) {
+  const Json recorded = InputsToJson(inputs);
+  (*manifest)["stages"][stage][kInputsKey] = recorded;
+  Json& all = (*manifest)[kInputsKey];
+  if (!all.is_object()) all = Json::object();
+  for (auto it = recorded.begin(); it != recorded.end(); ++it) all[it.key()] = it.value();
+  if (manifest->contains(kRemovedStagesKey) && (*manifest)[kRemovedStagesKey].is_array()) {
+    Json& names = (*manifest)[kRemovedStagesKey];
+    names.erase(std::remove(names.begin(), names.end(), Json(stage)), names.end());
+    if (names.empty()) manifest->erase(kRemovedStagesKey);
+  }
+}
+
+}  // namespace
+
 Status ResultFolder::WriteStageFolder(const std::string& stage,
                                       const std::function<Status(const std::string& dir)>& write,
-                                      Json entry) const {
-  ARCO_ASSIGN_OR_RETURN(const Json manifest, ReadManifest());  // not some other JSON
+                                      Json entry,
+                                      const CaptureInputs& inputs) const {
+  ARCO_ASSIGN_OR_RETURN(Json manifest, ReadManifest());  // not some other JSON
   ARCO_RETURN_IF_ERROR(MakeDirectories(dir_));
-  // The folder and result.json change together or not at all.
+  // The folder, result.json and the removal of the later stages happen together or not
+  // at all.
   OutputSet outputs;
   ARCO_ASSIGN_OR_RETURN(const std::string tmp_dir,
                         outputs.AddFolder(JoinPath(dir_, stage), OwnStageFolder()));
   ARCO_ASSIGN_OR_RETURN(const std::string tmp_manifest, outputs.AddFile(ManifestPath()));
+  ARCO_RETURN_IF_ERROR(RemoveLaterStages(stage, &outputs, &manifest).status());
   ARCO_RETURN_IF_ERROR(write(tmp_dir));
   entry["dir"] = stage;
-  ARCO_RETURN_IF_ERROR(WriteJsonFile(tmp_manifest, WithStage(manifest, stage, entry)));
+  manifest = WithStage(manifest, stage, entry);
+  RecordStageInputs(&manifest, stage, inputs);
+  ARCO_RETURN_IF_ERROR(WriteJsonFile(tmp_manifest, manifest));
   return outputs.Commit();
 }
 
@@ -272,18 +488,22 @@ Status ResultFolder::WriteRunOptions(const Json& options) const {
 
 // ---- triangulation/
 
-Status ResultFolder::WriteTriangulation(const CaptureManifest& manifest,
-                                        const KeypointLayout& layout,
-                                        const SequenceTriangulation& raw,
-                                        const NpyArray<double>& points3d_filtered,
-                                        const TriangulationRecord& record) const {
+StatusOr<std::vector<std::string>> ResultFolder::WriteTriangulation(
+    const CaptureManifest& manifest,
+    const KeypointLayout& layout,
+    const SequenceTriangulation& raw,
+    const NpyArray<double>& points3d_filtered,
+    const TriangulationRecord& record) const {
   ARCO_ASSIGN_OR_RETURN(Json result, ReadManifest());
   ARCO_RETURN_IF_ERROR(MakeDirectories(dir_));
-  // triangulation/ and result.json change together or not at all.
+  // triangulation/, result.json and the removal of the later stages happen together or
+  // not at all.
   OutputSet outputs;
   ARCO_ASSIGN_OR_RETURN(const std::string stage_tmp,
                         outputs.AddFolder(JoinPath(dir_, kTriangulationStage), OwnStageFolder()));
   ARCO_ASSIGN_OR_RETURN(const std::string manifest_tmp, outputs.AddFile(ManifestPath()));
+  ARCO_ASSIGN_OR_RETURN(const std::vector<std::string> removed,
+                        RemoveLaterStages(kTriangulationStage, &outputs, &result));
   auto write_all = [&](const std::string& tmp_dir) -> Status {
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, kPoints3dFile), points3d_filtered));
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, kPoints3dRawFile), raw.points3d));
@@ -322,8 +542,14 @@ Status ResultFolder::WriteTriangulation(const CaptureManifest& manifest,
                                              {"inlier_mask", kInlierMaskFile}}},
                                            {"options", record.options},
                                            {"summary", ToJson(record.summary)}};
+  // A new capture header: the result is now what this triangulation was made from, and
+  // `arco run`'s options no longer describe it.
+  result.erase(kInputsKey);
+  result.erase("options");
+  RecordStageInputs(&result, kTriangulationStage, record.inputs);
   ARCO_RETURN_IF_ERROR(WriteJsonFile(manifest_tmp, result));
-  return outputs.Commit();
+  ARCO_RETURN_IF_ERROR(outputs.Commit());
+  return removed;
 }
 
 StatusOr<NpyArray<double>> ResultFolder::ReadPoints3d(const std::string& stage) const {
@@ -355,7 +581,8 @@ Status ResultFolder::WriteInstrument(const InstrumentRecord& r) const {
         ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, kStringsFile), r.strings_mm));
         return WriteNpy(JoinPath(dir, kKeypointsFile), r.keypoints_mm);
       },
-      entry);
+      entry,
+      r.inputs);
 }
 
 StatusOr<double> ResultFolder::ReadWorldUnitsPerMm() const {
@@ -405,7 +632,8 @@ Status ResultFolder::WriteHand(const HandRecord& r) const {
         ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, kHandParamsFile), hand::HandParams(r.hands)));
         return WriteNpy(JoinPath(dir, kBoneLengthsFile), lengths);
       },
-      entry);
+      entry,
+      r.inputs);
 }
 
 StatusOr<HandRecord> ResultFolder::ReadHand() const {
@@ -426,7 +654,7 @@ StatusOr<HandRecord> ResultFolder::ReadHand() const {
 // ---- pitch.csv, notes.csv
 
 Status ResultFolder::WritePitch(const PitchRecord& r) const {
-  ARCO_ASSIGN_OR_RETURN(const Json manifest, ReadManifest());
+  ARCO_ASSIGN_OR_RETURN(Json manifest, ReadManifest());
   ARCO_RETURN_IF_ERROR(MakeDirectories(dir_));
   // pitch.csv, notes.csv and result.json change together or not at all.
   OutputSet outputs;
@@ -434,6 +662,7 @@ Status ResultFolder::WritePitch(const PitchRecord& r) const {
   ARCO_ASSIGN_OR_RETURN(const std::string notes_tmp,
                         outputs.AddFile(JoinPath(dir_, kNotesCsvFile)));
   ARCO_ASSIGN_OR_RETURN(const std::string manifest_tmp, outputs.AddFile(ManifestPath()));
+  ARCO_RETURN_IF_ERROR(RemoveLaterStages(kPitchStage, &outputs, &manifest).status());
   ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(pitch_tmp, r.frames));
   ARCO_RETURN_IF_ERROR(audio::WriteNotesCsv(notes_tmp, r.notes));
   const Json entry = {{"dir", "."},
@@ -441,7 +670,9 @@ Status ResultFolder::WritePitch(const PitchRecord& r) const {
                       {"a4_hz", r.a4_hz},
                       {"audio", r.summary.audio},
                       {"summary", ToJson(r.summary)}};
-  ARCO_RETURN_IF_ERROR(WriteJsonFile(manifest_tmp, WithStage(manifest, kPitchStage, entry)));
+  manifest = WithStage(manifest, kPitchStage, entry);
+  RecordStageInputs(&manifest, kPitchStage, r.inputs);
+  ARCO_RETURN_IF_ERROR(WriteJsonFile(manifest_tmp, manifest));
   return outputs.Commit();
 }
 
@@ -482,7 +713,10 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
                            {"keypoint_names", layout ? layout->names : std::vector<std::string>()},
                            {"units", "mm"},
                            {"options", refine::ToJson(r.options)},
-                           {"summary", refine::ToJson(r.summary)}});
+                           {"summary", refine::ToJson(r.summary)}},
+                          // The methods read the earlier stages, not the capture: those
+                          // stages' inputs are the method's too.
+                          CaptureInputs());
 }
 
 }  // namespace arco::pipeline

@@ -21,8 +21,16 @@
 //
 // hand_params.npy rows: the left wrist rotation as an angle-axis (3, rad), the wrist
 // position (3, mm), the 20 joint angles (rad, hand/hand_model.h); a NaN row is no hand.
-// Each writer writes its files and its entry in result.json (keeping the other stages')
-// as one transaction (util/output_set.h): all of them or none.
+// Each writer writes its files and its entry in result.json (keeping the earlier stages',
+// removing the later ones) as one transaction (util/output_set.h): all of them or none.
+//
+// Tied to the capture (docs/architecture.md, "Results are tied to their inputs"): every
+// stage records the fingerprints of the capture files it read (capture_inputs.h) in its
+// entry's "inputs", and result.json "inputs" holds them all; ReadHeader, which every
+// reader of a result goes through, re-hashes them and refuses a result whose capture
+// changed since. Writing a stage removes the stages after it (kStageOrder), in the same
+// transaction, and names them in result.json "removed_stages": they were made from what
+// it replaces.
 #pragma once
 
 #include <Eigen/Core>
@@ -37,6 +45,7 @@
 #include "arco/hand/hand_model.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/triangulate_sequence.h"
+#include "arco/pipeline/capture_inputs.h"
 #include "arco/pipeline/summaries.h"
 #include "arco/refine/contact_annotation.h"
 #include "arco/refine/refine.h"
@@ -44,6 +53,10 @@
 #include "arco/util/json_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/status.h"
+
+namespace arco {
+class OutputSet;
+}
 
 namespace arco::pipeline {
 
@@ -54,6 +67,10 @@ inline constexpr char kTriangulationStage[] = "triangulation";
 inline constexpr char kInstrumentStage[] = "instrument";
 inline constexpr char kHandStage[] = "hand";
 inline constexpr char kPitchStage[] = "pitch";  // writes pitch.csv and notes.csv, no folder
+// The order in which each stage reads the ones before it; any other stage (the method
+// folders vision, paper, arco) comes after all of these and reads none of its kind.
+inline constexpr const char* kStageOrder[] = {
+    kTriangulationStage, kInstrumentStage, kHandStage, kPitchStage};
 
 // fingering.csv: one row per note.
 inline constexpr char kFingeringCsvHeader[] =
@@ -66,6 +83,7 @@ struct TriangulationRecord {
   std::string units;  // of the rig
   Json options;       // triangulation and filter options as run
   SequenceTriangulationSummary summary;
+  CaptureInputs inputs;  // the capture files read (manifest, calibration, keypoints2d)
 };
 
 // instrument/ and its entry.
@@ -77,6 +95,7 @@ struct InstrumentRecord {
   NpyArray<double> strings_mm;              // (F, S, 2, 3), NaN without a pose
   NpyArray<double> keypoints_mm;            // (F, K, 3), NaN without a pose
   InstrumentStageSummary summary;           // written, not read back
+  CaptureInputs inputs;                     // the capture files read; written, not read back
 };
 
 // hand/ and its entry: the fitted left hand.
@@ -84,6 +103,7 @@ struct HandRecord {
   std::vector<std::optional<hand::HandPose>> hands;  // per frame
   hand::BoneLengthsMm bone_lengths_mm{};             // index = keypoint, [0] unused (0)
   HandStageSummary summary;                          // written, not read back
+  CaptureInputs inputs;  // the capture files read; written, not read back
 };
 
 // pitch.csv, notes.csv and the pitch entry.
@@ -92,6 +112,7 @@ struct PitchRecord {
   audio::NoteAnalysis notes;
   double a4_hz = 440.0;
   PitchStageSummary summary;  // summary.audio: the file tracked
+  CaptureInputs inputs;       // the capture files read; written, not read back
 };
 
 // One method folder (vision, paper, arco) and its entry.
@@ -124,6 +145,12 @@ struct ResultHeader {
   std::string capture_dir;  // "capture", resolved against the result folder ("" when absent)
 };
 
+// Whether ReadHeader compares the capture files with their recorded fingerprints.
+enum class InputCheck {
+  kCompare,  // every reader of a result
+  kSkip,     // only to list the paths a command touches (cli/command_paths.h)
+};
+
 class ResultFolder {
  public:
   explicit ResultFolder(std::string dir) : dir_(std::move(dir)) {}
@@ -145,17 +172,29 @@ class ResultFolder {
 
   // result.json: an empty object when absent; an error when it is not an arco result.
   StatusOr<Json> ReadManifest() const;
-  StatusOr<ResultHeader> ReadHeader() const;
+  // With kCompare, CheckInputs first: a result whose capture changed is an error.
+  StatusOr<ResultHeader> ReadHeader(InputCheck check = InputCheck::kCompare) const;
+
+  // Re-hashes every capture file result.json records ("inputs", and each stage's) and
+  // compares: one that differs or is gone is the error "FILE changed since the result
+  // DIR was made (re-run `arco run`)". A result without recorded inputs (written before
+  // arco recorded them) passes: there is nothing to compare.
+  Status CheckInputs() const;
+  // The same comparison against fingerprints already taken (a stage of `arco run` given
+  // the capture it opened): the roles both have must agree.
+  Status CheckInputsMatch(const CaptureInputs& capture) const;
   StatusOr<bool> HasStage(const std::string& stage) const;
   // The stages whose entry lists a points3d file, in result.json's order.
   StatusOr<std::vector<PointStage>> PointStages() const;
 
-  // triangulation/ and the capture header of result.json.
-  Status WriteTriangulation(const CaptureManifest& manifest,
-                            const KeypointLayout& layout,
-                            const SequenceTriangulation& raw,
-                            const NpyArray<double>& points3d_filtered,
-                            const TriangulationRecord& record) const;
+  // triangulation/ and the capture header of result.json, which starts anew: its
+  // "inputs" are the triangulation's, the run's "options" go, and so do the later stages
+  // (kStageOrder), whose names it returns.
+  StatusOr<std::vector<std::string>> WriteTriangulation(const CaptureManifest& manifest,
+                                                        const KeypointLayout& layout,
+                                                        const SequenceTriangulation& raw,
+                                                        const NpyArray<double>& points3d_filtered,
+                                                        const TriangulationRecord& record) const;
   // <stage>/points3d.npy of any stage (triangulation, vision, paper, arco).
   StatusOr<NpyArray<double>> ReadPoints3d(const std::string& stage) const;
   // triangulation/reprojection_rms_px.npy and inlier_count.npy, each (F, P) in the
@@ -196,11 +235,17 @@ class ResultFolder {
 
  private:
   // Writes RESULT_DIR/<stage>/ and result.json "stages"."<stage>" = `entry` plus "dir"
-  // (other stages kept; the manifest is created when absent) as one OutputSet: both or
-  // neither.
+  // and "inputs" (earlier stages kept, later ones removed; the manifest is created when
+  // absent) as one OutputSet: both or neither.
   Status WriteStageFolder(const std::string& stage,
                           const std::function<Status(const std::string& dir)>& write,
-                          Json entry) const;
+                          Json entry,
+                          const CaptureInputs& inputs) const;
+  // Declares in `outputs` the removal of every stage after `stage` and drops their
+  // entries from `manifest`, naming them in "removed_stages"; returns their names.
+  StatusOr<std::vector<std::string>> RemoveLaterStages(const std::string& stage,
+                                                       OutputSet* outputs,
+                                                       Json* manifest) const;
 
   std::string dir_;
 };

@@ -37,10 +37,13 @@ refine::SpdSources SourcesFor(const refine::testing::Scene& scene) {
   return s;
 }
 
-TEST(ResultFolder, TriangulationWritesStageFolderAndKeepsOtherStages) {
+// A new triangulation removes the stages made from the old one (result_inputs_test.cc
+// tries every stage).
+TEST(ResultFolder, TriangulationWritesStageFolderAndRemovesLaterStages) {
   TempDir dir;
   const std::string result_dir = dir / "result";
-  ASSERT_TRUE(MakeDirectories(result_dir).ok());
+  ASSERT_TRUE(MakeDirectories(result_dir + "/arco").ok());
+  ASSERT_TRUE(AtomicWriteFile(result_dir + "/arco/points3d.npy", "old").ok());
   ASSERT_TRUE(
       WriteJsonFile(result_dir + "/result.json",
                     Json{{"format", "arco-result"}, {"stages", {{"arco", {{"dir", "arco"}}}}}})
@@ -63,12 +66,16 @@ TEST(ResultFolder, TriangulationWritesStageFolderAndKeepsOtherStages) {
                          .string();
   info.units = "m";
   info.summary = Summarize(raw);
-  ASSERT_TRUE(ResultFolder(result_dir)
-                  .WriteTriangulation(m, *FindKeypointLayout("spd_cello"), raw, raw.points3d, info)
-                  .ok());
+  const auto removed =
+      ResultFolder(result_dir)
+          .WriteTriangulation(m, *FindKeypointLayout("spd_cello"), raw, raw.points3d, info);
+  ASSERT_TRUE(removed.ok()) << removed.status().message();
+  EXPECT_EQ(*removed, std::vector<std::string>{"arco"});
   auto manifest = ResultFolder(result_dir).ReadManifest();
   ASSERT_TRUE(manifest.ok());
-  EXPECT_TRUE((*manifest)["stages"].contains("arco"));
+  EXPECT_FALSE((*manifest)["stages"].contains("arco"));
+  EXPECT_EQ((*manifest)["removed_stages"], Json::array({"arco"}));
+  EXPECT_FALSE(FileExists(result_dir + "/arco"));
   EXPECT_EQ((*manifest)["stages"]["triangulation"]["summary"]["triangulated"], 568);
   EXPECT_EQ((*manifest)["keypoint_names"].size(), 142u);
   // The capture path is relative to the result folder, and read back against it.

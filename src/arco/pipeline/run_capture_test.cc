@@ -5,10 +5,17 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
+#include <vector>
 
 #include "arco/calibration/calibration_file.h"
 #include "arco/eval/evaluate.h"
 #include "arco/mocap/capture.h"
+#include "arco/pipeline/hand_stage.h"
+#include "arco/pipeline/instrument_stage.h"
+#include "arco/pipeline/pitch_stage.h"
+#include "arco/pipeline/preflight.h"
+#include "arco/pipeline/refine_stage.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"
@@ -175,6 +182,73 @@ TEST(RunCapture, BadInputIsOneClearError) {
   auto no_pitch = RunRefineStage(r);
   ASSERT_FALSE(no_pitch.ok());
   EXPECT_NE(no_pitch.status().message().find("pitch"), std::string::npos);
+}
+
+// Every stage that reads a result with its capture (docs/architecture.md, "Results are
+// tied to their inputs"), given a result made before the capture changed, refuses with
+// one line naming the changed file and leaves the result as it was: the stages of
+// `arco run` after the triangulation (given the capture as they would open it) and
+// `arco refine`'s. Each file the stages read, changed in turn.
+TEST(RunCapture, EveryStageRefusesAResultWhoseCaptureChanged) {
+  arco::testing::TempDir out;
+  const std::string capture = out / "capture";
+  fs::copy(SyntheticCapture(), capture, fs::copy_options::recursive);
+  RunOptions o;
+  o.capture_dir = capture;
+  o.result_dir = out / "result";
+  o.num_threads = 2;
+  ASSERT_TRUE(RunCapture(o).ok());
+  const auto manifest = ReadCaptureManifest(capture);
+  ASSERT_TRUE(manifest.ok());
+  // Flips one byte of FILE (inside the capture); returns its path.
+  auto flip = [&](const std::string& file, size_t from_end) {
+    const std::string path = JoinPath(capture, file);
+    std::string bytes = *ReadFileToString(path);
+    bytes[bytes.size() - from_end] ^= 1;
+    EXPECT_TRUE(AtomicWriteFile(path, bytes).ok());
+    return path;
+  };
+  struct Change {
+    std::string name;
+    std::function<std::string()> apply;  // returns the changed file's path
+  };
+  const std::vector<Change> changes = {
+      {"capture.json: the audio offset moved",
+       [&] {
+         CaptureManifest m = *manifest;
+         m.audio_offset_s += 0.001;
+         EXPECT_TRUE(WriteCaptureManifest(capture, m).ok());
+         return JoinPath(capture, "capture.json");
+       }},
+      {"the calibration: one more newline",
+       [&] {
+         const std::string path = JoinPath(capture, manifest->calibration);
+         EXPECT_TRUE(AtomicWriteFile(path, *ReadFileToString(path) + "\n").ok());
+         return path;
+       }},
+      {"keypoints2d.npy: one byte", [&] { return flip(manifest->keypoints2d, 1); }},
+      {"the audio: one byte", [&] { return flip(manifest->audio, 1000); }},
+  };
+  const std::string result_json = JoinPath(o.result_dir, "result.json");
+  const std::string before = *ReadFileToString(result_json);
+  for (const Change& change : changes) {
+    SCOPED_TRACE(change.name);
+    fs::remove_all(capture);
+    fs::copy(SyntheticCapture(), capture, fs::copy_options::recursive);
+    const std::string changed = change.apply();
+    const std::string expected =
+        changed + " changed since the result " + o.result_dir + " was made (re-run `arco run`)";
+    // The capture as `arco run` opens it, now (its result folder elsewhere).
+    RunOptions now = o;
+    now.result_dir = out / "elsewhere";
+    auto opened = PreflightRun(now);
+    ASSERT_TRUE(opened.ok()) << opened.status().message();
+    EXPECT_EQ(RunInstrumentStage(o.ForInstrument(), *opened).status().message(), expected);
+    EXPECT_EQ(RunHandStage(o.ForHands(), *opened).status().message(), expected);
+    EXPECT_EQ(RunPitchStage(o.ForPitch(), *opened).status().message(), expected);
+    EXPECT_EQ(RunRefineStage(o.ForRefine(refine::RefineMode::kArco)).status().message(), expected);
+    EXPECT_EQ(*ReadFileToString(result_json), before);
+  }
 }
 
 }  // namespace

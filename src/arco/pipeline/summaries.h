@@ -18,6 +18,8 @@ struct TriangulateStageSummary {
   std::string units;  // of the rig
   int64_t views = 0;
   int64_t keypoints = 0;
+  // Stages of an existing result that the new triangulation removed (made from the old).
+  std::vector<std::string> removed_stages;
 };
 
 struct InstrumentStageSummary {

@@ -55,6 +55,11 @@ StatusOr<TriangulateStageSummary> RunTriangulateStage(
     keypoints2d = std::make_shared<const NpyArray<double>>(std::move(read));
   }
   const NpyArray<double>& keypoints = *keypoints2d;
+  TriangulationRecord record;
+  ARCO_ASSIGN_OR_RETURN(
+      record.inputs,
+      FingerprintCaptureInputs(
+          o.capture_dir, manifest, {kManifestInput, kCalibrationInput, kKeypoints2dInput}));
   progress.SetTotal(manifest.frame_count);
   ARCO_ASSIGN_OR_RETURN(
       SequenceTriangulation raw,
@@ -68,14 +73,14 @@ StatusOr<TriangulateStageSummary> RunTriangulateStage(
   for (size_t i = 0; i < filter_groups.size(); ++i) {
     FilterPoints(o.filters[i].second, manifest.fps, *filter_groups[i], &filtered);
   }
-  TriangulationRecord record;
   record.capture_dir = o.capture_dir;
   record.units = calibration->rig.units;
   record.summary = Summarize(raw);
   record.options = ToJson(o);
-  ARCO_RETURN_IF_ERROR(
-      ResultFolder(o.result_dir).WriteTriangulation(manifest, layout, raw, filtered, record));
   TriangulateStageSummary summary;
+  ARCO_ASSIGN_OR_RETURN(
+      summary.removed_stages,
+      ResultFolder(o.result_dir).WriteTriangulation(manifest, layout, raw, filtered, record));
   summary.triangulation = record.summary;
   summary.units = record.units;
   summary.views = static_cast<int64_t>(view_to_camera.size());

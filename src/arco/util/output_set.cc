@@ -106,6 +106,7 @@ OutputSet::~OutputSet() {
   if (done_) return;
   std::error_code ec;
   for (const Output& o : outputs_) {
+    if (o.removal) continue;
     fs::remove_all(o.tmp, ec);
     UntrackTemporary(o.tmp);
   }
@@ -215,6 +216,21 @@ StatusOr<std::string> OutputSet::AddFolder(const std::string& given, const Folde
   return o.tmp;
 }
 
+Status OutputSet::AddRemoval(const std::string& given) {
+  const std::string path = NormalizeOutputPath(given);
+  if (path.empty() || path == "/") return Status::Error("'" + given + "': cannot be removed");
+  for (const Output& o : outputs_) {
+    if (o.path == path) return Status::Error(path + ": given for two outputs");
+  }
+  std::error_code ec;
+  const fs::file_status st = fs::symlink_status(path, ec);
+  Output o{path, "", HiddenSibling(path, "old"), fs::is_directory(st)};
+  o.removal = true;
+  RemoveStaleTemporaries(path);
+  outputs_.push_back(o);
+  return Status::Ok();
+}
+
 Status OutputSet::Commit() {
   if (done_) return Status::Error("output set committed twice");
   done_ = true;
@@ -223,7 +239,9 @@ Status OutputSet::Commit() {
   struct Untrack {
     const std::vector<Output>& outputs;
     ~Untrack() {
-      for (const Output& o : outputs) UntrackTemporary(o.tmp);
+      for (const Output& o : outputs) {
+        if (!o.removal) UntrackTemporary(o.tmp);
+      }
     }
   } untrack{outputs_};
   const std::unique_lock<std::mutex> no_interrupt = HoldOffInterrupts();
@@ -236,7 +254,9 @@ Status OutputSet::Commit() {
       fs::remove_all(outputs_[k].path, ignored);
       if (had_old[k]) fs::rename(outputs_[k].old, outputs_[k].path, ignored);
     }
-    for (const Output& o : outputs_) fs::remove_all(o.tmp, ignored);
+    for (const Output& o : outputs_) {
+      if (!o.removal) fs::remove_all(o.tmp, ignored);
+    }
   };
   for (size_t i = 0; i < outputs_.size(); ++i) {
     const Output& o = outputs_[i];
@@ -251,6 +271,7 @@ Status OutputSet::Commit() {
       }
       had_old[i] = true;
     }
+    if (o.removal) continue;
     fs::rename(o.tmp, o.path, ec);
     if (ec) {
       const std::string why = ec.message();

@@ -49,6 +49,11 @@ class OutputSet {
   // parents are created. An existing folder that is empty is replaced; a non-empty one
   // only with `replace.overwrite` and, when `replace.marker` is set, when it holds it.
   StatusOr<std::string> AddFolder(const std::string& path, const FolderReplace& replace);
+  // Declares that the file or folder `path` goes with this set: at Commit it is moved
+  // aside like a replaced output and deleted once every output is in (put back if a move
+  // fails), so a result never shows new outputs beside stale ones made from the old
+  // (a re-run stage and the later stages it invalidates). Absent: nothing to do.
+  Status AddRemoval(const std::string& path);
 
   // Moves every declared output into place, in order: an existing one is renamed aside
   // to a hidden sibling, the new one moved in, and the old ones deleted only once all are
@@ -63,6 +68,7 @@ class OutputSet {
   struct Output {
     std::string path, tmp, old;
     bool folder = false;
+    bool removal = false;  // AddRemoval: no temporary; the old one goes
   };
   std::vector<Output> outputs_;
   bool done_ = false;

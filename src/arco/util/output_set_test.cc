@@ -225,6 +225,40 @@ TEST(OutputSet, CommitWritesEveryOutput) {
   EXPECT_EQ(Entries(tmp.path()), (std::set<std::string>{"a.csv", "sub"}));
 }
 
+TEST(OutputSet, RemovalsGoWithTheCommit) {
+  testing::TempDir tmp;
+  ASSERT_TRUE(MakeDirectories(tmp / "later").ok());
+  ASSERT_TRUE(AtomicWriteFile(tmp / "later/x", "stale").ok());
+  ASSERT_TRUE(AtomicWriteFile(tmp / "notes.csv", "stale").ok());
+  OutputSet outputs;
+  auto a = outputs.AddFile(tmp / "a.csv");
+  ASSERT_TRUE(a.ok());
+  ASSERT_TRUE(outputs.AddRemoval(tmp / "later/").ok());
+  ASSERT_TRUE(outputs.AddRemoval(tmp / "notes.csv").ok());
+  ASSERT_TRUE(outputs.AddRemoval(tmp / "never-there").ok());  // absent: nothing to do
+  EXPECT_FALSE(outputs.AddRemoval(tmp / "later").ok());       // the same output twice
+  EXPECT_FALSE(outputs.AddRemoval(tmp / "a.csv").ok());
+  ASSERT_TRUE(AtomicWriteFile(*a, "a").ok());
+  // Nothing goes before the commit.
+  EXPECT_EQ(Read(tmp / "later/x"), "stale");
+  ASSERT_TRUE(outputs.Commit().ok());
+  EXPECT_EQ(Entries(tmp.path()), (std::set<std::string>{"a.csv"}));
+}
+
+TEST(OutputSet, AFailedMovePutsTheRemovalsBack) {
+  testing::TempDir tmp;
+  ASSERT_TRUE(MakeDirectories(tmp / "later").ok());
+  ASSERT_TRUE(AtomicWriteFile(tmp / "later/x", "stale").ok());
+  OutputSet outputs;
+  ASSERT_TRUE(outputs.AddRemoval(tmp / "later").ok());
+  auto b = outputs.AddFolder(tmp / "b", FolderReplace{});
+  ASSERT_TRUE(b.ok());
+  fs::remove_all(*b);  // the move of b will fail, after the removal was moved aside
+  EXPECT_FALSE(outputs.Commit().ok());
+  EXPECT_EQ(Read(tmp / "later/x"), "stale");
+  EXPECT_EQ(Entries(tmp.path()), (std::set<std::string>{"later"}));
+}
+
 // A pid no process has: a child that has exited and been reaped.
 long DeadPid() {
   const pid_t child = ::fork();

@@ -44,6 +44,9 @@ for x in c["cameras"]:
         x["rotate_deg"] = 90
 json.dump(c, open(path, "w"), indent=1)
 PY
+# The capture changed: its result is made again (a result is tied to its capture's files).
+"$arco" run "$tmp/cap" -o "$tmp/res" --overwrite >/dev/null 2>&1 ||
+  { echo "FAILED: run again after editing capture.json"; exit 1; }
 result_before=$(SNAPSHOT_DIR=$tmp/res snapshot)
 cache=$tmp/cache
 video=video_$("$py" -c "import json,sys; print([x['name'] for x in json.load(open(sys.argv[1]))['cameras']].index(sys.argv[2]))" \

@@ -45,6 +45,9 @@ for x in c["cameras"]:
         x["rotate_deg"] = 90
 json.dump(c, open(path, "w"), indent=1)
 PY
+# The capture changed: its result is made again (a result is tied to its capture's files).
+"$arco" run "$work/cap" -o "$work/res" --overwrite >/dev/null 2>&1 ||
+  { echo "FAILED: run again after editing capture.json"; exit 1; }
 
 fail=0
 bad() {  # bad NAME PATTERN ARGS...

@@ -1,10 +1,13 @@
 """arco.read_result on a real `arco run` output."""
 import json
+import re
+import shutil
 
 import numpy as np
 import pytest
 
 import arco
+from conftest import run_arco
 
 
 def test_read_result(result):
@@ -56,3 +59,19 @@ def test_bad_folders(tmp_path):
     (tmp_path / "result.json").write_text("[1, 2")
     with pytest.raises(RuntimeError, match="result.json"):
         arco.read_result(tmp_path)
+
+
+def test_a_result_whose_capture_changed_is_refused(arco_bin, capture, tmp_path):
+    """docs/architecture.md, "Results are tied to their inputs": read_result re-hashes the
+    capture files the result was made from, like every `arco` reader."""
+    shutil.copytree(capture, tmp_path / "cap")
+    p = run_arco(arco_bin, "triangulate", tmp_path / "cap", "-o", tmp_path / "res", "--threads", 2)
+    assert p.returncode == 0, p.stderr
+    assert set(arco.read_result(tmp_path / "res")["points3d"]) == {"triangulation"}
+    npy = tmp_path / "cap" / "keypoints2d.npy"
+    data = bytearray(npy.read_bytes())
+    data[-1] ^= 1
+    npy.write_bytes(bytes(data))
+    with pytest.raises(RuntimeError, match=re.escape(
+            f"{npy} changed since the result {tmp_path / 'res'} was made (re-run `arco run`)")):
+        arco.read_result(tmp_path / "res")
