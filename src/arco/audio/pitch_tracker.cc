@@ -1,5 +1,7 @@
 #include "arco/audio/pitch_tracker.h"
 
+#include "arco/util/csv.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -192,28 +194,28 @@ Status WritePitchCsv(const std::string& path, const std::vector<PitchFrame>& fra
 }
 
 StatusOr<std::vector<PitchFrame>> ReadPitchCsv(const std::string& path) {
-  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
-  std::istringstream in(text);
-  std::string line;
-  if (!std::getline(in, line) || line.rfind("frame,time_s,f0_hz,confidence,voiced", 0) != 0) {
-    return Status::Error(path + ": not a pitch.csv (bad header)");
-  }
+  ARCO_ASSIGN_OR_RETURN(
+      const CsvTable table,
+      ReadCsvTable(path,
+                   {"frame", "time_s", "f0_hz", "confidence", "voiced"},
+                   "frame,time_s,f0_hz,confidence,voiced"));
+  const int frame_col = table.Column("frame"), time_col = table.Column("time_s"),
+            f0_col = table.Column("f0_hz"), confidence_col = table.Column("confidence"),
+            voiced_col = table.Column("voiced");
   std::vector<PitchFrame> frames;
-  int line_number = 1;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (line.empty()) continue;
+  for (const CsvTable::Row& row : table.rows) {
     PitchFrame f;
-    long long frame = 0;
-    int voiced = 0;
-    if (std::sscanf(line.c_str(),
-                    "%lld,%lf,%lf,%lf,%d",
-                    &frame,
-                    &f.time_s,
-                    &f.f0_hz,
-                    &f.confidence,
-                    &voiced) != 5) {
-      return Status::Error(path + ": line " + std::to_string(line_number) + ": malformed row");
+    int64_t frame = 0, voiced = 0;
+    // Every cell a finite number: an empty cell would read as NaN, a value this format
+    // never writes.
+    if (!ParseCsvInt(row.cells[frame_col], &frame) ||
+        !ParseCsvDouble(row.cells[time_col], &f.time_s) || !std::isfinite(f.time_s) ||
+        !ParseCsvDouble(row.cells[f0_col], &f.f0_hz) || !std::isfinite(f.f0_hz) ||
+        !ParseCsvDouble(row.cells[confidence_col], &f.confidence) ||
+        !std::isfinite(f.confidence) || !ParseCsvInt(row.cells[voiced_col], &voiced) ||
+        (voiced != 0 && voiced != 1)) {
+      return Status::Error(table.Where(row) + "malformed row (frame, time_s, f0_hz, confidence: "
+                                              "numbers; voiced: 0 or 1)");
     }
     f.frame = frame;
     f.voiced = voiced != 0;
