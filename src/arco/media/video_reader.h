@@ -68,6 +68,11 @@ struct VideoProperties {
   double duration_s = 0;  // frame_count / fps (0 when the frame rate is unknown)
 };
 
+// Two frame rates are the same when within 0.1 % (29.97 vs 30000/1001 written rounded):
+// the one comparison of a rate the user gives with a container's (arco capture new,
+// arco sync), where a disagreement is an error, never a silent override.
+bool SameFrameRate(double a_hz, double b_hz);
+
 struct VideoReaderOptions {
   PixelFormat format = PixelFormat::kRgb8;
   // > 0: frames wider than this are scaled down to this width (area averaging), the
