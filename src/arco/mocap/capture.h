@@ -96,6 +96,9 @@ Status CheckCaptureHasKeypoints2d(const std::string& capture_dir, const CaptureM
 // the dtype: integer pixels are a writer's mistake, not converted) and its shape
 // (frames.count, cameras, layout size, 3).
 Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureManifest& manifest);
+// The dtype rule of 2D keypoints (a file's and the Python bindings' arrays): float32 or
+// float64; an error naming `source` and `dtype` otherwise.
+Status CheckKeypoints2dDtype(const std::string& source, const std::string& dtype, bool is_float);
 // Reads the 2D keypoints named by the manifest after CheckCaptureKeypoints2d. Frames a
 // camera dropped are set to NaN.
 StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,
