@@ -114,6 +114,8 @@ defect drops_twice; json drops_twice 'j["cameras"][0]["dropped_frames"] = [3, 3]
 every drops_twice "$tmp/drops_twice/$M" '"cameras[0].dropped_frames" lists frame 3 twice'
 defect offset_nan; sed -i 's/"offset_s": [0-9.]*/"offset_s": NaN/' "$tmp/offset_nan/$M"
 every offset_nan "$tmp/offset_nan/$M" '"audio.offset_s" is NaN'
+defect family; json family 'j["instrument"] = "violin"'
+every family "$tmp/family/$M" '"keypoints2d.layout" is "spd_cello", but "instrument" is "violin"'
 
 # The audio: run and pitch --capture (sync is given its audio on the command line).
 defect offset_far; json offset_far 'j["audio"]["offset_s"] = 99'

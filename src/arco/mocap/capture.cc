@@ -229,6 +229,19 @@ StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const st
     }
     const auto layout = m.Layout();
     if (!layout.ok()) return Status::Error(source + ": keypoints2d: " + layout.status().message());
+    // An SPD layout holds one instrument family's points: a violin capture with the
+    // cello's would run every stage and fail at the end naming a folder (issue 24).
+    std::string family = m.layout;
+    if (family.size() > 8 && family.compare(family.size() - 8, 8, "_contact") == 0)
+      family.resize(family.size() - 8);
+    if (family.rfind("spd_", 0) == 0 && m.instrument != "none") {
+      const StatusOr<std::string> wanted = DetectionLayoutName(m.instrument);
+      if (wanted.ok() && *wanted != family)
+        return fk.Bad("layout",
+                      "is \"" + m.layout + "\", but \"instrument\" is \"" + m.instrument +
+                          "\", whose points are " + *wanted +
+                          " (correct one of them)");
+    }
   }
   const Json* cams = f.Find("cameras");
   if (!cams || !cams->is_array() || cams->empty()) {
