@@ -44,9 +44,15 @@ Status PitchTrackerOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(CheckInRange("hops_per_frame", hops_per_frame, kHopsPerFrameRange));
   if (max_frames < -1) return Status::Error("max_frames must be >= -1");
   ARCO_RETURN_IF_ERROR(CheckInRange("a4_hz", a4_hz, kA4RangeHz));
-  if (!(range.min_f0_hz >= 20 && range.max_f0_hz > range.min_f0_hz &&
-        range.max_f0_hz <= range.analysis_rate_hz / 4.0)) {
-    return Status::Error("pitch range must satisfy 20 <= min < max <= analysis rate / 4");
+  // Named by the fields that override them (PitchRunOptions, `arco pitch --fmin/--fmax`).
+  const double top_hz = range.analysis_rate_hz / 4.0;
+  if (!(range.min_f0_hz >= 20 && range.min_f0_hz < range.max_f0_hz &&
+        range.max_f0_hz <= top_hz)) {
+    return Status::Error("min_f0_hz = " + NumberText(range.min_f0_hz) + " and max_f0_hz = " +
+                         NumberText(range.max_f0_hz) + " Hz must satisfy 20 <= min_f0_hz < " +
+                         "max_f0_hz <= " + NumberText(top_hz) + " (the " + range.name +
+                         "'s analysis rate " + std::to_string(range.analysis_rate_hz) +
+                         " Hz / 4)");
   }
   return Status::Ok();
 }

@@ -153,7 +153,7 @@ int RunImportKeypoints(const pipeline::ImportKeypointsOptions& o) {
       static_cast<long long>(r->report.frames_without_person),
       static_cast<long long>(r->report.frames_with_several),
       o.capture_dir.c_str());
-  for (const std::string& w : r->warnings) std::printf("warning: %s\n", w.c_str());
+  for (const std::string& w : r->warnings) PrintWarning(w);
   return 0;
 }
 

@@ -78,7 +78,7 @@ CommandRun Setup(CLI::App& app) {
         static_cast<long long>(r->files.files_missing),
         static_cast<long long>(r->files.frames_dropped),
         o->output_dir.c_str());
-    for (const std::string& w : r->warnings) std::printf("warning: %s\n", w.c_str());
+    for (const std::string& w : r->warnings) PrintWarning(w);
     return 0;
   }, paths);
 }

@@ -55,12 +55,13 @@ CommandRun SetupPitch(CLI::App& app) {
   AddNumber(cmd,
             "--fmin",
             o->min_f0_hz,
-            "Override the lowest f0 (Hz; 0 = the instrument's)",
+            "Override the lowest f0 (Hz; 0 = the instrument's; else >= 20 and below the highest)",
             audio::kF0OverrideRangeHz);
   AddNumber(cmd,
             "--fmax",
             o->max_f0_hz,
-            "Override the highest f0 (Hz; 0 = the instrument's)",
+            "Override the highest f0 (Hz; 0 = the instrument's; at most 4000 for cello and double "
+            "bass, 8000 for violin and viola: the analysis rate / 4)",
             audio::kF0OverrideRangeHz);
   AddNumber(cmd, "--a4", o->a4_hz, "Tuning reference A4 (Hz; default 440)", kA4RangeHz);
   cmd->add_option(
@@ -94,6 +95,7 @@ CommandRun SetupPitch(CLI::App& app) {
     bar.Finish();
     if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kPitchFlags));
     std::fputs(FormatPitchReport(*o, *result).c_str(), stdout);
+    for (const std::string& w : PitchWarnings(*result)) PrintWarning(w);
     return 0;
   }, paths);
 }

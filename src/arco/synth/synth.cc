@@ -22,6 +22,11 @@ Rigid RotationAbout(const Eigen::Matrix3d& r, const Eigen::Vector3d& pivot) {
 }  // namespace
 
 Status SynthOptions::Validate() const {
+  // The instrument is the user's option: checked here, before any file is read (the
+  // calibration is not to blame for it).
+  if (!ParseInstrumentKind(instrument).ok())
+    return Status::Error("instrument '" + instrument +
+                         "' is unknown (violin, viola, cello, double_bass)");
   if (!(fps >= 1 && fps <= 1000)) return Status::Error("fps must be in [1, 1000]");
   if (!(tempo_scale > 0.05 && tempo_scale < 20))
     return Status::Error("tempo scale must be in (0.05, 20)");
