@@ -1,7 +1,5 @@
 #include "arco/audio/notes.h"
 
-#include "arco/util/csv.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +7,7 @@
 #include <stdexcept>
 
 #include "arco/registry/instruments.h"
+#include "arco/util/csv.h"
 #include "arco/util/file_io.h"
 #include "arco/util/stats.h"
 

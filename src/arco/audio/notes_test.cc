@@ -167,13 +167,13 @@ TEST(ReadNotesCsv, MalformedFilesNameTheFileAndLine) {
     EXPECT_EQ(r.status().message().rfind(path + ":2: ", 0), 0u) << r.status().message();
   }
   // A row cut short is refused as pitch.csv's are, though the cells read back are there.
-  ASSERT_TRUE(AtomicWriteFile(path, header + "note,0.5,0.6,220,57,A3,0,0,0,,\nnote,1.0,1.5,220\n")
-                  .ok());
+  ASSERT_TRUE(
+      AtomicWriteFile(path, header + "note,0.5,0.6,220,57,A3,0,0,0,,\nnote,1.0,1.5,220\n").ok());
   const auto cut = ReadNotesCsv(path);
   ASSERT_FALSE(cut.ok());
   EXPECT_EQ(cut.status().message(), path + ":3: expected 11 fields (as the header), found 4");
-  ASSERT_TRUE(AtomicWriteFile(path,
-                              header + "note,1.0,1.2,220,57,A3,0,0,0,,\nnote,0.5,0.6,220,57,A3,0,0,0,,\n")
+  ASSERT_TRUE(AtomicWriteFile(
+                  path, header + "note,1.0,1.2,220,57,A3,0,0,0,,\nnote,0.5,0.6,220,57,A3,0,0,0,,\n")
                   .ok());
   EXPECT_FALSE(ReadNotesCsv(path).ok());  // onsets out of order
 }

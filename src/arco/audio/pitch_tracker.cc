@@ -1,7 +1,5 @@
 #include "arco/audio/pitch_tracker.h"
 
-#include "arco/util/csv.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +8,7 @@
 
 #include "arco/audio/sample_stream.h"
 #include "arco/registry/instruments.h"
+#include "arco/util/csv.h"
 #include "arco/util/file_io.h"
 
 namespace arco::audio {
@@ -46,13 +45,11 @@ Status PitchTrackerOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(CheckInRange("a4_hz", a4_hz, kA4RangeHz));
   // Named by the fields that override them (PitchRunOptions, `arco pitch --fmin/--fmax`).
   const double top_hz = range.analysis_rate_hz / 4.0;
-  if (!(range.min_f0_hz >= 20 && range.min_f0_hz < range.max_f0_hz &&
-        range.max_f0_hz <= top_hz)) {
+  if (!(range.min_f0_hz >= 20 && range.min_f0_hz < range.max_f0_hz && range.max_f0_hz <= top_hz)) {
     return Status::Error("min_f0_hz = " + NumberText(range.min_f0_hz) + " and max_f0_hz = " +
                          NumberText(range.max_f0_hz) + " Hz must satisfy 20 <= min_f0_hz < " +
                          "max_f0_hz <= " + NumberText(top_hz) + " (the " + range.name +
-                         "'s analysis rate " + std::to_string(range.analysis_rate_hz) +
-                         " Hz / 4)");
+                         "'s analysis rate " + std::to_string(range.analysis_rate_hz) + " Hz / 4)");
   }
   return Status::Ok();
 }
@@ -200,11 +197,10 @@ Status WritePitchCsv(const std::string& path, const std::vector<PitchFrame>& fra
 }
 
 StatusOr<std::vector<PitchFrame>> ReadPitchCsv(const std::string& path) {
-  ARCO_ASSIGN_OR_RETURN(
-      const CsvTable table,
-      ReadCsvTable(path,
-                   {"frame", "time_s", "f0_hz", "confidence", "voiced"},
-                   "frame,time_s,f0_hz,confidence,voiced"));
+  ARCO_ASSIGN_OR_RETURN(const CsvTable table,
+                        ReadCsvTable(path,
+                                     {"frame", "time_s", "f0_hz", "confidence", "voiced"},
+                                     "frame,time_s,f0_hz,confidence,voiced"));
   const int frame_col = table.Column("frame"), time_col = table.Column("time_s"),
             f0_col = table.Column("f0_hz"), confidence_col = table.Column("confidence"),
             voiced_col = table.Column("voiced");
@@ -217,11 +213,11 @@ StatusOr<std::vector<PitchFrame>> ReadPitchCsv(const std::string& path) {
     if (!ParseCsvInt(row.cells[frame_col], &frame) ||
         !ParseCsvDouble(row.cells[time_col], &f.time_s) || !std::isfinite(f.time_s) ||
         !ParseCsvDouble(row.cells[f0_col], &f.f0_hz) || !std::isfinite(f.f0_hz) ||
-        !ParseCsvDouble(row.cells[confidence_col], &f.confidence) ||
-        !std::isfinite(f.confidence) || !ParseCsvInt(row.cells[voiced_col], &voiced) ||
-        (voiced != 0 && voiced != 1)) {
-      return Status::Error(table.Where(row) + "malformed row (frame, time_s, f0_hz, confidence: "
-                                              "numbers; voiced: 0 or 1)");
+        !ParseCsvDouble(row.cells[confidence_col], &f.confidence) || !std::isfinite(f.confidence) ||
+        !ParseCsvInt(row.cells[voiced_col], &voiced) || (voiced != 0 && voiced != 1)) {
+      return Status::Error(table.Where(row) +
+                           "malformed row (frame, time_s, f0_hz, confidence: "
+                           "numbers; voiced: 0 or 1)");
     }
     f.frame = frame;
     f.voiced = voiced != 0;

@@ -452,17 +452,21 @@ CommandRun SetupCalibrate(CLI::App& app) {
     }
     return roles;
   };
-  return CommandRun([a, c, r, json, check, refine] {
-    if (check->parsed()) return RunCheck(*c, *json);
-    if (refine->parsed()) return RunRefine(*r);
-    ProgressBar bar("calibrate");
-    auto result = calibration::RunCalibrate(a->options, bar);
-    bar.Finish();
-    if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kCalibrateFlags));
-    std::fputs(FormatReport(*result, a->options.output).c_str(), stdout);
-    for (const auto& w : result->calibration.report.warnings) PrintWarning(w.code + ": " + w.message);
-    return 0;
-  }, paths);
+  return CommandRun(
+      [a, c, r, json, check, refine] {
+        if (check->parsed()) return RunCheck(*c, *json);
+        if (refine->parsed()) return RunRefine(*r);
+        ProgressBar bar("calibrate");
+        auto result = calibration::RunCalibrate(a->options, bar);
+        bar.Finish();
+        if (!result.ok())
+          return PrintError(WithFlagNames(result.status().message(), kCalibrateFlags));
+        std::fputs(FormatReport(*result, a->options.output).c_str(), stdout);
+        for (const auto& w : result->calibration.report.warnings)
+          PrintWarning(w.code + ": " + w.message);
+        return 0;
+      },
+      paths);
 }
 
 }  // namespace

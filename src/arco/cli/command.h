@@ -3,13 +3,12 @@
 // into a typed struct and calls a library/run function that tests call directly.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 #include "arco/util/path_roles.h"
 

@@ -89,15 +89,17 @@ CommandRun SetupPitch(CLI::App& app) {
     roles.AddOutput("--midi", o->midi_output);
     return roles;
   };
-  return CommandRun([o] {
-    ProgressBar bar("pitch");  // the bar starts at TrackPitch's SetTotal
-    auto result = pipeline::RunPitch(*o, bar);
-    bar.Finish();
-    if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kPitchFlags));
-    std::fputs(FormatPitchReport(*o, *result).c_str(), stdout);
-    for (const std::string& w : PitchWarnings(*result)) PrintWarning(w);
-    return 0;
-  }, paths);
+  return CommandRun(
+      [o] {
+        ProgressBar bar("pitch");  // the bar starts at TrackPitch's SetTotal
+        auto result = pipeline::RunPitch(*o, bar);
+        bar.Finish();
+        if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kPitchFlags));
+        std::fputs(FormatPitchReport(*o, *result).c_str(), stdout);
+        for (const std::string& w : PitchWarnings(*result)) PrintWarning(w);
+        return 0;
+      },
+      paths);
 }
 
 }  // namespace

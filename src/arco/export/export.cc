@@ -58,7 +58,8 @@ Status ExportOptions::Validate() const {
   if (!ParseExportFormat(format).ok()) {
     return Status::Error("format: '" + format + "' is not csv, trc, c3d, gltf (glb) or bvh");
   }
-  if (!output.empty()) ARCO_RETURN_IF_ERROR(CheckExportExtension(*ParseExportFormat(format), output));
+  if (!output.empty())
+    ARCO_RETURN_IF_ERROR(CheckExportExtension(*ParseExportFormat(format), output));
   bool known = false;
   for (const auto& m : ExportMethodNames()) known = known || m == method;
   if (!known) {
@@ -71,9 +72,9 @@ Status CheckExportExtension(ExportFormat format, const std::string& output) {
   const std::string wanted = format == ExportFormat::kGltf ? "glb" : ExportFormatName(format);
   const size_t slash = output.find_last_of('/');
   const size_t dot = output.find_last_of('.');
-  std::string extension =
-      dot == std::string::npos || (slash != std::string::npos && dot < slash) ? ""
-                                                                              : output.substr(dot + 1);
+  std::string extension = dot == std::string::npos || (slash != std::string::npos && dot < slash)
+                              ? ""
+                              : output.substr(dot + 1);
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (extension == wanted) return Status::Ok();
   return Status::Error(output + ": a " + ExportFormatName(format) + " export is named ." + wanted +
@@ -174,8 +175,8 @@ StatusOr<ExportData> LoadExportData(const ExportOptions& options) {
     data.instrument = inst.instrument;
     const auto& s = inst.strings_mm.shape;
     if (s.size() == 4 && s[0] == shape[0] && s[2] == 2 && s[3] == 3) {
-      ARCO_RETURN_IF_ERROR(CheckCoordinates(
-          inst.strings_mm.data, folder.InstrumentStringsPath(), [&](int64_t i) {
+      ARCO_RETURN_IF_ERROR(
+          CheckCoordinates(inst.strings_mm.data, folder.InstrumentStringsPath(), [&](int64_t i) {
             return "frame " + std::to_string(data.frame_first + i / (s[1] * 2)) + " string " +
                    std::to_string(i / 2 % s[1] + 1);
           }));

@@ -2,9 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include <array>
-
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>

@@ -60,7 +60,7 @@ struct VideoProperties {
   // pictures, which may be fewer).
   int64_t frame_count = 0;
   FrameCountSource frame_count_source = FrameCountSource::kContainer;
-  int width = 0, height = 0;  // of the frames Read returns (after max_width scaling)
+  int width = 0, height = 0;              // of the frames Read returns (after max_width scaling)
   int coded_width = 0, coded_height = 0;  // as stored in the file
   // Clockwise rotation a player applies for display (from the stream's display
   // matrix side data, rounded to a multiple of 90): 0, 90, 180 or 270.

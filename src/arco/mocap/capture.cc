@@ -239,8 +239,7 @@ StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const st
       if (wanted.ok() && *wanted != family)
         return fk.Bad("layout",
                       "is \"" + m.layout + "\", but \"instrument\" is \"" + m.instrument +
-                          "\", whose points are " + *wanted +
-                          " (correct one of them)");
+                          "\", whose points are " + *wanted + " (correct one of them)");
     }
   }
   const Json* cams = f.Find("cameras");

@@ -54,9 +54,9 @@ struct CaptureManifest {
   std::string calibration;      // calibration file (any format arco reads)
   std::string audio;            // optional audio file
   double audio_offset_s = 0.0;  // audio time of frame `frame_first`'s timestamp (mid-exposure)
-  double audio_sync_confidence = NAN;  // arco sync's confidence in audio_offset_s (NaN: none)
-  std::string keypoints2d;      // optional .npy of 2D keypoints
-  std::string layout;           // keypoint layout name, or "custom" with keypoint_names
+  double audio_sync_confidence = NAN;       // arco sync's confidence in audio_offset_s (NaN: none)
+  std::string keypoints2d;                  // optional .npy of 2D keypoints
+  std::string layout;                       // keypoint layout name, or "custom" with keypoint_names
   std::vector<std::string> keypoint_names;  // only for layout "custom"
   std::vector<CaptureCamera> cameras;
 

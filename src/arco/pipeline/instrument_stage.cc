@@ -23,9 +23,10 @@ Status InstrumentStageOptions::Validate() const {
 
 Json ToJson(const InstrumentStageOptions& o) {
   const InstrumentFitOptions& f = o.fit;
-  const char* scale = f.scale == InstrumentFitOptions::Scale::kFromStringLength ? "from_string_length"
+  const char* scale = f.scale == InstrumentFitOptions::Scale::kFromStringLength
+                          ? "from_string_length"
                       : f.scale == InstrumentFitOptions::Scale::kWorldIsMillimetres ? "world_is_mm"
-                                                                                 : "given";
+                                                                                    : "given";
   return {{"fit",
            {{"scale", scale},
             {"world_units_per_mm", f.world_units_per_mm},

@@ -92,8 +92,7 @@ StatusOr<std::vector<refine::NoteFingering>> ResultFolder::ReadFingering(
   // note_name is derived from midi_note; every other column is read.
   for (const std::string& w : SplitCsvLine(kFingeringCsvHeader))
     if (w != "note_name") required.push_back(w);
-  ARCO_ASSIGN_OR_RETURN(const CsvTable table,
-                        ReadCsvTable(path, required, kFingeringCsvHeader));
+  ARCO_ASSIGN_OR_RETURN(const CsvTable table, ReadCsvTable(path, required, kFingeringCsvHeader));
   for (const CsvTable::Row& row : table.rows) {
     const std::vector<std::string>& cells = row.cells;
     const std::string where = table.Where(row);

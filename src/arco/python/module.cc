@@ -377,8 +377,8 @@ py::dict TrackPitch(const py::array_t<float, py::array::c_style | py::array::for
   CheckValid(CheckInRange("fps", fps, audio::kTrackerFpsRange));
   CheckValid(CheckInRange("start_s", start_s, audio::kTrackerStartRangeS));
   CheckValid(CheckInRange("a4_hz", a4_hz, kA4RangeHz));
-  CheckValid(audio::CheckSamples(
-      samples.data(), samples.size(), channels, 0, sample_rate, "samples"));
+  CheckValid(
+      audio::CheckSamples(samples.data(), samples.size(), channels, 0, sample_rate, "samples"));
   pipeline::PitchRunOptions o;
   o.instrument = instrument;
   o.fps = fps;

@@ -1,11 +1,10 @@
 #include "arco/synth/synth.h"
 
-#include "arco/registry/instruments.h"
-
 #include <algorithm>
 #include <cmath>
 
 #include "arco/hand/kinematics.h"
+#include "arco/registry/instruments.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/synth/midi_reader.h"
 #include "arco/synth/synth_instrument.h"
