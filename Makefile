@@ -9,13 +9,21 @@ CMAKE_GEN := -G Ninja
 
 .PHONY: setup setup-demo build build-arco build-bench test test-unit test-asan test-fuzz fuzz-long demo bench package format clean
 
+# scripts/setup touches this stamp whenever it installed something; the configure step
+# runs again when the stamp is newer, so a package installed after the build was
+# configured (pybind11 by `make test` after `make demo`) is found, not silently missing.
+SETUP_STAMP := $(BUILD)/.setup-stamp
+
 setup:
-	@bash scripts/setup
+	@ARCO_SETUP_STAMP=$(SETUP_STAMP) bash scripts/setup
 
 setup-demo:
-	@bash scripts/setup demo
+	@ARCO_SETUP_STAMP=$(SETUP_STAMP) bash scripts/setup demo
 
-$(BUILD)/build.ninja:
+$(SETUP_STAMP):
+	@mkdir -p $(BUILD) && touch $@
+
+$(BUILD)/build.ninja: $(SETUP_STAMP)
 	cmake -S . -B $(BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release
 
 # Everything: libraries, `arco`, unit tests, benchmarks.
@@ -30,7 +38,7 @@ build-bench: setup $(BUILD)/build.ninja
 	cmake --build $(BUILD) -j $(JOBS) --target arco benchmarks
 
 test-unit: build
-	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+	cd $(BUILD) && ARCO_REQUIRE_PYTHON_MODULE=1 ctest --output-on-failure -j $(JOBS)
 
 # AddressSanitizer + UndefinedBehaviorSanitizer build (clang) of the unit tests and the
 # libFuzzer harnesses: one build serves both (scripts/configure-sanitized says why).

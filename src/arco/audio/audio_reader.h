@@ -36,6 +36,18 @@ struct AudioInfo {
 // Every command that decodes audio reports it through this one function.
 std::string TruncationWarning(const AudioInfo& info, int64_t delivered = -1);
 
+// The one check of decoded samples, used by every reader and by the Python bindings'
+// samples: each finite and within +-1e6 (float files hold about +-1). A NaN or an infinity
+// would poison every FFT downstream, and replacing it would hide a broken file, so it is
+// an error: "SOURCE: sample N (T s) is nan; ...". `values` are `channels` interleaved
+// values per sample, the first of them sample `first_sample`.
+Status CheckSamples(const float* values,
+                    int64_t count,
+                    int channels,
+                    int64_t first_sample,
+                    int rate_hz,
+                    const std::string& source);
+
 class AudioReader {
  public:
   virtual ~AudioReader() = default;

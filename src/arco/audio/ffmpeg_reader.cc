@@ -132,9 +132,9 @@ class FfmpegReader : public AudioReader {
                                 frame_->nb_samples);
     if (got < 0) return Status::Error(name_ + ": sample conversion failed");
     pending_.resize(static_cast<size_t>(got));
-    for (float& v : pending_) {
-      if (!(v == v) || v > 1e6f || v < -1e6f) v = 0.0f;
-    }
+    ARCO_RETURN_IF_ERROR(
+        CheckSamples(pending_.data(), got, 1, converted_, info_.sample_rate_hz, name_));
+    converted_ += got;
     pending_pos_ = 0;
     return Status::Ok();
   }
@@ -190,12 +190,36 @@ class FfmpegReader : public AudioReader {
   bool finished_ = false;
   std::vector<float> pending_;
   size_t pending_pos_ = 0;
+  int64_t converted_ = 0;  // samples converted so far (the index of pending_[0])
 };
 
 }  // namespace
 
 StatusOr<std::unique_ptr<AudioReader>> OpenAudioWithFfmpeg(const std::string& path) {
   return FfmpegReader::Open(path);
+}
+
+Status CheckSamples(const float* values,
+                    int64_t count,
+                    int channels,
+                    int64_t first_sample,
+                    int rate_hz,
+                    const std::string& source) {
+  for (int64_t i = 0; i < count; ++i) {
+    const float v = values[i];
+    if (v >= -1e6f && v <= 1e6f) continue;  // false for NaN
+    const int64_t sample = first_sample + i / std::max(channels, 1);
+    char text[160];
+    std::snprintf(text,
+                  sizeof(text),
+                  ": sample %lld (%.4f s) is %g; audio samples must be finite (a float "
+                  "recording holds about -1..1)",
+                  static_cast<long long>(sample),
+                  rate_hz > 0 ? static_cast<double>(sample) / rate_hz : 0.0,
+                  static_cast<double>(v));
+    return Status::Error(source + text);
+  }
+  return Status::Ok();
 }
 
 std::string TruncationWarning(const AudioInfo& info, int64_t delivered) {

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "arco/registry/instruments.h"
+#include "arco/util/csv.h"
 #include "arco/util/file_io.h"
 #include "arco/util/stats.h"
 
@@ -290,27 +291,27 @@ Status WriteNotesCsv(const std::string& path, const NoteAnalysis& analysis) {
 }
 
 StatusOr<std::vector<Note>> ReadNotesCsv(const std::string& path) {
-  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
-  // The columns read back: kind, onset_s, offset_s, median_f0_hz.
-  const std::string required(kNotesCsvHeader,
-                             std::string(kNotesCsvHeader).find(",midi_note"));
-  std::istringstream in(text);
-  std::string line;
-  if (!std::getline(in, line) || line.rfind(required, 0) != 0) {
-    return Status::Error(path + ": not a notes.csv (bad header)");
-  }
+  // The columns read back: kind, onset_s, offset_s, median_f0_hz; every row must still have
+  // all of the header's cells (a row cut short is an error, as in pitch.csv).
+  ARCO_ASSIGN_OR_RETURN(
+      const CsvTable table,
+      ReadCsvTable(path, {"kind", "onset_s", "offset_s", "median_f0_hz"}, kNotesCsvHeader));
+  const int kind_col = table.Column("kind"), onset_col = table.Column("onset_s"),
+            offset_col = table.Column("offset_s"), f0_col = table.Column("median_f0_hz");
   std::vector<Note> notes;
-  int line_number = 1;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (line.empty() || line.rfind("note,", 0) != 0) continue;
+  for (const CsvTable::Row& row : table.rows) {
+    const std::string& kind = row.cells[kind_col];
+    if (kind == "glide") continue;
+    if (kind != "note")
+      return Status::Error(table.Where(row) + "kind '" + kind + "' is neither note nor glide");
     Note n;
-    if (std::sscanf(line.c_str(), "note,%lf,%lf,%lf", &n.onset_s, &n.offset_s, &n.median_f0_hz) !=
-            3 ||
+    if (!ParseCsvDouble(row.cells[onset_col], &n.onset_s) ||
+        !ParseCsvDouble(row.cells[offset_col], &n.offset_s) ||
+        !ParseCsvDouble(row.cells[f0_col], &n.median_f0_hz) ||
         !(std::isfinite(n.onset_s) && std::isfinite(n.offset_s) && n.offset_s >= n.onset_s &&
           n.median_f0_hz > 0 && std::isfinite(n.median_f0_hz)) ||
         (!notes.empty() && n.onset_s < notes.back().onset_s)) {
-      return Status::Error(path + ": line " + std::to_string(line_number) + ": malformed note row");
+      return Status::Error(table.Where(row) + "malformed note row");
     }
     notes.push_back(n);
   }

@@ -8,6 +8,7 @@
 
 #include "arco/audio/sample_stream.h"
 #include "arco/registry/instruments.h"
+#include "arco/util/csv.h"
 #include "arco/util/file_io.h"
 
 namespace arco::audio {
@@ -42,9 +43,13 @@ Status PitchTrackerOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(CheckInRange("hops_per_frame", hops_per_frame, kHopsPerFrameRange));
   if (max_frames < -1) return Status::Error("max_frames must be >= -1");
   ARCO_RETURN_IF_ERROR(CheckInRange("a4_hz", a4_hz, kA4RangeHz));
-  if (!(range.min_f0_hz >= 20 && range.max_f0_hz > range.min_f0_hz &&
-        range.max_f0_hz <= range.analysis_rate_hz / 4.0)) {
-    return Status::Error("pitch range must satisfy 20 <= min < max <= analysis rate / 4");
+  // Named by the fields that override them (PitchRunOptions, `arco pitch --fmin/--fmax`).
+  const double top_hz = range.analysis_rate_hz / 4.0;
+  if (!(range.min_f0_hz >= 20 && range.min_f0_hz < range.max_f0_hz && range.max_f0_hz <= top_hz)) {
+    return Status::Error("min_f0_hz = " + NumberText(range.min_f0_hz) + " and max_f0_hz = " +
+                         NumberText(range.max_f0_hz) + " Hz must satisfy 20 <= min_f0_hz < " +
+                         "max_f0_hz <= " + NumberText(top_hz) + " (the " + range.name +
+                         "'s analysis rate " + std::to_string(range.analysis_rate_hz) + " Hz / 4)");
   }
   return Status::Ok();
 }
@@ -192,28 +197,27 @@ Status WritePitchCsv(const std::string& path, const std::vector<PitchFrame>& fra
 }
 
 StatusOr<std::vector<PitchFrame>> ReadPitchCsv(const std::string& path) {
-  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
-  std::istringstream in(text);
-  std::string line;
-  if (!std::getline(in, line) || line.rfind("frame,time_s,f0_hz,confidence,voiced", 0) != 0) {
-    return Status::Error(path + ": not a pitch.csv (bad header)");
-  }
+  ARCO_ASSIGN_OR_RETURN(const CsvTable table,
+                        ReadCsvTable(path,
+                                     {"frame", "time_s", "f0_hz", "confidence", "voiced"},
+                                     "frame,time_s,f0_hz,confidence,voiced"));
+  const int frame_col = table.Column("frame"), time_col = table.Column("time_s"),
+            f0_col = table.Column("f0_hz"), confidence_col = table.Column("confidence"),
+            voiced_col = table.Column("voiced");
   std::vector<PitchFrame> frames;
-  int line_number = 1;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (line.empty()) continue;
+  for (const CsvTable::Row& row : table.rows) {
     PitchFrame f;
-    long long frame = 0;
-    int voiced = 0;
-    if (std::sscanf(line.c_str(),
-                    "%lld,%lf,%lf,%lf,%d",
-                    &frame,
-                    &f.time_s,
-                    &f.f0_hz,
-                    &f.confidence,
-                    &voiced) != 5) {
-      return Status::Error(path + ": line " + std::to_string(line_number) + ": malformed row");
+    int64_t frame = 0, voiced = 0;
+    // Every cell a finite number: an empty cell would read as NaN, a value this format
+    // never writes.
+    if (!ParseCsvInt(row.cells[frame_col], &frame) ||
+        !ParseCsvDouble(row.cells[time_col], &f.time_s) || !std::isfinite(f.time_s) ||
+        !ParseCsvDouble(row.cells[f0_col], &f.f0_hz) || !std::isfinite(f.f0_hz) ||
+        !ParseCsvDouble(row.cells[confidence_col], &f.confidence) || !std::isfinite(f.confidence) ||
+        !ParseCsvInt(row.cells[voiced_col], &voiced) || (voiced != 0 && voiced != 1)) {
+      return Status::Error(table.Where(row) +
+                           "malformed row (frame, time_s, f0_hz, confidence: "
+                           "numbers; voiced: 0 or 1)");
     }
     f.frame = frame;
     f.voiced = voiced != 0;

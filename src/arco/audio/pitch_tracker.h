@@ -38,8 +38,12 @@ inline constexpr NumberRange kTrackerFpsRange = AboveZero(1000);
 // The video may start at most an hour before the audio.
 inline constexpr NumberRange kTrackerStartRangeS = Closed(-3600, 1e6);
 inline constexpr NumberRange kHopsPerFrameRange = Closed(0, 100);
-// Overrides of an instrument's f0 limits: 0 keeps the instrument's; else within hearing.
-inline constexpr NumberRange kF0OverrideRangeHz = Closed(0, 20000);
+// Overrides of an instrument's f0 limits: 0 keeps the instrument's; else what the
+// tracker can analyse: at least 20 Hz, at most the analysis rate / 4, which is 8000 Hz for
+// the violin and viola (32 kHz) and 4000 Hz for the cello and double bass (16 kHz:
+// PitchTrackerOptions::Validate checks the instrument's). A test checks 8000 against the
+// registry.
+inline constexpr NumberRange kF0OverrideRangeHz = Closed(0, 8000);
 
 struct PitchTrackerOptions {
   InstrumentRange range;    // from InstrumentRangeByName

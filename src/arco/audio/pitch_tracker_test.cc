@@ -313,6 +313,21 @@ TEST(WritePitchCsv, RoundTrips) {
   EXPECT_FALSE((*back)[0].voiced);
 }
 
+TEST(ReadPitchCsv, MalformedRowsNameTheFileAndLine) {
+  const std::string path = testing::TempPath("bad_pitch.csv");
+  const std::string header = "frame,time_s,f0_hz,confidence,voiced\n";
+  for (const char* row : {"0,0.0,220\n",
+                          "0,0.0,220,0.9,1,7\n",
+                          "0,0.0,220,0.9,2\n",
+                          "0,,220,0.9,1\n",
+                          "0,0.0,220x,0.9,1\n"}) {
+    ASSERT_TRUE(AtomicWriteFile(path, header + "0,0.0,220,0.9,1\n" + row).ok());
+    const auto r = ReadPitchCsv(path);
+    ASSERT_FALSE(r.ok()) << row;
+    EXPECT_EQ(r.status().message().rfind(path + ":3: ", 0), 0u) << r.status().message();
+  }
+}
+
 }  // namespace
 }  // namespace arco::audio
 

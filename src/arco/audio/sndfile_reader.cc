@@ -159,16 +159,16 @@ class SndfileReader : public AudioReader {
         }
         break;
       }
+      ARCO_RETURN_IF_ERROR(CheckSamples(
+          interleaved_.data(), got * channels, channels, read_, info_.sample_rate_hz, name_));
       const float scale = 1.0f / static_cast<float>(channels);
       for (sf_count_t i = 0; i < got; ++i) {
         float sum = 0.0f;
         const float* frame = interleaved_.data() + i * channels;
         for (int c = 0; c < channels; ++c) sum += frame[c];
-        float v = sum * scale;
-        // Non-finite samples (float files) would poison every FFT downstream.
-        if (!(v == v) || v > 1e6f || v < -1e6f) v = 0.0f;
-        out[total + i] = v;
+        out[total + i] = sum * scale;
       }
+      read_ += got;
       total += got;
     }
     return total;
@@ -181,6 +181,7 @@ class SndfileReader : public AudioReader {
   std::string name_;
   std::vector<float> interleaved_;
   bool eof_ = false;
+  int64_t read_ = 0;  // samples read so far
 };
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "arco/audio/audio_reader.h"
 #include "arco/audio/sample_stream.h"
 #include "arco/media/video_reader.h"
+#include "arco/util/number_range.h"
 
 namespace arco::audio {
 namespace {
@@ -324,13 +325,33 @@ StatusOr<SyncEvent> FindVideoEventInEnergy(const MotionEnergy& motion,
   return event;
 }
 
+namespace {
+
+// The rate a video's events are timed at. video_fps is for image folders, which carry no
+// rate; a video's own rate wins, and one that disagrees would shift the offset without a
+// word (15 for a 30 fps video doubles every video time), so it is an error.
+StatusOr<double> EventFps(const MotionEnergy& motion,
+                          const SyncOptions& options,
+                          const std::string& path) {
+  if (options.video_fps > 0 && motion.fps > 0 &&
+      !media::SameFrameRate(options.video_fps, motion.fps)) {
+    return Status::Error(path + ": " + NumberText(motion.fps) +
+                         " fps in the container, but video_fps = " + NumberText(options.video_fps) +
+                         " (video_fps sets the rate of image folders only; leave it out)");
+  }
+  const double fps = options.video_fps > 0 ? options.video_fps : motion.fps;
+  if (!(fps > 0)) return Status::Error(path + ": unknown frame rate; set video_fps");
+  return fps;
+}
+
+}  // namespace
+
 StatusOr<SyncEvent> FindVideoEvent(const std::string& path,
                                    const SyncOptions& options,
                                    double* fps_out) {
   ARCO_RETURN_IF_ERROR(options.Validate());
   ARCO_ASSIGN_OR_RETURN(const MotionEnergy motion, ComputeMotionEnergy(path, options.max_seconds));
-  const double fps = options.video_fps > 0 ? options.video_fps : motion.fps;
-  if (!(fps > 0)) return Status::Error(path + ": unknown frame rate; set video_fps");
+  ARCO_ASSIGN_OR_RETURN(const double fps, EventFps(motion, options, path));
   if (fps_out != nullptr) *fps_out = fps;
   return FindVideoEventInEnergy(motion, fps, options, path);
 }
@@ -347,7 +368,14 @@ StatusOr<SyncResult> SyncAudioToVideos(const std::string& audio_path,
   for (const SyncView& view : views) {
     SyncViewResult v;
     v.video = view.video;
-    auto event = FindVideoEvent(view.video, options, &v.fps);
+    StatusOr<SyncEvent> event = Status::Error("not run");
+    if (auto motion = ComputeMotionEnergy(view.video, options.max_seconds); !motion.ok()) {
+      event = motion.status();
+    } else {
+      // A wrong frame rate is the options' error, not one view without an event.
+      ARCO_ASSIGN_OR_RETURN(v.fps, EventFps(*motion, options, view.video));
+      event = FindVideoEventInEnergy(*motion, v.fps, options, view.video);
+    }
     if (event.ok()) {
       v.event = *event;
       const double frame = v.event.time_s * v.fps;

@@ -372,6 +372,21 @@ TEST(SyncAudioToVideos, SeveralCamerasAgreeOnOneOffset) {
   ASSERT_FALSE(disagree.ok());
   EXPECT_NE(disagree.status().message().find("disagree"), std::string::npos)
       << disagree.status().message();
+  // A frame rate given for 30 fps videos: their own (within 0.1 %) is fine, another one
+  // would scale every video time, so it is an error naming the video (not a view left
+  // out).
+  views[1].global_frame = nullptr;
+  SyncOptions same;
+  same.video_fps = 30.01;
+  EXPECT_TRUE(SyncAudioToVideos(wav, views, same).ok());
+  SyncOptions half;
+  half.video_fps = 15;
+  auto wrong = SyncAudioToVideos(wav, views, half);
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_EQ(wrong.status().message(),
+            views[0].video +
+                ": 30 fps in the container, but video_fps = 15 (video_fps sets the rate of "
+                "image folders only; leave it out)");
 }
 
 TEST(SyncAudioToVideo, ConfidenceFallsAndWarnsWithAComparableSecondOnset) {

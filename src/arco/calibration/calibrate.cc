@@ -59,9 +59,34 @@ StatusOr<CalibrateResult> RunCalibrate(const CalibrateOptions& options, Progress
         "a rig calibration needs at least two cameras, got " +
         std::to_string(options.inputs.size()) +
         (options.inputs.size() == 1 ? " (" + options.inputs[0].camera + ")" : std::string()));
+  // Two cameras reading one source would calibrate as a zero-baseline rig that
+  // triangulates nothing: refused before the detection.
+  for (size_t a = 0; a < options.inputs.size(); ++a)
+    for (size_t b = a + 1; b < options.inputs.size(); ++b) {
+      std::error_code ec;
+      if (options.inputs[a].path == options.inputs[b].path ||
+          std::filesystem::equivalent(options.inputs[a].path, options.inputs[b].path, ec))
+        return Status::Error(options.inputs[b].path + ": cameras '" + options.inputs[a].camera +
+                             "' and '" + options.inputs[b].camera +
+                             "' are given the same video or image folder (each camera needs its "
+                             "own)");
+    }
   std::optional<Calibration> intrinsics;
   if (!options.intrinsics.empty()) {
     ARCO_ASSIGN_OR_RETURN(intrinsics, LoadCalibration(options.intrinsics));
+    // Intrinsics are matched by camera name; a file naming none of the cameras would be
+    // ignored without a word.
+    std::string given, wanted;
+    bool any = false;
+    for (const Camera& c : intrinsics->rig.cameras) given += (given.empty() ? "" : ", ") + c.name;
+    for (const CalibrateInput& input : options.inputs) {
+      wanted += (wanted.empty() ? "" : ", ") + input.camera;
+      any = any || intrinsics->rig.FindCamera(input.camera) >= 0;
+    }
+    if (!any)
+      return Status::Error(options.intrinsics + ": names none of the cameras being calibrated (" +
+                           wanted + "); it has " + given +
+                           " (intrinsics are matched by camera name)");
   }
 
   const int n = static_cast<int>(options.inputs.size());

@@ -647,6 +647,20 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
     result.rig.cameras.push_back(camera);
   }
 
+  // Two cameras in one place (the same video given twice, or copies of it) make a rig that
+  // triangulates nothing: an error, not a calibration. 1 % of a board square is far below
+  // any real baseline and far above the adjustment's noise on identical views.
+  for (int a = 0; a < num_cameras; ++a)
+    for (int b = a + 1; b < num_cameras; ++b) {
+      const double baseline_mm =
+          (result.rig.cameras[a].CenterInWorld() - result.rig.cameras[b].CenterInWorld()).norm();
+      if (!(baseline_mm >= 0.01 * board.square_mm))
+        return Status::Error("cameras " + cameras[a].camera + " (" + cameras[a].source + ") and " +
+                             cameras[b].camera + " (" + cameras[b].source + ") are " +
+                             NumberText(std::round(baseline_mm * 1000) / 1000) +
+                             " mm apart: a rig needs a baseline (the same video given twice?)");
+    }
+
   std::vector<std::vector<double>> errors(num_cameras);
   std::vector<int> views_used(num_cameras, 0);
   for (size_t f = 0; f < ba_frames.size(); ++f) {

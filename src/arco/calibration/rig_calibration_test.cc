@@ -407,6 +407,17 @@ TEST(CalibrateRig, ExpectedFailuresAreOneLine) {
   auto twice = synthetic.views;
   twice[1].camera = "cam0";
   EXPECT_FALSE(CalibrateRig(RigCalibrationOptions(), board, twice).ok());
+
+  // Two cameras with identical views (one video given twice under two names): a
+  // zero-baseline rig is an error, not a calibration that triangulates nothing.
+  auto copied = synthetic.views;
+  copied[2].views = copied[1].views;
+  auto zero = CalibrateRig(RigCalibrationOptions(), board, copied);
+  ASSERT_FALSE(zero.ok());
+  EXPECT_NE(zero.status().message().find("cameras cam1 (synthetic cam1) and cam2 (synthetic "
+                                         "cam2) are 0 mm apart: a rig needs a baseline"),
+            std::string::npos)
+      << zero.status().message();
 }
 
 TEST(CalibrateRig, InvalidOptionsAndInputsThrow) {
@@ -780,6 +791,34 @@ TEST(RunCalibrate, BadInputIsOneErrorAndNothingIsWritten) {
   auto r = RunCalibrate(txt);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.status().message().find("unknown calibration extension"), std::string::npos);
+  // The same image for two cameras, spelled alike or not.
+  options.inputs = {{"left", PairImage("left", 1)}, {"again", PairImage("left", 1)}};
+  EXPECT_EQ(run(options),
+            PairImage("left", 1) +
+                ": cameras 'left' and 'again' are given the same video or image folder (each "
+                "camera needs its own)");
+  options.inputs = {{"left", PairImage("left", 1)},
+                    {"again", std::string(kOpenCvData) + "./left01.jpg"}};
+  EXPECT_NE(run(options).find("are given the same video or image folder"), std::string::npos);
+  // Intrinsics naming none of the cameras.
+  Rig other;
+  other.units = "mm";
+  Camera cam;
+  cam.name = "cam9";
+  cam.width = 640;
+  cam.height = 480;
+  cam.fx = cam.fy = 500;
+  cam.cx = 320;
+  cam.cy = 240;
+  other.cameras = {cam};
+  const std::string intrinsics = ::testing::TempDir() + "/other_intrinsics.json";
+  ASSERT_TRUE(SaveCalibration(intrinsics, other, CalibrationFormat::kArcoJson).ok());
+  options.inputs = {{"left", PairImage("left", 1)}, {"right", PairImage("right", 1)}};
+  options.intrinsics = intrinsics;
+  EXPECT_EQ(run(options),
+            intrinsics +
+                ": names none of the cameras being calibrated (left, right); it has cam9 "
+                "(intrinsics are matched by camera name)");
 }
 
 }  // namespace

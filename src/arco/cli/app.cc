@@ -20,6 +20,10 @@ std::vector<CommandEntry>& CommandRegistry() {
   return registry;
 }
 
+void PrintWarning(const std::string& message) {
+  std::fprintf(stderr, "warning: %s\n", message.c_str());
+}
+
 int PrintError(const std::string& message) {
   WaitIfInterrupted();  // an error caused by the cleanup removing a temporary is not news
   std::fprintf(stderr, "arco: error: %s\n", message.c_str());

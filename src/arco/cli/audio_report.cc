@@ -48,7 +48,6 @@ std::string FormatPitchReport(const pipeline::PitchRunOptions& o,
   out += "\n";
   out +=
       Format("notes: %d (%d with vibrato), glides: %d\n", r.notes, r.notes_with_vibrato, r.glides);
-  for (const auto& w : s.warnings) out += "warning: " + WithFlagNames(w, kPitchFlags) + "\n";
   out += Format("wrote %s; %.3f s CPU (%.0fx real time)\n",
                 o.output.c_str(),
                 s.cpu_seconds,
@@ -100,11 +99,22 @@ std::string FormatSyncReport(const pipeline::SyncRunOptions& o,
         run.offset_s,
         r.confidence);
   }
-  for (const auto& w : r.warnings) out += "warning: " + WithFlagNames(w, kSyncFlags) + "\n";
   if (run.wrote_capture) {
     out += "wrote audio.offset_s and audio.sync_confidence to " +
            JoinPath(o.capture_dir, kCaptureManifestName) + "\n";
   }
+  return out;
+}
+
+std::vector<std::string> PitchWarnings(const pipeline::PitchRunResult& result) {
+  std::vector<std::string> out;
+  for (const auto& w : result.summary.warnings) out.push_back(WithFlagNames(w, kPitchFlags));
+  return out;
+}
+
+std::vector<std::string> SyncWarnings(const pipeline::SyncRunResult& result) {
+  std::vector<std::string> out;
+  for (const auto& w : result.sync.warnings) out.push_back(WithFlagNames(w, kSyncFlags));
   return out;
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "arco/pipeline/pitch_sync.h"
 
@@ -12,5 +13,8 @@ std::string FormatPitchReport(const pipeline::PitchRunOptions& options,
                               const pipeline::PitchRunResult& result);
 std::string FormatSyncReport(const pipeline::SyncRunOptions& options,
                              const pipeline::SyncRunResult& result);
+// Their warnings (for stderr: PrintWarning), the fields named by the command's flags.
+std::vector<std::string> PitchWarnings(const pipeline::PitchRunResult& result);
+std::vector<std::string> SyncWarnings(const pipeline::SyncRunResult& result);
 
 }  // namespace arco::cli

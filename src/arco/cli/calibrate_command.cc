@@ -37,9 +37,11 @@ int RunCheck(const pipeline::CalibrationCheckOptions& options, bool json) {
   auto result = pipeline::CheckCalibration(options, bar);
   bar.Finish();
   if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kCheckFlags));
+  // Flagged cameras: exit kExitFoundProblems (after the report), as a linter does.
+  const int status = result->flagged.empty() ? 0 : kExitFoundProblems;
   if (json) {
     std::printf("%s\n", result->ToJson().dump(2).c_str());
-    return 0;
+    return status;
   }
   std::printf("%s against %s: %lld frames; rig median %.2f px, flag above %.2f px\n",
               result->calibration.c_str(),
@@ -65,10 +67,9 @@ int RunCheck(const pipeline::CalibrationCheckOptions& options, bool json) {
     std::printf("no camera flagged\n");
   } else {
     for (const auto& name : result->flagged)
-      std::printf("warning: %s: residuals stand out from the rig's: moved or mis-calibrated?\n",
-                  name.c_str());
+      PrintWarning(name + ": residuals stand out from the rig's: moved or mis-calibrated?");
   }
-  return 0;
+  return status;
 }
 
 inline constexpr FieldFlag kRefineFlags[] = {{"min_score", "--min-score"},
@@ -115,7 +116,7 @@ int RunRefine(const pipeline::CalibrationRefineOptions& options) {
                 c.focal_change_rel,
                 c.reference ? "  (reference)" : "");
   std::printf("reprojection rms %.2f px -> %.2f px\n", result->rms_before_px, result->rms_after_px);
-  for (const auto& w : result->warnings) std::printf("warning: %s\n", w.c_str());
+  for (const auto& w : result->warnings) PrintWarning(w);
   std::printf("wrote %s and its .report.json\n", options.output.c_str());
   return 0;
 }
@@ -181,7 +182,6 @@ std::string FormatReport(const calibration::CalibrateResult& result, const std::
                 r.bundle_adjustment.iterations,
                 r.bundle_adjustment.time_s);
   text += line;
-  for (const auto& w : r.warnings) text += "warning: " + w.code + ": " + w.message + "\n";
   text += "wrote " + output + " and " + result.report_path + "\n";
   return text;
 }
@@ -452,16 +452,21 @@ CommandRun SetupCalibrate(CLI::App& app) {
     }
     return roles;
   };
-  return CommandRun([a, c, r, json, check, refine] {
-    if (check->parsed()) return RunCheck(*c, *json);
-    if (refine->parsed()) return RunRefine(*r);
-    ProgressBar bar("calibrate");
-    auto result = calibration::RunCalibrate(a->options, bar);
-    bar.Finish();
-    if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kCalibrateFlags));
-    std::fputs(FormatReport(*result, a->options.output).c_str(), stdout);
-    return 0;
-  }, paths);
+  return CommandRun(
+      [a, c, r, json, check, refine] {
+        if (check->parsed()) return RunCheck(*c, *json);
+        if (refine->parsed()) return RunRefine(*r);
+        ProgressBar bar("calibrate");
+        auto result = calibration::RunCalibrate(a->options, bar);
+        bar.Finish();
+        if (!result.ok())
+          return PrintError(WithFlagNames(result.status().message(), kCalibrateFlags));
+        std::fputs(FormatReport(*result, a->options.output).c_str(), stdout);
+        for (const auto& w : result->calibration.report.warnings)
+          PrintWarning(w.code + ": " + w.message);
+        return 0;
+      },
+      paths);
 }
 
 }  // namespace

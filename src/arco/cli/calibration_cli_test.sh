@@ -133,9 +133,15 @@ cam["t"] = [sum(ry[i][k] * cam["t"][k] for k in range(3)) for i in range(3)]
 json.dump(d, open(sys.argv[2], "w"))
 EOF
 name=$(python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['cameras'][3]['name'])" "$tmp/cap/calibration.json")
+# A flagged camera: exit 3 (checked, found problems), as a linter does; the warning on
+# stderr, the table on stdout.
+"$arco" calibrate check "$tmp/cap" --calibration "$tmp/turned.json" >"$tmp/check_turned.out" 2>"$tmp/err"
+rc=$?
+check '[ $rc -eq 3 ] && grep -q "FLAGGED" "$tmp/check_turned.out" && ! grep -q "warning" "$tmp/check_turned.out" && grep -q "^warning: $name: residuals stand out" "$tmp/err"' \
+  "check of a turned camera exits 3 with its warning on stderr: exit $rc: $(cat "$tmp/err")"
 "$arco" calibrate check "$tmp/cap" --calibration "$tmp/turned.json" --json >"$tmp/check.json" 2>"$tmp/err"
 rc=$?
-check '[ $rc -eq 0 ] && python3 -c "import json, sys; d = json.load(open(sys.argv[1])); assert d[\"flagged\"] == [sys.argv[2]], d[\"flagged\"]" "$tmp/check.json" "$name"' \
+check '[ $rc -eq 3 ] && python3 -c "import json, sys; d = json.load(open(sys.argv[1])); assert d[\"flagged\"] == [sys.argv[2]], d[\"flagged\"]" "$tmp/check.json" "$name"' \
   "check flags the turned camera $name: $(cat "$tmp/err")"
 "$arco" calibrate check "$tmp/cap" --calibration "$tmp/missing.json" >/dev/null 2>"$tmp/err"
 rc=$?
@@ -150,7 +156,7 @@ rc=$?
 check '[ $rc -eq 0 ] && grep -q "no camera flagged" "$tmp/check_res.out"' "check on a result: $(tail -2 "$tmp/check_res.out") $(cat "$tmp/err")"
 "$arco" calibrate check "$tmp/res" --calibration "$tmp/turned.json" --json >"$tmp/check_res.json" 2>"$tmp/err"
 rc=$?
-check '[ $rc -eq 0 ] && python3 -c "import json, sys; d = json.load(open(sys.argv[1])); assert d[\"flagged\"] == [sys.argv[2]] and d[\"result\"] == sys.argv[3], d" "$tmp/check_res.json" "$name" "$tmp/res"' \
+check '[ $rc -eq 3 ] && python3 -c "import json, sys; d = json.load(open(sys.argv[1])); assert d[\"flagged\"] == [sys.argv[2]] and d[\"result\"] == sys.argv[3], d" "$tmp/check_res.json" "$name" "$tmp/res"' \
   "check on a result flags the turned camera $name: $(cat "$tmp/err")"
 
 # arco calibrate refine: the turned copy refined with the capture's keypoints and the

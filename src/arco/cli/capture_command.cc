@@ -13,8 +13,8 @@
 #include "arco/cli/command_paths.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
-#include "arco/pipeline/capture_new.h"
 #include "arco/mocap/capture.h"
+#include "arco/pipeline/capture_new.h"
 #include "arco/pipeline/import_keypoints.h"
 
 namespace arco::cli {
@@ -153,7 +153,7 @@ int RunImportKeypoints(const pipeline::ImportKeypointsOptions& o) {
       static_cast<long long>(r->report.frames_without_person),
       static_cast<long long>(r->report.frames_with_several),
       o.capture_dir.c_str());
-  for (const std::string& w : r->warnings) std::printf("warning: %s\n", w.c_str());
+  for (const std::string& w : r->warnings) PrintWarning(w);
   return 0;
 }
 
@@ -251,37 +251,36 @@ CommandRun SetupCapture(CLI::App& app) {
   if (!valid.ok()) throw CLI::ValidationError(WithFlagNames(valid.message(), kCaptureFlags));
 });
 
-  auto paths = [create, n, import, k] {
-    PathRoles roles;
-    if (create->parsed()) {
-      roles.AddInput("--calibration", n->options.calibration);
-      for (const std::string& v : n->videos) roles.AddInput("--video", AssignedPath(v));
-      for (const std::string& v : n->images) roles.AddInput("--images", AssignedPath(v));
-      roles.AddInput("--audio", n->options.audio);
-      roles.AddInput("--spd-summary", n->options.spd_summary);
-      roles.AddOutput("-o", n->options.output_dir);
-    }
-    if (import->parsed()) {
-      // The capture is the command's own: its keypoints and manifest are written in place.
-      const std::string& capture = k->options.capture_dir;
-      roles.AddOwnedFolder("CAPTURE", capture);
-      for (const std::string& c : k->cameras) roles.AddInput("--camera", AssignedPath(c));
-      auto manifest = ReadCaptureManifest(capture);
-      const std::string keypoints = manifest.ok() && !manifest->keypoints2d.empty()
-                                        ? manifest->keypoints2d
-                                        : "keypoints2d.npy";
-      roles.AddOutput("CAPTURE", ResolveCapturePath(capture, keypoints));
-      roles.AddOutput("CAPTURE", ResolveCapturePath(capture, "capture.json"));
-    }
-    return roles;
-  };
-  return CommandRun(
-      [create, n, import, k]() {
-        if (create->parsed()) return RunCaptureNew(n->options);
-        if (import->parsed()) return RunImportKeypoints(k->options);
-        return PrintError("capture: give a subcommand (new, import-keypoints)");
-      },
-      paths);
+auto paths = [create, n, import, k] {
+  PathRoles roles;
+  if (create->parsed()) {
+    roles.AddInput("--calibration", n->options.calibration);
+    for (const std::string& v : n->videos) roles.AddInput("--video", AssignedPath(v));
+    for (const std::string& v : n->images) roles.AddInput("--images", AssignedPath(v));
+    roles.AddInput("--audio", n->options.audio);
+    roles.AddInput("--spd-summary", n->options.spd_summary);
+    roles.AddOutput("-o", n->options.output_dir);
+  }
+  if (import->parsed()) {
+    // The capture is the command's own: its keypoints and manifest are written in place.
+    const std::string& capture = k->options.capture_dir;
+    roles.AddOwnedFolder("CAPTURE", capture);
+    for (const std::string& c : k->cameras) roles.AddInput("--camera", AssignedPath(c));
+    auto manifest = ReadCaptureManifest(capture);
+    const std::string keypoints =
+        manifest.ok() && !manifest->keypoints2d.empty() ? manifest->keypoints2d : "keypoints2d.npy";
+    roles.AddOutput("CAPTURE", ResolveCapturePath(capture, keypoints));
+    roles.AddOutput("CAPTURE", ResolveCapturePath(capture, "capture.json"));
+  }
+  return roles;
+};
+return CommandRun(
+    [create, n, import, k]() {
+      if (create->parsed()) return RunCaptureNew(n->options);
+      if (import->parsed()) return RunImportKeypoints(k->options);
+      return PrintError("capture: give a subcommand (new, import-keypoints)");
+    },
+    paths);
 }  // namespace
 
 }  // namespace arco::cli

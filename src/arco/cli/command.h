@@ -3,13 +3,12 @@
 // into a typed struct and calls a library/run function that tests call directly.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 #include "arco/util/path_roles.h"
 
@@ -56,6 +55,12 @@ struct CommandRegistrar {
 // Prints "arco: error: <message>" on stderr; returns 1. After an interrupt (SIGINT,
 // SIGTERM: util/interrupt.h) it prints nothing and waits for the cleanup to exit with 130.
 int PrintError(const std::string& message);
+// Prints "warning: <message>" on stderr: every command's warnings go there, never into
+// stdout (which holds the command's results, for scripts and pipes).
+void PrintWarning(const std::string& message);
+// The exit status of a command that checked something and found problems, as a linter's
+// (scripts can act on it): `arco calibrate check` flagging a camera. 1 stays "error".
+inline constexpr int kExitFoundProblems = 3;
 
 }  // namespace arco::cli
 

@@ -37,7 +37,7 @@ PY
 mkdir -p "$tmp/w"
 SNAPSHOT_DIR=$tmp/w
 for format in csv trc c3d gltf bvh; do
-  out=$tmp/w/take.$format
+  out=$tmp/w/take.${format/gltf/glb}
   if ! "$arco" export "$tmp/res" --format $format -o "$out" >"$tmp/out" 2>"$tmp/err"; then
     echo "FAILED: export --format $format: $(cat "$tmp/err")"; fail=1; continue
   fi
@@ -76,12 +76,12 @@ expect_error "points3d.npy of another layout" "$tmp/shape/arco/points3d.npy: sha
   export "$tmp/shape" --format gltf -o "$tmp/w/x.glb"
 cp -r "$tmp/res" "$tmp/json" && echo "{" >"$tmp/json/result.json"
 expect_error "result.json not JSON" "$tmp/json/result.json: *" export "$tmp/json" --format trc -o "$tmp/w/x.trc"
-mkdir -p "$tmp/w/dir"
-expect_error "output is a folder" "$tmp/w/dir: *" export "$tmp/res" --format trc -o "$tmp/w/dir"
+mkdir -p "$tmp/w/dir.trc"
+expect_error "output is a folder" "$tmp/w/dir.trc: *" export "$tmp/res" --format trc -o "$tmp/w/dir.trc"
 
 # The Khronos validator: 0 errors.
 if command -v node >/dev/null && [ -d "$validator/node_modules/gltf-validator" ]; then
-  check 'NODE_PATH="$validator/node_modules" node "$validator/validate.js" "$tmp/w/take.gltf"' \
+  check 'NODE_PATH="$validator/node_modules" node "$validator/validate.js" "$tmp/w/take.glb"' \
     "gltf-validator on the .glb"
 elif [ -n "${CI:-}" ]; then
   echo "FAILED: gltf-validator missing (scripts/fetch_gltf_validator)"; fail=1

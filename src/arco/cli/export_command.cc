@@ -12,8 +12,7 @@ namespace arco::cli {
 namespace {
 
 struct Args {
-  exporter::ExportOptions options;
-  std::string output;
+  exporter::ExportOptions options;  // options.output: -o, its extension checked by Validate
   bool residuals = false;
 };
 
@@ -24,9 +23,9 @@ std::string BaseName(const std::string& path) {
 
 int Run(const Args& a) {
   OutputSet outputs;
-  auto tmp = outputs.AddFile(a.output);
+  auto tmp = outputs.AddFile(a.options.output);
   if (!tmp.ok()) return PrintError(tmp.status().message());
-  auto summary = exporter::ExportResult(a.options, *tmp, BaseName(a.output));
+  auto summary = exporter::ExportResult(a.options, *tmp, BaseName(a.options.output));
   if (!summary.ok()) return PrintError(WithFlagNames(summary.status().message(), kExportFlags));
   const Status committed = outputs.Commit();
   if (!committed.ok()) return PrintError(committed.message());
@@ -36,7 +35,7 @@ int Run(const Args& a) {
               static_cast<long long>(summary->frames),
               summary->keypoints,
               static_cast<long long>(summary->bytes),
-              a.output.c_str());
+              a.options.output.c_str());
   if (summary->format == exporter::ExportFormat::kBvh) {
     std::printf(
         "BVH fit residual, median: body %.3f mm, left hand %.3f mm, right hand %.3f mm (per "
@@ -67,7 +66,7 @@ CommandRun SetupExport(CLI::App& app) {
       ->required();
   cmd->add_option("--method", a->options.method, "Which method's points: arco, paper or vision")
       ->capture_default_str();
-  cmd->add_option("-o,--output", a->output, "Output file")->required();
+  cmd->add_option("-o,--output", a->options.output, "Output file")->required();
   cmd->add_flag("--residuals", a->residuals, "BVH: print the fit residual of every joint");
   cmd->parse_complete_callback([a] {
     const Status valid = a->options.Validate();
@@ -77,7 +76,7 @@ CommandRun SetupExport(CLI::App& app) {
                     [a] {
                       PathRoles roles;
                       AddResultInputs(&roles, "RESULT_DIR", a->options.result_dir);
-                      roles.AddOutput("-o", a->output);
+                      roles.AddOutput("-o", a->options.output);
                       return roles;
                     });
 }

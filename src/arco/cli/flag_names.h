@@ -49,7 +49,8 @@ inline constexpr FieldFlag kEvalFlags[] = {{"truth_frames", "--truth-frame"},
 inline constexpr FieldFlag kExportFlags[] = {
     {"result_dir", "RESULT_DIR"}, {"format", "--format"}, {"method", "--method"}};
 // Synthesis (CaptureWriteOptions, as set by `arco synth`).
-inline constexpr FieldFlag kSynthFlags[] = {{"overwrite", "--overwrite"},
+inline constexpr FieldFlag kSynthFlags[] = {{"instrument", "--instrument"},
+                                            {"overwrite", "--overwrite"},
                                             {"max_duration_s", "--duration-s"},
                                             {"noise_px", "--noise-px"},
                                             {"outlier_rate", "--outlier-rate"},

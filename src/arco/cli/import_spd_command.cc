@@ -65,22 +65,25 @@ CommandRun Setup(CLI::App& app) {
     roles.AddOutput("-o", o->output_dir);
     return roles;
   };
-  return CommandRun([o]() {
-    auto r = pipeline::ImportSpdCapture(*o);
-    if (!r.ok()) return PrintError(r.status().message());
-    std::printf(
-        "imported %lld frames x %lld views x %lld points (%lld files read, %lld missing -> NaN, "
-        "%lld dropped frames) -> %s\n",
-        static_cast<long long>(r->frames),
-        static_cast<long long>(r->views),
-        static_cast<long long>(r->points),
-        static_cast<long long>(r->files.files_read),
-        static_cast<long long>(r->files.files_missing),
-        static_cast<long long>(r->files.frames_dropped),
-        o->output_dir.c_str());
-    for (const std::string& w : r->warnings) std::printf("warning: %s\n", w.c_str());
-    return 0;
-  }, paths);
+  return CommandRun(
+      [o]() {
+        auto r = pipeline::ImportSpdCapture(*o);
+        if (!r.ok()) return PrintError(r.status().message());
+        std::printf(
+            "imported %lld frames x %lld views x %lld points (%lld files read, %lld missing -> "
+            "NaN, "
+            "%lld dropped frames) -> %s\n",
+            static_cast<long long>(r->frames),
+            static_cast<long long>(r->views),
+            static_cast<long long>(r->points),
+            static_cast<long long>(r->files.files_read),
+            static_cast<long long>(r->files.files_missing),
+            static_cast<long long>(r->files.frames_dropped),
+            o->output_dir.c_str());
+        for (const std::string& w : r->warnings) PrintWarning(w);
+        return 0;
+      },
+      paths);
 }
 
 }  // namespace

@@ -59,9 +59,10 @@ refused "pitch --capture -o its audio" pitch --capture "$w/cap" -o "$w/cap/audio
 refused "pitch --capture -o into the capture" pitch --capture "$w/cap" -o "$w/cap/pitch.csv"
 
 # export, eval, overlay, plot, view: the result folder and the capture it names.
-refused "export -o a result file" export "$w/res" --format csv -o "$w/res/arco/points3d.npy"
-refused "export -o result.json" export "$w/res" --format csv --method vision -o "$w/res/result.json"
-refused "export -o the result's capture.json" export "$w/res" --format csv --method vision -o "$w/cap/capture.json"
+# (export's output is named by its format's extension: .csv files of the result.)
+refused "export -o a result file" export "$w/res" --format csv -o "$w/res/arco/contacts.csv"
+refused "export -o the result's notes.csv" export "$w/res" --format csv --method vision -o "$w/res/notes.csv"
+refused "export -o into the result's capture" export "$w/res" --format csv --method vision -o "$w/cap/x.csv"
 refused "eval -o result.json" eval "$w/res" --truth "$w/cap/truth" -o "$w/res/result.json"
 refused "eval -o into --truth" eval "$w/res" --truth "$w/cap/truth" -o "$w/cap/truth/eval.json"
 refused "eval --plot into the result" eval "$w/res" --truth "$w/cap/truth" -o "$w/e.json" --plot "$w/res/e.svg"

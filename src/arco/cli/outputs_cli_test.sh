@@ -114,7 +114,8 @@ ok "export -o" "${X[@]}" -o "$w/x.c3d"
 check '[ -s "$w/x.c3d" ]' "export writes its file"
 rm "$w/x.c3d"
 bad_at "export in a missing folder" "$w/nodir/x.c3d" "${X[@]}" -o "$w/nodir/x.c3d"
-bad_at "export -o a folder" "$w/dir" "${X[@]}" -o "$w/dir"
+mkdir -p "$w/dir.c3d"
+bad_at "export -o a folder" "$w/dir.c3d" "${X[@]}" -o "$w/dir.c3d"
 bad_at "export under a file" "$w/file/x.c3d" "${X[@]}" -o "$w/file/x.c3d"
 
 # overlay: one video file.

@@ -55,12 +55,13 @@ CommandRun SetupPitch(CLI::App& app) {
   AddNumber(cmd,
             "--fmin",
             o->min_f0_hz,
-            "Override the lowest f0 (Hz; 0 = the instrument's)",
+            "Override the lowest f0 (Hz; 0 = the instrument's; else >= 20 and below the highest)",
             audio::kF0OverrideRangeHz);
   AddNumber(cmd,
             "--fmax",
             o->max_f0_hz,
-            "Override the highest f0 (Hz; 0 = the instrument's)",
+            "Override the highest f0 (Hz; 0 = the instrument's; at most 4000 for cello and double "
+            "bass, 8000 for violin and viola: the analysis rate / 4)",
             audio::kF0OverrideRangeHz);
   AddNumber(cmd, "--a4", o->a4_hz, "Tuning reference A4 (Hz; default 440)", kA4RangeHz);
   cmd->add_option(
@@ -88,14 +89,17 @@ CommandRun SetupPitch(CLI::App& app) {
     roles.AddOutput("--midi", o->midi_output);
     return roles;
   };
-  return CommandRun([o] {
-    ProgressBar bar("pitch");  // the bar starts at TrackPitch's SetTotal
-    auto result = pipeline::RunPitch(*o, bar);
-    bar.Finish();
-    if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kPitchFlags));
-    std::fputs(FormatPitchReport(*o, *result).c_str(), stdout);
-    return 0;
-  }, paths);
+  return CommandRun(
+      [o] {
+        ProgressBar bar("pitch");  // the bar starts at TrackPitch's SetTotal
+        auto result = pipeline::RunPitch(*o, bar);
+        bar.Finish();
+        if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kPitchFlags));
+        std::fputs(FormatPitchReport(*o, *result).c_str(), stdout);
+        for (const std::string& w : PitchWarnings(*result)) PrintWarning(w);
+        return 0;
+      },
+      paths);
 }
 
 }  // namespace

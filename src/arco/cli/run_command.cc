@@ -32,7 +32,7 @@ int RunRun(const RunArgs& a) {
     total_s += t.seconds;
   }
   for (const auto& m : summary->methods) std::printf("%s\n", FormatRefineSummary(m).c_str());
-  for (const std::string& w : summary->warnings) std::printf("warning: %s\n", w.c_str());
+  for (const std::string& w : summary->warnings) PrintWarning(w);
   // Name only the method folders this run wrote (no audio: vision/ alone).
   std::string folders;
   for (const auto& m : summary->methods) {

@@ -61,6 +61,7 @@ std::function<int()> SetupSync(CLI::App& app) {
     auto result = pipeline::RunSync(*o);
     if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kSyncFlags));
     std::fputs(FormatSyncReport(*o, *result).c_str(), stdout);
+    for (const std::string& w : SyncWarnings(*result)) PrintWarning(w);
     return 0;
   };
 }

@@ -1,7 +1,9 @@
 #include "arco/export/export.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 
 #include "arco/pipeline/result_folder.h"
@@ -56,6 +58,8 @@ Status ExportOptions::Validate() const {
   if (!ParseExportFormat(format).ok()) {
     return Status::Error("format: '" + format + "' is not csv, trc, c3d, gltf (glb) or bvh");
   }
+  if (!output.empty())
+    ARCO_RETURN_IF_ERROR(CheckExportExtension(*ParseExportFormat(format), output));
   bool known = false;
   for (const auto& m : ExportMethodNames()) known = known || m == method;
   if (!known) {
@@ -63,6 +67,41 @@ Status ExportOptions::Validate() const {
   }
   return Status::Ok();
 }
+
+Status CheckExportExtension(ExportFormat format, const std::string& output) {
+  const std::string wanted = format == ExportFormat::kGltf ? "glb" : ExportFormatName(format);
+  const size_t slash = output.find_last_of('/');
+  const size_t dot = output.find_last_of('.');
+  std::string extension = dot == std::string::npos || (slash != std::string::npos && dot < slash)
+                              ? ""
+                              : output.substr(dot + 1);
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == wanted) return Status::Ok();
+  return Status::Error(output + ": a " + ExportFormatName(format) + " export is named ." + wanted +
+                       ", not " +
+                       (extension.empty() ? std::string("without an extension") : "." + extension) +
+                       " (rename the output, or choose the format its extension names)");
+}
+
+namespace {
+
+// The one check of the coordinates the writers receive (see kMaxExportCoordinateMm):
+// `values` (..., 3) mm, NaN allowed; `where(i)` names the point of flat index i.
+Status CheckCoordinates(const std::vector<double>& values,
+                        const std::string& path,
+                        const std::function<std::string(int64_t)>& where) {
+  for (size_t i = 0; i < values.size(); ++i) {
+    const double v = values[i];
+    if (std::isnan(v) || std::abs(v) <= kMaxExportCoordinateMm) continue;
+    char text[64];
+    std::snprintf(text, sizeof(text), "%g", v);
+    return Status::Error(path + ": " + where(static_cast<int64_t>(i / 3)) + ": coordinate " + text +
+                         " mm is not finite or beyond 1e9 mm; no export can hold it");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
 
 int ExportData::Find(const std::string& name) const {
   for (size_t i = 0; i < keypoint_names.size(); ++i) {
@@ -102,6 +141,10 @@ StatusOr<ExportData> LoadExportData(const ExportOptions& options) {
     return Status::Error(stage->points3d_path + ": shape is not (frames >= 1, " +
                          std::to_string(data.keypoint_names.size()) + ", 3)");
   }
+  ARCO_RETURN_IF_ERROR(CheckCoordinates(data.points_mm.data, stage->points3d_path, [&](int64_t i) {
+    return "frame " + std::to_string(data.frame_first + i / shape[1]) + " keypoint '" +
+           data.keypoint_names[i % shape[1]] + "'";
+  }));
   // The triangulation's quality, matched by name (absent in results of older versions).
   auto quality = folder.ReadTriangulationQuality();
   if (quality.ok()) {
@@ -132,6 +175,11 @@ StatusOr<ExportData> LoadExportData(const ExportOptions& options) {
     data.instrument = inst.instrument;
     const auto& s = inst.strings_mm.shape;
     if (s.size() == 4 && s[0] == shape[0] && s[2] == 2 && s[3] == 3) {
+      ARCO_RETURN_IF_ERROR(
+          CheckCoordinates(inst.strings_mm.data, folder.InstrumentStringsPath(), [&](int64_t i) {
+            return "frame " + std::to_string(data.frame_first + i / (s[1] * 2)) + " string " +
+                   std::to_string(i / 2 % s[1] + 1);
+          }));
       data.strings_mm = std::move(inst.strings_mm);
     }
   }

@@ -31,8 +31,19 @@ struct ExportOptions {
   std::string result_dir;       // an `arco run` result folder
   std::string format = "csv";   // ParseExportFormat
   std::string method = "arco";  // ExportMethodNames
+  // The file the user names, checked by Validate (CheckExportExtension); empty: not
+  // checked (the viewer and overlays read the data without writing a file).
+  std::string output;
   Status Validate() const;
 };
+
+// The one check of an output's name against the format: its extension must be the
+// format's (.csv, .trc, .c3d, .glb, .bvh; any case), so BVH text never lands in a .glb.
+Status CheckExportExtension(ExportFormat format, const std::string& output);
+
+// Coordinates every format can hold: finite (NaN is a gap) and within this many mm of the
+// origin (1000 km; C3D and glTF store float32, which turns 1e300 into inf).
+inline constexpr double kMaxExportCoordinateMm = 1e9;
 
 // What the exporters read: one method's points with their names and timing.
 struct ExportData {
@@ -63,7 +74,8 @@ struct ExportData {
 };
 
 // Errors (naming the file): no result.json, no such method in the result, a points3d.npy
-// whose shape disagrees with the names.
+// whose shape disagrees with the names, a coordinate that is infinite or beyond
+// kMaxExportCoordinateMm (naming the frame and keypoint).
 StatusOr<ExportData> LoadExportData(const ExportOptions& options);
 
 // The writers: the file's contents. CSV columns: frame, time_s, keypoint, x_mm, y_mm, z_mm,

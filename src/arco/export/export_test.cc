@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -56,6 +57,29 @@ TEST(ExportOptions, RejectsUnknownFormatAndMethod) {
   o.method = "paper";
   o.result_dir = "";
   EXPECT_FALSE(o.Validate().ok());
+}
+
+TEST(ExportOptions, TheOutputsExtensionIsTheFormats) {
+  ExportOptions o;
+  o.result_dir = "r";
+  o.format = "bvh";
+  o.output = "x.glb";
+  EXPECT_EQ(o.Validate().message(),
+            "x.glb: a bvh export is named .bvh, not .glb (rename the output, or choose the format "
+            "its extension names)");
+  for (const auto& [format, good, bad] :
+       std::vector<std::array<std::string, 3>>{{"csv", "a/b.CSV", "b.txt"},
+                                               {"trc", "b.trc", "b.csv"},
+                                               {"c3d", "b.c3d", "b.trc"},
+                                               {"gltf", "b.glb", "b.gltf"},
+                                               {"glb", "x.y/b.glb", "x.glb/b"},
+                                               {"bvh", "b.bvh", "b.glb"}}) {
+    o.format = format;
+    o.output = good;
+    EXPECT_TRUE(o.Validate().ok()) << format << " " << good;
+    o.output = bad;
+    EXPECT_FALSE(o.Validate().ok()) << format << " " << bad;
+  }
 }
 
 TEST(ParseExportFormat, NamesEveryFormat) {

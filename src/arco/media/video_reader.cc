@@ -10,6 +10,10 @@
 #include "arco/util/file_io.h"
 
 namespace arco::media {
+
+bool SameFrameRate(double a_hz, double b_hz) {
+  return std::abs(a_hz - b_hz) <= 1e-3 * std::max(a_hz, b_hz);
+}
 namespace {
 
 bool HasImageExtension(const std::filesystem::path& path) {

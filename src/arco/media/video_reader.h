@@ -60,13 +60,18 @@ struct VideoProperties {
   // pictures, which may be fewer).
   int64_t frame_count = 0;
   FrameCountSource frame_count_source = FrameCountSource::kContainer;
-  int width = 0, height = 0;  // of the frames Read returns (after max_width scaling)
+  int width = 0, height = 0;              // of the frames Read returns (after max_width scaling)
   int coded_width = 0, coded_height = 0;  // as stored in the file
   // Clockwise rotation a player applies for display (from the stream's display
   // matrix side data, rounded to a multiple of 90): 0, 90, 180 or 270.
   int rotation_deg = 0;
   double duration_s = 0;  // frame_count / fps (0 when the frame rate is unknown)
 };
+
+// Two frame rates are the same when within 0.1 % (29.97 vs 30000/1001 written rounded):
+// the one comparison of a rate the user gives with a container's (arco capture new,
+// arco sync), where a disagreement is an error, never a silent override.
+bool SameFrameRate(double a_hz, double b_hz);
 
 struct VideoReaderOptions {
   PixelFormat format = PixelFormat::kRgb8;

@@ -229,6 +229,18 @@ StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const st
     }
     const auto layout = m.Layout();
     if (!layout.ok()) return Status::Error(source + ": keypoints2d: " + layout.status().message());
+    // An SPD layout holds one instrument family's points: a violin capture with the
+    // cello's would run every stage and fail at the end naming a folder (issue 24).
+    std::string family = m.layout;
+    if (family.size() > 8 && family.compare(family.size() - 8, 8, "_contact") == 0)
+      family.resize(family.size() - 8);
+    if (family.rfind("spd_", 0) == 0 && m.instrument != "none") {
+      const StatusOr<std::string> wanted = DetectionLayoutName(m.instrument);
+      if (wanted.ok() && *wanted != family)
+        return fk.Bad("layout",
+                      "is \"" + m.layout + "\", but \"instrument\" is \"" + m.instrument +
+                          "\", whose points are " + *wanted + " (correct one of them)");
+    }
   }
   const Json* cams = f.Find("cameras");
   if (!cams || !cams->is_array() || cams->empty()) {
@@ -329,18 +341,21 @@ std::string ShapeString(const std::vector<int64_t>& s) {
 
 }  // namespace
 
+Status CheckKeypoints2dDtype(const std::string& source, const std::string& dtype, bool is_float) {
+  // Pixel coordinates are fractional: an integer array is a writer's mistake (rounded
+  // pixels, or scores of 0/1), not something to convert silently.
+  if (is_float) return Status::Ok();
+  return Status::Error(source + ": dtype " + dtype +
+                       "; keypoints2d must be float32 or float64 (x_px, y_px, score; NaN = "
+                       "missing)");
+}
+
 Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureManifest& m) {
   const std::string manifest_path = JoinPath(capture_dir, kCaptureManifestName);
   ARCO_RETURN_IF_ERROR(CheckCaptureHasKeypoints2d(capture_dir, m));
   const std::string path = ResolveCapturePath(capture_dir, m.keypoints2d);
   ARCO_ASSIGN_OR_RETURN(const NpyHeader header, ReadNpyHeader(path));
-  // Pixel coordinates are fractional: an integer array is a writer's mistake (rounded
-  // pixels, or scores of 0/1), not something to convert silently.
-  if (!header.is_float) {
-    return Status::Error(path + ": dtype " + header.dtype +
-                         "; keypoints2d must be float32 or float64 (x_px, y_px, score; NaN = "
-                         "missing)");
-  }
+  ARCO_RETURN_IF_ERROR(CheckKeypoints2dDtype(path, header.dtype, header.is_float));
   StatusOr<KeypointLayout> layout = m.Layout();
   if (!layout.ok()) return layout.status().WithContext(manifest_path);
   const std::vector<int64_t> expected = {

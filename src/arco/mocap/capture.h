@@ -54,9 +54,9 @@ struct CaptureManifest {
   std::string calibration;      // calibration file (any format arco reads)
   std::string audio;            // optional audio file
   double audio_offset_s = 0.0;  // audio time of frame `frame_first`'s timestamp (mid-exposure)
-  double audio_sync_confidence = NAN;  // arco sync's confidence in audio_offset_s (NaN: none)
-  std::string keypoints2d;      // optional .npy of 2D keypoints
-  std::string layout;           // keypoint layout name, or "custom" with keypoint_names
+  double audio_sync_confidence = NAN;       // arco sync's confidence in audio_offset_s (NaN: none)
+  std::string keypoints2d;                  // optional .npy of 2D keypoints
+  std::string layout;                       // keypoint layout name, or "custom" with keypoint_names
   std::vector<std::string> keypoint_names;  // only for layout "custom"
   std::vector<CaptureCamera> cameras;
 
@@ -96,6 +96,9 @@ Status CheckCaptureHasKeypoints2d(const std::string& capture_dir, const CaptureM
 // the dtype: integer pixels are a writer's mistake, not converted) and its shape
 // (frames.count, cameras, layout size, 3).
 Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureManifest& manifest);
+// The dtype rule of 2D keypoints (a file's and the Python bindings' arrays): float32 or
+// float64; an error naming `source` and `dtype` otherwise.
+Status CheckKeypoints2dDtype(const std::string& source, const std::string& dtype, bool is_float);
 // Reads the 2D keypoints named by the manifest after CheckCaptureKeypoints2d. Frames a
 // camera dropped are set to NaN.
 StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,

@@ -21,9 +21,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Two frame rates are the same when within 0.1 % (29.97 vs 30000/1001 written rounded).
-bool SameFps(double a, double b) { return std::abs(a - b) <= 1e-3 * std::max(a, b); }
-
 std::string FpsText(double fps) {
   char text[32];
   std::snprintf(text, sizeof text, "%.6g", fps);
@@ -190,12 +187,12 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
     const bool has_rate =
         p.frame_count_source != media::FrameCountSource::kImageFiles && p.fps_hz > 0;
     if (has_rate) {
-      if (o.fps > 0 && !SameFps(o.fps, p.fps_hz)) {
+      if (o.fps > 0 && !media::SameFrameRate(o.fps, p.fps_hz)) {
         return Status::Error(input.path + ": " + FpsText(p.fps_hz) +
                              " fps in the container, but fps = " + FpsText(o.fps) +
                              " (fps sets the rate of image folders only)");
       }
-      if (fps_from && !SameFps(fps_from->fps_hz, p.fps_hz)) {
+      if (fps_from && !media::SameFrameRate(fps_from->fps_hz, p.fps_hz)) {
         return Status::Error(input.path + ": " + FpsText(p.fps_hz) + " fps, but " + fps_from->path +
                              " has " + FpsText(fps_from->fps_hz) + " fps");
       }

@@ -23,9 +23,10 @@ Status InstrumentStageOptions::Validate() const {
 
 Json ToJson(const InstrumentStageOptions& o) {
   const InstrumentFitOptions& f = o.fit;
-  const char* scale = f.scale == InstrumentFitOptions::Scale::kFromStringLength ? "from_string_length"
+  const char* scale = f.scale == InstrumentFitOptions::Scale::kFromStringLength
+                          ? "from_string_length"
                       : f.scale == InstrumentFitOptions::Scale::kWorldIsMillimetres ? "world_is_mm"
-                                                                                 : "given";
+                                                                                    : "given";
   return {{"fit",
            {{"scale", scale},
             {"world_units_per_mm", f.world_units_per_mm},
@@ -87,7 +88,8 @@ StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions
   if (units == "mm") fit_options.scale = InstrumentFitOptions::Scale::kWorldIsMillimetres;
   fit_options.num_threads = options.num_threads;
   StatusOr<InstrumentFit> fit = FitInstrument(model, keypoints, hints, fit_options);
-  if (!fit.ok()) return fit.status().WithContext("instrument fit");
+  // FitInstrument's messages start "instrument fit: "; the context is the file it fitted.
+  if (!fit.ok()) return fit.status().WithContext(result.Points3dPath(kTriangulationStage));
   const std::vector<InstrumentFramePose> poses = SmoothFramePoses(fit->frames, options.smoothing);
   InstrumentStageSummary summary;
   for (const std::string& w : fit->summary.warnings) summary.warnings.push_back("instrument: " + w);

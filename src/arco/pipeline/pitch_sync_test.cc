@@ -10,6 +10,7 @@
 #include "arco/audio/test_media.h"
 #include "arco/audio/test_signals.h"
 #include "arco/mocap/capture.h"
+#include "arco/registry/instruments.h"
 #include "arco/util/file_io.h"
 
 namespace arco::pipeline {
@@ -319,6 +320,30 @@ TEST(RunPitch, F0OverridesOutsideTheirRangeAreErrors) {
   auto result = RunPitch(p);
   ASSERT_FALSE(result.ok());
   EXPECT_EQ(result.status().message(), "min_f0_hz must be below max_f0_hz");
+}
+
+// The overrides' declared range is what some instrument can analyse (its top is the
+// largest analysis rate / 4 of the registry); the instrument's own limit names both
+// fields and the numbers (issue 24: --fmax 5000 passed the flag's [0, 20000] and then
+// failed with "pitch range must satisfy ..." naming no flag).
+TEST(PitchTrackerOptionsFor, TheF0OverridesAreCheckedAgainstTheInstrument) {
+  double top_hz = 0;
+  for (const InstrumentInfo& info : AllInstruments())
+    top_hz = std::max(top_hz, info.pitch_search.analysis_rate_hz / 4.0);
+  EXPECT_EQ(audio::kF0OverrideRangeHz.max, top_hz);
+  PitchRunOptions p;
+  p.instrument = "cello";
+  p.max_f0_hz = 5000;
+  auto cello = PitchTrackerOptionsFor(p);
+  ASSERT_FALSE(cello.ok());
+  EXPECT_EQ(cello.status().message(),
+            "min_f0_hz = 60 and max_f0_hz = 5000 Hz must satisfy 20 <= min_f0_hz < max_f0_hz <= "
+            "4000 (the cello's analysis rate 16000 Hz / 4)");
+  p.instrument = "violin";
+  EXPECT_TRUE(PitchTrackerOptionsFor(p).ok());
+  p.max_f0_hz = 0;
+  p.min_f0_hz = 10;
+  EXPECT_FALSE(PitchTrackerOptionsFor(p).ok());
 }
 
 }  // namespace

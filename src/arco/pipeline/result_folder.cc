@@ -158,35 +158,17 @@ StatusOr<std::vector<refine::NoteFingering>> ResultFolder::ReadFingering(
   const std::string path = FingeringPath(method);
   std::vector<refine::NoteFingering> rows;
   if (!FileExists(path)) return rows;
-  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
-  std::istringstream in(text);
-  std::string line;
-  if (!std::getline(in, line)) return Status::Error(path + ": empty (no header)");
-  const std::vector<std::string> header = SplitCsvLine(line);
-  const std::vector<std::string> wanted = SplitCsvLine(kFingeringCsvHeader);
-  std::vector<int> column(wanted.size(), -1);
-  for (size_t w = 0; w < wanted.size(); ++w) {
-    for (size_t h = 0; h < header.size(); ++h) {
-      if (header[h] == wanted[w]) column[w] = static_cast<int>(h);
-    }
-    // note_name is derived from midi_note; every other column is read.
-    if (column[w] < 0 && wanted[w] != "note_name") {
-      return Status::Error(path + ": no column '" + wanted[w] + "'");
-    }
-  }
-  int line_number = 1;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (line.empty()) continue;
-    const std::vector<std::string> cells = SplitCsvLine(line);
-    const std::string where = path + ": line " + std::to_string(line_number);
+  std::vector<std::string> required;
+  // note_name is derived from midi_note; every other column is read.
+  for (const std::string& w : SplitCsvLine(kFingeringCsvHeader))
+    if (w != "note_name") required.push_back(w);
+  ARCO_ASSIGN_OR_RETURN(const CsvTable table, ReadCsvTable(path, required, kFingeringCsvHeader));
+  for (const CsvTable::Row& row : table.rows) {
+    const std::vector<std::string>& cells = row.cells;
+    const std::string where = table.Where(row);
     auto cell = [&](const char* name) -> const std::string* {
-      for (size_t w = 0; w < wanted.size(); ++w) {
-        if (wanted[w] == name) {
-          return column[w] < static_cast<int>(cells.size()) ? &cells[column[w]] : nullptr;
-        }
-      }
-      return nullptr;
+      const int c = table.Column(name);
+      return c < 0 ? nullptr : &cells[c];
     };
     bool ok = true;
     auto integer = [&](const char* name, auto* out) {
@@ -223,9 +205,9 @@ StatusOr<std::vector<refine::NoteFingering>> ResultFolder::ReadFingering(
     integer("pressed_frames", &r.pressed_frames);
     integer("open_frames", &r.open_frames);
     integer("uncertain_frames", &r.uncertain_frames);
-    if (!ok) return Status::Error(where + ": a short row or a cell that is not a number");
+    if (!ok) return Status::Error(where + "a cell that is not a number");
     if (r.last_frame < r.first_frame) {
-      return Status::Error(where + ": last_frame is before first_frame");
+      return Status::Error(where + "last_frame is before first_frame");
     }
     rows.push_back(std::move(r));
   }

@@ -143,7 +143,7 @@ TEST(RunCapture, EveryStageAndThreeMethodsThatEvalScores) {
                   .ok());
   auto bad = RunRefineStage(r);
   ASSERT_FALSE(bad.ok());
-  EXPECT_NE(bad.status().message().find("notes.csv: line 2"), std::string::npos)
+  EXPECT_NE(bad.status().message().find("notes.csv:2: malformed note row"), std::string::npos)
       << bad.status().message();
   EXPECT_EQ(*arco_before, *ReadFileToString(JoinPath(result, "arco/contacts.csv")));
 }

@@ -32,6 +32,7 @@
 #include "arco/hand/kinematics.h"
 #include "arco/instrument/contact.h"
 #include "arco/instrument/instrument_model.h"
+#include "arco/mocap/capture.h"
 #include "arco/mocap/triangulate_sequence.h"
 #include "arco/pipeline/pitch_sync.h"
 #include "arco/pipeline/result_folder.h"
@@ -196,6 +197,10 @@ py::array_t<double> ProjectPoints(
 // Copies `array` (any real dtype, any layout) into the library's float64 array: one pass,
 // float32 keypoints (keypoints2d.npy) converted as they are copied.
 NpyArray<double> ToNpyArray(const py::array& array) {
+  // The dtype rule of keypoints2d.npy (mocap::CheckKeypoints2dDtype), shared with the CLI:
+  // integer pixels are a writer's mistake, not something to convert silently.
+  CheckValid(CheckKeypoints2dDtype(
+      "keypoints2d", py::str(array.dtype()).cast<std::string>(), array.dtype().kind() == 'f'));
   NpyArray<double> out;
   out.shape.assign(array.shape(), array.shape() + array.ndim());
   if (py::isinstance<py::array_t<float>>(array)) {
@@ -293,8 +298,8 @@ py::dict Triangulate(const py::object& keypoints2d_arg,
 
 // Float samples held by the caller (the numpy array outlives the reader), (frames,) or
 // interleaved (frames, channels). Mixed down as the file readers do (audio/audio_reader.h:
-// the channels' float sum times 1 / channels; a non-finite or absurd sample reads as 0), so
-// a WAV's samples give `arco pitch`'s rows.
+// the channels' float sum times 1 / channels), so a WAV's samples give `arco pitch`'s rows;
+// TrackPitch refuses non-finite samples first, with the readers' check (CheckSamples).
 class SamplesReader : public audio::AudioReader {
  public:
   SamplesReader(const float* samples, int64_t frames, int channels, int rate_hz)
@@ -312,9 +317,7 @@ class SamplesReader : public audio::AudioReader {
       const float* frame = samples_ + (position_ + i) * channels_;
       float sum = 0.0f;
       for (int c = 0; c < channels_; ++c) sum += frame[c];
-      float v = sum * scale;
-      if (!(v == v) || v > 1e6f || v < -1e6f) v = 0.0f;
-      out[i] = v;
+      out[i] = sum * scale;
     }
     position_ += n;
     return n;
@@ -374,6 +377,8 @@ py::dict TrackPitch(const py::array_t<float, py::array::c_style | py::array::for
   CheckValid(CheckInRange("fps", fps, audio::kTrackerFpsRange));
   CheckValid(CheckInRange("start_s", start_s, audio::kTrackerStartRangeS));
   CheckValid(CheckInRange("a4_hz", a4_hz, kA4RangeHz));
+  CheckValid(
+      audio::CheckSamples(samples.data(), samples.size(), channels, 0, sample_rate, "samples"));
   pipeline::PitchRunOptions o;
   o.instrument = instrument;
   o.fps = fps;

@@ -29,34 +29,17 @@ Status WriteContactsCsv(const std::string& path, const std::vector<FrameContact>
 }
 
 StatusOr<std::vector<ContactRow>> ReadContactsCsv(const std::string& path) {
-  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
-  std::istringstream in(text);
-  std::string line;
-  if (!std::getline(in, line)) return Status::Error(path + ": empty contact file");
-  const std::vector<std::string> header = SplitCsvLine(line);
-  std::map<std::string, size_t> col;
-  for (size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
-  for (const char* need :
-       {"frame", "string", "finger", "contact_x_mm", "contact_y_mm", "contact_z_mm"}) {
-    if (!col.count(need)) {
-      return Status::Error(path + ": no column '" + need + "' (expected a header like '" +
-                           std::string(kContactsCsvHeader) + "')");
-    }
-  }
+  ARCO_ASSIGN_OR_RETURN(
+      const CsvTable table,
+      ReadCsvTable(path,
+                   {"frame", "string", "finger", "contact_x_mm", "contact_y_mm", "contact_z_mm"},
+                   kContactsCsvHeader));
   std::vector<ContactRow> rows;
-  int line_number = 1;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (line.empty()) continue;
-    const std::vector<std::string> cells = SplitCsvLine(line);
-    const std::string where = path + ":" + std::to_string(line_number) + ": ";
-    if (cells.size() < header.size()) {
-      return Status::Error(where + "expected " + std::to_string(header.size()) + " fields, found " +
-                           std::to_string(cells.size()));
-    }
+  for (const CsvTable::Row& row : table.rows) {
+    const std::string where = table.Where(row);
     auto cell = [&](const char* name) -> const std::string* {
-      const auto it = col.find(name);
-      return it == col.end() ? nullptr : &cells[it->second];
+      const int c = table.Column(name);
+      return c < 0 ? nullptr : &row.cells[c];
     };
     bool ok = true;
     auto integer = [&](const char* name, int64_t fallback) {

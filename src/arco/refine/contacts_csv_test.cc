@@ -34,6 +34,14 @@ TEST(ReadContactsCsv, MalformedFilesNameTheFileAndLine) {
   const auto f = ReadContactsCsv(dir / "f.csv");
   ASSERT_TRUE(f.ok()) << f.status().message();
   EXPECT_TRUE(std::isnan((*f)[0].point_mm.x()));
+  // A row with a cell more than the header is as damaged as one cut short.
+  ASSERT_TRUE(AtomicWriteFile(dir / "g.csv",
+                              header + "0,rest,unvoiced,0,0,-1,nan,nan,nan,nan,0,0.1,nan,nan,0,7\n")
+                  .ok());
+  const auto g = ReadContactsCsv(dir / "g.csv");
+  ASSERT_FALSE(g.ok());
+  EXPECT_NE(g.status().message().find("g.csv:2: expected 15 fields"), std::string::npos)
+      << g.status().message();
 }
 
 TEST(ReadContactsCsv, ReadsTruthContactFilesByColumnName) {

@@ -1,11 +1,10 @@
 #include "arco/synth/synth.h"
 
-#include "arco/registry/instruments.h"
-
 #include <algorithm>
 #include <cmath>
 
 #include "arco/hand/kinematics.h"
+#include "arco/registry/instruments.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/synth/midi_reader.h"
 #include "arco/synth/synth_instrument.h"
@@ -22,6 +21,11 @@ Rigid RotationAbout(const Eigen::Matrix3d& r, const Eigen::Vector3d& pivot) {
 }  // namespace
 
 Status SynthOptions::Validate() const {
+  // The instrument is the user's option: checked here, before any file is read (the
+  // calibration is not to blame for it).
+  if (!ParseInstrumentKind(instrument).ok())
+    return Status::Error("instrument '" + instrument +
+                         "' is unknown (violin, viola, cello, double_bass)");
   if (!(fps >= 1 && fps <= 1000)) return Status::Error("fps must be in [1, 1000]");
   if (!(tempo_scale > 0.05 && tempo_scale < 20))
     return Status::Error("tempo scale must be in (0.05, 20)");

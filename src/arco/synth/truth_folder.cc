@@ -27,7 +27,6 @@ constexpr char kContactCsvHeader[] =
 constexpr char kNotesCsvHeader[] =
     "note,onset_s,offset_s,midi_note,name,velocity,string,finger,position_semitones,"
     "intonation_cents,vibrato_rate_hz,vibrato_extent_cents";
-constexpr int kNotesCsvColumns = 12;
 
 Json ManifestJson(const TruthManifest& m) {
   Json j;
@@ -210,23 +209,15 @@ std::string NotesCsv(const std::vector<TruthNote>& notes) {
 }
 
 StatusOr<std::vector<TruthNote>> ReadNotesCsv(const std::string& path) {
-  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
-  std::istringstream in(text);
-  std::string line;
-  if (!std::getline(in, line) || line != kNotesCsvHeader) {
+  ARCO_ASSIGN_OR_RETURN(const CsvTable table,
+                        ReadCsvTable(path, SplitCsvLine(kNotesCsvHeader), kNotesCsvHeader));
+  if (table.header != SplitCsvLine(kNotesCsvHeader)) {
     return Status::Error(path + ": expected the header '" + std::string(kNotesCsvHeader) + "'");
   }
   std::vector<TruthNote> notes;
-  int line_number = 1;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (line.empty()) continue;
-    const std::string where = path + ":" + std::to_string(line_number) + ": ";
-    const std::vector<std::string> c = SplitCsvLine(line);
-    if (c.size() != kNotesCsvColumns) {
-      return Status::Error(where + "expected " + std::to_string(kNotesCsvColumns) +
-                           " fields, found " + std::to_string(c.size()));
-    }
+  for (const CsvTable::Row& row : table.rows) {
+    const std::string where = table.Where(row);
+    const std::vector<std::string>& c = row.cells;
     int64_t index = 0, midi = 0, velocity = 0, string = 0, finger = 0, position = 0;
     TruthNote n;
     const bool ok =

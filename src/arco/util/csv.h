@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "arco/util/status.h"
+
 namespace arco {
 
 // The cells of one line; a trailing comma is one more (empty) cell.
@@ -19,5 +21,29 @@ bool ParseCsvDouble(const std::string& cell, double* out);
 bool ParseCsvInt(const std::string& cell, int64_t* out);
 // The shortest text that reads back as the same double (%.17g); NaN and infinities "nan".
 std::string FormatCsvDouble(double v);
+
+// A CSV file read strictly, the one way every arco CSV reader reads its rows: a header
+// line, then rows each with exactly as many cells as the header (a row cut short or with
+// extra cells is an error naming the file and line, never a silently missing value).
+// Blank lines are skipped; a "\r" before the newline is dropped.
+struct CsvTable {
+  struct Row {
+    int line = 0;  // 1-based line number in the file
+    std::vector<std::string> cells;
+  };
+  std::string path;
+  std::vector<std::string> header;
+  std::vector<Row> rows;
+
+  int Column(const std::string& name) const;  // -1 when the header lacks it
+  // "PATH:LINE: " for messages about a row.
+  std::string Where(const Row& row) const;
+};
+// Errors name the file: unreadable, empty, a header lacking one of `required_columns`
+// (listing the expected header `expected_header` when given), a row with the wrong number
+// of cells.
+StatusOr<CsvTable> ReadCsvTable(const std::string& path,
+                                const std::vector<std::string>& required_columns,
+                                const std::string& expected_header = "");
 
 }  // namespace arco

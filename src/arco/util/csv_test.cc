@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+
+#include "arco/util/test_dir.h"
 
 namespace arco {
 namespace {
@@ -37,6 +40,36 @@ TEST(Csv, FormattedDoublesReadBackExactly) {
   }
   EXPECT_EQ(FormatCsvDouble(std::nan("")), "nan");
   EXPECT_EQ(FormatCsvDouble(INFINITY), "nan");
+}
+
+TEST(CsvTable, RejectsRowsCutShortOrTooLong) {
+  testing::TempDir dir;
+  const std::string path = dir / "t.csv";
+  std::ofstream(path) << "a,b,c\r\n1,2,3\n\n4,5\n";
+  const StatusOr<CsvTable> cut = ReadCsvTable(path, {"a"});
+  ASSERT_FALSE(cut.ok());
+  EXPECT_EQ(cut.status().message(), path + ":4: expected 3 fields (as the header), found 2");
+  std::ofstream(path) << "a,b,c\n1,2,3,4\n";
+  EXPECT_FALSE(ReadCsvTable(path, {"a"}).ok());
+  std::ofstream(path) << "a,b,c\n1,2,3\r\n4,,\n";
+  const StatusOr<CsvTable> ok = ReadCsvTable(path, {"c", "a"});
+  ASSERT_TRUE(ok.ok()) << ok.status().message();
+  ASSERT_EQ(ok->rows.size(), 2u);
+  EXPECT_EQ(ok->rows[1].line, 3);
+  EXPECT_EQ(ok->rows[0].cells[2], "3");
+  EXPECT_EQ(ok->Column("c"), 2);
+}
+
+TEST(CsvTable, RejectsMissingColumnsAndEmptyFiles) {
+  testing::TempDir dir;
+  const std::string path = dir / "t.csv";
+  std::ofstream(path) << "a,b\n";
+  const StatusOr<CsvTable> missing = ReadCsvTable(path, {"a", "z"}, "a,z");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.status().message(),
+            path + ": no column 'z' in the header (expected the header 'a,z')");
+  std::ofstream(path) << "";
+  EXPECT_FALSE(ReadCsvTable(path, {}).ok());
 }
 
 }  // namespace

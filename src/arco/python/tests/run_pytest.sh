@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # ctest's python_test: pytest on the module with Debian's python3 (/usr/bin/python3 sees
 # Debian's numpy and pytest). Exit 77 (skipped) when the module was not built because
-# pybind11 was absent at configure time (unless CI is set), or in a sanitizer build.
+# pybind11 was absent at configure time, or in a sanitizer build; a failure instead when
+# CI or ARCO_REQUIRE_PYTHON_MODULE is set (`make test`, whose README promises the module).
 #   run_pytest.sh TESTS_DIR   (PYTHONPATH, ARCO_BIN, ARCO_PYTHON_MODULE from ctest)
 set -euo pipefail
 if [ "${ARCO_PYTHON_MODULE:-ON}" = SANITIZED ]; then
@@ -10,7 +11,11 @@ if [ "${ARCO_PYTHON_MODULE:-ON}" = SANITIZED ]; then
 fi
 if [ "${ARCO_PYTHON_MODULE:-ON}" != ON ]; then
   echo "python_test: the module was not built (pybind11 absent at configure time)" >&2
-  if [ -n "${CI:-}" ]; then exit 1; fi
+  if [ -n "${CI:-}" ] || [ -n "${ARCO_REQUIRE_PYTHON_MODULE:-}" ]; then
+    echo "python_test: required here: scripts/setup installs pybind11-dev and python3-dev," \
+      "then configure the build again" >&2
+    exit 1
+  fi
   exit 77
 fi
 # No __pycache__ or .pytest_cache in the source tree.

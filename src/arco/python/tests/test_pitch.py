@@ -98,6 +98,15 @@ def test_bad_inputs(arco_bin, tmp_path):
         arco.track_pitch(x, 8000, 30, a4_hz=float("inf"))
     with pytest.raises(ValueError, match="min_f0_hz must be below max_f0_hz"):
         arco.track_pitch(x, 8000, 30, min_f0_hz=500, max_f0_hz=100)
+    # Non-finite samples: the readers' check (a float WAV holding them is refused too).
+    bad = x.copy()
+    bad[4000] = np.nan
+    with pytest.raises(ValueError, match=r"samples: sample 4000 \(0.5000 s\) is nan; audio samples must be finite"):
+        arco.track_pitch(bad, 8000, 30)
+    stereo = np.zeros((8000, 2), np.float32)
+    stereo[100, 1] = np.inf
+    with pytest.raises(ValueError, match=r"samples: sample 100 \(0.0125 s\) is inf"):
+        arco.track_pitch(stereo, 8000, 30)
     with pytest.raises(ValueError, match="sample_rate 10 outside"):
         arco.track_pitch(x, 10, 30)
     # The same one-line message as the CLI.

@@ -109,9 +109,12 @@ def test_bad_inputs(spd_rig):
         arco.triangulate(views, "/nonexistent/rig.xml")
     with pytest.raises(TypeError):
         arco.triangulate(views, spd_rig, 0.5)  # options are keyword-only
+    # Integer pixels: the dtype rule of keypoints2d.npy (`arco triangulate` refuses them).
+    with pytest.raises(ValueError, match="keypoints2d: dtype int64; keypoints2d must be float32 or float64"):
+        arco.triangulate(np.zeros((1, 20, 5, 3), np.int64), spd_rig)
 
 
-def test_any_dtype_and_layout(spd_rig):
+def test_any_float_dtype_and_layout(spd_rig):
     centre = np.mean([c.center for c in spd_rig.cameras], axis=0)
     truth = centre + np.random.default_rng(5).uniform(-0.1, 0.1, (2, 6, 3))
     views = synthetic_views(spd_rig, truth)
