@@ -93,6 +93,16 @@ Status Convert(const char* raw, int64_t count, const std::string& source, std::v
       if (!std::isfinite(v)) {
         return Status::Error(source + ": non-finite value in an array read as integers");
       }
+      // A finite value beyond the integer type's range is undefined behaviour to convert
+      // (found by fuzz_npy): [-2^digits, 2^digits) for signed, [0, 2^digits) for unsigned,
+      // bounds that are exact powers of two in any floating type.
+      const From hi = std::ldexp(From(1), std::numeric_limits<To>::digits);
+      const From lo = std::numeric_limits<To>::is_signed ? -hi : From(0);
+      const From t = std::trunc(v);
+      if (!(t >= lo && t < hi)) {
+        return Status::Error(source + ": value out of the integer range in an array read as "
+                                      "integers");
+      }
     }
     (*out)[static_cast<size_t>(i)] = static_cast<To>(v);
   }

@@ -46,6 +46,26 @@ TEST(Npy, HeaderIsAlignedAndScalarShapeWorks) {
   EXPECT_EQ(b->data, a.data);
 }
 
+// A float array read as integers: values beyond the integer type are an error, not an
+// undefined conversion (fuzz_npy found -3e231 read as int32).
+TEST(Npy, FloatsBeyondTheIntegerRangeAreRejected) {
+  NpyArray<double> a;
+  a.shape = {4};
+  a.data = {1.0, -2147483648.0, 2147483647.9, 3.0};
+  auto ok = ParseNpy<int32_t>(SerializeNpy(a), "in.npy");
+  ASSERT_TRUE(ok.ok()) << ok.status().message();
+  EXPECT_EQ(ok->data[1], -2147483647 - 1);
+  EXPECT_EQ(ok->data[2], 2147483647);
+  for (double bad : {2147483648.0, -2147483649.0, -3.10504e+231, 1e300}) {
+    a.data[3] = bad;
+    auto r = ParseNpy<int32_t>(SerializeNpy(a), "bad.npy");
+    ASSERT_FALSE(r.ok()) << bad;
+    EXPECT_NE(r.status().message().find("bad.npy: value out of the integer range"),
+              std::string::npos)
+        << r.status().message();
+  }
+}
+
 TEST(Npy, RejectsTruncatedAndGarbage) {
   NpyArray<double> a;
   a.shape = {10};
