@@ -17,7 +17,11 @@ namespace {
 // 23.9 mm at the nut and 48.2 mm at the bridge on the cello. String heights above the
 // fingerboard end: cello 4.0-5.5 mm (A) and 6.5-8.0 mm (C) depending on steel or gut
 // strings (ICS cello setup notes), violin about 3.5 (E) and 5.5 mm (G); at the nut
-// 0.5-0.75 mm on cello. All of these vary per instrument: override them in the options.
+// 0.5-0.75 mm on cello. Bridge arch radius: on SPD's real cello01 take the bow on the A
+// string is inclined 30.2 degrees (median of 262 frames; docs/bowing.md) at 23.5 mm from
+// the centre line, so R = 23.5 / sin(30.2 deg) = 46.8 mm; the other instruments are
+// given the same ratio of radius to bridge spacing, an assumption no real take here
+// checks. All of these vary per instrument: override them in the options.
 // Open strings, names and keypoint layouts: registry/instruments.h.
 struct Spec {
   InstrumentKind kind;
@@ -28,12 +32,12 @@ struct Spec {
 };
 
 // StringSetup fields: nut height, end height high, end height low, fingerboard length,
-// EA/T, pad centre offset.
+// EA/T, pad centre offset, bridge arch radius.
 const Spec kSpecs[] = {
-    {InstrumentKind::kViolin, 328.0, 16.5, 34.0, {0.4, 3.5, 5.5, 270.0, 100.0, 4.0}},
-    {InstrumentKind::kViola, 370.0, 17.5, 37.0, {0.5, 4.0, 6.0, 290.0, 100.0, 4.5}},
-    {InstrumentKind::kCello, 695.0, 23.0, 47.0, {0.6, 4.5, 7.0, 580.0, 100.0, 5.0}},
-    {InstrumentKind::kDoubleBass, 1050.0, 31.0, 85.0, {1.0, 6.0, 9.0, 880.0, 100.0, 6.0}},
+    {InstrumentKind::kViolin, 328.0, 16.5, 34.0, {0.4, 3.5, 5.5, 270.0, 100.0, 4.0, 34.0}},
+    {InstrumentKind::kViola, 370.0, 17.5, 37.0, {0.5, 4.0, 6.0, 290.0, 100.0, 4.5, 37.0}},
+    {InstrumentKind::kCello, 695.0, 23.0, 47.0, {0.6, 4.5, 7.0, 580.0, 100.0, 5.0, 46.8}},
+    {InstrumentKind::kDoubleBass, 1050.0, 31.0, 85.0, {1.0, 6.0, 9.0, 880.0, 100.0, 6.0, 85.0}},
 };
 
 const Spec& SpecFor(InstrumentKind kind) {
@@ -104,7 +108,8 @@ Status InstrumentOptions::Validate() const {
                             setup.height_at_fingerboard_end_low_mm,
                             setup.fingerboard_length_mm,
                             setup.stiffness_over_tension,
-                            setup.pad_centre_offset_mm};
+                            setup.pad_centre_offset_mm,
+                            setup.bridge_arch_radius_mm};
   for (double v : lengths) {
     if (!std::isfinite(v) || v < 0) {
       return Status::Error("instrument options: lengths must be finite and >= 0 (0 = typical)");
@@ -159,6 +164,11 @@ StatusOr<InstrumentModel> InstrumentModel::Create(const InstrumentOptions& optio
   m.setup_.stiffness_over_tension =
       OrDefault(in.stiffness_over_tension, typ.stiffness_over_tension);
   m.setup_.pad_centre_offset_mm = OrDefault(in.pad_centre_offset_mm, typ.pad_centre_offset_mm);
+  m.setup_.bridge_arch_radius_mm = OrDefault(in.bridge_arch_radius_mm, typ.bridge_arch_radius_mm);
+  if (!(m.setup_.bridge_arch_radius_mm > 0.5 * m.bridge_spacing_mm_)) {
+    return Status::Error(
+        "instrument options: bridge_arch_radius_mm must exceed half the bridge spacing");
+  }
   if (m.setup_.fingerboard_length_mm >= m.string_length_mm_) {
     return Status::Error(
         "instrument options: fingerboard_length_mm must be shorter than the "
@@ -217,6 +227,12 @@ double InstrumentModel::LateralOffsetAtNutMm(int string) const {
 double InstrumentModel::LateralOffsetAtBridgeMm(int string) const {
   CheckString(string);
   return (0.5 - AcrossFromLow(string, num_strings())) * bridge_spacing_mm_;
+}
+
+double InstrumentModel::BowInclinationRad(int string) const {
+  // The arch z(y) = sqrt(R^2 - y^2) has the slope dz/dy = -y / sqrt(R^2 - y^2) at the
+  // string's lateral offset y, i.e. the angle asin(-y / R).
+  return std::asin(-LateralOffsetAtBridgeMm(string) / setup_.bridge_arch_radius_mm);
 }
 
 double InstrumentModel::StringHeightMm(int string, double from_nut_mm) const {

@@ -66,6 +66,10 @@ struct StringSetup {
   // Distance from the string's stopping point (bridge-side edge of the finger's contact
   // patch) to the centre of the finger pad, toward the nut: about half the patch width.
   double pad_centre_offset_mm = 0;
+  // Radius of the bridge's top arch through the strings (the curve that lets the bow
+  // touch one string at a time): the inclination of a bow on each string
+  // (InstrumentModel::BowInclinationRad).
+  double bridge_arch_radius_mm = 0;
 };
 
 struct InstrumentOptions {
@@ -110,6 +114,12 @@ class InstrumentModel {
   // String height above the fingerboard at a distance from the nut (linear from the nut to
   // the fingerboard end, constant beyond), interpolated between high and low strings.
   double StringHeightMm(int string, double from_nut_mm) const;
+  // Inclination of a bow that touches only `string`: the tangent to the bridge's arch
+  // (a circle of setup().bridge_arch_radius_mm through the strings) at the string,
+  // measured across the strings (the instrument frame's y-z plane) from the string plane
+  // toward the front (+z) as y decreases: positive on the high-string side, 0 at the
+  // centre line. A bow line with direction u has the inclination atan(u_z / u_y).
+  double BowInclinationRad(int string) const;
 
   // SPD instrument keypoints, in SPD order (DOMAIN.md section 3): the points after the
   // body in the instrument's spd_* keypoint layout (registry/keypoint_layout.h). Cello and
