@@ -130,6 +130,7 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
   std::vector<std::string> truth_names;
   std::vector<double> truth_f0;
   std::vector<bool> truth_scored;
+  std::vector<refine::BowingFrame> truth_bowing;  // empty: no bow-arm truth
   EvalOptions options = r.metrics;
   const bool folder = r.labels.empty();
   if (folder && !std::filesystem::is_directory(r.truth)) {
@@ -155,6 +156,7 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
     for (size_t i = 0; i < truth_names.size(); ++i) {
       if (truth_names[i] == "string4_top") options.string_points_first = static_cast<int>(i);
     }
+    truth_bowing = tf.bowing;
     for (const audio::PitchFrame& f : tf.pitch) {
       truth_f0.push_back(f.voiced ? f.f0_hz : 0.0);
       truth_scored.push_back(f.confidence > 0);  // confidence 0: not scored
@@ -258,6 +260,15 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
     }
     report.methods.push_back(EvaluateMethod(
         stage->name, truth, truth_contact, rs, contact ? &*contact : nullptr, options));
+    if (!stage->bowing_path.empty() && !truth_bowing.empty()) {
+      ARCO_ASSIGN_OR_RETURN(const std::vector<refine::BowingFrame> bowing,
+                            refine::ReadBowingCsv(stage->bowing_path));
+      if (bowing.size() != truth_bowing.size()) {
+        return Status::Error(stage->bowing_path + ": " + std::to_string(bowing.size()) +
+                             " frames but the truth has " + std::to_string(truth_bowing.size()));
+      }
+      ScoreBowing(truth_bowing, bowing, &report.methods.back());
+    }
   }
   if (report.methods.empty())
     return Status::Error(r.result_dir + ": no stage with 3D points to evaluate");
@@ -335,6 +346,9 @@ Json EvalReport::ToJson(const EvalOptions& options) const {
       mj["left_group_world_mm"][kGroups[g]] = JsonFromDouble(m.left_group_world_mm[g]);
     mj["playing_tip_world_mm"] = JsonFromDouble(m.playing_tip_world_mm);
     mj["contact_point_error_mm"] = JsonFromDouble(m.contact_point_error_mm);
+    mj["bow_direction_accuracy"] = JsonFromDouble(m.bow_direction_accuracy);
+    mj["bow_string_accuracy"] = JsonFromDouble(m.bow_string_accuracy);
+    mj["sounding_point_error_mm"] = JsonFromDouble(m.sounding_point_error_mm);
     j["methods"][m.method] = mj;
   }
   if (pitch) {

@@ -281,4 +281,34 @@ PitchMetrics EvaluatePitch(const std::vector<double>& truth_f0_hz,
   return m;
 }
 
+void ScoreBowing(const std::vector<refine::BowingFrame>& truth,
+                 const std::vector<refine::BowingFrame>& method,
+                 MethodMetrics* metrics) {
+  if (truth.size() != method.size()) {
+    throw std::invalid_argument("bowing: " + std::to_string(method.size()) +
+                                " frames but the truth has " + std::to_string(truth.size()));
+  }
+  int sounding = 0, string_right = 0, moving = 0, direction_right = 0, sp_count = 0;
+  double sp_sum = 0;
+  for (size_t f = 0; f < truth.size(); ++f) {
+    const refine::BowingFrame& t = truth[f];
+    const refine::BowingFrame& m = method[f];
+    if (t.string <= 0) continue;
+    ++sounding;
+    const bool same_string = m.string == t.string || m.second_string == t.string;
+    string_right += same_string;
+    if (t.direction != refine::BowDirection::kNone) {
+      ++moving;
+      direction_right += m.direction == t.direction;
+    }
+    if (same_string && std::isfinite(m.sounding_point_mm) && std::isfinite(t.sounding_point_mm)) {
+      sp_sum += std::abs(m.sounding_point_mm - t.sounding_point_mm);
+      ++sp_count;
+    }
+  }
+  if (sounding > 0) metrics->bow_string_accuracy = static_cast<double>(string_right) / sounding;
+  if (moving > 0) metrics->bow_direction_accuracy = static_cast<double>(direction_right) / moving;
+  if (sp_count > 0) metrics->sounding_point_error_mm = sp_sum / sp_count;
+}
+
 }  // namespace arco::eval

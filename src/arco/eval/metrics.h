@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "arco/refine/bowing.h"
 #include "arco/registry/keypoint_layout.h"
 
 namespace arco::eval {
@@ -105,6 +106,11 @@ struct MethodMetrics {
   // The method's own contact point to the truth's, on frames where both press (needs a
   // contact annotation with points).
   double contact_point_error_mm = NAN;
+  // The bow arm (refine/bowing.h) against a truth's bowing.csv (ScoreBowing); NaN when
+  // either has none.
+  double bow_direction_accuracy = NAN;
+  double bow_string_accuracy = NAN;
+  double sounding_point_error_mm = NAN;
   // Per frame (NaN where not measured): wrist-aligned left-hand error and
   // contact deviation, for plots.
   std::vector<double> frame_hand_mm, frame_contact_mm;
@@ -118,6 +124,14 @@ MethodMetrics EvaluateMethod(const std::string& method,
                              const PointSequence& result,
                              const ContactTrack* result_contact,
                              const EvalOptions& options);
+
+// Bow-arm metrics over the truth's sounding frames (string > 0): the direction where the
+// truth moves the bow, the string under the bow (a double stop's second string counts),
+// the sounding point's mean absolute error where the strings agree. Throws
+// std::invalid_argument when the frame counts differ.
+void ScoreBowing(const std::vector<refine::BowingFrame>& truth,
+                 const std::vector<refine::BowingFrame>& method,
+                 MethodMetrics* metrics);
 
 // Geometric flexion of a hand's PIP and DIP joints (degrees) from its 21
 // keypoints, signed: positive bends towards the palm. The flexion axis is the

@@ -1,5 +1,6 @@
 #include "arco/pipeline/refine_stage.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -38,10 +39,41 @@ StatusOr<NpyArray<double>> FitBody(const RefineInputs& inputs, int num_threads) 
   return std::move(fit.points_mm);
 }
 
+// The bow arm from the triangulated frog and tip and the placed strings.
+StatusOr<refine::BowingResult> AnalyzeBow(const RefineInputs& inputs,
+                                          const refine::RefineResult& r,
+                                          const refine::BowingOptions& options) {
+  const InstrumentModel& m = *inputs.instrument;
+  const std::vector<std::string>& names = m.keypoint_names();
+  const auto frog = std::find(names.begin(), names.end(), "frog");
+  const auto tip = std::find(names.begin(), names.end(), "tip");
+  if (frog == names.end() || tip == names.end()) {
+    return Status::Error(std::string("the ") + m.name() + " layout has no frog and tip");
+  }
+  const int64_t frog_index = kNumWholeBody + (frog - names.begin());
+  const int64_t tip_index = kNumWholeBody + (tip - names.begin());
+  const NpyArray<double>& points = inputs.spd.base_points_mm;
+  const int64_t frames = points.shape.empty() ? 0 : points.shape[0];
+  refine::BowingInput in;
+  for (int64_t f = 0; f < frames; ++f) {
+    auto point = [&](int64_t k) {
+      return Eigen::Vector3d(points.at(f, k, 0), points.at(f, k, 1), points.at(f, k, 2));
+    };
+    in.frog_in_world_mm.push_back(point(frog_index));
+    in.tip_in_world_mm.push_back(point(tip_index));
+  }
+  in.strings_in_world_mm = inputs.input.strings_in_world_mm;
+  in.notes = r.fingering;
+  in.fps = inputs.input.fps;
+  in.start_s = inputs.input.start_s;
+  return refine::AnalyzeBowing(m, in, options);
+}
+
 }  // namespace
 
 Status RefineStageOptions::Validate() const {
   if (result_dir.empty()) return Status::Error("result_dir is empty");
+  ARCO_RETURN_IF_ERROR(bowing.Validate());
   return refine.Validate();
 }
 
@@ -167,7 +199,8 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
 
 StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
                                                const RefineInputs& inputs,
-                                               const refine::RefineOptions& options) {
+                                               const refine::RefineOptions& options,
+                                               const refine::BowingOptions& bowing) {
   const ResultFolder result(result_dir);
   if (options.mode != refine::RefineMode::kVision && !inputs.has_pitch) {
     return Status::Error(result.ManifestPath() +
@@ -197,6 +230,11 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
   out.options = options;
   if (inputs.input.audio_notes.empty()) out.options.decode.audio_onsets = false;
   out.summary = r.summary;
+  if (options.mode == refine::RefineMode::kArco) {
+    ARCO_ASSIGN_OR_RETURN(refine::BowingResult bow, AnalyzeBow(inputs, r, bowing));
+    out.bowing = std::move(bow);
+    out.bowing_options = bowing;
+  }
   ARCO_RETURN_IF_ERROR(result.WriteMethod(out));
   return r.summary;
 }
@@ -204,7 +242,7 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
 StatusOr<refine::RefineSummary> RunRefineStage(const RefineStageOptions& options) {
   ARCO_RETURN_IF_ERROR(options.Validate());
   ARCO_ASSIGN_OR_RETURN(RefineInputs inputs, LoadRefineInputs(options.result_dir));
-  return RefineAndWrite(options.result_dir, inputs, options.refine);
+  return RefineAndWrite(options.result_dir, inputs, options.refine, options.bowing);
 }
 
 }  // namespace arco::pipeline

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "arco/instrument/instrument_model.h"
+#include "arco/refine/bowing.h"
 #include "arco/refine/method_result.h"
 #include "arco/refine/refine.h"
 #include "arco/util/status.h"
@@ -17,6 +18,7 @@ namespace arco::pipeline {
 struct RefineStageOptions {
   std::string result_dir;        // written by stages 1-4
   refine::RefineOptions refine;  // refine.mode picks the method
+  refine::BowingOptions bowing;  // arco's bow arm (arco/bowing.csv)
   Status Validate() const;
 };
 
@@ -30,11 +32,13 @@ struct RefineInputs {
 // Errors name the file: no hand or instrument stage, shapes that disagree.
 StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir);
 
-// Refines one method (options.mode) and writes its folder. Errors: a method that needs
-// audio on a result without a pitch stage.
+// Refines one method (options.mode) and writes its folder; arco's also gets the bow arm
+// (refine/bowing.h: bowing.csv, bowing_notes.csv). Errors: a method that needs audio on a
+// result without a pitch stage.
 StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
                                                const RefineInputs& inputs,
-                                               const refine::RefineOptions& options);
+                                               const refine::RefineOptions& options,
+                                               const refine::BowingOptions& bowing = {});
 
 // LoadRefineInputs + RefineAndWrite.
 StatusOr<refine::RefineSummary> RunRefineStage(const RefineStageOptions& options);

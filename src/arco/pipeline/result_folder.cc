@@ -34,6 +34,8 @@ constexpr char kPitchCsvFile[] = "pitch.csv";
 constexpr char kNotesCsvFile[] = "notes.csv";
 constexpr char kContactsCsvFile[] = "contacts.csv";
 constexpr char kFingeringCsvFile[] = "fingering.csv";
+constexpr char kBowingCsvFile[] = "bowing.csv";
+constexpr char kBowingNotesCsvFile[] = "bowing_notes.csv";
 
 Status WriteFingeringCsv(const std::string& path, const std::vector<refine::NoteFingering>& rows) {
   return AtomicWriteWith(path, [&](std::ostream& out) {
@@ -341,6 +343,8 @@ StatusOr<std::vector<PointStage>> ResultFolder::PointStages() const {
       s.keypoint_names = sj["keypoint_names"].get<std::vector<std::string>>();
     if (sj["files"].contains("contact"))
       s.contacts_path = JoinPath(dir, sj["files"]["contact"].get<std::string>());
+    if (sj["files"].contains("bowing"))
+      s.bowing_path = JoinPath(dir, sj["files"]["bowing"].get<std::string>());
     out.push_back(std::move(s));
   }
   return out;
@@ -678,6 +682,10 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
     files["contact"] = kContactsCsvFile;
     files["fingering"] = kFingeringCsvFile;
   }
+  if (r.bowing) {
+    files["bowing"] = kBowingCsvFile;
+    files["bowing_notes"] = kBowingNotesCsvFile;
+  }
   const KeypointLayout* layout = FindKeypointLayout(r.layout);
   auto write = [&](const std::string& dir) -> Status {
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, kPoints3dFile), r.points3d));
@@ -686,16 +694,26 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
       ARCO_RETURN_IF_ERROR(refine::WriteContactsCsv(JoinPath(dir, kContactsCsvFile), r.contacts));
       ARCO_RETURN_IF_ERROR(WriteFingeringCsv(JoinPath(dir, kFingeringCsvFile), r.fingering));
     }
+    if (r.bowing) {
+      ARCO_RETURN_IF_ERROR(refine::WriteBowingCsv(JoinPath(dir, kBowingCsvFile), r.bowing->frames));
+      ARCO_RETURN_IF_ERROR(
+          refine::WriteBowingNotesCsv(JoinPath(dir, kBowingNotesCsvFile), r.bowing->notes));
+    }
     return Status::Ok();
   };
+  Json entry = {{"files", files},
+                {"layout", r.layout},
+                {"keypoint_names", layout ? layout->names : std::vector<std::string>()},
+                {"units", "mm"},
+                {"options", refine::ToJson(r.options)},
+                {"summary", refine::ToJson(r.summary)}};
+  if (r.bowing) {
+    entry["bowing"] = {{"options", refine::ToJson(r.bowing_options)},
+                       {"summary", refine::ToJson(r.bowing->summary)}};
+  }
   return WriteStageFolder(r.method,
                           write,
-                          {{"files", files},
-                           {"layout", r.layout},
-                           {"keypoint_names", layout ? layout->names : std::vector<std::string>()},
-                           {"units", "mm"},
-                           {"options", refine::ToJson(r.options)},
-                           {"summary", refine::ToJson(r.summary)}},
+                          entry,
                           // The methods read the earlier stages, not the capture: those
                           // stages' inputs are the method's too.
                           CaptureInputs());

@@ -47,6 +47,7 @@
 #include "arco/mocap/triangulate_sequence.h"
 #include "arco/pipeline/capture_inputs.h"
 #include "arco/pipeline/summaries.h"
+#include "arco/refine/bowing.h"
 #include "arco/refine/contact_annotation.h"
 #include "arco/refine/refine.h"
 #include "arco/registry/keypoint_layout.h"
@@ -125,6 +126,8 @@ struct MethodRecord {
   std::vector<refine::NoteFingering> fingering;  // written with contacts
   refine::RefineOptions options;                 // as applied (refine::ToJson)
   refine::RefineSummary summary;
+  std::optional<refine::BowingResult> bowing;  // arco's: bowing.csv, bowing_notes.csv
+  refine::BowingOptions bowing_options;
 };
 
 // A stage with 3D points, as `arco eval` finds them.
@@ -133,6 +136,7 @@ struct PointStage {
   std::string points3d_path;
   std::vector<std::string> keypoint_names;  // empty: the result's
   std::string contacts_path;                // empty: none
+  std::string bowing_path;                  // empty: none (refine/bowing.h)
 };
 
 // The capture header of result.json (with the defaults of a manifest that lacks them).

@@ -98,6 +98,7 @@ Status BowingOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(
       CheckInRange("bowing min_speed_mm_per_s", min_speed_mm_per_s, kBowMinSpeedRangeMmPerS));
   ARCO_RETURN_IF_ERROR(CheckInRange("bowing max_lift_mm", max_lift_mm, kBowMaxLiftRangeMm));
+  ARCO_RETURN_IF_ERROR(CheckInRange("bowing min_stroke_mm", min_stroke_mm, kBowMinStrokeRangeMm));
   ARCO_RETURN_IF_ERROR(CheckInRange(
       "bowing double_stop_margin_deg", double_stop_margin_deg, kBowDoubleStopMarginRangeDeg));
   return CheckInRange("bowing onset_tolerance_s", onset_tolerance_s, kBowOnsetToleranceRangeS);
@@ -188,59 +189,81 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
     } else if (prev) {
       v = (along_mm[f] - along_mm[f - 1]) * input.fps;
     }
-    BowingFrame& bf = out.frames[f];
-    bf.bow_speed_mm_per_s = v;
-    if (std::isfinite(v) && std::abs(v) >= options.min_speed_mm_per_s) {
-      bf.direction = v > 0 ? BowDirection::kDown : BowDirection::kUp;
-    }
+    out.frames[f].bow_speed_mm_per_s = v;
   }
 
-  // Bow changes: between two moving frames of opposite directions, at the turning point of
-  // the contact's place; its instant is where the straight strokes on either side meet.
-  size_t last_moving = n;
+  // Strokes: the turning points of the contact's place on the bow, each confirmed only once
+  // the bow has gone back min_stroke_mm from it (a zigzag filter: the points' jitter and a
+  // slow bow's wobble make no bow change). Frames off the strings take no part.
+  std::vector<size_t> on;  // frames on a string, in order
   for (size_t f = 0; f < n; ++f) {
-    const BowDirection d = out.frames[f].direction;
-    if (d == BowDirection::kNone) continue;
-    if (last_moving < n && out.frames[last_moving].direction != d) {
-      const double sign = out.frames[last_moving].direction == BowDirection::kDown ? 1.0 : -1.0;
-      size_t k = last_moving;
-      for (size_t g = last_moving; g <= f; ++g) {
-        if (seen(g) && sign * along_mm[g] > sign * along_mm[k]) k = g;
-      }
-      auto time = [&](size_t g) { return out.frames[g].time_s; };
-      std::vector<std::pair<double, double>> before, after;
-      for (size_t g = k >= 3 ? k - 3 : 0; g < k; ++g) {
-        if (seen(g)) before.emplace_back(time(g), along_mm[g]);
-      }
-      for (size_t g = k + 1; g <= std::min(n - 1, k + 3); ++g) {
-        if (seen(g)) after.emplace_back(time(g), along_mm[g]);
-      }
-      double t_change = time(k);
-      double b0 = 0, b1 = 0, a0 = 0, a1 = 0;
-      if (FitLine(before, &b0, &b1) && FitLine(after, &a0, &a1) && std::abs(b1 - a1) > 1e-9) {
-        const double t = (a0 - b0) / (b1 - a1);
-        const double lo = k > 0 ? time(k - 1) : time(k), hi = k + 1 < n ? time(k + 1) : time(k);
-        t_change = std::clamp(t, lo, hi);
-      }
-      out.change_times_s.push_back(t_change);
-      // Frames between the two moving frames take their side's direction; still frames
-      // farther than 1.5 frames from the change stay without one.
-      const BowDirection from = out.frames[last_moving].direction;
-      for (size_t g = last_moving + 1; g < f; ++g) {
-        BowingFrame& bg = out.frames[g];
-        if (!bg.seen) continue;
-        const bool near = std::abs(bg.time_s - t_change) * input.fps <= 1.5;
-        if (bg.direction == BowDirection::kNone && !near) continue;
-        bg.direction = bg.time_s < t_change ? from : d;
-      }
-      for (size_t g = last_moving + 1; g <= f; ++g) {
-        if (out.frames[g].time_s >= t_change) {
-          out.frames[g].bow_change = true;
-          break;
+    if (seen(f) && out.frames[f].string > 0) on.push_back(f);
+  }
+  const double step = options.min_stroke_mm;
+  int first_direction = 0;           // +1 down, -1 up; 0 until the bow has moved `step`
+  std::vector<size_t> turns;         // frames of the turning points
+  {
+    int dir = 0;
+    size_t lo = 0, hi = 0, ext = 0;  // indices into `on`
+    for (size_t i = 0; i < on.size(); ++i) {
+      const double p = along_mm[on[i]];
+      if (dir == 0) {
+        if (p < along_mm[on[lo]]) lo = i;
+        if (p > along_mm[on[hi]]) hi = i;
+        if (p - along_mm[on[lo]] >= step) {
+          dir = first_direction = 1, ext = i;
+        } else if (along_mm[on[hi]] - p >= step) {
+          dir = first_direction = -1, ext = i;
         }
+        continue;
+      }
+      if (dir * (p - along_mm[on[ext]]) > 0) {
+        ext = i;
+      } else if (dir * (along_mm[on[ext]] - p) >= step) {
+        turns.push_back(ext);
+        dir = -dir;
+        ext = i;
       }
     }
-    last_moving = f;
+  }
+  // Each turn's instant: where lines through the three frames on either side meet.
+  auto time = [&](size_t f) { return out.frames[f].time_s; };
+  for (size_t k : turns) {
+    std::vector<std::pair<double, double>> before, after;
+    for (size_t j = k >= 3 ? k - 3 : 0; j < k; ++j) before.emplace_back(time(on[j]), along_mm[on[j]]);
+    for (size_t j = k + 1; j < std::min(on.size(), k + 4); ++j) {
+      after.emplace_back(time(on[j]), along_mm[on[j]]);
+    }
+    double t_change = time(on[k]);
+    double b0 = 0, b1 = 0, a0 = 0, a1 = 0;
+    if (FitLine(before, &b0, &b1) && FitLine(after, &a0, &a1) && std::abs(b1 - a1) > 1e-9) {
+      const double lo = k > 0 ? time(on[k - 1]) : time(on[k]);
+      const double hi = k + 1 < on.size() ? time(on[k + 1]) : time(on[k]);
+      t_change = std::clamp((a0 - b0) / (b1 - a1), lo, hi);
+    }
+    out.change_times_s.push_back(t_change);
+  }
+  // Directions: each frame on a string takes its stroke's, where the bow moves (or within
+  // 1.5 frames of a change); the first frame after each change is marked.
+  if (first_direction != 0) {
+    size_t next_change = 0;
+    int dir = first_direction;
+    for (size_t f : on) {
+      BowingFrame& bf = out.frames[f];
+      while (next_change < out.change_times_s.size() && bf.time_s >= out.change_times_s[next_change]) {
+        ++next_change;
+        dir = -dir;
+        bf.bow_change = true;
+      }
+      const bool moving = std::isfinite(bf.bow_speed_mm_per_s) &&
+                          std::abs(bf.bow_speed_mm_per_s) >= options.min_speed_mm_per_s;
+      bool near_change = false;
+      for (size_t c = next_change > 0 ? next_change - 1 : 0;
+           c < std::min(out.change_times_s.size(), next_change + 1); ++c) {
+        near_change = near_change || std::abs(bf.time_s - out.change_times_s[c]) * input.fps <= 1.5;
+      }
+      if (moving || near_change) bf.direction = dir > 0 ? BowDirection::kDown : BowDirection::kUp;
+    }
   }
 
   // Notes: the refinement's, with their frames' bowing.
@@ -335,6 +358,7 @@ Json ToJson(const BowingSummary& s) {
 Json ToJson(const BowingOptions& o) {
   return {{"min_speed_mm_per_s", o.min_speed_mm_per_s},
           {"max_lift_mm", o.max_lift_mm},
+          {"min_stroke_mm", o.min_stroke_mm},
           {"double_stop_margin_deg", o.double_stop_margin_deg},
           {"onset_tolerance_s", o.onset_tolerance_s}};
 }

@@ -16,9 +16,10 @@
 //
 // Motion. The contact's place along the bow (mm from the frog) over time: its rate is the
 // bow speed, positive for a down-bow (the contact moves from the frog toward the tip, the
-// bow is drawn toward the performer's right). A bow change is located between frames
-// where the two straight strokes around the turning point meet (their lines intersected),
-// and each frame takes the direction of its side of that instant.
+// bow is drawn toward the performer's right). Bow changes are its turning points, each
+// confirmed once the bow has gone back `min_stroke_mm` (a zigzag filter: jitter and a slow
+// bow's wobble are no change), located between frames where the two straight strokes
+// around it meet; each frame on a string takes its stroke's direction where the bow moves.
 #pragma once
 
 #include <Eigen/Core>
@@ -36,12 +37,16 @@ namespace arco::refine {
 
 inline constexpr NumberRange kBowMinSpeedRangeMmPerS = Closed(0, 1000);
 inline constexpr NumberRange kBowMaxLiftRangeMm = AboveZero(500);
+inline constexpr NumberRange kBowMinStrokeRangeMm = AboveZero(500);
 inline constexpr NumberRange kBowDoubleStopMarginRangeDeg = Closed(0, 20);
 inline constexpr NumberRange kBowOnsetToleranceRangeS = AboveZero(1);
 
 struct BowingOptions {
   // Slower than this the bow is still: no direction (unless at a bow change).
   double min_speed_mm_per_s = 50;
+  // A bow change is confirmed once the bow has gone back this far from the turning point:
+  // smaller reversals are the points' jitter or a slow bow's wobble.
+  double min_stroke_mm = 20;
   // A bow line farther than this from the string it is inclined to is off the strings.
   // SPD's stick points lie up to 26 mm from the string they play (docs/bowing.md).
   double max_lift_mm = 30;

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "arco/util/npy.h"
+
 namespace arco::refine {
 namespace {
 
@@ -266,6 +268,52 @@ TEST(BowingCsv, RoundTripsAndRejectsBadRows) {
     EXPECT_NE(r.status().message().find(what), std::string::npos) << r.status().message();
   }
   std::filesystem::remove_all(dir);
+}
+
+// SPD's real cello take (their 3D: the bow's frog and tip on the stick, the strings lowest
+// first): the bow is on the A string wherever a finger presses it (DOMAIN.md: every pressed
+// frame of this half is on the A string), and it moves in strokes.
+TEST(AnalyzeBowing, RealTakeBowIsOnTheStringSpdPlays) {
+  const auto take = ReadNpy<double>(std::string(ARCO_SHARED_DATA_DIR) +
+                                    "/spd/cello01_first_half_results.npy");
+  ASSERT_TRUE(take.ok()) << take.status().message();
+  const NpyArray<double>& a = *take;
+  ASSERT_EQ(a.shape, (std::vector<int64_t>{330, 155, 3}));
+  const InstrumentModel cello = Scene::MakeModel(InstrumentKind::kCello);
+  auto point = [&](int64_t f, int64_t k) {
+    return Eigen::Vector3d(a.at(f, k, 0), a.at(f, k, 1), a.at(f, k, 2));
+  };
+  BowingInput in;
+  for (int64_t f = 0; f < a.shape[0]; ++f) {
+    in.frog_in_world_mm.push_back(point(f, 140));
+    in.tip_in_world_mm.push_back(point(f, 141));
+    std::vector<StringSegment> strings(4);
+    for (int k = 0; k < 4; ++k) {  // SPD: C, G, D, A (top = nut end, bottom = bridge end)
+      StringSegment& s = strings[static_cast<size_t>(3 - k)];
+      s.string = 4 - k;
+      s.nut = point(f, 142 + 2 * k);
+      s.bridge = point(f, 143 + 2 * k);
+    }
+    in.strings_in_world_mm.push_back(strings);
+  }
+  const BowingResult r = AnalyzeBowing(cello, in, {}).value();
+  int pressed = 0, on_a = 0;
+  for (int64_t f = 0; f < a.shape[0]; ++f) {
+    if (!std::isfinite(a.at(f, 150, 0))) continue;
+    ++pressed;
+    on_a += r.frames[static_cast<size_t>(f)].string == 1;
+  }
+  EXPECT_EQ(pressed, 262);
+  EXPECT_GE(on_a, 0.97 * pressed) << on_a << " of " << pressed;
+  // Strokes: the contact's place on SPD's bow (read off their points, docs/bowing.md) runs
+  // from 0.16 of the bow to 0.85 by frame 130 (many notes slurred in one down-bow), back
+  // to 0.22 by frame 211, to 0.71 by 259, then toward the frog: three bow changes.
+  ASSERT_EQ(r.change_times_s.size(), 3u);
+  const double turns_s[] = {130 / 30.0, 211 / 30.0, 259 / 30.0};
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(r.change_times_s[static_cast<size_t>(i)], turns_s[i], 0.15);
+  // The sounding point lies between the bridge and the fingerboard's end.
+  EXPECT_GT(r.summary.median_sounding_point_mm, 20);
+  EXPECT_LT(r.summary.median_sounding_point_mm, 115);
 }
 
 }  // namespace

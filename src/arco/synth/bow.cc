@@ -39,9 +39,8 @@ Status BowOptions::Validate() const {
   if (!(contact_fraction > 0 && contact_fraction < 0.3)) {
     return Status::Error("bow: contact fraction must be in (0, 0.3)");
   }
-  if (!(crossing_s >= 0) || !(lift_mm >= 0) ||
-      !(tilt_per_string_deg >= 0 && tilt_per_string_deg < 40)) {
-    return Status::Error("bow: crossing_s, lift_mm >= 0 and tilt in [0, 40) degrees");
+  if (!(crossing_s >= 0) || !(lift_mm >= 0)) {
+    return Status::Error("bow: crossing_s and lift_mm must be >= 0");
   }
   return Status::Ok();
 }
@@ -91,10 +90,15 @@ BowAnimator::BowAnimator(const hand::HandModel& right_hand,
   hold_ = hand::ClampToLimits(right_hand, hold_);
 }
 
-double BowAnimator::TiltDeg(int string) const {
-  // Centre strings ~0, outer strings tilted; the sign follows the string's side.
-  const double mid = 0.5 * (instrument_.num_strings() + 1);
-  return options_.tilt_per_string_deg * (string - mid);
+double BowAnimator::TiltRad(int string) const {
+  // The bow direction u = (0, -side cos t, sin t) has the inclination atan(u_z / u_y) =
+  // BowInclinationRad(string) when t = -side * that inclination.
+  return -side_sign_ * instrument_.BowInclinationRad(string);
+}
+
+double BowAnimator::ContactFraction(size_t note) const {
+  const double v = std::clamp(perf_.notes[note].note.velocity, 1, 127);
+  return options_.contact_fraction * (1.25 - 0.5 * (v - 1) / 126.0);
 }
 
 double BowAnimator::BowFractionAt(double t) const {
@@ -135,21 +139,26 @@ BowFrame BowAnimator::At(double t) const {
     crossing_u =
         SmoothStep((t - notes[cur].note.onset_s + options_.crossing_s) / options_.crossing_s);
   }
-  const double tilt =
-      (TiltDeg(prev_string) + (TiltDeg(string) - TiltDeg(prev_string)) * crossing_u) * kDeg;
+  const double tilt = TiltRad(prev_string) + (TiltRad(string) - TiltRad(prev_string)) * crossing_u;
   out.string = idx >= 0 ? string : 0;
   const double lift = idx >= 0 ? 0.0 : options_.lift_mm;
 
   // Contact on the string (interpolated across strings while crossing).
-  const double f = options_.contact_fraction;
+  const double f = ContactFraction(cur);
   const Eigen::Vector3d c0 =
       tmpl_.strings_mm[static_cast<size_t>(prev_string - 1)].PointAtFraction(f);
   const Eigen::Vector3d c1 = tmpl_.strings_mm[static_cast<size_t>(string - 1)].PointAtFraction(f);
+  if (idx >= 0) {
+    const StringSegment& sounding = tmpl_.strings_mm[static_cast<size_t>(string - 1)];
+    out.sounding_point_mm = f * (sounding.nut - sounding.bridge).norm();
+    out.direction = stroke_end_[cur] >= stroke_start_[cur] ? 1 : -1;
+  }
   const Eigen::Vector3d contact = c0 + (c1 - c0) * crossing_u + Eigen::Vector3d(0, 0, lift);
   // Bow direction frog -> tip: away from the performer's right, tilted about x.
   const Eigen::Vector3d u =
       (Eigen::Vector3d(0, -side_sign_ * std::cos(tilt), std::sin(tilt))).normalized();
   const double s = BowFractionAt(t);
+  out.bow_position = s;
   out.frog_mm = contact - s * bow_length_mm_ * u;
   out.tip_mm = contact + (1 - s) * bow_length_mm_ * u;
 

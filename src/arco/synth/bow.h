@@ -1,10 +1,12 @@
 // The bow and the right hand, in the instrument frame (synth_instrument.h).
 //
 // The bow is a straight hair line of `bow_length_mm` from the frog to the tip,
-// perpendicular to the strings, touching the sounding string at
+// perpendicular to the strings, touching the sounding string at about
 // `contact_fraction` of the string length from the bridge (between bridge and
-// fingerboard). It is tilted about the string axis to select the string
-// (string crossings glide over `crossing_s`). Each note is one stroke,
+// fingerboard): louder notes nearer the bridge (the fraction scaled from 1.25x at
+// velocity 1 to 0.75x at 127), so the sounding point changes from note to note. It is
+// inclined about the string axis as a bow resting on that string of an arched bridge
+// (InstrumentModel::BowInclinationRad; string crossings glide over `crossing_s`). Each note is one stroke,
 // alternating down-bow (the contact moves from the frog towards the tip) and
 // up-bow; a stroke uses more bow for longer notes. In silence the bow rests
 // `lift_mm` above the string. The right hand holds the frog in a fixed bow-hold
@@ -26,13 +28,18 @@ struct BowOptions {
   double contact_fraction = 0.08;   // bow-string contact, fraction of the string from the bridge
   double crossing_s = 0.06;         // duration of a string crossing
   double lift_mm = 15;              // bow above the string in silence
-  double tilt_per_string_deg = 12;  // tilt between adjacent strings
   Status Validate() const;
 };
 
 struct BowFrame {
   Eigen::Vector3d frog_mm, tip_mm;  // instrument frame
   int string = 0;                   // 1 = highest; 0 in silence
+  // Truth of the bow arm (refine/bowing.h's conventions): +1 down-bow (the contact moves
+  // from the frog toward the tip), -1 up-bow, 0 in silence; the contact's distance from
+  // the bridge along the string and its place on the bow (0 frog, 1 tip).
+  int direction = 0;
+  double sounding_point_mm = 0;
+  double bow_position = 0;
   hand::HandPose right_hand;        // instrument_from_wrist
 };
 
@@ -49,7 +56,8 @@ class BowAnimator {
   BowFrame At(double time_s) const;
 
  private:
-  double TiltDeg(int string) const;
+  double TiltRad(int string) const;
+  double ContactFraction(size_t note) const;
   double BowFractionAt(double time_s) const;  // fraction of the bow at the contact
 
   const hand::HandModel& right_hand_;

@@ -66,6 +66,7 @@ TruthFolder MakeTruthFolder(const SyntheticCapture& c,
   t.left_hand.resize(frames);  // no hand pose truth: NaN rows
   t.right_hand.resize(frames);
   t.world_from_instrument = c.world_from_instrument;
+  t.bowing = c.bowing;
   for (int f = 0; f < c.num_frames; ++f) {
     const ContactTruth& truth = c.contact[static_cast<size_t>(f)];
     refine::ContactRow r;

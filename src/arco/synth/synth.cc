@@ -124,6 +124,7 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
   cap.left_hand.resize(static_cast<size_t>(F));
   cap.right_hand.resize(static_cast<size_t>(F));
   cap.contact.resize(static_cast<size_t>(F));
+  cap.bowing.resize(static_cast<size_t>(F));
   cap.world_from_instrument.resize(static_cast<size_t>(F));
   std::vector<DetectionFrame> det_frames(static_cast<size_t>(F));
 
@@ -156,6 +157,13 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
 
     // Bow and right hand.
     const BowFrame bf = bow.At(t);
+    refine::BowingFrame& bow_truth = cap.bowing[static_cast<size_t>(fr)];
+    bow_truth.time_s = t;
+    bow_truth.seen = true;
+    bow_truth.string = bf.string;
+    bow_truth.direction = static_cast<refine::BowDirection>(bf.direction);
+    bow_truth.sounding_point_mm = bf.string > 0 ? bf.sounding_point_mm : NAN;
+    bow_truth.bow_position = bf.bow_position;
     hand::HandPose rw = bf.right_hand;
     rw.world_from_wrist_rotation =
         world_from_instrument.rotation * bf.right_hand.world_from_wrist_rotation;

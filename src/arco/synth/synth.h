@@ -16,6 +16,7 @@
 #include "arco/camera/rig.h"
 #include "arco/hand/hand_model.h"
 #include "arco/instrument/instrument_model.h"
+#include "arco/refine/bowing.h"
 #include "arco/synth/body.h"
 #include "arco/synth/bow.h"
 #include "arco/synth/detections.h"
@@ -80,6 +81,7 @@ struct SyntheticCapture {
   NpyArray<double> points3d;
   std::vector<hand::HandPose> left_hand, right_hand;  // world_from_wrist, mm
   std::vector<ContactTruth> contact;
+  std::vector<refine::BowingFrame> bowing;  // the bow arm (bow.h); empty for a recording
   std::vector<Eigen::Matrix4d> world_from_instrument;  // rotation | bridge centre, mm
   NpyArray<float> keypoints2d;                         // (frames, views, capture points, 3)
   double max_residual_shift_mm = 0;  // largest whole-hand correction the IK needed

@@ -22,13 +22,14 @@ constexpr char kInstrumentPoseFile[] = "instrument_pose.npy";
 constexpr char kContactFile[] = "contact.csv";
 constexpr char kPitchFile[] = "pitch.csv";
 constexpr char kNotesFile[] = "notes.csv";
+constexpr char kBowingFile[] = "bowing.csv";  // refine/bowing.h's format
 constexpr char kContactCsvHeader[] =
     "frame,time_s,state,string,finger,note,f0_hz,contact_x_mm,contact_y_mm,contact_z_mm";
 constexpr char kNotesCsvHeader[] =
     "note,onset_s,offset_s,midi_note,name,velocity,string,finger,position_semitones,"
     "intonation_cents,vibrato_rate_hz,vibrato_extent_cents";
 
-Json ManifestJson(const TruthManifest& m) {
+Json ManifestJson(const TruthManifest& m, bool has_bowing) {
   Json j;
   j["format"] = kTruthFormat;
   j["version"] = kTruthVersion;
@@ -73,6 +74,7 @@ Json ManifestJson(const TruthManifest& m) {
                 {"contact", kContactFile},
                 {"pitch", kPitchFile},
                 {"notes", kNotesFile}};
+  if (has_bowing) j["files"]["bowing"] = kBowingFile;
   return j;
 }
 
@@ -262,7 +264,11 @@ Status WriteTruthFolder(const std::string& dir, const TruthFolder& t) {
   // A recording's pitch is not known: no pitch.csv (eval reports pitch absent).
   if (t.manifest.motion_source.empty())
     ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(JoinPath(dir, kPitchFile), t.pitch));
-  return WriteJsonFile(JoinPath(dir, kManifestFile), ManifestJson(t.manifest));
+  // The bow arm's truth (generated performances; a recording has none).
+  if (!t.bowing.empty()) {
+    ARCO_RETURN_IF_ERROR(refine::WriteBowingCsv(JoinPath(dir, kBowingFile), t.bowing));
+  }
+  return WriteJsonFile(JoinPath(dir, kManifestFile), ManifestJson(t.manifest, !t.bowing.empty()));
 }
 
 StatusOr<TruthFolder> ReadTruthFolder(const std::string& dir) {
@@ -310,6 +316,13 @@ StatusOr<TruthFolder> ReadTruthFolder(const std::string& dir) {
   const std::string pitch_path = JoinPath(dir, kPitchFile);
   if (FileExists(pitch_path)) {
     ARCO_ASSIGN_OR_RETURN(t.pitch, audio::ReadPitchCsv(pitch_path));
+  }
+  // bowing.csv may be absent (a recording, or a truth written before it existed).
+  const std::string bowing_path = JoinPath(dir, kBowingFile);
+  if (FileExists(bowing_path)) {
+    ARCO_ASSIGN_OR_RETURN(t.bowing, refine::ReadBowingCsv(bowing_path));
+    if (static_cast<int64_t>(t.bowing.size()) != frames)
+      return frames_error(bowing_path, static_cast<int64_t>(t.bowing.size()));
   }
   return t;
 }

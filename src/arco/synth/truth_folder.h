@@ -13,6 +13,9 @@
 //                          contact_y_mm,contact_z_mm (time_s = frame / fps)
 //   pitch.csv              frame,time_s,f0_hz,confidence,voiced (confidence 0: not scored)
 //   notes.csv              one row per note: timing, pitch, fingering, expression
+//   bowing.csv             the bow arm per frame (refine/bowing.h's format: string,
+//                          direction, sounding_point_mm, bow_position); absent for a
+//                          re-captured recording
 //
 // The CSVs print fixed decimals (contact.csv 4 for mm and Hz, notes.csv 6 for seconds and 3
 // for cents and Hz): values read back equal the written ones only to that precision.
@@ -27,6 +30,7 @@
 
 #include "arco/audio/pitch_tracker.h"
 #include "arco/hand/hand_model.h"
+#include "arco/refine/bowing.h"
 #include "arco/refine/contacts_csv.h"
 #include "arco/util/npy.h"
 #include "arco/util/json_io.h"
@@ -90,6 +94,7 @@ struct TruthFolder {
   std::vector<refine::ContactRow> contacts;
   std::vector<audio::PitchFrame> pitch;  // one per frame
   std::vector<TruthNote> notes;
+  std::vector<refine::BowingFrame> bowing;  // one per frame, or empty: no bow truth
 };
 
 // Paths of files inside a truth folder `dir`, for messages about their contents.
