@@ -221,6 +221,13 @@ for expected in \
   check 'grep -q "^arco workflow: $expected.*; its capture stage fails$" badopts.txt' \
     "no line \"$expected\": $(grep "arco workflow" badopts.txt)"
 done
+# A flag in both the config's args and a take's options: arco's own line, naming the key.
+mkdir -p clashtakes && cp -r badopts/range clashtakes/clash
+sed -i 's/min-confidence: 7/min-confidence: 0.7/' clashtakes/clash/take.yaml
+"${snakemake[@]}" -s "$snakefile" --cores 2 -n --config takes=clashtakes out=out-c \
+  arco="$arco" args="{run: '--min-confidence 0.6'}" > clash.txt 2>&1
+check 'grep -q "^arco workflow: take clash: .*take.yaml: options.run.min-confidence: --min-confidence: At Most 1 required but received 2" clash.txt' \
+  "a flag in args and options: $(grep "arco workflow" clash.txt)"
 check '! grep -qE "Traceback|^  File \"|Error in file" badopts.txt' \
   "a Python traceback: $(grep -B2 -A8 -E "Traceback|File \"" badopts.txt | head -20)"
 
