@@ -84,6 +84,14 @@ rc=$?
 check '[ $rc -eq 1 ] && grep -q "^arco: error: snakemake: not found; .*apt-get install snakemake" batch2.txt' \
   "arco batch without snakemake: $(cat batch2.txt)"
 
+# A workflow that cannot start is one line, not Snakemake's report of the Snakefile's stack.
+mkdir notakes
+"$arco" batch notakes -o out-none --workflow "$here" > batch3.txt 2>&1
+rc=$?
+check '[ $rc -eq 1 ] && grep -q "^arco workflow: error: no takes in .*notakes$" batch3.txt &&
+       ! grep -qE "Traceback|File \"|SystemExit|WorkflowError" batch3.txt' \
+  "arco batch without takes: exit $rc: $(cat batch3.txt)"
+
 # A changed input redoes only its take (Snakemake compares contents: a touch alone is no change).
 before1=$(stat -c %Y out/take1/eval.json)
 echo " " >> takes/take2/capture.json
@@ -153,6 +161,9 @@ labels:
   cam0: labels/cam0.json
   cam1: labels/cam1.json
 sync: clap
+options:
+  track: {no-bow: true, inlier-px: 2.5}
+  run: {min-confidence: 0.6}
 YAML
 cp takes/take1/calibration.json sessions/spd1/spd1_camera.json
 echo '{"StartFrame": 1, "EndFrame": 10}' > sessions/spd1/spd1_summary.json
@@ -166,14 +177,59 @@ check 'grep -q "capture new --calibration .*video1/calibration.json --instrument
 check 'grep -q "detect .*out-s/video1/detect --threads" sessions.txt' "video1: detect"
 check 'grep -q "sync .*audio.wav --capture .*out-s/video1/sync --event clap" sessions.txt' "video1: sync"
 check 'grep -q "run .*out-s/video1/sync -o .*out-s/video1/result" sessions.txt' "video1: run"
+check 'grep -q "run .*out-s/video1/result --threads [0-9]*  *--min-confidence 0.6 " sessions.txt' \
+  "video1: run without the take's options: $(grep " run " sessions.txt)"
 if "$arco" --help | grep -qE '^\s+track\s'; then
   check 'grep -q "track .*out-s/video1/track --labels cam0=" sessions.txt' "video1: track"
+  check 'grep -q "track .*out-s/video1/track .*--no-bow --inlier-px 2.5 " sessions.txt' \
+    "video1: track without the take's options: $(grep " track " sessions.txt)"
 else
   check '! grep -q "rule track" sessions.txt' "video1: track without arco track"
 fi
 check 'grep -q "import-spd --calibration .*spd1_camera.json --human .*spd1/human --instrument violin --instrument-points .*spd1/instrument --summary .*spd1_summary.json --name spd1 -o .*out-s/spd1/capture" sessions.txt' \
   "spd1: import-spd: $(grep "import-spd" sessions.txt)"
 check 'grep -q "notatake: not a take" sessions.txt' "notatake was not skipped with a message"
+
+# A take's options are checked by arco when the takes are planned: each defect is one
+# line naming the take file and the key, and fails that take alone; a take file that is
+# not text is such a line too, never a Python traceback.
+mkdir -p badopts
+for t in unknown range stage workflow notmap list binary; do
+  mkdir -p badopts/$t/videos
+  cp takes/take1/calibration.json badopts/$t/
+  touch badopts/$t/videos/cam0.mp4
+  printf 'calibration: calibration.json\ncameras:\n  cam0: videos/cam0.mp4\n' > badopts/$t/take.yaml
+done
+echo 'options: {run: {no-such-flag: 1}}' >> badopts/unknown/take.yaml
+echo 'options: {run: {min-confidence: 7}}' >> badopts/range/take.yaml
+echo 'options: {track: {no-bow: true}}' >> badopts/stage/take.yaml
+echo 'options: {run: {threads: 3}}' >> badopts/workflow/take.yaml
+echo 'options: [run]' >> badopts/notmap/take.yaml
+echo 'options: {detect: {chunk-frames: {a: 1}}}' >> badopts/list/take.yaml
+printf '\xff\xfe\x00 not text' > badopts/binary/take.yaml
+"${snakemake[@]}" -s "$snakefile" --cores 2 -n --config takes=badopts out=out-b \
+  arco="$arco" > badopts.txt 2>&1
+y=".*badopts/[a-z]*/take.yaml"
+for expected in \
+  "take unknown: $y: options.run.no-such-flag: .*--no-such-flag" \
+  "take range: $y: options.run.min-confidence: --min-confidence: 7 is outside \[0.2, 1\]" \
+  "take stage: $y: options.track: not a stage of this take (its stages: capture, detect, run)" \
+  "take workflow: $y: options.run.threads: set by the workflow, not by a take" \
+  "take notmap: $y: options must map stages to their flags" \
+  "take list: $y: options.detect.chunk-frames: give a value, true/false or a list of values" \
+  "take binary: $y: not UTF-8 text (byte 0)"; do
+  check 'grep -q "^arco workflow: $expected.*; its capture stage fails$" badopts.txt' \
+    "no line \"$expected\": $(grep "arco workflow" badopts.txt)"
+done
+# A flag in both the config's args and a take's options: arco's own line, naming the key.
+mkdir -p clashtakes && cp -r badopts/range clashtakes/clash
+sed -i 's/min-confidence: 7/min-confidence: 0.7/' clashtakes/clash/take.yaml
+"${snakemake[@]}" -s "$snakefile" --cores 2 -n --config takes=clashtakes out=out-c \
+  arco="$arco" args="{run: '--min-confidence 0.6'}" > clash.txt 2>&1
+check 'grep -q "^arco workflow: take clash: .*take.yaml: options.run.min-confidence: --min-confidence: At Most 1 required but received 2" clash.txt' \
+  "a flag in args and options: $(grep "arco workflow" clash.txt)"
+check '! grep -qE "Traceback|^  File \"|Error in file" badopts.txt' \
+  "a Python traceback: $(grep -B2 -A8 -E "Traceback|File \"" badopts.txt | head -20)"
 
 # An SPD session for real: take1's capture written out in SPD's layout (per camera and
 # frame JSON, a summary, the calibration, the audio), then import-spd -> run.
@@ -197,6 +253,8 @@ with open(os.path.join(session, "session_summary.json"), "w") as out:
 shutil.copy(os.path.join(capture, m["calibration"]), os.path.join(session, "session_camera.json"))
 shutil.copy(os.path.join(capture, "audio.wav"), os.path.join(session, "audio.wav"))
 PY
+  # Its take file passes an option to `arco run` (recorded with the result's options).
+  echo 'options: {run: {min-confidence: 0.7}}' > spdtakes/spd1/take.yaml
   # Beside it a video session whose take file names a missing calibration: it fails alone.
   mkdir -p spdtakes/missing
   printf 'calibration: cal.json\ncameras:\n  cam0: cam0.mp4\n' > spdtakes/missing/take.yaml
@@ -208,6 +266,8 @@ PY
   check 'grep -q "imported 75 frames x 20 views x 142 points" out-spd/spd1/logs/capture.log &&
          [ "$(tail -1 out-spd/summary.tsv | cut -f1-5)" = "$(printf "spd1\tok\t\t75\t20")" ]' \
     "SPD session: $(tail -5 spd.txt) $(cat out-spd/summary.tsv)"
+  check 'grep -q "\"min_confidence\": 0.7" out-spd/spd1/result/result.json' \
+    "the take's option did not reach arco run: $(grep -o "\"min_confidence\": [0-9.]*" out-spd/spd1/result/result.json)"
 else
   echo "no numpy for Debian's python3: the SPD session is only dry-run"
 fi

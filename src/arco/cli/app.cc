@@ -42,6 +42,10 @@ App BuildApp() {
                  *built.data_dir,
                  "Folder of arco's data (viewer page, three.js, detector models, workflow); "
                  "default: $ARCO_DATA_DIR, else ../share/arco beside the executable's folder");
+  app.add_flag("--check-args",
+               *built.check_args,
+               "Check the command line (every flag and range, the command's options) and exit "
+               "0 when it is valid, reading and writing nothing");
   auto registry = CommandRegistry();
   std::stable_sort(registry.begin(),
                    registry.end(),
@@ -73,6 +77,7 @@ void App::Parse(std::vector<std::string> args) {
 }
 
 int App::Run() {
+  if (*check_args) return 0;  // Parse() has checked everything a command line can hold
   // --data-dir as $ARCO_DATA_DIR, which every lookup (util/data_dir.h) and every arco this
   // one starts (arco batch's workflow) reads.
   if (!data_dir->empty()) {

@@ -26,6 +26,9 @@ struct App {
   // `arco --data-dir DIR`: Run() makes it $ARCO_DATA_DIR (util/data_dir.h). Shared so the
   // option's storage stays put when the App moves.
   std::shared_ptr<std::string> data_dir = std::make_shared<std::string>();
+  // `arco --check-args COMMAND ...`: Run() returns 0 after a successful Parse(), running
+  // nothing (the workflow checks a take's `options:` so, docs/workflow.md).
+  std::shared_ptr<bool> check_args = std::make_shared<bool>(false);
 
   // Throws CLI::ParseError (CallForHelp and CallForVersion included) and nothing else for
   // any argv. args excludes the program name.

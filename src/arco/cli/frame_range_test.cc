@@ -34,5 +34,15 @@ TEST(ParseFrameRange, RejectsWhatIsNotTwoWholeNumbers) {
   }
 }
 
+// The flag the user typed, not the options' fields ("last_frame 2 is before first_frame 5").
+TEST(ParseFrameRange, RejectsLastBeforeFirstNamingTheFlag) {
+  int64_t first = -1, last = -1;
+  const Status status = ParseFrameRange("5:2", &first, &last);
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.message(), "--frames \"5:2\": LAST is before FIRST");
+  first = last = -1;
+  EXPECT_TRUE(ParseFrameRange("5:5", &first, &last).ok());
+}
+
 }  // namespace
 }  // namespace arco::cli

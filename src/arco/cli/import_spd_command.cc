@@ -3,11 +3,16 @@
 #include <memory>
 
 #include "arco/cli/command.h"
+#include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
 #include "arco/pipeline/import_spd.h"
 
 namespace arco::cli {
 namespace {
+
+// ImportSpdOptions' fields as `arco import-spd` sets them.
+inline constexpr FieldFlag kImportSpdFlags[] = {{"frame_first", "--first"},
+                                                {"frame_last", "--last"}};
 
 CommandRun Setup(CLI::App& app) {
   auto o = std::make_shared<pipeline::ImportSpdOptions>();
@@ -68,7 +73,7 @@ CommandRun Setup(CLI::App& app) {
   return CommandRun(
       [o]() {
         auto r = pipeline::ImportSpdCapture(*o);
-        if (!r.ok()) return PrintError(r.status().message());
+        if (!r.ok()) return PrintError(WithFlagNames(r.status().message(), kImportSpdFlags));
         std::printf(
             "imported %lld frames x %lld views x %lld points (%lld files read, %lld missing -> "
             "NaN, "

@@ -45,7 +45,7 @@ int RunTrack(const TrackArgs& a) {
   ProgressBar bar("track");
   auto summary = pipeline::RunTrackStage(a.o, bar);
   bar.Finish();
-  if (!summary.ok()) return PrintError(summary.status().message());
+  if (!summary.ok()) return PrintError(WithFlagNames(summary.status().message(), kTrackFlags));
   const auto& s = *summary;
   for (const auto& w : s.warnings) {
     std::fprintf(stderr, "arco: warning: %s\n", WithFlagNames(w, kTrackFlags).c_str());
@@ -59,6 +59,12 @@ int RunTrack(const TrackArgs& a) {
   std::string points;
   for (const auto& p : s.tracked_points) points += (points.empty() ? "" : " ") + p;
   std::printf("  points: %s (labels agree to %.2f px)\n", points.c_str(), s.label_rms_px);
+  if (s.units != "mm") {
+    std::printf("  world in %s units: %.4g mm per unit%s\n",
+                s.units.c_str(),
+                s.mm_per_unit,
+                s.units == "m" ? "" : " (the labelled nut-bridge distance as the string length)");
+  }
   for (const auto& c : s.cameras) {
     std::printf(
         "  %-12s %6lld frames  inliers %6.1f  residual %5.2f px  lost %lld  "

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <optional>
@@ -10,6 +11,7 @@
 #include <utility>
 
 #include "arco/calibration/calibration_file.h"
+#include "arco/instrument/instrument_model.h"
 #include "arco/media/video_reader.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/labelme.h"
@@ -27,6 +29,12 @@ constexpr float kNaNf = std::numeric_limits<float>::quiet_NaN();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr char kKeypointsFile[] = "keypoints2d.npy";
 constexpr char kReportFile[] = "track.json";
+
+std::string FormatNumber(double v) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.4g", v);
+  return text;
+}
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -104,6 +112,34 @@ Json ViewJson(const track::ViewTrackReport& r) {
               {"added", r.added},
               {"lost", r.lost},
               {"reacquired", r.reacquired}};
+}
+
+// Millimetres per world unit of the calibration: its unit when it has one ("mm", "m"),
+// else (Metashape's arbitrary chunk units, "unknown") the instrument's labelled nut and
+// bridge, whose midpoints lie the model's string length apart, as the instrument stage
+// scales the world (instrument/template_fit.h, Scale::kFromStringLength).
+StatusOr<double> MmPerWorldUnit(const std::string& units,
+                                const std::string& calibration_path,
+                                const std::string& instrument,
+                                const std::vector<std::string>& names,
+                                const std::vector<Eigen::Vector3d>& points,
+                                const std::string& label_files) {
+  if (units == "mm") return 1.0;
+  if (units == "m") return 1000.0;
+  const auto point = [&](const char* name) {
+    const auto it = std::find(names.begin(), names.end(), name);
+    return it == names.end() ? Eigen::Vector3d::Constant(kNaN) : points[it - names.begin()];
+  };
+  const Eigen::Vector3d nut = 0.5 * (point("nut_l") + point("nut_r"));
+  const Eigen::Vector3d bridge = 0.5 * (point("bridge_l") + point("bridge_r"));
+  if (!nut.allFinite() || !bridge.allFinite() || !((nut - bridge).norm() > 0)) {
+    return Status::Error(label_files + ": the calibration " + calibration_path +
+                         " is in units '" + units +
+                         "' (no metric scale): label nut_l, nut_r, bridge_l and bridge_r in two "
+                         "views, whose distance gives the scale");
+  }
+  ARCO_ASSIGN_OR_RETURN(const InstrumentModel model, InstrumentModel::Create(instrument));
+  return model.string_length_mm() / (nut - bridge).norm();
 }
 
 }  // namespace
@@ -184,6 +220,8 @@ Json ToJson(const TrackStageSummary& s) {
               {"bow_frames_without_pose", s.bow_frames_without_pose},
               {"bow_hand_frames", s.bow_hand_frames},
               {"kept_other_points", s.kept_other_points},
+              {"units", s.units},
+              {"mm_per_unit", s.mm_per_unit},
               {"cameras", cameras},
               {"warnings", s.warnings},
               {"decode_s", s.decode_s},
@@ -320,13 +358,29 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
       template_frame = frame;
     }
   }
+  std::string label_files;
+  for (const auto& l : options.labels) label_files += (label_files.empty() ? "" : ", ") + l.path;
   track::FrameLabels frame_labels{names, labelled[template_frame]};
   StatusOr<track::RigidTemplate> body = track::TriangulateTemplate(cameras, frame_labels);
-  if (!body.ok()) {
-    std::string files;
-    for (const auto& l : options.labels) files += (files.empty() ? "" : ", ") + l.path;
-    return Status::Error(files + ": " + body.status().message());
-  }
+  if (!body.ok()) return Status::Error(label_files + ": " + body.status().message());
+  // The trackers' lengths are mm (the bow's slide search, sample step and priors, its
+  // minimum length): the world is scaled to mm for them; projections do not change
+  // (t and X both times the scale). Outputs are pixels; track.json's 3D points are put
+  // back into the calibration's units.
+  const std::string calibration_path = ResolveCapturePath(dir, manifest.calibration);
+  ARCO_ASSIGN_OR_RETURN(const Calibration calibration, LoadCalibration(calibration_path));
+  ARCO_ASSIGN_OR_RETURN(const double mm_per_unit,
+                        MmPerWorldUnit(calibration.rig.units,
+                                       calibration_path,
+                                       manifest.instrument,
+                                       names,
+                                       body->points,
+                                       label_files));
+  summary.units = calibration.rig.units;
+  summary.mm_per_unit = mm_per_unit;
+  for (Camera& c : cameras) c.cam_from_world_translation *= mm_per_unit;
+  for (Eigen::Vector3d& x : body->points) x *= mm_per_unit;
+  body->plane_point *= mm_per_unit;
   summary.template_frame = template_frame;
   summary.label_rms_px = body->rms_reprojection_px;
   for (size_t p = 0; p < names.size(); ++p) {
@@ -349,6 +403,14 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
     if (bow.ok())
       for (const auto& x : bow->points) bow_points += std::isfinite(x.x());
     if (bow.ok() && bow_points == bow_names.size()) {
+      const double length_mm = (bow->points[1] - bow->points[0]).norm();
+      if (!(length_mm >= track::kMinBowLengthMm)) {
+        return Status::Error(label_files + ": frog and tip are " + FormatNumber(length_mm) +
+                             " mm apart in frame " + std::to_string(template_frame) +
+                             " (a bow is at least " + FormatNumber(track::kMinBowLengthMm) +
+                             " mm long; scale " + FormatNumber(mm_per_unit) + " mm per " +
+                             calibration.rig.units + " unit of " + calibration_path + ")");
+      }
       bow_body = *bow;
       summary.bow_tracked = true;
     } else {
@@ -547,7 +609,7 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   }
   Json template_json = Json::array();
   for (size_t p = 0; p < names.size(); ++p) {
-    const Eigen::Vector3d& x = body->points[p];
+    const Eigen::Vector3d x = body->points[p] / mm_per_unit;
     template_json.push_back(
         {{"name", names[p]},
          {"label_views", body->label_views[p]},

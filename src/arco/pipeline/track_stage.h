@@ -71,6 +71,11 @@ struct TrackStageSummary {
   std::vector<std::string> tracked_points;    // instrument points with a template point
   std::vector<std::string> untracked_points;  // labelled in fewer than two views
   double label_rms_px = 0;                    // the labels' triangulation residual
+  // The calibration's unit and millimetres per unit: 1 for "mm", 1000 for "m"; for
+  // another unit (Metashape's) the labelled nut-bridge distance against the instrument's
+  // string length. The trackers work in mm.
+  std::string units;
+  double mm_per_unit = 1;
   int64_t frames_without_pose = 0;            // the pose was the prediction
   bool bow_tracked = false;  // frog and tip labelled in two views: the bow slots written
   int64_t bow_frames_without_pose = 0;

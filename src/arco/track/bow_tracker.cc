@@ -503,8 +503,9 @@ BowTracker::BowTracker(std::vector<Camera> cameras,
     : state_(std::make_unique<State>()) {
   const Status s = options.Validate();
   if (!s.ok()) throw std::invalid_argument("BowTracker: " + s.message());
-  if (!frog.allFinite() || !tip.allFinite() || (tip - frog).norm() < 50) {
-    throw std::invalid_argument("BowTracker: frog and tip must be finite and >= 50 mm apart");
+  if (!frog.allFinite() || !tip.allFinite() || (tip - frog).norm() < kMinBowLengthMm) {
+    throw std::invalid_argument(
+        "BowTracker: frog and tip must be finite and >= kMinBowLengthMm (50 mm) apart");
   }
   State& st = *state_;
   st.options = options;

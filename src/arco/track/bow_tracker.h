@@ -38,6 +38,10 @@
 
 namespace arco::track {
 
+// A bow's frog and tip closer than this are not a bow (a violin bow is about 750 mm, a
+// double bass's about 700 mm): bad labels, or a world not in mm.
+constexpr double kMinBowLengthMm = 50;
+
 struct BowTrackerOptions {
   double roi_margin_px = 40;      // the box around the predicted stick grown by this much
   double search_px = 15;          // segments farther than this from the predicted line: out
@@ -64,8 +68,10 @@ Json ToJson(const BowTrackerOptions& options);
 
 class BowTracker {
  public:
-  // frog and tip: the labelled frame's triangulated points (world, mm). Throws
-  // std::invalid_argument on invalid options or a bow shorter than 50 mm.
+  // frog and tip: the labelled frame's triangulated points. The world must be in mm
+  // (every length option is mm): a caller with another unit scales the cameras'
+  // translations and the points first (pipeline/track_stage.cc). Throws
+  // std::invalid_argument on invalid options or a bow shorter than kMinBowLengthMm.
   BowTracker(std::vector<Camera> cameras,
              const Eigen::Vector3d& frog,
              const Eigen::Vector3d& tip,
