@@ -155,6 +155,13 @@ std::string ResultFolder::FingeringPath(const std::string& method) const {
   return StagePath(method, kFingeringCsvFile);
 }
 
+StatusOr<std::vector<refine::BowingNote>> ResultFolder::ReadBowingNotes(
+    const std::string& method) const {
+  const std::string path = StagePath(method, kBowingNotesCsvFile);
+  if (!FileExists(path)) return std::vector<refine::BowingNote>();
+  return refine::ReadBowingNotesCsv(path);
+}
+
 StatusOr<std::vector<refine::NoteFingering>> ResultFolder::ReadFingering(
     const std::string& method) const {
   const std::string path = FingeringPath(method);

@@ -232,6 +232,8 @@ class ResultFolder {
   // method has none (vision). Errors name the file and line: a missing column, a short
   // row, an unparsable number.
   StatusOr<std::vector<refine::NoteFingering>> ReadFingering(const std::string& method) const;
+  // A method's bowing_notes.csv (refine/bowing.h); empty when it has none.
+  StatusOr<std::vector<refine::BowingNote>> ReadBowingNotes(const std::string& method) const;
 
   // result.json "options": every option `arco run` applied (pipeline::ToJson(RunOptions)),
   // written once all stages are done.

@@ -448,4 +448,55 @@ StatusOr<std::vector<BowingFrame>> ReadBowingCsv(const std::string& path) {
   return frames;
 }
 
+StatusOr<std::vector<BowingNote>> ReadBowingNotesCsv(const std::string& path) {
+  ARCO_ASSIGN_OR_RETURN(const CsvTable table,
+                        ReadCsvTable(path, SplitCsvLine(kBowingNotesCsvHeader), kBowingNotesCsvHeader));
+  std::vector<BowingNote> notes;
+  for (const CsvTable::Row& row : table.rows) {
+    const std::string where = table.Where(row);
+    auto cell = [&](const char* name) -> const std::string& {
+      return row.cells[static_cast<size_t>(table.Column(name))];
+    };
+    BowingNote n;
+    int64_t note = 0, fingered = 0, bow = 0, second = 0, agree = 0;
+    if (!ParseCsvInt(cell("note"), &note) || note < 0 || !ParseCsvInt(cell("fingered_string"), &fingered) ||
+        !ParseCsvInt(cell("bow_string"), &bow) || !ParseCsvInt(cell("bow_second_string"), &second) ||
+        !ParseCsvInt(cell("strings_agree"), &agree) || fingered < 0 || fingered > 6 || bow < 0 ||
+        bow > 6 || second < 0 || second > 6 || (agree != 0 && agree != 1)) {
+      return Status::Error(where + "note, the strings and strings_agree must be small integers");
+    }
+    n.note = static_cast<int>(note);
+    n.fingered_string = static_cast<int>(fingered);
+    n.bow_string = static_cast<int>(bow);
+    n.bow_second_string = static_cast<int>(second);
+    n.strings_agree = agree == 1;
+    const std::string& d = cell("direction");
+    if (d == "down") {
+      n.direction = BowDirection::kDown;
+    } else if (d == "up") {
+      n.direction = BowDirection::kUp;
+    } else if (d != "none") {
+      return Status::Error(where + "direction must be down, up or none, got \"" + d + "\"");
+    }
+    const std::pair<const char*, double*> numbers[] = {
+        {"onset_s", &n.onset_s},
+        {"duration_s", &n.duration_s},
+        {"mean_speed_mm_per_s", &n.mean_speed_mm_per_s},
+        {"sounding_point_mm", &n.sounding_point_mm},
+        {"bow_from", &n.bow_from},
+        {"bow_to", &n.bow_to},
+        {"change_to_onset_s", &n.change_to_onset_s}};
+    for (const auto& [name, out] : numbers) {
+      if (!ParseCsvDouble(cell(name), out) || std::isinf(*out)) {
+        return Status::Error(where + name + " is not a number");
+      }
+    }
+    if (!std::isfinite(n.onset_s) || !(n.duration_s >= 0)) {
+      return Status::Error(where + "onset_s and duration_s must be finite, duration >= 0");
+    }
+    notes.push_back(n);
+  }
+  return notes;
+}
+
 }  // namespace arco::refine

@@ -135,5 +135,7 @@ Status WriteBowingNotesCsv(const std::string& path, const std::vector<BowingNote
 // Reads bowing.csv (arco's or a truth folder's: the columns frame, string, direction,
 // sounding_point_mm are required, the others optional); errors name the file and line.
 StatusOr<std::vector<BowingFrame>> ReadBowingCsv(const std::string& path);
+// Reads bowing_notes.csv (every column); errors name the file and line.
+StatusOr<std::vector<BowingNote>> ReadBowingNotesCsv(const std::string& path);
 
 }  // namespace arco::refine

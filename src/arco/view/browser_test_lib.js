@@ -6,6 +6,7 @@
 const fs = require('fs');
 const path = require('path');
 const { spawn } = require('child_process');
+const zlib = require('zlib');
 
 // check(ok, what) prints one line per check; failures() counts the failed ones.
 function makeChecker() {
@@ -87,4 +88,52 @@ function stopServer(server) {
   });
 }
 
-module.exports = { makeChecker, readNpy, launchChromium, openPage, startServer, stopServer };
+// 8-bit RGB/RGBA, non-interlaced PNG (what Chromium's screenshots are) -> RGBA-less pixels.
+function decodePng(buf) {
+  let o = 8, width = 0, height = 0, type = 0;
+  const idat = [];
+  while (o < buf.length) {
+    const len = buf.readUInt32BE(o), id = buf.toString('latin1', o + 4, o + 8);
+    const body = buf.subarray(o + 8, o + 8 + len);
+    if (id === 'IHDR') {
+      width = body.readUInt32BE(0); height = body.readUInt32BE(4); type = body[9];
+      if (body[8] !== 8 || body[12] !== 0 || (type !== 2 && type !== 6)) throw new Error('unsupported PNG');
+    }
+    if (id === 'IDAT') idat.push(body);
+    o += 12 + len;
+  }
+  const raw = zlib.inflateSync(Buffer.concat(idat));
+  const bpp = type === 6 ? 4 : 3, stride = width * bpp;
+  const out = new Uint8Array(height * stride);
+  for (let y = 0; y < height; ++y) {
+    const filter = raw[y * (stride + 1)];
+    for (let x = 0; x < stride; ++x) {
+      const v = raw[y * (stride + 1) + 1 + x];
+      const a = x >= bpp ? out[y * stride + x - bpp] : 0;
+      const b = y > 0 ? out[(y - 1) * stride + x] : 0;
+      const c = x >= bpp && y > 0 ? out[(y - 1) * stride + x - bpp] : 0;
+      let p = 0;
+      if (filter === 1) p = a; else if (filter === 2) p = b; else if (filter === 3) p = (a + b) >> 1;
+      else if (filter === 4) {
+        const pa = Math.abs(b - c), pb = Math.abs(a - c), pc = Math.abs(a + b - 2 * c);
+        p = pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
+      }
+      out[y * stride + x] = (v + p) & 255;
+    }
+  }
+  return { width, height, bpp, pixels: out };
+}
+// Over the columns [x0, x1) (default: all).
+function lumaVariance(png, x0 = 0, x1 = png.width) {
+  let s = 0, s2 = 0, n = 0;
+  for (let y = 0; y < png.height; ++y) {
+    for (let x = x0; x < x1; ++x, ++n) {
+      const k = (y * png.width + x) * png.bpp;
+      const l = 0.299 * png.pixels[k] + 0.587 * png.pixels[k + 1] + 0.114 * png.pixels[k + 2];
+      s += l; s2 += l * l;
+    }
+  }
+  return s2 / n - (s / n) * (s / n);
+}
+
+module.exports = { makeChecker, readNpy, decodePng, lumaVariance, launchChromium, openPage, startServer, stopServer };

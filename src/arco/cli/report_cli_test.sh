@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# `arco report` (docs/report.md): a teacher's page of a synthetic result (arco synth + arco
+# run): one row per note with the truth's strings and fingers, intonation and bowing, the
+# bad inputs (one line, nothing written), and the page in Debian's chromium
+# (report_browser_check.js; skipped, 77, only when /usr/bin/chromium is absent).
+# usage: report_cli_test.sh ARCO_BINARY SOURCE_DIR
+set -uo pipefail
+arco=$(realpath "$1")
+src=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+source "$src/src/arco/cli/cli_test_lib.sh"
+
+"$arco" synth --duration-s 12 --piece slow-melody --seed 2 -o "$tmp/cap" >/dev/null 2>&1 &&
+  "$arco" run "$tmp/cap" -o "$tmp/res" >/dev/null 2>&1 ||
+  { echo "FAILED: synth + run"; exit 1; }
+ok "report" report "$tmp/res" -o "$tmp/report.html"
+check 'grep -q "with bowing" "$tmp/out"' "the summary line says the bowing is in: $(cat "$tmp/out")"
+/usr/bin/python3 - "$tmp/report.html" "$tmp/res/arco/fingering.csv" "$tmp/res/arco/bowing_notes.csv" \
+  "$tmp/cap/truth/notes.csv" <<'PY' || fail=1
+import csv, html.parser, sys
+page, fingering, bowing, truth = sys.argv[1:]
+class Rows(html.parser.HTMLParser):
+    def __init__(self):
+        super().__init__(); self.rows = []; self.cell = None; self.in_row = False
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if tag == "tr" and "note" in a.get("class", "").split():
+            self.rows.append({"note": a["data-note"], "cells": []}); self.in_row = True
+        elif tag == "td" and self.in_row:
+            self.cell = ""
+    def handle_endtag(self, tag):
+        if tag == "td" and self.cell is not None:
+            self.rows[-1]["cells"].append(self.cell.strip()); self.cell = None
+        if tag == "tr": self.in_row = False
+    def handle_data(self, data):
+        if self.cell is not None: self.cell += data
+p = Rows(); p.feed(open(page).read())
+notes = list(csv.DictReader(open(fingering)))
+bows = {b["note"]: b for b in csv.DictReader(open(bowing))}
+bad = []
+if len(p.rows) != len(notes): bad.append("%d rows for %d notes" % (len(p.rows), len(notes)))
+by_note = {r["note"]: r["cells"] for r in p.rows}
+for n in notes:
+    cells = by_note.get(n["note"])
+    if cells is None: bad.append("note %s missing" % n["note"]); continue
+    # columns: #, time, note, string, finger, position, cents, vibrato, bow, sounding point, bow on
+    if cells[2] != n["note_name"]: bad.append("note %s: name %s vs %s" % (n["note"], cells[2], n["note_name"]))
+    cents = round(float(n["cents_off"]))
+    if cells[6].replace("+", "") != str(cents) and not (cents == 0 and cells[6] in ("+0", "-0", "0")):
+        bad.append("note %s: cents %s vs %s" % (n["note"], cells[6], n["cents_off"]))
+    b = bows.get(n["note"])
+    if b is None or cells[8] != b["direction"]: bad.append("note %s: bow %s vs %s" % (n["note"], cells[8], b and b["direction"]))
+# The strings shown are arco's; on this clean synthetic take they are the truth's (by onset).
+truth = list(csv.DictReader(open(truth)))
+agree = 0
+for n in notes:
+    t = min(truth, key=lambda t: abs(float(t["onset_s"]) - float(n["onset_s"])))
+    agree += t["string"] == n["string"]
+if agree < 0.9 * len(notes): bad.append("only %d of %d notes on the truth's string" % (agree, len(notes)))
+print("%d notes, %d rows, %d truth notes, %d on the truth's string" % (len(notes), len(p.rows), len(truth), agree))
+for b in bad[:10]: print("FAILED: " + b)
+sys.exit(1 if bad else 0)
+PY
+
+# Bad input: one line, nothing written.
+SNAPSHOT_DIR=$tmp
+mkdir -p "$tmp/empty"
+expect_error "not a result" "*empty/result.json*" report "$tmp/empty" -o "$tmp/r.html"
+expect_error "not .html" "*-o*html*" report "$tmp/res" -o "$tmp/report.pdf"
+expect_error "vision has no fingering" "*--method*" report "$tmp/res" --method vision -o "$tmp/r.html"
+expect_error "passage gap out of range" "*--passage-gap-s*" report "$tmp/res" --passage-gap-s 0 -o "$tmp/r.html"
+expect_error "output inside the result" "*-o*" report "$tmp/res" -o "$tmp/res/report.html"
+cp -r "$tmp/res" "$tmp/res_no_fingering"
+rm "$tmp/res_no_fingering/arco/fingering.csv"
+expect_error "no fingering" "*fingering.csv*" report "$tmp/res_no_fingering" -o "$tmp/r.html"
+[ $fail -eq 0 ] || exit 1
+
+if [ ! -x /usr/bin/chromium ]; then
+  echo "SKIPPED: /usr/bin/chromium is not installed (apt-get install chromium)"
+  exit 77
+fi
+playwright=$src/tools/view/node_modules/playwright-core
+if ! command -v node >/dev/null || [ ! -f "$playwright/package.json" ]; then
+  echo "FAILED: node or $playwright missing (run scripts/fetch_view_tools)"
+  exit 1
+fi
+node "$src/src/arco/cli/report_browser_check.js" "$playwright" "$tmp/report.html" \
+  "$tmp/res/arco/fingering.csv" "$tmp" || fail=1
+[ $fail -eq 0 ] && echo "report_cli_test: passed"
+exit $fail
