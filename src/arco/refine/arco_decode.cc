@@ -357,17 +357,13 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
       const FrameContact& cp = out[static_cast<size_t>(p)];
       const FrameContact& cq = out[static_cast<size_t>(q)];
       if (cp.note == cq.note || cp.string != c.string || cq.string != c.string) continue;
+      // The glide is heard: the frame's own pitch, trusted, between the two notes'.
       const double lo = std::min(cp.f0_hz, cq.f0_hz), hi = std::max(cp.f0_hz, cq.f0_hz);
       const FramePitch& own = input.pitch[static_cast<size_t>(f)];
-      double f0_hz = 0;
-      if (own.f0_hz >= lo && own.f0_hz <= hi && own.confidence >= pitch_options.min_confidence) {
-        f0_hz = own.f0_hz;  // the glide is heard
-      } else {
-        const double t = static_cast<double>(f - p) / static_cast<double>(q - p);
-        f0_hz = std::exp2((1 - t) * std::log2(cp.f0_hz) + t * std::log2(cq.f0_hz));
-      }
+      if (!(own.f0_hz >= lo && own.f0_hz <= hi && own.confidence >= pitch_options.min_confidence))
+        continue;
       FrameContact glide = c;
-      AssignFrame(context, c.string, c.finger, f0_hz, pitch_options, lift_max_mm, f, &glide);
+      AssignFrame(context, c.string, c.finger, own.f0_hz, pitch_options, lift_max_mm, f, &glide);
       if (!glide.pressed()) continue;  // the lift test: keep the note's contact
       glide.reason = c.reason;
       out[static_cast<size_t>(f)] = glide;

@@ -35,10 +35,11 @@
 // Glides: a transition frame (kNoteBoundary, kBeforeOnset) with a frame of another note on
 // either side within glide_frames (the nearest non-transition pressed frames, both on its
 // string) is where the stopping point moves from one note's place to the other's: its
-// contact is at the frame's own pitch when trusted (min_confidence) and between the two
-// frames' pitches (the glide is heard), otherwise at their pitches interpolated in cents,
-// linearly in time. A finger cannot jump: on a real take (SPD cello01) the note's own
-// pitch put these frames 14-18 mm from SPD's contact (docs/refine.md).
+// contact is at the frame's own pitch when that is trusted (min_confidence) and between the
+// two frames' pitches: the glide is heard, the string is stopped there. Otherwise the
+// note's contact stays (an untrusted pitch says nothing; the finger may have landed). On
+// a real take (SPD cello01) the note's pitch put such frames 14-18 mm from SPD's contact
+// (docs/refine.md).
 #pragma once
 
 #include <array>

@@ -115,9 +115,8 @@ struct ArcoDecodeOptions {
   // previous note to the next) between two notes' own frames on the same string, each at
   // most glide_frames away: the stopping point moves along the string with the shift, so
   // the contact is at the frame's own pitch when that is trusted (min_confidence) and lies
-  // between the two notes' pitches (a glide heard), otherwise interpolated in cents,
-  // linearly in time, between the nearest frames of the two notes (arco_decode.h). 0: the
-  // note's pitch, the former rule.
+  // between the two notes' pitches (a glide heard; arco_decode.h). 0: always the note's
+  // pitch, the former rule.
   int glide_frames = 3;
   // Note boundaries from the audio's onsets (note_boundaries.h), when the input has them.
   bool audio_onsets = true;
