@@ -15,7 +15,7 @@ arco=$1
 spd=$2/spd
 model=${3:-shared}
 cameras=${4:-}  # empty: every camera of the rig
-max_contact_mm=${5:-4.8}
+max_contact_mm=${5:-5.2}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
