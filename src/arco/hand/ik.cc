@@ -32,6 +32,8 @@ struct TipCost {
   Eigen::Vector3d target;
   double pip_weight = 0;
   Eigen::Vector3d pip_target = Eigen::Vector3d::Zero();
+  double dip_weight = 0;
+  Eigen::Vector3d dip_target = Eigen::Vector3d::Zero();
 
   template <typename T>
   bool operator()(const T* x, T* residual) const {
@@ -42,9 +44,11 @@ struct TipCost {
     FingerPointsInWrist(*model, finger, dof, p);
     const Eigen::Matrix<T, 3, 1> tip = rotation.cast<T>() * p[3] + translation.cast<T>();
     const Eigen::Matrix<T, 3, 1> pip = rotation.cast<T>() * p[1] + translation.cast<T>();
+    const Eigen::Matrix<T, 3, 1> dip = rotation.cast<T>() * p[2] + translation.cast<T>();
     for (int r = 0; r < 3; ++r) {
       residual[r] = tip[r] - T(target[r]);
       residual[3 + r] = T(pip_weight) * (pip[r] - T(pip_target[r]));
+      residual[6 + r] = T(dip_weight) * (dip[r] - T(dip_target[r]));
     }
     return true;
   }
@@ -84,7 +88,7 @@ struct SolveOutcome {
 
 template <int N>
 ceres::CostFunction* MakeTipCost(const TipCost<N>& functor) {
-  return new ceres::AutoDiffCostFunction<TipCost<N>, 6, N>(new TipCost<N>(functor));
+  return new ceres::AutoDiffCostFunction<TipCost<N>, 9, N>(new TipCost<N>(functor));
 }
 
 struct IkProblemSpec {
@@ -98,6 +102,8 @@ struct IkProblemSpec {
   Eigen::Vector3d translation, target;
   double pip_weight = 0;  // FingerIkOptions::pip_weight (0 without a PIP target)
   Eigen::Vector3d pip_target = Eigen::Vector3d::Zero();
+  double dip_weight = 0;  // FingerIkOptions::dip_weight (0 without a DIP target)
+  Eigen::Vector3d dip_target = Eigen::Vector3d::Zero();
 };
 
 double TipDistance(const IkProblemSpec& s, const std::vector<double>& x) {
@@ -108,14 +114,16 @@ double TipDistance(const IkProblemSpec& s, const std::vector<double>& x) {
   return (s.rotation * p[3] + s.translation - s.target).norm();
 }
 
-// pip_weight times the PIP keypoint's distance from pip_target (0 without a target).
-double PipTerm(const IkProblemSpec& s, const std::vector<double>& x) {
-  if (s.pip_weight <= 0) return 0.0;
+// The squared PIP and DIP terms: weight times the keypoint's distance from its target
+// (0 without a target).
+double KeypointTerms(const IkProblemSpec& s, const std::vector<double>& x) {
+  if (s.pip_weight <= 0 && s.dip_weight <= 0) return 0.0;
   std::array<double, 4> dof = s.reference;
   for (size_t i = 0; i < s.slots.size(); ++i) dof[s.slots[i]] = x[i];
   Eigen::Vector3d p[4];
   FingerPointsInWrist(*s.model, s.finger, dof.data(), p);
-  return s.pip_weight * (s.rotation * p[1] + s.translation - s.pip_target).norm();
+  return std::pow(s.pip_weight * (s.rotation * p[1] + s.translation - s.pip_target).norm(), 2) +
+         std::pow(s.dip_weight * (s.rotation * p[2] + s.translation - s.dip_target).norm(), 2);
 }
 
 // One bounded trust-region solve from x (in place) with the given weights.
@@ -138,6 +146,8 @@ void SolveOnce(const IkProblemSpec& s,
     functor.target = s.target;
     functor.pip_weight = s.pip_weight;
     functor.pip_target = s.pip_target;
+    functor.dip_weight = s.dip_weight;
+    functor.dip_target = s.dip_target;
     return MakeTipCost(functor);
   };
   switch (n) {
@@ -196,7 +206,10 @@ std::vector<double> CostGradient(const IkProblemSpec& s,
       s.rotation.cast<Jet>() * p[3] + (s.translation - s.target).cast<Jet>();
   const Eigen::Matrix<Jet, 3, 1> r_pip =
       s.rotation.cast<Jet>() * p[1] + (s.translation - s.pip_target).cast<Jet>();
-  const Jet cost = r.squaredNorm() + s.pip_weight * s.pip_weight * r_pip.squaredNorm();
+  const Eigen::Matrix<Jet, 3, 1> r_dip =
+      s.rotation.cast<Jet>() * p[2] + (s.translation - s.dip_target).cast<Jet>();
+  const Jet cost = r.squaredNorm() + s.pip_weight * s.pip_weight * r_pip.squaredNorm() +
+                   s.dip_weight * s.dip_weight * r_dip.squaredNorm();
   std::vector<double> g(x.size());
   for (size_t i = 0; i < x.size(); ++i) {
     g[i] = cost.v[i] + 2 * w_ref * w_ref * (x[i] - s.ref_free[i]);
@@ -279,7 +292,7 @@ SolveOutcome SolveFrom(const IkProblemSpec& s,
   for (size_t i = 0; i < x.size(); ++i) x[i] = std::clamp(x[i], s.lower[i], s.upper[i]);
   out.x = x;
   out.distance_mm = TipDistance(s, x);
-  out.regularisation = std::pow(PipTerm(s, x), 2);
+  out.regularisation = KeypointTerms(s, x);
   for (size_t i = 0; i < x.size(); ++i) {
     out.regularisation += std::pow(o.reference_weight_mm_per_rad * (x[i] - s.ref_free[i]), 2);
     if (s.has_prev) {
@@ -336,6 +349,10 @@ Status FingerIkOptions::Validate() const {
     return bad("pip_weight must be finite and >= 0");
   if (pip_target_in_world_mm && !pip_target_in_world_mm->allFinite())
     return bad("pip_target_in_world_mm must be finite");
+  if (!(dip_weight >= 0) || !std::isfinite(dip_weight))
+    return bad("dip_weight must be finite and >= 0");
+  if (dip_target_in_world_mm && !dip_target_in_world_mm->allFinite())
+    return bad("dip_target_in_world_mm must be finite");
   if (seed_levels < 0 || seed_levels == 1 || seed_levels > 32) {
     return bad("seed_levels must be 0 (auto) or in [2, 32]");
   }
@@ -385,6 +402,10 @@ FingerIkResult SolveFingertipIk(const HandModel& model,
   if (options.pip_target_in_world_mm && options.pip_weight > 0) {
     s.pip_weight = options.pip_weight;
     s.pip_target = *options.pip_target_in_world_mm;
+  }
+  if (options.dip_target_in_world_mm && options.dip_weight > 0) {
+    s.dip_weight = options.dip_weight;
+    s.dip_target = *options.dip_target_in_world_mm;
   }
   s.has_prev = options.previous_pose.has_value() && options.previous_weight_mm_per_rad > 0;
   const double max_change_rad = options.max_change_deg * kDegToRad;

@@ -5,10 +5,11 @@
 // paper's Eq. 3 adjusts PIP and DIP of the note-playing finger: kPipDip).
 //
 // Cost over the free angles x (rad) of one finger:
-//   |tip(x) - target|^2 + w_pip^2 |pip(x) - pip_target|^2
+//   |tip(x) - target|^2 + w_pip^2 |pip(x) - pip_target|^2 + w_dip^2 |dip(x) - dip_target|^2
 //     + w_ref^2 |x - x_ref|^2 + w_prev^2 |x - x_prev|^2
 // (the PIP term only with a pip_target: where the PIP keypoint is seen, in position space,
-// so the MCP's angles explain the tip's residual only as far as the PIP allows).
+// so the MCP's angles explain the tip's residual only as far as the PIP allows; the DIP
+// term likewise with a dip_target: the PIP's flexion only as far as the DIP allows).
 // subject to  max(min_k, x_ref,k - max_change) <= x_k <= min(max_k, x_ref,k + max_change).
 // With exact_reach, a second solve with the weights scaled by 1e-4 starts from
 // the first: the regularisation picks the solution (redundant dofs, unreachable
@@ -44,6 +45,9 @@ struct FingerIkOptions {
   // to the tip's (0 = none). Moves only with the MCP's angles free.
   std::optional<Eigen::Vector3d> pip_target_in_world_mm;
   double pip_weight = 0.0;
+  // The same for the DIP keypoint (moves with the MCP's and the PIP's angles).
+  std::optional<Eigen::Vector3d> dip_target_in_world_mm;
+  double dip_weight = 0.0;
   bool exact_reach = true;  // see the header comment
   // When the tip ends farther than reach_tolerance_mm, evaluate a grid of
   // seed_levels values per free joint over its bounds (0 = automatic: 33, 17, 9

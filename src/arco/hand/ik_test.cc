@@ -285,5 +285,55 @@ TEST(SolveFingertipIk, APipObservationHoldsThePipWhereItWasSeen) {
   EXPECT_FALSE(bad.Validate().ok());
 }
 
+// The DIP observation (FingerIkOptions::dip_target_in_world_mm), as the PIP's above, with
+// the distal joints free (the DIP keypoint moves with the PIP's flexion): held at the
+// truth's DIP, the solution's DIP ends nearer it, and the tip still comes near its target.
+TEST(SolveFingertipIk, ADipObservationHoldsTheDipWhereItWasSeen) {
+  std::mt19937 rng(11);
+  const HandModel model = HandModel::Default(HandSide::kLeft);
+  double with_sum = 0, without_sum = 0, with_tip = 0;
+  int cases = 0;
+  for (int f = 1; f < kNumFingers; ++f) {
+    const Finger finger = static_cast<Finger>(f);
+    for (int trial = 0; trial < 10; ++trial) {
+      const HandPose truth = testing::RandomPose(model, rng, 0.02);
+      const Eigen::Vector3d target = FingertipInWorld(model, truth, finger);
+      const HandPose ref = PerturbFreeDofs(model, truth, finger, FingerIkJoints::kAll, rng);
+      const int dip = KeypointIndex(finger, 2);
+      const Eigen::Vector3d seen = ForwardKinematics(model, truth)[dip];
+      FingerIkOptions without;
+      without.joints = FingerIkJoints::kAll;
+      without.exact_reach = false;
+      FingerIkOptions with = without;
+      with.dip_target_in_world_mm = seen;
+      with.dip_weight = 1.0;
+      const FingerIkResult a = SolveFingertipIk(model, ref, finger, target, without);
+      const FingerIkResult b = SolveFingertipIk(model, ref, finger, target, with);
+      ASSERT_TRUE(a.status.ok());
+      ASSERT_TRUE(b.status.ok());
+      EXPECT_EQ(CountLimitViolations(model, b.pose, 0.0), 0);
+      with_tip += b.final_distance_mm;
+      with_sum += (ForwardKinematics(model, b.pose)[dip] - seen).norm();
+      without_sum += (ForwardKinematics(model, a.pose)[dip] - seen).norm();
+      ++cases;
+    }
+  }
+  std::printf(
+      "[ ik ] DIP from where it was seen, mean over %d: with the observation %.2f mm, "
+      "without %.2f mm; tip %.2f mm from its target\n",
+      cases,
+      with_sum / cases,
+      without_sum / cases,
+      with_tip / cases);
+  EXPECT_LT(with_sum, 0.5 * without_sum);
+  EXPECT_LT(with_tip / cases, 3.0);
+  FingerIkOptions bad;
+  bad.dip_weight = -1;
+  EXPECT_FALSE(bad.Validate().ok());
+  bad.dip_weight = 1;
+  bad.dip_target_in_world_mm = Eigen::Vector3d(0, NAN, 0);
+  EXPECT_FALSE(bad.Validate().ok());
+}
+
 }  // namespace
 }  // namespace arco::hand

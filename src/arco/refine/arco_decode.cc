@@ -325,6 +325,50 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
       out[i] = lead;
     }
   }
+  // Glides (header comment): transition frames between two notes on the same string.
+  if (options.glide_frames > 0) {
+    auto transition = [&](int f) {
+      const FrameContact& c = out[static_cast<size_t>(f)];
+      return c.reason == ContactReason::kNoteBoundary || c.reason == ContactReason::kBeforeOnset;
+    };
+    // A note's own frame: pressed, stopped, not a transition (never modified below).
+    auto anchor = [&](int f) {
+      const FrameContact& c = out[static_cast<size_t>(f)];
+      return c.pressed() && c.finger > 0 && !transition(f) && c.f0_hz > 0 &&
+             c.point_in_world_mm.allFinite();
+    };
+    for (int f = 0; f < n; ++f) {
+      const FrameContact& c = out[static_cast<size_t>(f)];
+      if (!c.pressed() || c.finger == 0 || !transition(f)) continue;
+      int p = -1, q = -1;
+      for (int g = f - 1; g >= 0 && g >= f - options.glide_frames; --g) {
+        if (anchor(g)) {
+          p = g;
+          break;
+        }
+      }
+      for (int g = f + 1; g < n && g <= f + options.glide_frames; ++g) {
+        if (anchor(g)) {
+          q = g;
+          break;
+        }
+      }
+      if (p < 0 || q < 0) continue;
+      const FrameContact& cp = out[static_cast<size_t>(p)];
+      const FrameContact& cq = out[static_cast<size_t>(q)];
+      if (cp.note == cq.note || cp.string != c.string || cq.string != c.string) continue;
+      // The glide is heard: the frame's own pitch, trusted, between the two notes'.
+      const double lo = std::min(cp.f0_hz, cq.f0_hz), hi = std::max(cp.f0_hz, cq.f0_hz);
+      const FramePitch& own = input.pitch[static_cast<size_t>(f)];
+      if (!(own.f0_hz >= lo && own.f0_hz <= hi && own.confidence >= pitch_options.min_confidence))
+        continue;
+      FrameContact glide = c;
+      AssignFrame(context, c.string, c.finger, own.f0_hz, pitch_options, lift_max_mm, f, &glide);
+      if (!glide.pressed()) continue;  // the lift test: keep the note's contact
+      glide.reason = c.reason;
+      out[static_cast<size_t>(f)] = glide;
+    }
+  }
   // Usable notes that no string can play.
   for (int note_index : usable) {
     if (decoded_note[static_cast<size_t>(note_index)]) continue;

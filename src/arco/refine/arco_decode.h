@@ -32,6 +32,14 @@
 // With the audio's onsets, frames still with the previous note are not handed over.
 // Only where the fitted tip is no more than onset_lead_margin_mm farther from the contact
 // than its median over the note (the hand is already in place).
+// Glides: a transition frame (kNoteBoundary, kBeforeOnset) with a frame of another note on
+// either side within glide_frames (the nearest non-transition pressed frames, both on its
+// string) is where the stopping point moves from one note's place to the other's: its
+// contact is at the frame's own pitch when that is trusted (min_confidence) and between the
+// two frames' pitches: the glide is heard, the string is stopped there. Otherwise the
+// note's contact stays (an untrusted pitch says nothing; the finger may have landed). On
+// a real take (SPD cello01) the note's pitch put such frames 14-18 mm from SPD's contact
+// (docs/refine.md).
 #pragma once
 
 #include <array>

@@ -88,6 +88,27 @@ FrameIk SolveArcoFrame(const DecodeContext& context,
       ik.pip_weight = options.pip_weight;
     }
   }
+  // A transition frame's contact is where the string is stopped while the hand moves
+  // (arco_decode.h, glides; the frame's own pitch was not trusted): the finger's DIP
+  // keypoint is held toward what the cameras saw, as the PIP's, so the tip moves toward
+  // that contact only as far as the DIP allows (ArcoIkOptions::transition_dip_weight).
+  const bool transition =
+      c.reason == ContactReason::kNoteBoundary || c.reason == ContactReason::kBeforeOnset;
+  if (options.transition_dip_weight > 0 && transition) {
+    const hand::Finger finger = static_cast<hand::Finger>(c.finger);
+    const size_t dip = static_cast<size_t>(hand::KeypointIndex(finger, 2));
+    const auto& fitted = context.vision_points[static_cast<size_t>(f)];
+    if (fitted && (*fitted)[dip].allFinite()) {
+      Eigen::Vector3d target = (*fitted)[dip];
+      const auto& detected = context.input->detected_left_hand;
+      if (!detected.empty() && detected[static_cast<size_t>(f)] &&
+          (*detected[static_cast<size_t>(f)])[dip].allFinite()) {
+        target = 0.5 * (target + (*detected[static_cast<size_t>(f)])[dip]);
+      }
+      ik.dip_target_in_world_mm = target;
+      ik.dip_weight = options.transition_dip_weight;
+    }
+  }
   if (options.temporal_weight_mm_per_rad > 0 && prev != nullptr && prev->solved) {
     ik.previous_pose = prev->pose;
     ik.previous_weight_mm_per_rad = options.temporal_weight_mm_per_rad;
@@ -180,9 +201,20 @@ bool ApplyArcoIk(const DecodeContext& context,
         return false;
       }
       // The note is played whether or not arco's hand reaches it: the decision stands and
-      // the finger goes as near as its joints allow; the hand stays where the cameras put
-      // it (a real hand is not arco's model).
-      *hand_out = pose;
+      // the hand stays where the cameras put it (a real hand is not arco's model). The
+      // finger too, by default: a contact beyond what the model's finger and the allowed
+      // hand move can explain says that the contact (a transition, a wrong note) or the
+      // model is off, not the finger the cameras saw; stretched toward it, every joint of
+      // the finger got worse on the real take (docs/accuracy.md). With
+      // stretch_unreachable the finger goes as near as its joints allow (the former rule).
+      if (options.stretch_unreachable) {
+        *hand_out = pose;
+      } else if (*hand_out) {
+        c->tip_distance_refined_mm =
+            (hand::FingertipInWorld(context.input->hand_model, **hand_out, finger) -
+             c->point_in_world_mm)
+                .norm();
+      }
       return false;
     }
     const Eigen::Vector3d tip = hand::FingertipInWorld(context.input->hand_model, pose, finger);
@@ -406,6 +438,7 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
     c = alt;
     hands[static_cast<size_t>(f)] = pose;
   }
+
   return hands;
 }
 

@@ -127,6 +127,37 @@ TEST(NoteBoundaries, FramesAtNoteChangesGoToTheNoteSoundingAtTheirTime) {
   EXPECT_EQ(Identification(scene, Refine(scene.input, off)).right, without.right);
 }
 
+// A glide heard at a note change (ArcoDecodeOptions::glide_frames): the second note's first
+// frame sounds, trusted, a pitch between the two notes' (the finger slides on the string).
+// The frame stays the second note's (a boundary frame: string and finger decoded with
+// it) and its contact is where that pitch is stopped, between the two notes' places; with
+// glides off it takes the note's contact, as an untrusted frame still does.
+TEST(NoteBoundaries, AHeardGlideIsContactedWhereItSounds) {
+  int short_first = -1;
+  testing::Scene scene = BlurredFastPassage(&short_first);
+  const size_t f = 6;  // the second note's first frame; frame 7 is a drop-out
+  scene.input.pitch[f] = {std::sqrt(scene.input.pitch[5].f0_hz * scene.input.pitch[8].f0_hz), 0.9};
+  const RefineResult r = Refine(scene.input, Arco());
+  const FrameContact& c = r.contacts[f];
+  ASSERT_TRUE(c.pressed());
+  // This scene's fitted finger is already on the second note's place, farther from the
+  // glide's point than the IK may reach: out_of_reach, the decision kept.
+  EXPECT_TRUE(c.reason == ContactReason::kNoteBoundary || c.reason == ContactReason::kOutOfReach);
+  EXPECT_EQ(r.analysis.frame_state[f], FrameAudioState::kBoundary);
+  EXPECT_EQ(c.string, scene.truth_string[f]);
+  EXPECT_EQ(c.finger, scene.truth_finger[f]);
+  const double before = r.contacts[5].from_nut_mm, after = r.contacts[8].from_nut_mm;
+  EXPECT_GT(c.from_nut_mm, std::min(before, after) + 2.0);
+  EXPECT_LT(c.from_nut_mm, std::max(before, after) - 2.0);
+  // The drop-out after it is not heard: the note's contact.
+  EXPECT_LT((r.contacts[7].point_in_world_mm - scene.truth_contact[7]).norm(), 1e-6);
+  RefineOptions off = Arco();
+  off.decode.glide_frames = 0;
+  const RefineResult n = Refine(scene.input, off);
+  EXPECT_LT((n.contacts[f].point_in_world_mm - scene.truth_contact[f]).norm(), 1e-6);
+  EXPECT_EQ(r.summary.joint_limit_violations, 0);
+}
+
 TEST(NoteBoundaries, TrustedFramesOfAnotherNoteAreNeverTaken) {
   int short_first = -1;
   testing::Scene scene = BlurredFastPassage(&short_first);

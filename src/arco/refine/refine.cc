@@ -163,6 +163,7 @@ Status ArcoDecodeOptions::Validate() const {
   }
   if (onset_lead_frames < 0)
     return Status::Error("arco decode options: onset_lead_frames must be >= 0");
+  if (glide_frames < 0) return Status::Error("arco decode options: glide_frames must be >= 0");
   if (!(boundaries.onset_tolerance_s >= 0 && Finite(boundaries.onset_tolerance_s))) {
     return Status::Error("arco decode options: onset_tolerance_s must be finite and >= 0");
   }
@@ -194,6 +195,8 @@ Status ArcoIkOptions::Validate() const {
   }
   ARCO_RETURN_IF_ERROR(
       CheckInRange("pip_weight", pip_weight, kCostWeightRange).WithContext("arco IK options"));
+  ARCO_RETURN_IF_ERROR(CheckInRange("transition_dip_weight", transition_dip_weight, kCostWeightRange)
+                           .WithContext("arco IK options"));
   if (max_iterations < 1) return Status::Error("arco IK options: max_iterations must be >= 1");
   if (neighbour_shift_frames < 0) {
     return Status::Error("arco IK options: neighbour_shift_frames must be >= 0");
@@ -301,6 +304,7 @@ Json ToJson(const RefineOptions& o) {
             {"onset_lead_frames", o.decode.onset_lead_frames},
             {"onset_lead_margin_mm", o.decode.onset_lead_margin_mm},
             {"handover_margin_mm", JsonFromDouble(o.decode.handover_margin_mm)},  // inf: off
+            {"glide_frames", o.decode.glide_frames},
             {"audio_onsets", o.decode.audio_onsets},
             {"boundaries",
              {{"onset_tolerance_s", o.decode.boundaries.onset_tolerance_s},
@@ -318,6 +322,8 @@ Json ToJson(const RefineOptions& o) {
             {"detected_hand_shift", o.ik.detected_hand_shift},
             {"move_hand", o.ik.move_hand},
             {"keep_unreachable", o.ik.keep_unreachable},
+            {"stretch_unreachable", o.ik.stretch_unreachable},
+            {"transition_dip_weight", o.ik.transition_dip_weight},
             {"distal_first", o.ik.distal_first},
             {"pip_weight", o.ik.pip_weight},
             {"neighbour_shift_frames", o.ik.neighbour_shift_frames},

@@ -111,6 +111,13 @@ struct ArcoDecodeOptions {
   // next finger's fitted tip is nearer its contact by more than this (the sound lags the
   // hand by up to a frame); infinity disables it.
   double handover_margin_mm = 5.0;
+  // Transition frames (note_boundary, before_onset: the finger is on its way from the
+  // previous note to the next) between two notes' own frames on the same string, each at
+  // most glide_frames away: the stopping point moves along the string with the shift, so
+  // the contact is at the frame's own pitch when that is trusted (min_confidence) and lies
+  // between the two notes' pitches (a glide heard; arco_decode.h). 0: always the note's
+  // pitch, the former rule.
+  int glide_frames = 3;
   // Note boundaries from the audio's onsets (note_boundaries.h), when the input has them.
   bool audio_onsets = true;
   NoteBoundaryOptions boundaries;
@@ -165,9 +172,22 @@ struct ArcoIkOptions {
   bool move_hand = false;
   // A contact still farther than max_hand_shift_mm after the IK and the hand's move: true
   // keeps the decoded note, string and finger (state pressed, reason out_of_reach) with the
-  // finger as near as its joints reach; false rejects the contact (state uncertain) and
+  // hand as below (stretch_unreachable); false rejects the contact (state uncertain) and
   // leaves the fitted hand, the former lift test.
   bool keep_unreachable = true;
+  // Such a kept, unreachable contact: false leaves the whole fitted hand, the finger as the
+  // cameras saw it (the contact or the model is off, not that finger); true moves the
+  // finger as near as its joints reach (the former rule: on the real take it made the
+  // playing finger's PIP, DIP and tip worse than vision on those frames).
+  bool stretch_unreachable = false;
+  // Transition frames (reasons note_boundary, before_onset: the hand moves from one note
+  // to the next, the contact is where the string is stopped meanwhile, arco_decode.h): the
+  // playing finger's DIP keypoint is held toward the mean of its fitted and triangulated
+  // position with this weight relative to the tip's (0 = off), as pip_weight holds the PIP.
+  // Unheld, the finger solved onto those contacts made the DIP worse than vision on the
+  // real take (docs/accuracy.md, "A real take"); on a note's own frames the contact is
+  // trusted and the DIP is not held.
+  double transition_dip_weight = 1.0;
   // A frame the lift test rejected inside a note starts from the fitted hand moved by the
   // whole-hand shift of its nearest accepted frames of the same note, string and finger
   // within this many frames (the fitted hand lags fast shifts); 0: off.
