@@ -14,6 +14,7 @@
 #include "arco/refine/bowing.h"
 #include "arco/refine/contact_annotation.h"
 #include "arco/util/file_io.h"
+#include "arco/util/stats.h"
 
 namespace arco::exporter {
 namespace {
@@ -65,13 +66,11 @@ double Slope(const std::vector<std::pair<double, double>>& xy) {
   return sxx > 0 ? sxy / sxx : NAN;
 }
 
-double Median(std::vector<double> v) {
+// The median of the finite values (NaN when there are none).
+double FiniteMedian(std::vector<double> v) {
   v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }),
           v.end());
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  return v.empty() ? NAN : Median(std::move(v));
 }
 
 struct Row {
@@ -211,13 +210,13 @@ StatusOr<std::string> BuildTeacherReport(const TeacherReportOptions& options,
     << "<div><b id=\"notes\">" << rows.size() << "</b>notes</div>"
     << "<div><b>" << in_tune << " of " << tuned << "</b>in tune (&plusmn;"
     << Num(options.in_tune_cents, "%.3g") << " cents)</div>"
-    << "<div><b>" << Num(Median(abs_cents), "%.1f") << "</b>median cents off</div>"
+    << "<div><b>" << Num(FiniteMedian(abs_cents), "%.1f") << "</b>median cents off</div>"
     << "<div><b>" << vibrato << "</b>notes with vibrato" << (rates.empty() ? "" : ", ")
-    << (rates.empty() ? "" : Num(Median(rates), "%.1f") + " Hz, &plusmn;" +
-                                 Num(Median(widths), "%.0f") + " cents")
+    << (rates.empty() ? "" : Num(FiniteMedian(rates), "%.1f") + " Hz, &plusmn;" +
+                                 Num(FiniteMedian(widths), "%.0f") + " cents")
     << "</div><div><b>" << shifts << "</b>shifts</div>";
   if (!bowing.empty()) {
-    h << "<div><b>" << Num(Median(sounding), "%.0f") << " mm</b>sounding point (median)</div>"
+    h << "<div><b>" << Num(FiniteMedian(sounding), "%.0f") << " mm</b>sounding point (median)</div>"
       << "<div><b>" << disagree << "</b>notes bowed on another string</div>";
   }
   h << "</div>\n";
@@ -253,18 +252,18 @@ StatusOr<std::string> BuildTeacherReport(const TeacherReportOptions& options,
     h << "<section class=\"passage\" data-passage=\"" << passage_index << "\"><h2>Passage "
       << passage_index << ": " << Clock(a.onset_s) << "&ndash;" << Clock(b.onset_s + b.duration_s)
       << ", " << (last - first) << " notes</h2>\n<p>";
-    h << "Intonation: median " << Num(Median(cents), "%+.0f") << " cents";
+    h << "Intonation: median " << Num(FiniteMedian(cents), "%+.0f") << " cents";
     if (std::isfinite(slope)) {
       const double drift = slope * (b.onset_s - a.onset_s);
       h << ", " << (std::abs(drift) < options.in_tune_cents ? "steady" : drift > 0 ? "drifting sharp" : "drifting flat")
         << " (" << Num(drift, "%+.0f") << " cents over the passage)";
     }
     h << ". Shifts: " << p_shifts << ". Vibrato on " << p_vibrato << " of " << (last - first)
-      << " notes" << (p_rates.empty() ? "" : " (median " + Num(Median(p_rates), "%.1f") + " Hz)")
+      << " notes" << (p_rates.empty() ? "" : " (median " + Num(FiniteMedian(p_rates), "%.1f") + " Hz)")
       << ".";
     if (!bowing.empty()) {
       h << " Bow: " << p_changes << " bow change" << (p_changes == 1 ? "" : "s")
-        << " between notes, sounding point " << Num(Median(p_sounding), "%.0f") << " mm from the bridge.";
+        << " between notes, sounding point " << Num(FiniteMedian(p_sounding), "%.0f") << " mm from the bridge.";
     }
     h << "</p>\n<table><tr><th>#</th><th>time</th><th class=\"name\">note</th><th>string</th>"
       << "<th>finger</th><th>position</th><th>cents</th><th>vibrato</th>"

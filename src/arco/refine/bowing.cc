@@ -7,6 +7,7 @@
 
 #include "arco/util/csv.h"
 #include "arco/util/file_io.h"
+#include "arco/util/stats.h"
 
 namespace arco::refine {
 namespace {
@@ -71,13 +72,11 @@ bool FitLine(const std::vector<std::pair<double, double>>& samples, double* c0, 
   return true;
 }
 
-double Median(std::vector<double> v) {
+// The upper median of the finite values (NaN when there are none).
+double FiniteMedian(std::vector<double> v) {
   v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }),
           v.end());
-  if (v.empty()) return kNaN;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-  return v[mid];
+  return v.empty() ? kNaN : UpperMedian(std::move(v));
 }
 
 }  // namespace
@@ -308,7 +307,7 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
       for (double v : speeds) total += v;
       note.mean_speed_mm_per_s = total / static_cast<double>(speeds.size());
     }
-    note.sounding_point_mm = Median(sounding);
+    note.sounding_point_mm = FiniteMedian(sounding);
     for (double t : out.change_times_s) {
       const double dt = t - nf.onset_s;
       if (!std::isfinite(note.change_to_onset_s) || std::abs(dt) < std::abs(note.change_to_onset_s)) {
@@ -337,8 +336,8 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
       }
     }
   }
-  sum.median_sounding_point_mm = Median(sounding);
-  sum.median_speed_mm_per_s = Median(speeds);
+  sum.median_sounding_point_mm = FiniteMedian(sounding);
+  sum.median_speed_mm_per_s = FiniteMedian(speeds);
   return out;
 }
 
