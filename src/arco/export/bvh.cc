@@ -165,11 +165,11 @@ std::optional<RigidRoot> MakeRigidRoot(const ExportData& data,
 
 // Rotation and centroid of frame f (the previous ones held when fewer than two points, or
 // for a body of more than two, fewer than three, exist).
-void FitRigid(const ExportData& data,
-              int64_t f,
-              RigidRoot& root,
-              Eigen::Matrix3d& rotation,
-              Eigen::Vector3d& centroid) {
+void FitRigidRootFrame(const ExportData& data,
+                       int64_t f,
+                       RigidRoot& root,
+                       Eigen::Matrix3d& rotation,
+                       Eigen::Vector3d& centroid) {
   std::vector<Eigen::Vector3d> rest, measured;
   Eigen::Vector3d rest_mean = Eigen::Vector3d::Zero(), mean = Eigen::Vector3d::Zero();
   for (size_t i = 0; i < root.keypoints.size(); ++i) {
@@ -317,7 +317,7 @@ StatusOr<BvhExport> ExportBvh(const ExportData& data) {
       for (int k = 0; k < 3; ++k) AppendF(motion, " %.6f", zxy[k]);
     }
     for (size_t r = 0; r < rigid.size(); ++r) {
-      FitRigid(data, f, rigid[r], rigid_rotation[r], rigid_centroid[r]);
+      FitRigidRootFrame(data, f, rigid[r], rigid_rotation[r], rigid_centroid[r]);
       for (int k = 0; k < 3; ++k) AppendF(motion, " %.6f", rigid_centroid[r][k]);
       const Eigen::Vector3d zxy = rigid_rotation[r].eulerAngles(2, 0, 1) * (180.0 / M_PI);
       for (int k = 0; k < 3; ++k) AppendF(motion, " %.6f", zxy[k]);

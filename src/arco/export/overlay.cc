@@ -17,6 +17,7 @@
 #include "arco/pipeline/preflight.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/refine/contact_annotation.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
 
 namespace arco::exporter {
@@ -374,7 +375,7 @@ StatusOr<OverlaySummary> WriteOverlay(const OverlayOptions& options,
   for (int k = 0; k < data.points(); ++k) {
     const std::string& n = data.keypoint_names[k];
     const bool face = n.rfind("face", 0) == 0;
-    if (k < 133 && !face) drawing.points.push_back(k);
+    if (k < wholebody::kNumPoints && !face) drawing.points.push_back(k);
   }
   const char* tip_names[5] = {"left_hand_thumb_tip",
                               "left_hand_index_tip",

@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "arco/geometry/rotation.h"
+
 namespace arco {
 namespace {
 
@@ -42,9 +44,9 @@ std::optional<Sim3d> SolveWeighted(const std::vector<Eigen::Vector3d>& source,
   const Eigen::Vector3d d = svd.singularValues();
   // Rank < 2: all points on a line (or the target collapsed), rotation undetermined.
   if (!(d(1) > 1e-12 * d(0))) return std::nullopt;
-  Eigen::Vector3d signs(1, 1, 1);
-  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) signs(2) = -1;  // no mirror
-  const Eigen::Matrix3d rotation = svd.matrixU() * signs.asDiagonal() * svd.matrixV().transpose();
+  bool reflected = false;  // no mirror: the last singular direction flipped
+  const Eigen::Matrix3d rotation = ProperRotationFromSvd(svd.matrixU(), svd.matrixV(), &reflected);
+  const Eigen::Vector3d signs(1, 1, reflected ? -1 : 1);
   const double scale = estimate_scale ? d.dot(signs) / variance_source : 1.0;
   if (!(scale > 0) || !std::isfinite(scale)) return std::nullopt;
   const Eigen::Vector3d translation = mean_target - scale * rotation * mean_source;

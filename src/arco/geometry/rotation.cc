@@ -43,11 +43,19 @@ double RotationAngleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) 
   return AxisAngleFromRotation(a.transpose() * b).norm();
 }
 
-Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& matrix) {
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(matrix, Eigen::ComputeFullU | Eigen::ComputeFullV);
+Eigen::Matrix3d ProperRotationFromSvd(const Eigen::Matrix3d& left,
+                                      const Eigen::Matrix3d& right,
+                                      bool* reflected) {
   Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) d(2, 2) = -1;
-  return svd.matrixU() * d * svd.matrixV().transpose();
+  const bool flip = (left * right.transpose()).determinant() < 0;
+  if (flip) d(2, 2) = -1;
+  if (reflected != nullptr) *reflected = flip;
+  return left * d * right.transpose();
+}
+
+Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& matrix) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(matrix, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  return ProperRotationFromSvd(svd.matrixU(), svd.matrixV());
 }
 
 std::optional<Eigen::Matrix3d> RotationFrom6d(const Eigen::Matrix<double, 6, 1>& columns) {
@@ -103,10 +111,9 @@ Eigen::Matrix3d KabschRotation(const std::vector<Eigen::Vector3d>& a,
   if (a.size() != b.size()) throw std::invalid_argument("KabschRotation: sizes differ");
   Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
   for (size_t i = 0; i < a.size(); ++i) h += a[i] * b[i].transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
-  return svd.matrixV() * d * svd.matrixU().transpose();
+  // R maximises tr(R h): V diag(1, 1, det) U^T for h = U S V^T.
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  return ProperRotationFromSvd(svd.matrixV(), svd.matrixU());
 }
 
 }  // namespace arco

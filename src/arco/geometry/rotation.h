@@ -24,6 +24,14 @@ double RotationAngleBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);
 
 // The rotation nearest to `matrix` in the Frobenius norm (SVD, det fixed to +1).
 Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& matrix);
+// The proper rotation left * diag(1, 1, +-1) * right^T from the orthogonal factors of an
+// SVD, the sign making det = +1; `reflected`, when given, is set when it is -1. The one
+// place arco turns a cross-covariance into a rotation: NearestRotation (U, V of the
+// matrix), KabschRotation (V, U of sum a b^T; Kabsch 1976) and the Umeyama alignment
+// (geometry/alignment.h, which also needs the singular values; Umeyama, PAMI 1991).
+Eigen::Matrix3d ProperRotationFromSvd(const Eigen::Matrix3d& left,
+                                      const Eigen::Matrix3d& right,
+                                      bool* reflected = nullptr);
 
 // The rotation R minimising sum_i |R a_i - b_i|^2 over vectors already relative to a
 // common origin (Kabsch 1976: SVD of sum a_i b_i^T, det fixed to +1). Sizes must match.

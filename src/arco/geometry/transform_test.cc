@@ -153,6 +153,22 @@ TEST(KabschRotation, RecoversTheRotationOfVectorsAndNeverAReflection) {
   EXPECT_THROW(KabschRotation(a, plane), std::invalid_argument);
 }
 
+TEST(ProperRotationFromSvd, FlipsTheLastDirectionOnlyForAReflection) {
+  std::mt19937 rng(17);
+  const Eigen::Matrix3d u = RandomRotation(&rng).toRotationMatrix();
+  const Eigen::Matrix3d v = RandomRotation(&rng).toRotationMatrix();
+  bool reflected = true;
+  EXPECT_LT((ProperRotationFromSvd(u, v, &reflected) - u * v.transpose()).norm(), 1e-12);
+  EXPECT_FALSE(reflected);
+  // A mirrored left factor (det -1): the last column is flipped back, det +1.
+  Eigen::Matrix3d mirrored = u;
+  mirrored.col(2) = -mirrored.col(2);
+  const Eigen::Matrix3d r = ProperRotationFromSvd(mirrored, v, &reflected);
+  EXPECT_TRUE(reflected);
+  EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
+  EXPECT_LT((r - u * v.transpose()).norm(), 1e-12);
+}
+
 TEST(Rotation6d, RoundTripsAndOrthonormalisesAndRejectsDegenerate) {
   std::mt19937 rng(15);
   for (int i = 0; i < 50; ++i) {

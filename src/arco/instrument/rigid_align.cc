@@ -12,12 +12,12 @@ namespace arco {
 
 // The spread check here is stricter than AlignPoints' own rank test: a near-collinear
 // triple of noisy keypoints fixes the roll about its line only to noise / spread.
-bool FitRigid(const Eigen::Matrix3Xd& source,
-              const Eigen::Matrix3Xd& target,
-              const std::vector<int>& indices,
-              double min_spread,
-              Eigen::Matrix3d* rotation,
-              Eigen::Vector3d* translation) {
+bool FitRigidSubset(const Eigen::Matrix3Xd& source,
+                    const Eigen::Matrix3Xd& target,
+                    const std::vector<int>& indices,
+                    double min_spread,
+                    Eigen::Matrix3d* rotation,
+                    Eigen::Vector3d* translation) {
   const int n = static_cast<int>(indices.size());
   if (n < 3) return false;
   Eigen::Vector3d s_mean = Eigen::Vector3d::Zero();
@@ -93,7 +93,7 @@ RigidAlignment AlignRigidRobust(const Eigen::Matrix3Xd& source,
 
   Hypothesis best;
   bool have_best = false;
-  if (FitRigid(source, target, common, min_spread, &best.rotation, &best.translation)) {
+  if (FitRigidSubset(source, target, common, min_spread, &best.rotation, &best.translation)) {
     Score(source, target, common, gate, &best);
     have_best = true;
   }
@@ -106,7 +106,7 @@ RigidAlignment AlignRigidRobust(const Eigen::Matrix3Xd& source,
       for (int b = a + 1; b < n; ++b) {
         for (int c = b + 1; c < n; ++c) {
           sample = {common[a], common[b], common[c]};
-          if (!FitRigid(source, target, sample, min_spread, &h.rotation, &h.translation)) {
+          if (!FitRigidSubset(source, target, sample, min_spread, &h.rotation, &h.translation)) {
             continue;
           }
           Score(source, target, common, gate, &h);
@@ -122,7 +122,8 @@ RigidAlignment AlignRigidRobust(const Eigen::Matrix3Xd& source,
   // Refit on the inliers, then re-select once with the refined pose.
   for (int round = 0; round < 2; ++round) {
     Hypothesis refit;
-    if (!FitRigid(source, target, best.inliers, min_spread, &refit.rotation, &refit.translation)) {
+    if (!FitRigidSubset(
+            source, target, best.inliers, min_spread, &refit.rotation, &refit.translation)) {
       break;
     }
     Score(source, target, common, gate, &refit);
@@ -132,7 +133,7 @@ RigidAlignment AlignRigidRobust(const Eigen::Matrix3Xd& source,
     if (same) break;
   }
   // Final least squares on the final inlier set (also checks it is not collinear).
-  if (!FitRigid(source, target, best.inliers, min_spread, &out.rotation, &out.translation)) {
+  if (!FitRigidSubset(source, target, best.inliers, min_spread, &out.rotation, &out.translation)) {
     return out;
   }
   out.ok = true;

@@ -33,11 +33,11 @@ RigidAlignment AlignRigidRobust(const Eigen::Matrix3Xd& source,
 
 // Least-squares rigid fit (no scale) of the columns listed in `indices`; false when the
 // points are collinear (second singular value of the centred source below min_spread).
-bool FitRigid(const Eigen::Matrix3Xd& source,
-              const Eigen::Matrix3Xd& target,
-              const std::vector<int>& indices,
-              double min_spread,
-              Eigen::Matrix3d* rotation,
-              Eigen::Vector3d* translation);
+bool FitRigidSubset(const Eigen::Matrix3Xd& source,
+                    const Eigen::Matrix3Xd& target,
+                    const std::vector<int>& indices,
+                    double min_spread,
+                    Eigen::Matrix3d* rotation,
+                    Eigen::Vector3d* translation);
 
 }  // namespace arco

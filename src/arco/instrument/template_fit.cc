@@ -211,7 +211,7 @@ StatusOr<InstrumentFit> FitInstrument(const InstrumentModel& model,
     }
     Eigen::Matrix3d gauge_r;
     Eigen::Vector3d gauge_t;
-    if (FitRigid(updated, shape, common, options.min_spread_mm, &gauge_r, &gauge_t)) {
+    if (FitRigidSubset(updated, shape, common, options.min_spread_mm, &gauge_r, &gauge_t)) {
       updated = (gauge_r * updated).colwise() + gauge_t;
     }
     const double change = MaxChange(shape, updated);

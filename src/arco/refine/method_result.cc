@@ -8,7 +8,7 @@
 namespace arco::refine {
 namespace {
 
-constexpr int kLeftHandFirst = 91;
+using wholebody::kLeftHandFirst;
 constexpr int kNumWholeBody = wholebody::kNumPoints;
 
 void SetPoint(NpyArray<double>* a, int64_t f, int64_t p, const Eigen::Vector3d& v) {

@@ -88,6 +88,8 @@ TEST(KeypointLayoutRegistry, WholeBodyConstantsMatchTheLayouts) {
     EXPECT_EQ(l.Find("left_hand_wrist"), wholebody::kLeftHandFirst);
     EXPECT_EQ(l.Find("left_shoulder"), wholebody::kLeftShoulder);
     EXPECT_EQ(l.Find("right_shoulder"), wholebody::kRightShoulder);
+    EXPECT_EQ(l.Find("left_wrist"), wholebody::kLeftWrist);
+    EXPECT_EQ(l.Find("right_wrist"), wholebody::kRightWrist);
     EXPECT_EQ(l.Find("right_hand_wrist"), wholebody::kRightHandFirst);
     EXPECT_EQ(l.Find("right_hand_little_tip"), wholebody::kNumPoints - 1);
     if (l.size() > wholebody::kNumPoints) {

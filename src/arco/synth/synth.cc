@@ -189,9 +189,10 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
                   performer_from_world * right_pts[0],
                   violin_like,
                   &body);
-    for (int p = 0; p < 91; ++p) set(p, world_from_performer * body[static_cast<size_t>(p)]);
-    set(9, left_pts[0]);  // body wrists are the hands' wrists exactly
-    set(10, right_pts[0]);
+    for (int p = 0; p < wholebody::kLeftHandFirst; ++p)
+      set(p, world_from_performer * body[static_cast<size_t>(p)]);
+    set(wholebody::kLeftWrist, left_pts[0]);  // body wrists are the hands' wrists exactly
+    set(wholebody::kRightWrist, right_pts[0]);
 
     // Contact-stage extras: strings lowest first (nut end, bridge end), contact,
     // playing finger MCP..tip.
