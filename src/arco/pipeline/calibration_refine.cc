@@ -18,7 +18,7 @@
 #include "arco/instrument/template_fit.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/triangulate_point.h"
-#include "arco/pipeline/preflight.h"
+#include "arco/pipeline/capture_checks.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/output_set.h"
 

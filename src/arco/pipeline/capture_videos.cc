@@ -2,7 +2,7 @@
 
 #include "arco/calibration/calibration_file.h"
 #include "arco/media/video_reader.h"
-#include "arco/pipeline/preflight.h"
+#include "arco/pipeline/capture_checks.h"
 #include "arco/util/file_io.h"
 
 namespace arco::pipeline {

@@ -9,7 +9,7 @@
 #include "arco/mocap/capture.h"
 #include "arco/mocap/mmpose_json.h"
 #include "arco/mocap/openpose_json.h"
-#include "arco/pipeline/preflight.h"
+#include "arco/pipeline/capture_checks.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/check.h"
 #include "arco/util/file_io.h"

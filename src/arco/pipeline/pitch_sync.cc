@@ -7,7 +7,7 @@
 #include <utility>
 
 #include "arco/mocap/capture.h"
-#include "arco/pipeline/preflight.h"
+#include "arco/pipeline/capture_checks.h"
 #include "arco/util/file_io.h"
 #include "arco/util/output_set.h"
 

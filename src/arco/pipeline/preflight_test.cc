@@ -1,14 +1,14 @@
 // PreflightRun and its checks on a small hand-written capture (the real SPD calibration,
 // a 2-camera keypoint array, a generated WAV): each defect is one error naming the file
 // and the field, found before any result folder exists.
-#include "arco/pipeline/preflight.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 
 #include "arco/audio/test_signals.h"
+#include "arco/pipeline/capture_checks.h"
+#include "arco/pipeline/run_capture.h"
 #include "arco/util/file_io.h"
 #include "arco/util/test_dir.h"
 

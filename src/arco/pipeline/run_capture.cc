@@ -3,10 +3,11 @@
 #include <chrono>
 #include <utility>
 
+#include "arco/pipeline/capture_checks.h"
 #include "arco/pipeline/capture_context.h"
-#include "arco/pipeline/preflight.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/util/atomic_dir.h"
+#include "arco/util/file_io.h"
 
 namespace arco::pipeline {
 namespace {
@@ -101,8 +102,9 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
   };
 
   auto start = stage(1, "triangulate");
-  ARCO_ASSIGN_OR_RETURN(summary.triangulate,
-                        RunTriangulateStage(options.ForTriangulate(), progress, capture.keypoints2d));
+  ARCO_ASSIGN_OR_RETURN(
+      summary.triangulate,
+      RunTriangulateStage(options.ForTriangulate(), progress, capture.keypoints2d));
   summary.timings.push_back({"triangulate", SecondsSince(start)});
 
   start = stage(2, "instrument");
@@ -143,6 +145,31 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
 }
 
 }  // namespace
+
+StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options.result_dir, options.Replace()));
+  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, OpenCapture(options.capture_dir));
+  const CaptureManifest& m = capture.manifest;
+  ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(options.capture_dir, m));
+  ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(options.capture_dir, m));
+  // Read once here; the stages of the run use it (CaptureContext::keypoints2d).
+  ARCO_ASSIGN_OR_RETURN(capture.keypoints2d, ReadKeypoints2d(capture));
+  ARCO_RETURN_IF_ERROR(CheckCaptureInstrumentPoints(capture));
+  ARCO_RETURN_IF_ERROR(
+      CheckTriangulationFilters(options.ForTriangulate(),
+                                capture.layout,
+                                m.fps,
+                                JoinPath(options.capture_dir, kCaptureManifestName)));
+  ARCO_RETURN_IF_ERROR(CheckCaptureAudio(options.capture_dir, m).status());
+  // After the checks, so that a bad file gets its own message rather than the hash's.
+  ARCO_ASSIGN_OR_RETURN(capture.inputs,
+                        FingerprintCaptureInputs(
+                            options.capture_dir,
+                            m,
+                            {kManifestInput, kCalibrationInput, kKeypoints2dInput, kAudioInput}));
+  return capture;
+}
 
 StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
   // Every input checked before the first stage (and before the result folder exists).

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "arco/pipeline/capture_context.h"
 #include "arco/pipeline/hand_stage.h"
 #include "arco/pipeline/instrument_stage.h"
 #include "arco/pipeline/pitch_stage.h"
@@ -73,6 +74,17 @@ struct RunSummary {
 Json ToJson(const RunOptions& options);
 
 inline constexpr int kRunStages = 5;
+
+// Fail early: every input `arco run` will need is checked before its first stage
+// (pipeline/capture_checks.h), so a bad capture costs milliseconds, not the triangulation
+// and hand fitting before it, and leaves no result folder (docs/architecture.md,
+// "Validation rules").
+// Every check of `arco run`, in the order a user fixes them: options, the result folder
+// (writable; replaceable only with --overwrite), capture.json and its instrument and
+// layout (OpenCapture), the calibration and cameras, keypoints2d.npy (dtype and shape,
+// from its header; the instrument's string ends present), the filters, the audio and its offset.
+// Returns the opened capture.
+StatusOr<CaptureContext> PreflightRun(const RunOptions& options);
 
 // Progress: StartStage(i, 5, name) for each stage, then that stage's SetTotal / Advance.
 StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress = NoProgress());

@@ -2,7 +2,7 @@
 
 #include "arco/calibration/calibration_file.h"
 #include "arco/mocap/capture.h"
-#include "arco/pipeline/preflight.h"
+#include "arco/pipeline/capture_checks.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/util/file_io.h"
 
@@ -40,7 +40,7 @@ StatusOr<TriangulateStageSummary> RunTriangulateStage(
     if (!l.ok()) return l.status().WithContext(manifest_path);
     return l;
   }());
-  // Filters refer to groups of the layout; checked before any work (pipeline/preflight.h).
+  // Filters refer to groups of the layout; checked before any work (pipeline/capture_checks.h).
   ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(o, layout, manifest.fps, manifest_path));
   std::vector<const std::vector<int>*> filter_groups;
   for (const auto& entry : o.filters) filter_groups.push_back(layout.Group(entry.first));

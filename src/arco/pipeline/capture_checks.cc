@@ -1,4 +1,4 @@
-#include "arco/pipeline/preflight.h"
+#include "arco/pipeline/capture_checks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -167,28 +167,6 @@ Status CheckCaptureInstrumentPoints(const CaptureContext& capture) {
                        "'s nut_l, nut_r, bridge_l and bridge_r in two views each (the strings "
                        "cannot be placed); a capture made from videos gets them from `arco "
                        "track` after `arco detect`");
-}
-
-StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
-  ARCO_RETURN_IF_ERROR(options.Validate());
-  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options.result_dir, options.Replace()));
-  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, OpenCapture(options.capture_dir));
-  const CaptureManifest& m = capture.manifest;
-  ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(options.capture_dir, m));
-  ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(options.capture_dir, m));
-  // Read once here; the stages of the run use it (CaptureContext::keypoints2d).
-  ARCO_ASSIGN_OR_RETURN(capture.keypoints2d, ReadKeypoints2d(capture));
-  ARCO_RETURN_IF_ERROR(CheckCaptureInstrumentPoints(capture));
-  ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(
-      options.ForTriangulate(), capture.layout, m.fps, ManifestPath(options.capture_dir)));
-  ARCO_RETURN_IF_ERROR(CheckCaptureAudio(options.capture_dir, m).status());
-  // After the checks, so that a bad file gets its own message rather than the hash's.
-  ARCO_ASSIGN_OR_RETURN(capture.inputs,
-                        FingerprintCaptureInputs(
-                            options.capture_dir,
-                            m,
-                            {kManifestInput, kCalibrationInput, kKeypoints2dInput, kAudioInput}));
-  return capture;
 }
 
 }  // namespace arco::pipeline

@@ -1,8 +1,7 @@
-// Fail early: every input `arco run` will need is checked before its first stage, so a
-// bad capture costs milliseconds, not the triangulation and hand fitting before it, and
-// leaves no result folder (docs/architecture.md, "Validation rules"). Each check is also
-// a function of its own for the commands that read the same input (arco triangulate,
-// arco pitch --capture). Errors are one line naming the file and the field.
+// The checks of a capture's inputs, one function each, for every command that reads them
+// (arco run's PreflightRun in run_capture.h, arco triangulate, arco pitch --capture, arco
+// calibrate check/refine, arco overlay, importers). Errors are one line naming the file
+// and the field (docs/architecture.md, "Validation rules").
 #pragma once
 
 #include <string>
@@ -11,7 +10,7 @@
 #include "arco/camera/rig.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/capture_context.h"
-#include "arco/pipeline/run_capture.h"
+#include "arco/pipeline/triangulate_stage.h"
 #include "arco/util/status.h"
 
 namespace arco::pipeline {
@@ -56,11 +55,5 @@ Status CheckTriangulationFilters(const TriangulateStageOptions& options,
 // without them this is one line naming keypoints2d.npy, before any work. Reads the 2D
 // keypoints (their header was checked by CheckCaptureKeypoints2d).
 Status CheckCaptureInstrumentPoints(const CaptureContext& capture);
-
-// Every check of `arco run`, in the order a user fixes them: options, the result folder
-// (writable; replaceable only with --overwrite), capture.json and its instrument and
-// layout (OpenCapture), the calibration and cameras, keypoints2d.npy (dtype and shape,
-// from its header; the instrument's string ends present), the filters, the audio and its offset. Returns the opened capture.
-StatusOr<CaptureContext> PreflightRun(const RunOptions& options);
 
 }  // namespace arco::pipeline
