@@ -344,17 +344,16 @@ StatusOr<OverlaySummary> WriteOverlay(const OverlayOptions& options,
   // The background video, when the camera has one.
   OverlaySummary summary;
   summary.camera = manifest.cameras[view].name;
-  std::optional<media::VideoReader> reader;
+  std::optional<pipeline::CaptureFrameReader> reader;
   int rotate_deg = 0;
   if (!manifest.cameras[view].video.empty()) {
     ARCO_ASSIGN_OR_RETURN(
-        const pipeline::CaptureVideo video,
+        pipeline::CaptureVideo video,
         pipeline::OpenCaptureVideo(
             header.capture_dir, manifest, view, camera, calibration_path, first, last));
-    ARCO_ASSIGN_OR_RETURN(media::VideoReader r, media::VideoReader::Open(video.video));
-    reader.emplace(std::move(r));
     rotate_deg = video.rotate_deg;
     summary.video = video.video;
+    reader.emplace(manifest, view, std::move(video));
   }
 
   ARCO_ASSIGN_OR_RETURN(const auto fingering, folder.ReadFingering(options.method));
@@ -409,15 +408,11 @@ StatusOr<OverlaySummary> WriteOverlay(const OverlayOptions& options,
   media::Image decoded, scaled;
   for (int64_t g = first; g <= last; ++g) {
     canvas.setTo(cv::Scalar(0, 0, 0));
-    const int64_t n = reader ? manifest.VideoFrameNumber(view, g) : -1;
-    if (reader && n >= 1) {
-      const int64_t index = n - 1;
-      if (reader->next_frame() == index) {
-        ARCO_ASSIGN_OR_RETURN(const bool more, reader->Read(&decoded));
-        if (!more) return Status::Error(summary.video + ": ends before frame " + std::to_string(n));
-      } else {
-        ARCO_ASSIGN_OR_RETURN(decoded, reader->ReadFrame(index));
-      }
+    bool recorded = false;  // the camera has frame g (it may have dropped it)
+    if (reader) {
+      ARCO_ASSIGN_OR_RETURN(recorded, reader->Read(g, &decoded, /*rotate=*/false));
+    }
+    if (recorded) {
       // Scaled down first, then turned: the same picture (area averaging commutes with a
       // quarter turn), and fewer pixels to turn (turning a 6-megapixel frame was a third
       // of the time of `arco view`'s videos, docs/performance.md).

@@ -76,4 +76,28 @@ StatusOr<CaptureVideo> OpenCaptureVideo(const std::string& dir,
   return in;
 }
 
+CaptureFrameReader::CaptureFrameReader(const CaptureManifest& manifest,
+                                       int view,
+                                       CaptureVideo video,
+                                       media::VideoReaderOptions options)
+    : manifest_(&manifest), view_(view), video_(std::move(video)), options_(options) {}
+
+StatusOr<bool> CaptureFrameReader::Read(int64_t g, media::Image* frame, bool rotate) {
+  const int64_t n = manifest_->VideoFrameNumber(view_, g);  // 1-based, -1: dropped
+  if (n < 0) return false;
+  if (!reader_) {
+    ARCO_ASSIGN_OR_RETURN(media::VideoReader r, media::VideoReader::Open(video_.video, options_));
+    reader_.emplace(std::move(r));
+  }
+  if (reader_->next_frame() != n - 1) ARCO_RETURN_IF_ERROR(reader_->Seek(n - 1));
+  const bool turn = rotate && video_.rotate_deg != 0;
+  ARCO_ASSIGN_OR_RETURN(const bool more, reader_->Read(turn ? &decoded_ : frame));
+  if (!more) {
+    return Status::Error(video_.video + ": frame " + std::to_string(n - 1) +
+                         " could not be read (the video ends early)");
+  }
+  if (turn) *frame = media::RotateClockwise(decoded_, video_.rotate_deg);
+  return true;
+}
+
 }  // namespace arco::pipeline

@@ -5,10 +5,13 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "arco/camera/camera.h"
+#include "arco/media/image.h"
+#include "arco/media/video_reader.h"
 #include "arco/mocap/capture.h"
 #include "arco/util/status.h"
 
@@ -38,5 +41,30 @@ StatusOr<CaptureVideo> OpenCaptureVideo(const std::string& capture_dir,
                                         const std::string& calibration_path,
                                         int64_t first,
                                         int64_t last);
+
+// The one way a stage reads a capture camera's frames by the capture's frame number (`arco
+// detect`, `arco track`, `arco overlay`): the manifest maps frame g to the camera's video
+// frame (none where it dropped it), the reader seeks only when g is not the next frame,
+// and the picture is turned by rotate_deg unless the caller turns it itself. Opened on the
+// first read (a worker may hold readers it never uses).
+class CaptureFrameReader {
+ public:
+  CaptureFrameReader(const CaptureManifest& manifest,
+                     int view,
+                     CaptureVideo video,
+                     media::VideoReaderOptions options = {});
+  // Frame g into *frame: false when the camera dropped it (*frame untouched). An error
+  // naming the video when it does not open, cannot seek, or ends before the frame.
+  StatusOr<bool> Read(int64_t g, media::Image* frame, bool rotate = true);
+  const CaptureVideo& video() const { return video_; }
+
+ private:
+  const CaptureManifest* manifest_;
+  int view_;
+  CaptureVideo video_;
+  media::VideoReaderOptions options_;
+  std::optional<media::VideoReader> reader_;
+  media::Image decoded_;  // reused when the frame is turned
+};
 
 }  // namespace arco::pipeline

@@ -39,7 +39,7 @@ struct Chunk {
 // Per-worker state: its tracker and the videos it has open.
 struct Worker {
   std::optional<detect::WholeBodyTracker> tracker;
-  std::map<int, media::VideoReader> readers;
+  std::map<int, CaptureFrameReader> readers;
   double decode_s = 0;
 };
 
@@ -229,36 +229,23 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
         }
         auto reader_it = w.readers.find(c.view);
         if (reader_it == w.readers.end()) {
-          auto reader = media::VideoReader::Open(in.video);
-          if (!reader.ok()) return fail(reader.status());
-          reader_it = w.readers.emplace(c.view, std::move(*reader)).first;
+          reader_it = w.readers.emplace(c.view, CaptureFrameReader(manifest, c.view, in)).first;
         }
-        media::VideoReader& reader = reader_it->second;
+        CaptureFrameReader& reader = reader_it->second;
         const detect::WholeBodySummary before = w.tracker->summary();
         w.tracker->Reset();
         media::Image frame;
         for (int64_t g = c.first; g <= c.last; ++g) {
-          const int64_t n = manifest.VideoFrameNumber(c.view, g);  // 1-based, -1 dropped
           progress.Advance(1);
-          if (n < 0) {
+          const auto decode_start = std::chrono::steady_clock::now();
+          auto read = reader.Read(g, &frame);
+          if (!read.ok()) return fail(read.status());
+          if (!*read) {
             ++chunk_dropped[i];
             continue;
           }
-          const auto decode_start = std::chrono::steady_clock::now();
-          if (reader.next_frame() != n - 1) {
-            const Status s = reader.Seek(n - 1);
-            if (!s.ok()) return fail(s);
-          }
-          auto more = reader.Read(&frame);
-          if (!more.ok()) return fail(more.status());
-          if (!*more) {
-            return fail(Status::Error(in.video + ": frame " + std::to_string(n - 1) +
-                                      " could not be read (the video ends early)"));
-          }
-          media::Image turned;
-          if (in.rotate_deg != 0) turned = media::RotateClockwise(frame, in.rotate_deg);
           w.decode_s += SecondsSince(decode_start);
-          auto found = w.tracker->Track(in.rotate_deg != 0 ? turned : frame);
+          auto found = w.tracker->Track(frame);
           if (!found.ok()) return fail(found.status());
           ++chunk_read[i];
           for (int p = 0; p < wholebody::kNumPoints; ++p) {

@@ -40,56 +40,35 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Each camera's video, read in order or by seeking; frames turned by rotate_deg.
+// Each camera's video (gray), read in order or by seeking; frames turned by rotate_deg.
 class Frames {
  public:
   Frames(const CaptureManifest& manifest, const std::vector<CaptureVideo>& inputs)
-      : manifest_(manifest), inputs_(inputs), readers_(inputs.size()), images_(inputs.size()) {}
+      : images_(inputs.size()) {
+    media::VideoReaderOptions gray;
+    gray.format = media::PixelFormat::kGray8;
+    for (size_t v = 0; v < inputs.size(); ++v) {
+      readers_.emplace_back(manifest, static_cast<int>(v), inputs[v], gray);
+    }
+  }
 
   // Reads global frame g of every view (in parallel over views); a null pointer for a
   // view that dropped it.
   StatusOr<std::vector<const media::Image*>> Read(int64_t g, int threads, double* decode_s) {
     const auto start = std::chrono::steady_clock::now();
-    const int n = static_cast<int>(inputs_.size());
+    const int n = static_cast<int>(readers_.size());
     std::vector<Status> status(n, Status::Ok());
     std::vector<const media::Image*> out(n, nullptr);
     ParallelFor(
         n,
         threads,
         [&](int64_t v, int) {
-          const int64_t k = manifest_.VideoFrameNumber(static_cast<int>(v), g);
-          if (k < 0) return;
-          if (!readers_[v]) {
-            media::VideoReaderOptions o;
-            o.format = media::PixelFormat::kGray8;
-            auto r = media::VideoReader::Open(inputs_[v].video, o);
-            if (!r.ok()) {
-              status[v] = r.status();
-              return;
-            }
-            readers_[v].emplace(std::move(*r));
+          StatusOr<bool> read = readers_[v].Read(g, &images_[v]);
+          if (!read.ok()) {
+            status[v] = read.status();
+          } else if (*read) {
+            out[v] = &images_[v];
           }
-          media::VideoReader& reader = *readers_[v];
-          if (reader.next_frame() != k - 1) {
-            const Status s = reader.Seek(k - 1);
-            if (!s.ok()) {
-              status[v] = s;
-              return;
-            }
-          }
-          media::Image frame;
-          auto more = reader.Read(&frame);
-          if (!more.ok() || !*more) {
-            status[v] = more.ok()
-                            ? Status::Error(inputs_[v].video + ": frame " + std::to_string(k - 1) +
-                                            " could not be read (the video ends early)")
-                            : more.status();
-            return;
-          }
-          images_[v] = inputs_[v].rotate_deg != 0
-                           ? media::RotateClockwise(frame, inputs_[v].rotate_deg)
-                           : std::move(frame);
-          out[v] = &images_[v];
         },
         1);
     for (const Status& s : status) ARCO_RETURN_IF_ERROR(s);
@@ -98,9 +77,7 @@ class Frames {
   }
 
  private:
-  const CaptureManifest& manifest_;
-  const std::vector<CaptureVideo>& inputs_;
-  std::vector<std::optional<media::VideoReader>> readers_;
+  std::vector<CaptureFrameReader> readers_;
   std::vector<media::Image> images_;
 };
 
