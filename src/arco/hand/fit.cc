@@ -66,6 +66,10 @@ ceres::Solver::Options SolverOptions(int max_iterations) {
   options.parameter_tolerance = 1e-8;
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
+  // No projected line search after each trust-region step (Ceres runs one on problems
+  // with bounds, the joint limits here): it evaluated the Jacobian a second time per
+  // iteration. Steps still stay within the bounds (Ceres projects them).
+  options.max_num_line_search_step_size_iterations = 0;
   return options;
 }
 
