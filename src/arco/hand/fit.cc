@@ -58,14 +58,21 @@ ceres::Solver::Options SolverOptions(int max_iterations) {
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   options.max_num_iterations = max_iterations;
-  // Ceres' default tolerances. 1e-10 (until issue 16) took twice the iterations (49
-  // vs 26 per frame of a 20-camera take, both solves) for changes far below the
-  // keypoints' noise: the same figures in docs/accuracy.md's table to 0.01 mm
-  // (docs/performance.md, "The multi-view hand fit").
-  options.function_tolerance = 1e-6;
+  // A relative cost change of 1e-5 ends the solve. 1e-10 (until issue 16) took twice the
+  // iterations of Ceres' default 1e-6; 1e-5 takes a quarter fewer again (per frame of the
+  // one-minute 20-camera take: 17 -> 12.5 iterations in solve 1, 28 -> 24 in the 3D
+  // initialisation) for changes far below the keypoints' noise: docs/accuracy.md's
+  // table (seed 0) within 0.01 mm on average per method and setting. 1e-4 halves solve
+  // 1 again but moved the arco method's harsh contact deviation by +0.04 mm
+  // (docs/performance.md, issue 28 part 3).
+  options.function_tolerance = 1e-5;
   options.parameter_tolerance = 1e-8;
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
+  // No projected line search after each trust-region step (Ceres runs one on problems
+  // with bounds, the joint limits here): it evaluated the Jacobian a second time per
+  // iteration. Steps still stay within the bounds (Ceres projects them).
+  options.max_num_line_search_step_size_iterations = 0;
   return options;
 }
 

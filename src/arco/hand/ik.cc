@@ -183,6 +183,10 @@ void SolveOnce(const IkProblemSpec& s,
   options.parameter_tolerance = 1e-12;
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
+  // No projected line search per step (a second Jacobian evaluation per iteration);
+  // Ceres still projects each step onto the bounds. The active-set loop around this
+  // solve handles the limits.
+  options.max_num_line_search_step_size_iterations = 0;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   out->converged = summary.termination_type == ceres::CONVERGENCE;

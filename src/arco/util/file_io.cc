@@ -20,10 +20,23 @@ StatusOr<std::string> ReadFileToString(const std::string& path) {
   if (fs::is_directory(path, ec)) return Status::Error(path + ": is a directory, expected a file");
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status::Error(path + ": cannot open: " + std::strerror(errno));
+  // One allocation and one read when the size is known (a 59 MB keypoints2d.npy took
+  // 0.3 s through a growing ostringstream and its copy); a stream of unknown size
+  // (a pipe) is read to its end.
+  std::string bytes;
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (!ec && fs::is_regular_file(path, ec)) {
+    bytes.resize(static_cast<size_t>(size));
+    in.read(bytes.data(), static_cast<std::streamsize>(size));
+    bytes.resize(static_cast<size_t>(in.gcount()));
+    if (in.bad()) return Status::Error(path + ": read error");
+    if (in.eof() || in.peek() == std::char_traits<char>::eof()) return bytes;
+    in.clear();
+  }
   std::ostringstream ss;
   ss << in.rdbuf();
   if (in.bad()) return Status::Error(path + ": read error");
-  return ss.str();
+  return bytes + ss.str();
 }
 
 Status AtomicWriteWith(const std::string& path,
