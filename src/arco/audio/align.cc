@@ -166,6 +166,10 @@ Status AlignOptions::Validate() const {
   return Status::Ok();
 }
 
+double TrackLevelDbfs(const AudioTrack& track) {
+  return RmsDbfs(track.samples.data(), static_cast<int64_t>(track.samples.size()));
+}
+
 StatusOr<AudioTrack> LoadAudioTrack(const std::string& path, int rate_hz, double max_seconds) {
   ARCO_ASSIGN_OR_RETURN(std::unique_ptr<AudioReader> reader, OpenAudio(path));
   const int source_rate = reader->info().sample_rate_hz;

@@ -62,6 +62,9 @@ struct AudioTrack {
 // an audio file) at `rate_hz`. Errors name the file: no audio stream, undecodable.
 StatusOr<AudioTrack> LoadAudioTrack(const std::string& path, int rate_hz, double max_seconds);
 
+// RMS level of a track, dBFS (below kAlignSilentDbfs: silent).
+double TrackLevelDbfs(const AudioTrack& track);
+
 struct AlignResult {
   double offset_s = 0;    // see the clock model above
   double drift_ppm = 0;   // 0 when the span was too short to measure it
