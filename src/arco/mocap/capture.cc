@@ -381,7 +381,8 @@ Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureMani
 }
 
 StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,
-                                                  const CaptureManifest& m) {
+                                                  const CaptureManifest& m,
+                                                  KeypointTimes times) {
   ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(capture_dir, m));
   const std::string path = ResolveCapturePath(capture_dir, m.keypoints2d);
   ARCO_ASSIGN_OR_RETURN(NpyArray<double> k, ReadNpy<double>(path));
@@ -397,8 +398,8 @@ StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir
       }
     }
   }
-  for (size_t v = 0; v < m.cameras.size(); ++v) {
-    ResampleCameraKeypoints(m, static_cast<int>(v), &k);
+  if (times == KeypointTimes::kCaptureFrames) {
+    for (size_t v = 0; v < m.cameras.size(); ++v) ResampleCameraKeypoints(m, static_cast<int>(v), &k);
   }
   return k;
 }

@@ -111,9 +111,14 @@ Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureMani
 Status CheckKeypoints2dDtype(const std::string& source, const std::string& dtype, bool is_float);
 // Reads the 2D keypoints named by the manifest after CheckCaptureKeypoints2d. Frames a
 // camera dropped are set to NaN. A camera with an offset or a drift (not OnCaptureClock()) is
-// then sampled at the capture's frame times (ResampleCameraKeypoints).
-StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,
-                                                  const CaptureManifest& manifest);
+// then sampled at the capture's frame times (ResampleCameraKeypoints), unless `times` is
+// kAsRecorded: the rows as stored, each camera's own frames (for a stage that rewrites
+// the file: `arco detect`, `arco track`).
+enum class KeypointTimes { kCaptureFrames, kAsRecorded };
+StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(
+    const std::string& capture_dir,
+    const CaptureManifest& manifest,
+    KeypointTimes times = KeypointTimes::kCaptureFrames);
 
 // Row f of `keypoints` (F, V, P, 3) for view `view` holds the camera's own global frame
 // frame_first + f; afterwards it holds the camera at the capture's frame

@@ -336,5 +336,30 @@ TEST(CaptureKeypoints, CameraWithAnOffsetIsSampledAtTheCaptureFrameTimes) {
   EXPECT_FALSE(std::isnan(k.at(22, 1, 2, 0)));
 }
 
+// The reader samples at the capture's frame times; a stage that rewrites the file reads
+// the rows as recorded.
+TEST(CaptureKeypoints, ReaderSamplesAtCaptureTimesUnlessAskedForTheRecordedRows) {
+  TempDir dir;
+  CaptureManifest m = SampleManifest();
+  m.cameras[0].dropped_frames = {};
+  m.cameras[1].offset_s = 0.5 / m.fps;  // half a frame late
+  ASSERT_TRUE(WriteCaptureManifest(dir.path(), m).ok());
+  NpyArray<float> k;
+  k.shape = {4, 2, 142, 3};
+  k.data.assign(4 * 2 * 142 * 3, 1.0f);
+  for (int64_t f = 0; f < 4; ++f) k.data[static_cast<size_t>(((f * 2 + 1) * 142) * 3)] = 10.0f * f;
+  ASSERT_TRUE(WriteNpy(dir / "keypoints2d.npy", k).ok());
+  auto capture = ReadCaptureKeypoints2d(dir.path(), m);
+  ASSERT_TRUE(capture.ok()) << capture.status().message();
+  EXPECT_TRUE(std::isnan(capture->at(0, 1, 0, 0)));  // before the camera's first frame
+  EXPECT_NEAR(capture->at(1, 1, 0, 0), 5.0, 1e-9);   // between its frames 0 and 1
+  EXPECT_NEAR(capture->at(3, 1, 0, 0), 25.0, 1e-9);
+  EXPECT_EQ(capture->at(2, 0, 0, 0), 1.0);
+  auto recorded = ReadCaptureKeypoints2d(dir.path(), m, KeypointTimes::kAsRecorded);
+  ASSERT_TRUE(recorded.ok());
+  EXPECT_EQ(recorded->at(0, 1, 0, 0), 0.0);
+  EXPECT_EQ(recorded->at(3, 1, 0, 0), 30.0);
+}
+
 }  // namespace
 }  // namespace arco
