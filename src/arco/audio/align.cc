@@ -40,6 +40,8 @@ struct Correlation {
   int64_t max_lag() const { return min_lag + static_cast<int64_t>(values.size()) - 1; }
 };
 
+constexpr double kPhatFloor = 0.1;  // of the mean cross-spectrum magnitude
+
 Correlation GccPhat(const float* a, int64_t na, const float* b, int64_t nb, double rate_hz) {
   constexpr double kMinHz = 60.0;
   int64_t n = 1;
@@ -70,10 +72,16 @@ Correlation GccPhat(const float* a, int64_t na, const float* b, int64_t nb, doub
     largest = std::max(largest, std::hypot(re, im));
   }
   const int64_t first_bin = static_cast<int64_t>(std::ceil(kMinHz * double(n) / rate_hz));
+  double mean = 0;
+  for (int64_t i = first_bin; i < bins; ++i) mean += std::hypot(fa[i][0], fa[i][1]);
+  mean /= double(std::max<int64_t>(1, bins - first_bin));
+  // Regularised PHAT: 1 / (|X| + floor). Bins far below the mean (between a periodic
+  // sound's harmonics, numerical noise) would otherwise vote as loudly as the sound
+  // itself, and their votes are about the recordings' edges, not their content.
+  const double floor = kPhatFloor * mean;
   for (int64_t i = 0; i < bins; ++i) {
     const double mag = std::hypot(fa[i][0], fa[i][1]);
-    // Bins with no energy in one of the signals carry no phase: left out.
-    const double w = (i < first_bin || !(mag > 1e-9 * largest)) ? 0.0 : 1.0 / mag;
+    const double w = (i < first_bin || !(mag > 1e-12 * largest)) ? 0.0 : 1.0 / (mag + floor);
     fa[i][0] *= w;
     fa[i][1] *= w;
   }
