@@ -221,8 +221,19 @@ StatusOr<AlignResult> AlignTracks(const AudioTrack& ref,
 
   // 1. Global lag at the coarse rate.
   const double cs = kAlignCoarseRateHz;
-  const std::vector<float> cr = Resample(ref.samples, o.fine_rate_hz, kAlignCoarseRateHz);
-  const std::vector<float> co = Resample(other.samples, o.fine_rate_hz, kAlignCoarseRateHz);
+  std::vector<float> cr = Resample(ref.samples, o.fine_rate_hz, kAlignCoarseRateHz);
+  std::vector<float> co = Resample(other.samples, o.fine_rate_hz, kAlignCoarseRateHz);
+  // Faded in and out (raised cosine over a tenth of each, at most 1 s): the whitened
+  // spectrum of a periodic sound is mostly its edges, and sharp edges would make the
+  // lag that lines them up win over the other beats.
+  for (std::vector<float>* x : {&cr, &co}) {
+    const size_t fade = std::min<size_t>(static_cast<size_t>(cs), x->size() / 10);
+    for (size_t i = 0; i < fade; ++i) {
+      const float w = static_cast<float>(0.5 - 0.5 * std::cos(M_PI * (i + 0.5) / fade));
+      (*x)[i] *= w;
+      (*x)[x->size() - 1 - i] *= w;
+    }
+  }
   const Correlation global = GccPhat(cr.data(), static_cast<int64_t>(cr.size()), co.data(),
                                      static_cast<int64_t>(co.size()), cs);
   // Lags leaving less overlap than this are not searched (a few samples always correlate).

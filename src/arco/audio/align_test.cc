@@ -143,21 +143,31 @@ TEST(AlignTracks, NoisyCopyStillWithinAMillisecond) {
 }
 
 TEST(AlignTracks, PeriodicSoundIsAmbiguous) {
-  // A metronome: the same click every 0.5 s matches at every multiple of 0.5 s.
-  std::vector<float> clicks(static_cast<size_t>(12 * kRate), 0.0f);
-  for (int64_t beat = 0; beat < 24; ++beat) {
-    for (int i = 0; i < 200; ++i) {
-      clicks[static_cast<size_t>(beat * kRate / 2 + i)] =
-          static_cast<float>(0.5 * std::sin(2 * M_PI * 2000.0 * i / kRate) * std::exp(-i / 40.0));
+  // A metronome: the same click every 0.5 s matches at every multiple of 0.5 s, whatever
+  // the click's pitch and whichever recording is longer.
+  for (double click_hz : {1000.0, 2000.0}) {
+    std::vector<float> clicks(static_cast<size_t>(12 * kRate), 0.0f);
+    for (int64_t beat = 0; beat < 24; ++beat) {
+      for (int i = 0; i < 400; ++i) {
+        clicks[static_cast<size_t>(beat * kRate / 2 + i)] = static_cast<float>(
+            0.5 * std::sin(2 * M_PI * click_hz * i / kRate) * std::exp(-i / 80.0));
+      }
+    }
+    for (double other_s : {7.0, 8.0, 11.0}) {
+      const AudioTrack ref = Track("ref.wav", std::vector<float>(clicks.begin(), clicks.begin() + 8 * kRate), kRate);
+      const int64_t first = 3 * kRate / 10;
+      const AudioTrack other =
+          Track("other.wav",
+                std::vector<float>(clicks.begin() + first,
+                                   clicks.begin() + first + static_cast<int64_t>(other_s * kRate)),
+                kRate);
+      const auto r = AlignTracks(ref, other, AlignOptions{});
+      ASSERT_FALSE(r.ok()) << click_hz << " Hz, " << other_s << " s: offset " << r->offset_s
+                           << " confidence " << r->confidence;
+      EXPECT_NE(r.status().message().find("ambiguous"), std::string::npos) << r.status().message();
+      EXPECT_NE(r.status().message().find("other.wav"), std::string::npos);
     }
   }
-  const AudioTrack ref = Track("ref.wav", clicks, kRate);
-  const AudioTrack other =
-      Track("other.wav", std::vector<float>(clicks.begin() + 3 * kRate / 10, clicks.end()), kRate);
-  const auto r = AlignTracks(ref, other, AlignOptions{});
-  ASSERT_FALSE(r.ok()) << "offset " << r->offset_s;
-  EXPECT_NE(r.status().message().find("ambiguous"), std::string::npos) << r.status().message();
-  EXPECT_NE(r.status().message().find("other.wav"), std::string::npos);
 }
 
 TEST(AlignTracks, SilenceIsAnError) {

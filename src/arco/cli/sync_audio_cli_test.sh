@@ -141,10 +141,10 @@ ffmpeg -v error -y -f lavfi -i "testsrc2=size=320x240:rate=30" -f lavfi -i "anul
 bad "a silent track" "$w/silent.mp4: the audio track is silent" "${N[@]}" --video "$A=cut0.mp4" \
   --video "$B=$w/silent.mp4" -o "$w/cap"
 # A metronome: the same click every half second matches at every beat.
-ffmpeg -v error -y -f lavfi -i "aevalsrc=0.5*sin(2*PI*2000*t)*exp(-mod(t\,0.5)*200):s=16000:d=10" \
+ffmpeg -v error -y -f lavfi -i "aevalsrc=0.5*sin(2*PI*1000*t)*exp(-mod(t\,0.5)*200):s=16000:d=10" \
   clicks.wav
 ffmpeg -v error -y -i clicks.wav -ss 0.3 -t 8 clicks_late.wav
-video "$w/clicks.mp4" clicks.wav 8
+video "$w/clicks.mp4" clicks.wav 7
 video "$w/clicks_late.mp4" clicks_late.wav 7
 bad "a periodic sound" "ambiguous alignment" "${N[@]}" --video "$A=$w/clicks.mp4" \
   --video "$B=$w/clicks_late.mp4" -o "$w/cap"
