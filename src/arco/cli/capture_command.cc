@@ -129,6 +129,7 @@ int RunCaptureNew(const pipeline::CaptureNewOptions& o) {
   if (synced) {
     std::printf("synced by sound (clock: %s)\n", r->sync_reference.c_str());
   }
+  for (const std::string& w : r->warnings) PrintWarning(w);
   std::printf(
       "capture of %zu cameras x %lld frames at %.6g fps -> %s (no 2D keypoints yet: run "
       "`arco detect %s`; layout %s)\n",

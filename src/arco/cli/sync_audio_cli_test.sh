@@ -6,7 +6,8 @@
 # say within 1 ms; with the recorder given (--audio) the same, and audio.offset_s is the
 # recorder's time of the capture's first frame. A camera whose clock runs 40 ppm slow over
 # a 36 s take gives its drift_ppm. Bad input (a video without an audio track, a silent
-# track, a periodic sound) is one line naming the file, exit 1, no capture folder.
+# track, a periodic sound) is one line naming the file, exit 1, no capture folder. Part 2:
+# a video whose timestamps jump is reported as a warning naming it.
 # usage: sync_audio_cli_test.sh ARCO_BINARY SHARED_DATA_DIR
 set -uo pipefail
 arco=$(realpath "$1")
@@ -129,6 +130,21 @@ assert abs(c[1]["drift_ppm"] - 40) < 5, c
 t = c[1]["offset_s"] + (1 + c[1]["drift_ppm"] * 1e-6) * 1049 / 30
 assert abs(t - (0.6 + (1 + 40e-6) * 1049 / 30)) < 0.0002, t
 EOF
+
+# Variable frame rate (part 2): a video whose timestamps jump (frames 30-39 of 120 cut
+# out) is reported, naming it; one whose timestamps jitter by a third of a frame is not.
+ffmpeg -v error -y -f lavfi -i "testsrc2=size=320x240:rate=30" -t 4 \
+  -vf "select='not(between(n\,30\,39))'" -fps_mode vfr -c:v libx264 -preset ultrafast \
+  -pix_fmt yuv420p gap.mp4
+ffmpeg -v error -y -f lavfi -i "testsrc2=size=320x240:rate=30" -t 4 \
+  -vf "setpts='PTS+0.3*sin(N)/TB/30'" -fps_mode vfr -c:v libx264 -preset ultrafast \
+  -pix_fmt yuv420p jitter.mp4
+ok "a video whose timestamps jump" capture new --calibration rig.json --video "$A=gap.mp4" -o caps/gap
+check 'grep -q "^warning: gap.mp4: timestamps jump 1 time (the largest by 0.367 s, 11.0 frames at 30 fps, before 1.333 s)" "$tmp/err"' \
+  "the jump is reported: $(cat "$tmp/err")"
+ok "a video whose timestamps jitter" capture new --calibration rig.json --video "$A=jitter.mp4" \
+  -o caps/jitter
+check '[ ! -s "$tmp/err" ]' "jitter below a frame is not a jump: $(cat "$tmp/err")"
 
 # Bad inputs: one line naming the file, exit 1, no capture folder.
 N=(capture new --calibration rig.json --sync audio)

@@ -9,6 +9,7 @@
 #include "arco/audio/align.h"
 #include "arco/audio/audio_reader.h"
 #include "arco/calibration/calibration_file.h"
+#include "arco/media/frame_times.h"
 #include "arco/media/video_reader.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/spd_import.h"
@@ -327,6 +328,13 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
     std::sort(in.drops.begin(), in.drops.end());
     in.drops.erase(std::unique(in.drops.begin(), in.drops.end()), in.drops.end());
   }
+  std::vector<std::string> warnings;
+  for (const OpenedInput& in : opened) {
+    if (in.properties.frame_count_source == media::FrameCountSource::kImageFiles) continue;
+    ARCO_ASSIGN_OR_RETURN(const media::FrameTimes times, media::ReadFrameTimes(in.input->path));
+    const std::string jumps = media::DescribeTimestampJumps(in.input->path, times);
+    if (!jumps.empty()) warnings.push_back(jumps);
+  }
   if (fps <= 0) {
     return Status::Error(opened.front().input->path +
                          ": images carry no frame rate and no video gives one; give fps");
@@ -397,6 +405,7 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
   m.calibration = "calibration" + fs::path(o.calibration).extension().string();
   if (!o.audio.empty()) m.audio = PathRelativeTo(o.audio, o.output_dir);
   CaptureNewSummary out;
+  out.warnings = warnings;
   if (o.sync == CaptureSync::kAudio) {
     m.audio = PathRelativeTo(sync.audio, o.output_dir);
     m.audio_offset_s = sync.audio_offset_s;

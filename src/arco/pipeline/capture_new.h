@@ -30,6 +30,11 @@
 // recording (frames + dropped frames). Errors name the file: a video without an audio
 // track, a silent track, an ambiguous alignment.
 //
+// Frame times: a video's frames sit on the capture's regular timeline by their container
+// timestamps (media::VideoReader: frame n is the picture shown at n / fps); a video whose
+// timestamps jump by 1.5 frame periods or more is reported in the summary's warnings
+// (the picture before the jump repeats over it), never silently stretched.
+//
 // Rotation: a camera's rotate_deg is the one given, else the container's display
 // rotation (a phone's portrait video), else 0.
 #pragma once
@@ -92,6 +97,8 @@ struct CaptureNewSummary {
   std::string layout;  // the layout `arco detect` will write
   std::vector<CaptureNewCamera> cameras;
   std::string sync_reference;  // sync kAudio: the recorder's or the camera's name
+  // A video whose timestamps jump (media/frame_times.h), one line each naming the file.
+  std::vector<std::string> warnings;
 };
 
 StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& options);
