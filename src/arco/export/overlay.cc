@@ -408,7 +408,15 @@ StatusOr<OverlaySummary> WriteOverlay(const OverlayOptions& options,
   media::Image decoded, scaled;
   for (int64_t g = first; g <= last; ++g) {
     canvas.setTo(cv::Scalar(0, 0, 0));
-    const int64_t n = reader ? manifest.VideoFrameNumber(view, g) : -1;
+    // The camera's picture nearest the capture's frame g (a camera synced by sound starts
+    // and runs on its own clock: docs/formats.md).
+    const int64_t own = std::llround(manifest.CameraFrameAt(view, static_cast<double>(g)));
+    const int64_t n =
+        reader && (manifest.cameras.at(static_cast<size_t>(view)).OnCaptureClock() ||
+                   (own >= manifest.frame_first &&
+                    own < manifest.frame_first + manifest.frame_count))
+            ? manifest.VideoFrameNumber(view, own)
+            : -1;
     if (reader && n >= 1) {
       const int64_t index = n - 1;
       if (reader->next_frame() == index) {

@@ -160,6 +160,15 @@ int64_t CaptureManifest::VideoFrameNumber(int view, int64_t global_frame) const 
   return global_frame - (it - drops.begin());
 }
 
+double CaptureManifest::CameraFrameAt(int view, double capture_frame) const {
+  const CaptureCamera& cam = cameras.at(static_cast<size_t>(view));
+  if (cam.OnCaptureClock()) return capture_frame;
+  // Capture frame g is at (g - 1) / fps; the camera's frame x at
+  // offset_s + (1 + drift) (x - 1) / fps.
+  const double time_s = (capture_frame - 1) / fps;
+  return (time_s - cam.offset_s) / (1.0 + cam.drift_ppm * 1e-6) * fps + 1.0;
+}
+
 StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const std::string& source) {
   // NaN / Infinity tokens (not JSON, but Python writes them) are told from absent fields.
   ARCO_ASSIGN_OR_RETURN(Json j, ParseJsonMarkingNonFinite(text, source));
@@ -421,11 +430,9 @@ void ResampleCameraKeypoints(const CaptureManifest& m, int view, NpyArray<double
     return own[static_cast<size_t>((f * points + p) * 3 + c)];
   };
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const double scale = 1.0 + cam.drift_ppm * 1e-6;
   for (int64_t f = 0; f < frames; ++f) {
     // Capture frame g at (g - 1) / fps is the camera's (fractional) global frame x.
-    const double time_s = static_cast<double>(m.frame_first + f - 1) / m.fps;
-    const double x = (time_s - cam.offset_s) / scale * m.fps + 1.0;
+    const double x = m.CameraFrameAt(view, static_cast<double>(m.frame_first + f));
     const double row = x - static_cast<double>(m.frame_first);
     double lower = std::floor(row);
     double w = row - lower;

@@ -79,6 +79,10 @@ struct CaptureManifest {
   // is its video frame g - (its drops before g), 1-based (SPD's FrameDropIDLog rule).
   // -1 when the camera dropped g.
   int64_t VideoFrameNumber(int view, int64_t global_frame) const;
+  // The camera's own global frame (fractional) exposed at the capture's global frame
+  // `capture_frame` (cameras[].offset_s, drift_ppm); the frame itself for a camera on the
+  // capture's clock.
+  double CameraFrameAt(int view, double capture_frame) const;
 };
 
 // `source` names the manifest in error messages.

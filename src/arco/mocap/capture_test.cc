@@ -336,6 +336,19 @@ TEST(CaptureKeypoints, CameraWithAnOffsetIsSampledAtTheCaptureFrameTimes) {
   EXPECT_FALSE(std::isnan(k.at(22, 1, 2, 0)));
 }
 
+// The camera's own frame at a capture frame: its clock's start and rate.
+TEST(CaptureManifest, CameraFrameAtFollowsTheCameraClock) {
+  CaptureManifest m = SampleManifest();
+  m.fps = 30;
+  m.cameras[1].offset_s = 1.1;  // started 33 frames after the capture's zero
+  EXPECT_EQ(m.CameraFrameAt(0, 129.0), 129.0);
+  EXPECT_NEAR(m.CameraFrameAt(1, 34.0), 1.0, 1e-12);
+  EXPECT_NEAR(m.CameraFrameAt(1, 100.5), 67.5, 1e-12);
+  m.cameras[1].offset_s = 0;
+  m.cameras[1].drift_ppm = 50;  // 60 s of capture are 60 / (1 + 50e-6) s of its frames
+  EXPECT_NEAR(m.CameraFrameAt(1, 1801.0), 1.0 + 1800.0 / (1 + 50e-6), 1e-9);
+}
+
 // The reader samples at the capture's frame times; a stage that rewrites the file reads
 // the rows as recorded.
 TEST(CaptureKeypoints, ReaderSamplesAtCaptureTimesUnlessAskedForTheRecordedRows) {
