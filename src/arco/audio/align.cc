@@ -159,17 +159,15 @@ std::vector<float> Resample(const std::vector<float>& in, int from_hz, int to_hz
 }  // namespace
 
 Status AlignOptions::Validate() const {
-  ARCO_RETURN_IF_ERROR(CheckInRange("fine_rate_hz", double(fine_rate_hz),
-                                    Closed(kAlignCoarseRateHz, 96000)));
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("fine_rate_hz", double(fine_rate_hz), Closed(kAlignCoarseRateHz, 96000)));
   ARCO_RETURN_IF_ERROR(CheckInRange("max_seconds", max_seconds, Closed(1, 86400)));
   ARCO_RETURN_IF_ERROR(CheckInRange("max_lag_s", max_lag_s, Closed(0, 86400)));
   ARCO_RETURN_IF_ERROR(CheckInRange("window_s", window_s, Closed(0.5, 60)));
   ARCO_RETURN_IF_ERROR(CheckInRange("max_windows", double(max_windows), Closed(1, 1000)));
   ARCO_RETURN_IF_ERROR(CheckInRange("max_drift_ppm", max_drift_ppm, Closed(0, 10000)));
-  ARCO_RETURN_IF_ERROR(
-      CheckInRange("min_drift_span_s", min_drift_span_s, Closed(1, 86400)));
-  ARCO_RETURN_IF_ERROR(
-      CheckInRange("ambiguous_ratio", ambiguous_ratio, Closed(0.05, 0.99)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("min_drift_span_s", min_drift_span_s, Closed(1, 86400)));
+  ARCO_RETURN_IF_ERROR(CheckInRange("ambiguous_ratio", ambiguous_ratio, Closed(0.05, 0.99)));
   ARCO_RETURN_IF_ERROR(CheckInRange("outlier_s", outlier_s, Closed(1e-5, 1)));
   return Status::Ok();
 }
@@ -195,7 +193,8 @@ StatusOr<AudioTrack> LoadAudioTrack(const std::string& path, int rate_hz, double
   AudioTrack track;
   track.source = path;
   track.rate_hz = rate_hz;
-  track.samples = source_rate == rate_hz ? std::move(samples) : Resample(samples, source_rate, rate_hz);
+  track.samples =
+      source_rate == rate_hz ? std::move(samples) : Resample(samples, source_rate, rate_hz);
   return track;
 }
 
@@ -207,8 +206,7 @@ StatusOr<AlignResult> AlignTracks(const AudioTrack& ref,
     throw std::invalid_argument("AlignTracks: tracks must be at options.fine_rate_hz");
   }
   for (const AudioTrack* t : {&ref, &other}) {
-    const double level =
-        RmsDbfs(t->samples.data(), static_cast<int64_t>(t->samples.size()));
+    const double level = RmsDbfs(t->samples.data(), static_cast<int64_t>(t->samples.size()));
     if (level < kAlignSilentDbfs) {
       return Status::Error(t->source + ": the audio track is silent (" + Fixed(level, 0) +
                            " dBFS RMS, below " + Fixed(kAlignSilentDbfs, 0) +
@@ -234,8 +232,8 @@ StatusOr<AlignResult> AlignTracks(const AudioTrack& ref,
       (*x)[x->size() - 1 - i] *= w;
     }
   }
-  const Correlation global = GccPhat(cr.data(), static_cast<int64_t>(cr.size()), co.data(),
-                                     static_cast<int64_t>(co.size()), cs);
+  const Correlation global = GccPhat(
+      cr.data(), static_cast<int64_t>(cr.size()), co.data(), static_cast<int64_t>(co.size()), cs);
   // Lags leaving less overlap than this are not searched (a few samples always correlate).
   const double min_overlap_s = std::min(1.0, 0.5 * std::min(len_r, len_o));
   double lo_s = -(len_o - min_overlap_s), hi_s = len_r - min_overlap_s;
@@ -266,13 +264,13 @@ StatusOr<AlignResult> AlignTracks(const AudioTrack& ref,
   const double overlap_lo = std::max(0.0, -lag0), overlap_hi = std::min(len_o, len_r - lag0);
   const double window_s = std::min(o.window_s, overlap_hi - overlap_lo - 2 * margin_s - 0.01);
   if (window_s < 0.25) {
-    return Status::Error(pair + ": the recordings overlap by " +
-                         Fixed(overlap_hi - overlap_lo, 2) + " s only; too short to align");
+    return Status::Error(pair + ": the recordings overlap by " + Fixed(overlap_hi - overlap_lo, 2) +
+                         " s only; too short to align");
   }
   const double c_lo = overlap_lo + margin_s + 0.5 * window_s + 0.002;
   const double c_hi = overlap_hi - margin_s - 0.5 * window_s - 0.002;
-  const int count = std::clamp(static_cast<int>(std::floor((c_hi - c_lo) / window_s)) + 1, 1,
-                               o.max_windows);
+  const int count =
+      std::clamp(static_cast<int>(std::floor((c_hi - c_lo) / window_s)) + 1, 1, o.max_windows);
   const int64_t wn = static_cast<int64_t>(std::llround(window_s * fs));
   const int64_t mn = static_cast<int64_t>(std::ceil(margin_s * fs));
   std::vector<double> xs, ys;
@@ -297,8 +295,9 @@ StatusOr<AlignResult> AlignTracks(const AudioTrack& ref,
     ys.push_back((double(sr - so) + p.refined) / fs);
   }
   if (xs.empty()) {
-    return Status::Error(pair + ": no stretch of the recordings correlates clearly (silent or "
-                                "different sounds?)");
+    return Status::Error(pair +
+                         ": no stretch of the recordings correlates clearly (silent or "
+                         "different sounds?)");
   }
 
   // 3. The line through the local lags.
@@ -358,8 +357,8 @@ StatusOr<AlignResult> AlignTracks(const AudioTrack& ref,
   result.offset_s = offset;
   result.drift_ppm = slope * 1e6;
   if (std::abs(result.drift_ppm) > o.max_drift_ppm) {
-    return Status::Error(pair + ": clock drift of " + Fixed(result.drift_ppm, 0) +
-                         " ppm, beyond " + Fixed(o.max_drift_ppm, 0) + " ppm");
+    return Status::Error(pair + ": clock drift of " + Fixed(result.drift_ppm, 0) + " ppm, beyond " +
+                         Fixed(o.max_drift_ppm, 0) + " ppm");
   }
   return result;
 }

@@ -66,14 +66,14 @@ StatusOr<AudioTrack> LoadAudioTrack(const std::string& path, int rate_hz, double
 double TrackLevelDbfs(const AudioTrack& track);
 
 struct AlignResult {
-  double offset_s = 0;    // see the clock model above
-  double drift_ppm = 0;   // 0 when the span was too short to measure it
-  double confidence = 0;  // 0..1: 1 - runner-up / winner of the global correlation
-  double runner_up_lag_s = 0;      // where the runner-up was (reference minus other)
-  int windows = 0;                 // local windows tried
-  int windows_used = 0;            // ... that agreed with the line
-  double residual_rms_s = 0;       // of the used windows' lags about the line
-  double span_s = 0;               // between the first and last used window centres
+  double offset_s = 0;         // see the clock model above
+  double drift_ppm = 0;        // 0 when the span was too short to measure it
+  double confidence = 0;       // 0..1: 1 - runner-up / winner of the global correlation
+  double runner_up_lag_s = 0;  // where the runner-up was (reference minus other)
+  int windows = 0;             // local windows tried
+  int windows_used = 0;        // ... that agreed with the line
+  double residual_rms_s = 0;   // of the used windows' lags about the line
+  double span_s = 0;           // between the first and last used window centres
 };
 
 // Aligns `other` to `reference` (both at options.fine_rate_hz). Errors (naming the

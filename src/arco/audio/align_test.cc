@@ -22,7 +22,7 @@ std::vector<Note> Score(double duration_s, uint32_t seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
   std::vector<Note> notes;
-  for (double t = 0.05; t < duration_s; ) {
+  for (double t = 0.05; t < duration_s;) {
     Note n;
     n.onset_s = t;
     n.length_s = 0.15 + 0.6 * u(rng);
@@ -67,8 +67,7 @@ std::vector<float> Render(const std::vector<Note>& notes,
       }
       if (n.burst && t < 0.04) {
         for (int h = 0; h < 6; ++h) {
-          v += 0.8 * std::sin(2 * M_PI * (900 + 517.3 * h * h) * t + n.phases[h]) *
-               (1 - t / 0.04);
+          v += 0.8 * std::sin(2 * M_PI * (900 + 517.3 * h * h) * t + n.phases[h]) * (1 - t / 0.04);
         }
       }
       out[static_cast<size_t>(i)] += n.amplitude * env * v;
@@ -154,7 +153,8 @@ TEST(AlignTracks, PeriodicSoundIsAmbiguous) {
       }
     }
     for (double other_s : {7.0, 8.0, 11.0}) {
-      const AudioTrack ref = Track("ref.wav", std::vector<float>(clicks.begin(), clicks.begin() + 8 * kRate), kRate);
+      const AudioTrack ref =
+          Track("ref.wav", std::vector<float>(clicks.begin(), clicks.begin() + 8 * kRate), kRate);
       const int64_t first = 3 * kRate / 10;
       const AudioTrack other =
           Track("other.wav",

@@ -412,9 +412,9 @@ StatusOr<OverlaySummary> WriteOverlay(const OverlayOptions& options,
     // and runs on its own clock: docs/formats.md).
     const int64_t own = std::llround(manifest.CameraFrameAt(view, static_cast<double>(g)));
     const int64_t n =
-        reader && (manifest.cameras.at(static_cast<size_t>(view)).OnCaptureClock() ||
-                   (own >= manifest.frame_first &&
-                    own < manifest.frame_first + manifest.frame_count))
+        reader &&
+                (manifest.cameras.at(static_cast<size_t>(view)).OnCaptureClock() ||
+                 (own >= manifest.frame_first && own < manifest.frame_first + manifest.frame_count))
             ? manifest.VideoFrameNumber(view, own)
             : -1;
     if (reader && n >= 1) {

@@ -61,8 +61,9 @@ StatusOr<FrameTimes> ReadFrameTimes(const std::string& path) {
 std::string DescribeTimestampJumps(const std::string& path, const FrameTimes& times) {
   if (times.jumps.empty()) return "";
   const auto largest = std::max_element(
-      times.jumps.begin(), times.jumps.end(),
-      [](const TimestampJump& a, const TimestampJump& b) { return a.step_s < b.step_s; });
+      times.jumps.begin(), times.jumps.end(), [](const TimestampJump& a, const TimestampJump& b) {
+        return a.step_s < b.step_s;
+      });
   char text[256];
   std::snprintf(text,
                 sizeof text,

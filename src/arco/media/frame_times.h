@@ -26,8 +26,8 @@ struct TimestampJump {
 };
 
 struct FrameTimes {
-  double fps = 0;             // the stream's nominal rate (0 when unknown)
-  std::vector<double> time_s; // every frame's timestamp from the first's, sorted
+  double fps = 0;              // the stream's nominal rate (0 when unknown)
+  std::vector<double> time_s;  // every frame's timestamp from the first's, sorted
   std::vector<TimestampJump> jumps;
   double min_step_s = 0, max_step_s = 0;  // between consecutive frames
 };

@@ -106,7 +106,8 @@ Status ParseCamera(const Json& j,
   cam->rotate_deg = static_cast<int>(rotate_deg);
   ARCO_RETURN_IF_ERROR(f.Number("offset_s", false, &cam->offset_s));
   if (!(std::abs(cam->offset_s) <= kMaxCameraOffsetS)) {
-    return f.Bad("offset_s", "is " + Written(*f.Find("offset_s")) + "; must be in [-86400, 86400] s");
+    return f.Bad("offset_s",
+                 "is " + Written(*f.Find("offset_s")) + "; must be in [-86400, 86400] s");
   }
   ARCO_RETURN_IF_ERROR(f.Number("drift_ppm", false, &cam->drift_ppm));
   if (!(std::abs(cam->drift_ppm) <= kMaxCameraDriftPpm)) {
@@ -408,7 +409,8 @@ StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir
     }
   }
   if (times == KeypointTimes::kCaptureFrames) {
-    for (size_t v = 0; v < m.cameras.size(); ++v) ResampleCameraKeypoints(m, static_cast<int>(v), &k);
+    for (size_t v = 0; v < m.cameras.size(); ++v)
+      ResampleCameraKeypoints(m, static_cast<int>(v), &k);
   }
   return k;
 }
@@ -423,7 +425,8 @@ void ResampleCameraKeypoints(const CaptureManifest& m, int view, NpyArray<double
   std::vector<double> own(static_cast<size_t>(frames * points * 3));
   for (int64_t f = 0; f < frames; ++f) {
     for (int64_t p = 0; p < points; ++p) {
-      for (int c = 0; c < 3; ++c) own[static_cast<size_t>((f * points + p) * 3 + c)] = k.at(f, v, p, c);
+      for (int c = 0; c < 3; ++c)
+        own[static_cast<size_t>((f * points + p) * 3 + c)] = k.at(f, v, p, c);
     }
   }
   const auto at = [&](int64_t f, int64_t p, int c) {

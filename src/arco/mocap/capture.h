@@ -32,8 +32,8 @@ inline constexpr char kResultManifestName[] = "result.json";
 inline constexpr double kMaxCaptureFps = 10000;
 inline constexpr int64_t kMaxCaptureFrames = 100000000;              // frames.count
 inline constexpr int64_t kMaxCaptureFrameNumber = int64_t{1} << 40;  // frames.first
-inline constexpr double kMaxCameraOffsetS = 86400;  // |cameras[].offset_s|
-inline constexpr double kMaxCameraDriftPpm = 10000;  // |cameras[].drift_ppm|
+inline constexpr double kMaxCameraOffsetS = 86400;                   // |cameras[].offset_s|
+inline constexpr double kMaxCameraDriftPpm = 10000;                  // |cameras[].drift_ppm|
 
 struct CaptureCamera {
   std::string name;                     // matches a calibration camera's name or serial
@@ -130,6 +130,8 @@ StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(
 // (x and y; the score is the lower of the two). NaN where either neighbour is missing
 // or the time is outside what the camera recorded. Nothing changes for an OnCaptureClock()
 // camera, so that hardware-synced captures read bit-identically.
-void ResampleCameraKeypoints(const CaptureManifest& manifest, int view, NpyArray<double>* keypoints);
+void ResampleCameraKeypoints(const CaptureManifest& manifest,
+                             int view,
+                             NpyArray<double>* keypoints);
 
 }  // namespace arco

@@ -276,7 +276,8 @@ TEST(CaptureManifest, CameraClockRoundTripsAndIsCheckedForRange) {
   bad["cameras"][1]["offset_s"] = "0.3";
   auto e = ParseCaptureManifest(bad.dump(), "cap/capture.json");
   ASSERT_FALSE(e.ok());
-  EXPECT_EQ(e.status().message(), "cap/capture.json: \"cameras[1].offset_s\" is \"0.3\"; must be a number");
+  EXPECT_EQ(e.status().message(),
+            "cap/capture.json: \"cameras[1].offset_s\" is \"0.3\"; must be a number");
   bad = j;
   bad["cameras"][1]["drift_ppm"] = 20000;
   e = ParseCaptureManifest(bad.dump(), "cap/capture.json");

@@ -74,7 +74,7 @@ struct AudioSync {
   std::string audio;                                    // the capture's audio file
   double audio_offset_s = 0;
   double lowest_confidence = 1;  // of the alignments
-  std::string reference;  // the recorder's or the camera's name
+  std::string reference;         // the recorder's or the camera's name
 };
 
 // t_ref = offset + (1 + drift) t_other, inverted: t_other on t_ref's clock.
@@ -101,14 +101,16 @@ StatusOr<AudioSync> SyncByAudio(const std::vector<OpenedInput>& opened,
                            ": a folder of images has no sound; sync audio needs every camera's "
                            "video file with its audio track");
     }
-    ARCO_ASSIGN_OR_RETURN(tracks[i],
-                          audio::LoadAudioTrack(input.path, align.fine_rate_hz, o.sync_max_seconds));
+    ARCO_ASSIGN_OR_RETURN(
+        tracks[i], audio::LoadAudioTrack(input.path, align.fine_rate_hz, o.sync_max_seconds));
     const double level = audio::TrackLevelDbfs(tracks[i]);
     if (level < audio::kAlignSilentDbfs) {
       char text[160];
-      std::snprintf(text, sizeof text,
+      std::snprintf(text,
+                    sizeof text,
                     ": the audio track is silent (%.0f dBFS RMS, below %.0f): nothing to sync by",
-                    level, audio::kAlignSilentDbfs);
+                    level,
+                    audio::kAlignSilentDbfs);
       return Status::Error(input.path + text);
     }
     ARCO_ASSIGN_OR_RETURN(video_start_s[i], audio::VideoStartOnAudioClock(input.path));
