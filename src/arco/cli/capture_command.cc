@@ -26,6 +26,8 @@ inline constexpr FieldFlag kCaptureFlags[] = {{"inputs", "--video/--images"},
                                               {"dropped_frames", "--dropped-frames"},
                                               {"spd_summary", "--spd-summary"},
                                               {"fps", "--fps"},
+                                              {"sync_max_seconds", "--sync-max-seconds"},
+                                              {"sync audio", "--sync audio"},
                                               {"output_dir", "-o"},
                                               {"format", "--format"},
                                               {"sources", "--camera"},
@@ -59,10 +61,12 @@ int64_t ParseWhole(const std::string& flag, const std::string& text, int64_t min
 
 struct CaptureNewArgs {
   std::vector<std::string> videos, images, rotate, drops;
+  std::string sync = "none";
   pipeline::CaptureNewOptions options;
   // The typed options from the CAMERA=VALUE lists (parse-complete).
   void Convert() {
     auto& o = options;
+    o.sync = sync == "audio" ? pipeline::CaptureSync::kAudio : pipeline::CaptureSync::kNone;
     o.inputs.clear();
     for (const std::string& v : videos) {
       const auto [camera, path] = SplitAssignment("--video", v, "CAMERA=FILE");
@@ -103,7 +107,15 @@ struct CaptureNewArgs {
 int RunCaptureNew(const pipeline::CaptureNewOptions& o) {
   auto r = pipeline::CreateCapture(o);
   if (!r.ok()) return PrintError(WithFlagNames(r.status().message(), kCaptureFlags));
+  const bool synced = o.sync == pipeline::CaptureSync::kAudio;
   for (const pipeline::CaptureNewCamera& c : r->cameras) {
+    if (synced) {
+      std::printf("  %-12s starts at %+.6f s, clock %+.1f ppm, confidence %.2f\n",
+                  c.name.c_str(),
+                  c.offset_s,
+                  c.drift_ppm,
+                  c.sync_confidence);
+    }
     std::printf("  %-12s %-10s %5dx%-5d rotate %3d  %7lld frames  %5lld dropped  %s\n",
                 c.name.c_str(),
                 c.serial.empty() ? "-" : c.serial.c_str(),
@@ -114,6 +126,10 @@ int RunCaptureNew(const pipeline::CaptureNewOptions& o) {
                 static_cast<long long>(c.dropped),
                 c.video.c_str());
   }
+  if (synced) {
+    std::printf("synced by sound (clock: %s)\n", r->sync_reference.c_str());
+  }
+  for (const std::string& w : r->warnings) PrintWarning(w);
   std::printf(
       "capture of %zu cameras x %lld frames at %.6g fps -> %s (no 2D keypoints yet: run "
       "`arco detect %s`; layout %s)\n",
@@ -178,7 +194,25 @@ CommandRun SetupCapture(CLI::App& app) {
       n->images,
       "CAMERA=DIR: a camera's folder of images, one per frame (natural order); views: "
       "the --video cameras first, then these");
-  create->add_option("--audio", n->options.audio, "Audio file of the performance (referenced)");
+  create->add_option("--audio",
+                     n->options.audio,
+                     "Audio file of the performance (referenced); with --sync audio, the "
+                     "recorder every camera is aligned to");
+  create
+      ->add_option("--sync",
+                   n->sync,
+                   "none: the cameras are synchronised (a trigger: frame g is one instant); "
+                   "audio: find each camera's start and clock drift from its sound (GCC-PHAT "
+                   "of the videos' audio tracks, and of --audio if given), recorded as "
+                   "cameras[].offset_s and drift_ppm")
+      ->check(CLI::IsMember({"none", "audio"}))
+      ->capture_default_str();
+  AddNumber(create,
+            "--sync-max-seconds",
+            n->options.sync_max_seconds,
+            "With --sync audio: align at most this much of each recording, seconds",
+            Closed(1, 86400))
+      ->capture_default_str();
   create
       ->add_option("--instrument",
                    n->options.instrument,

@@ -408,9 +408,15 @@ StatusOr<OverlaySummary> WriteOverlay(const OverlayOptions& options,
   media::Image decoded, scaled;
   for (int64_t g = first; g <= last; ++g) {
     canvas.setTo(cv::Scalar(0, 0, 0));
-    bool recorded = false;  // the camera has frame g (it may have dropped it)
-    if (reader) {
-      ARCO_ASSIGN_OR_RETURN(recorded, reader->Read(g, &decoded, /*rotate=*/false));
+    // The camera's picture nearest the capture's frame g (a camera synced by sound starts
+    // and runs on its own clock: docs/formats.md).
+    const int64_t own = std::llround(manifest.CameraFrameAt(view, static_cast<double>(g)));
+    const bool inside =
+        manifest.cameras.at(static_cast<size_t>(view)).OnCaptureClock() ||
+        (own >= manifest.frame_first && own < manifest.frame_first + manifest.frame_count);
+    bool recorded = false;  // the camera has that frame (it may have dropped it)
+    if (reader && inside) {
+      ARCO_ASSIGN_OR_RETURN(recorded, reader->Read(own, &decoded, /*rotate=*/false));
     }
     if (recorded) {
       // Scaled down first, then turned: the same picture (area averaging commutes with a

@@ -104,6 +104,16 @@ Status ParseCamera(const Json& j,
     return f.Bad("rotate_deg", "is " + std::to_string(rotate_deg) + "; must be 0, 90, 180 or 270");
   }
   cam->rotate_deg = static_cast<int>(rotate_deg);
+  ARCO_RETURN_IF_ERROR(f.Number("offset_s", false, &cam->offset_s));
+  if (!(std::abs(cam->offset_s) <= kMaxCameraOffsetS)) {
+    return f.Bad("offset_s",
+                 "is " + Written(*f.Find("offset_s")) + "; must be in [-86400, 86400] s");
+  }
+  ARCO_RETURN_IF_ERROR(f.Number("drift_ppm", false, &cam->drift_ppm));
+  if (!(std::abs(cam->drift_ppm) <= kMaxCameraDriftPpm)) {
+    return f.Bad("drift_ppm",
+                 "is " + Written(*f.Find("drift_ppm")) + "; must be in [-10000, 10000] ppm");
+  }
   if (const Json* drops = f.Find("dropped_frames"); drops && !drops->is_null()) {
     if (!drops->is_array()) return f.Bad("dropped_frames", "must be an array of frame numbers");
     for (const Json& d : *drops) {
@@ -149,6 +159,15 @@ int64_t CaptureManifest::VideoFrameNumber(int view, int64_t global_frame) const 
   const auto it = std::lower_bound(drops.begin(), drops.end(), global_frame);
   if (it != drops.end() && *it == global_frame) return -1;
   return global_frame - (it - drops.begin());
+}
+
+double CaptureManifest::CameraFrameAt(int view, double capture_frame) const {
+  const CaptureCamera& cam = cameras.at(static_cast<size_t>(view));
+  if (cam.OnCaptureClock()) return capture_frame;
+  // Capture frame g is at (g - 1) / fps; the camera's frame x at
+  // offset_s + (1 + drift) (x - 1) / fps.
+  const double time_s = (capture_frame - 1) / fps;
+  return (time_s - cam.offset_s) / (1.0 + cam.drift_ppm * 1e-6) * fps + 1.0;
 }
 
 StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const std::string& source) {
@@ -301,6 +320,9 @@ Json CaptureManifestToJson(const CaptureManifest& m) {
     if (!c.serial.empty()) cj["serial"] = c.serial;
     if (!c.video.empty()) cj["video"] = c.video;
     if (c.rotate_deg != 0) cj["rotate_deg"] = c.rotate_deg;
+    // Written only when set: a hardware-synced capture's manifest is unchanged.
+    if (c.offset_s != 0) cj["offset_s"] = c.offset_s;
+    if (c.drift_ppm != 0) cj["drift_ppm"] = c.drift_ppm;
     cj["dropped_frames"] = c.dropped_frames;
     j["cameras"].push_back(cj);
   }
@@ -369,7 +391,8 @@ Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureMani
 }
 
 StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,
-                                                  const CaptureManifest& m) {
+                                                  const CaptureManifest& m,
+                                                  KeypointTimes times) {
   ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(capture_dir, m));
   const std::string path = ResolveCapturePath(capture_dir, m.keypoints2d);
   ARCO_ASSIGN_OR_RETURN(NpyArray<double> k, ReadNpy<double>(path));
@@ -385,7 +408,57 @@ StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir
       }
     }
   }
+  if (times == KeypointTimes::kCaptureFrames) {
+    for (size_t v = 0; v < m.cameras.size(); ++v)
+      ResampleCameraKeypoints(m, static_cast<int>(v), &k);
+  }
   return k;
+}
+
+void ResampleCameraKeypoints(const CaptureManifest& m, int view, NpyArray<double>* keypoints) {
+  const CaptureCamera& cam = m.cameras.at(static_cast<size_t>(view));
+  if (cam.OnCaptureClock()) return;
+  NpyArray<double>& k = *keypoints;
+  const int64_t frames = k.shape.at(0), points = k.shape.at(2);
+  const int64_t v = view;
+  // The camera's own rows, before they are overwritten.
+  std::vector<double> own(static_cast<size_t>(frames * points * 3));
+  for (int64_t f = 0; f < frames; ++f) {
+    for (int64_t p = 0; p < points; ++p) {
+      for (int c = 0; c < 3; ++c)
+        own[static_cast<size_t>((f * points + p) * 3 + c)] = k.at(f, v, p, c);
+    }
+  }
+  const auto at = [&](int64_t f, int64_t p, int c) {
+    return own[static_cast<size_t>((f * points + p) * 3 + c)];
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int64_t f = 0; f < frames; ++f) {
+    // Capture frame g at (g - 1) / fps is the camera's (fractional) global frame x.
+    const double x = m.CameraFrameAt(view, static_cast<double>(m.frame_first + f));
+    const double row = x - static_cast<double>(m.frame_first);
+    double lower = std::floor(row);
+    double w = row - lower;
+    // Within a rounding error of a frame: that frame alone (no neighbour needed).
+    if (w < 1e-9) w = 0;
+    if (w > 1 - 1e-9) {
+      lower += 1;
+      w = 0;
+    }
+    const int64_t i0 = static_cast<int64_t>(lower);
+    const int64_t i1 = w == 0 ? i0 : i0 + 1;
+    const bool inside = lower >= 0 && i1 < frames;
+    for (int64_t p = 0; p < points; ++p) {
+      if (!inside) {
+        for (int c = 0; c < 3; ++c) k.at(f, v, p, c) = nan;
+        continue;
+      }
+      for (int c = 0; c < 2; ++c) k.at(f, v, p, c) = (1 - w) * at(i0, p, c) + w * at(i1, p, c);
+      k.at(f, v, p, 2) = std::min(at(i0, p, 2), at(i1, p, 2));
+      // std::min passes one NaN through only when it is the first argument.
+      if (std::isnan(at(i0, p, 2)) || std::isnan(at(i1, p, 2))) k.at(f, v, p, 2) = nan;
+    }
+  }
 }
 
 }  // namespace arco

@@ -32,6 +32,8 @@ inline constexpr char kResultManifestName[] = "result.json";
 inline constexpr double kMaxCaptureFps = 10000;
 inline constexpr int64_t kMaxCaptureFrames = 100000000;              // frames.count
 inline constexpr int64_t kMaxCaptureFrameNumber = int64_t{1} << 40;  // frames.first
+inline constexpr double kMaxCameraOffsetS = 86400;                   // |cameras[].offset_s|
+inline constexpr double kMaxCameraDriftPpm = 10000;                  // |cameras[].drift_ppm|
 
 struct CaptureCamera {
   std::string name;                     // matches a calibration camera's name or serial
@@ -41,6 +43,14 @@ struct CaptureCamera {
   // Clockwise rotation (0, 90, 180, 270) applied to the video's decoded frames (coded
   // orientation, media::VideoReader) to get the calibration's image; SPD's are 90.
   int rotate_deg = 0;
+  // Where this camera's clock sits on the capture's (`arco capture new --sync audio`;
+  // docs/formats.md): its global frame g was exposed at capture time
+  //   offset_s + (1 + drift_ppm * 1e-6) * (g - 1) / fps,
+  // where the capture's frame g is at (g - 1) / fps. Both 0 (absent in capture.json):
+  // the camera's frames are the capture's (hardware-synced rigs, SPD).
+  double offset_s = 0;
+  double drift_ppm = 0;
+  bool OnCaptureClock() const { return offset_s == 0 && drift_ppm == 0; }
 };
 
 struct CaptureManifest {
@@ -69,6 +79,10 @@ struct CaptureManifest {
   // is its video frame g - (its drops before g), 1-based (SPD's FrameDropIDLog rule).
   // -1 when the camera dropped g.
   int64_t VideoFrameNumber(int view, int64_t global_frame) const;
+  // The camera's own global frame (fractional) exposed at the capture's global frame
+  // `capture_frame` (cameras[].offset_s, drift_ppm); the frame itself for a camera on the
+  // capture's clock.
+  double CameraFrameAt(int view, double capture_frame) const;
 };
 
 // `source` names the manifest in error messages.
@@ -100,8 +114,24 @@ Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureMani
 // float64; an error naming `source` and `dtype` otherwise.
 Status CheckKeypoints2dDtype(const std::string& source, const std::string& dtype, bool is_float);
 // Reads the 2D keypoints named by the manifest after CheckCaptureKeypoints2d. Frames a
-// camera dropped are set to NaN.
-StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,
-                                                  const CaptureManifest& manifest);
+// camera dropped are set to NaN. A camera with an offset or a drift (not OnCaptureClock()) is
+// then sampled at the capture's frame times (ResampleCameraKeypoints), unless `times` is
+// kAsRecorded: the rows as stored, each camera's own frames (for a stage that rewrites
+// the file: `arco detect`, `arco track`).
+enum class KeypointTimes { kCaptureFrames, kAsRecorded };
+StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(
+    const std::string& capture_dir,
+    const CaptureManifest& manifest,
+    KeypointTimes times = KeypointTimes::kCaptureFrames);
+
+// Row f of `keypoints` (F, V, P, 3) for view `view` holds the camera's own global frame
+// frame_first + f; afterwards it holds the camera at the capture's frame
+// frame_first + f, interpolated linearly between the two nearest frames it recorded
+// (x and y; the score is the lower of the two). NaN where either neighbour is missing
+// or the time is outside what the camera recorded. Nothing changes for an OnCaptureClock()
+// camera, so that hardware-synced captures read bit-identically.
+void ResampleCameraKeypoints(const CaptureManifest& manifest,
+                             int view,
+                             NpyArray<double>* keypoints);
 
 }  // namespace arco

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 
 #include "arco/mocap/sample_manifest.h"
@@ -253,6 +254,125 @@ TEST(CaptureKeypoints, ShapeIsCheckedAndDroppedFramesBecomeNaN) {
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.status().message().find("keypoints2d.npy"), std::string::npos);
   EXPECT_NE(r.status().message().find("(4, 2, 142, 3)"), std::string::npos);
+}
+
+// A camera's clock on the capture's (cameras[].offset_s, drift_ppm) round-trips; 0 is
+// not written, so a hardware-synced capture's manifest is unchanged.
+TEST(CaptureManifest, CameraClockRoundTripsAndIsCheckedForRange) {
+  CaptureManifest m = SampleManifest();
+  m.cameras[1].offset_s = 0.35012;
+  m.cameras[1].drift_ppm = -31.5;
+  const Json j = CaptureManifestToJson(m);
+  EXPECT_FALSE(j["cameras"][0].contains("offset_s"));
+  EXPECT_FALSE(j["cameras"][0].contains("drift_ppm"));
+  EXPECT_EQ(j["cameras"][1]["offset_s"], 0.35012);
+  const auto r = ParseCaptureManifest(j.dump(), "capture.json");
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->cameras[0].offset_s, 0.0);
+  EXPECT_TRUE(r->cameras[0].OnCaptureClock());
+  EXPECT_EQ(r->cameras[1].offset_s, 0.35012);
+  EXPECT_EQ(r->cameras[1].drift_ppm, -31.5);
+  Json bad = j;
+  bad["cameras"][1]["offset_s"] = "0.3";
+  auto e = ParseCaptureManifest(bad.dump(), "cap/capture.json");
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.status().message(),
+            "cap/capture.json: \"cameras[1].offset_s\" is \"0.3\"; must be a number");
+  bad = j;
+  bad["cameras"][1]["drift_ppm"] = 20000;
+  e = ParseCaptureManifest(bad.dump(), "cap/capture.json");
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.status().message(),
+            "cap/capture.json: \"cameras[1].drift_ppm\" is 20000; must be in [-10000, 10000] ppm");
+}
+
+// A point moving at constant speed: camera 1 started 0.0123 s after the capture's clock
+// and runs slow by 40 ppm, so its frame g shows the point at its own instant. Sampled at
+// the capture's frame times, both views show the point at the same instant (a bow at
+// 1 m/s is not triangulated from moments apart).
+TEST(CaptureKeypoints, CameraWithAnOffsetIsSampledAtTheCaptureFrameTimes) {
+  CaptureManifest m = SampleManifest();
+  m.frame_first = 1;
+  m.frame_count = 30;
+  m.cameras[0].dropped_frames = {};
+  m.cameras[1].offset_s = 0.0123;
+  m.cameras[1].drift_ppm = 40;
+  const auto x_at = [](double time_s) { return 100.0 + 900.0 * time_s; };  // px
+  NpyArray<double> k;
+  k.shape = {30, 2, 3, 3};
+  k.data.assign(30 * 2 * 3 * 3, 0.0);
+  for (int64_t f = 0; f < 30; ++f) {
+    const double capture_s = f / m.fps;
+    const double camera1_s = 0.0123 + (1 + 40e-6) * f / m.fps;
+    for (int64_t p = 0; p < 3; ++p) {
+      k.at(f, 0, p, 0) = x_at(capture_s);
+      k.at(f, 1, p, 0) = x_at(camera1_s);
+      k.at(f, 0, p, 1) = k.at(f, 1, p, 1) = 50.0 + p;
+      k.at(f, 0, p, 2) = 0.9;
+      k.at(f, 1, p, 2) = f == 10 ? 0.4 : 0.8;
+    }
+  }
+  k.at(20, 1, 2, 0) = NAN;  // one missing detection
+  const NpyArray<double> before = k;
+  ResampleCameraKeypoints(m, 0, &k);
+  // A camera on the capture's clock is untouched (bit for bit; the NaN too).
+  ASSERT_EQ(k.data.size(), before.data.size());
+  EXPECT_EQ(std::memcmp(k.data.data(), before.data.data(), k.data.size() * sizeof(double)), 0);
+  ResampleCameraKeypoints(m, 1, &k);
+  // Frame 0 is before camera 1 started: nothing there.
+  for (int c = 0; c < 3; ++c) EXPECT_TRUE(std::isnan(k.at(0, 1, 0, c))) << c;
+  for (int64_t f = 1; f < 30; ++f) {
+    for (int64_t p = 0; p < 2; ++p) {
+      EXPECT_NEAR(k.at(f, 1, p, 0), k.at(f, 0, p, 0), 1e-9) << f;  // the same instant
+      EXPECT_NEAR(k.at(f, 1, p, 1), 50.0 + p, 1e-12);
+    }
+  }
+  // Frames 10 and 11 are between camera 1's frames 9, 10 and 10, 11: the lower score.
+  EXPECT_EQ(k.at(10, 1, 0, 2), 0.4);
+  EXPECT_EQ(k.at(11, 1, 0, 2), 0.4);
+  EXPECT_EQ(k.at(12, 1, 0, 2), 0.8);
+  // A missing neighbour leaves the sample missing.
+  EXPECT_TRUE(std::isnan(k.at(20, 1, 2, 0)));
+  EXPECT_TRUE(std::isnan(k.at(21, 1, 2, 0)));
+  EXPECT_FALSE(std::isnan(k.at(22, 1, 2, 0)));
+}
+
+// The camera's own frame at a capture frame: its clock's start and rate.
+TEST(CaptureManifest, CameraFrameAtFollowsTheCameraClock) {
+  CaptureManifest m = SampleManifest();
+  m.fps = 30;
+  m.cameras[1].offset_s = 1.1;  // started 33 frames after the capture's zero
+  EXPECT_EQ(m.CameraFrameAt(0, 129.0), 129.0);
+  EXPECT_NEAR(m.CameraFrameAt(1, 34.0), 1.0, 1e-12);
+  EXPECT_NEAR(m.CameraFrameAt(1, 100.5), 67.5, 1e-12);
+  m.cameras[1].offset_s = 0;
+  m.cameras[1].drift_ppm = 50;  // 60 s of capture are 60 / (1 + 50e-6) s of its frames
+  EXPECT_NEAR(m.CameraFrameAt(1, 1801.0), 1.0 + 1800.0 / (1 + 50e-6), 1e-9);
+}
+
+// The reader samples at the capture's frame times; a stage that rewrites the file reads
+// the rows as recorded.
+TEST(CaptureKeypoints, ReaderSamplesAtCaptureTimesUnlessAskedForTheRecordedRows) {
+  TempDir dir;
+  CaptureManifest m = SampleManifest();
+  m.cameras[0].dropped_frames = {};
+  m.cameras[1].offset_s = 0.5 / m.fps;  // half a frame late
+  ASSERT_TRUE(WriteCaptureManifest(dir.path(), m).ok());
+  NpyArray<float> k;
+  k.shape = {4, 2, 142, 3};
+  k.data.assign(4 * 2 * 142 * 3, 1.0f);
+  for (int64_t f = 0; f < 4; ++f) k.data[static_cast<size_t>(((f * 2 + 1) * 142) * 3)] = 10.0f * f;
+  ASSERT_TRUE(WriteNpy(dir / "keypoints2d.npy", k).ok());
+  auto capture = ReadCaptureKeypoints2d(dir.path(), m);
+  ASSERT_TRUE(capture.ok()) << capture.status().message();
+  EXPECT_TRUE(std::isnan(capture->at(0, 1, 0, 0)));  // before the camera's first frame
+  EXPECT_NEAR(capture->at(1, 1, 0, 0), 5.0, 1e-9);   // between its frames 0 and 1
+  EXPECT_NEAR(capture->at(3, 1, 0, 0), 25.0, 1e-9);
+  EXPECT_EQ(capture->at(2, 0, 0, 0), 1.0);
+  auto recorded = ReadCaptureKeypoints2d(dir.path(), m, KeypointTimes::kAsRecorded);
+  ASSERT_TRUE(recorded.ok());
+  EXPECT_EQ(recorded->at(0, 1, 0, 0), 0.0);
+  EXPECT_EQ(recorded->at(3, 1, 0, 0), 30.0);
 }
 
 }  // namespace

@@ -6,8 +6,10 @@
 #include <filesystem>
 #include <set>
 
+#include "arco/audio/align.h"
 #include "arco/audio/audio_reader.h"
 #include "arco/calibration/calibration_file.h"
+#include "arco/media/frame_times.h"
 #include "arco/media/video_reader.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/spd_import.h"
@@ -66,6 +68,119 @@ StatusOr<media::VideoProperties> ProbeInput(const CaptureNewInput& input) {
   return p;
 }
 
+// The cameras' clocks from their sound (CaptureSync::kAudio; see the header).
+struct AudioSync {
+  std::vector<double> offset_s, drift_ppm, confidence;  // per camera
+  std::string audio;                                    // the capture's audio file
+  double audio_offset_s = 0;
+  double lowest_confidence = 1;  // of the alignments
+  std::string reference;         // the recorder's or the camera's name
+};
+
+// t_ref = offset + (1 + drift) t_other, inverted: t_other on t_ref's clock.
+audio::AlignResult Inverse(const audio::AlignResult& r) {
+  audio::AlignResult inv = r;
+  const double scale = 1.0 + r.drift_ppm * 1e-6;
+  inv.offset_s = -r.offset_s / scale;
+  inv.drift_ppm = r.drift_ppm == 0 ? 0.0 : (1.0 / scale - 1.0) * 1e6;
+  return inv;
+}
+
+StatusOr<AudioSync> SyncByAudio(const std::vector<OpenedInput>& opened,
+                                const CaptureNewOptions& o) {
+  audio::AlignOptions align;
+  align.max_seconds = o.sync_max_seconds;
+  ARCO_RETURN_IF_ERROR(align.Validate());
+  const size_t n = opened.size();
+  std::vector<audio::AudioTrack> tracks(n);
+  std::vector<double> video_start_s(n, 0.0);
+  for (size_t i = 0; i < n; ++i) {
+    const CaptureNewInput& input = *opened[i].input;
+    if (input.images) {
+      return Status::Error(input.path +
+                           ": a folder of images has no sound; sync audio needs every camera's "
+                           "video file with its audio track");
+    }
+    ARCO_ASSIGN_OR_RETURN(
+        tracks[i], audio::LoadAudioTrack(input.path, align.fine_rate_hz, o.sync_max_seconds));
+    const double level = audio::TrackLevelDbfs(tracks[i]);
+    if (level < audio::kAlignSilentDbfs) {
+      char text[160];
+      std::snprintf(text,
+                    sizeof text,
+                    ": the audio track is silent (%.0f dBFS RMS, below %.0f): nothing to sync by",
+                    level,
+                    audio::kAlignSilentDbfs);
+      return Status::Error(input.path + text);
+    }
+    ARCO_ASSIGN_OR_RETURN(video_start_s[i], audio::VideoStartOnAudioClock(input.path));
+  }
+  // Each camera's alignment to the reference: t_ref = offset + (1 + drift) t_camera_audio.
+  std::vector<audio::AlignResult> to_ref(n);
+  AudioSync sync;
+  if (!o.audio.empty()) {
+    ARCO_ASSIGN_OR_RETURN(const audio::AudioTrack recorder,
+                          audio::LoadAudioTrack(o.audio, align.fine_rate_hz, o.sync_max_seconds));
+    for (size_t i = 0; i < n; ++i) {
+      ARCO_ASSIGN_OR_RETURN(to_ref[i], audio::AlignTracks(recorder, tracks[i], align));
+    }
+    sync.audio = o.audio;
+    sync.reference = o.audio;
+  } else {
+    // Every pair once; the reference is the camera whose worst alignment is the best.
+    std::vector<std::vector<StatusOr<audio::AlignResult>>> pair(n);
+    for (size_t i = 0; i < n; ++i) {
+      pair[i].resize(n, Status::Error("not aligned"));
+    }
+    for (size_t i = 0; i < n; ++i) {
+      for (size_t j = i + 1; j < n; ++j) {
+        pair[i][j] = audio::AlignTracks(tracks[i], tracks[j], align);
+        if (pair[i][j].ok()) {
+          pair[j][i] = Inverse(*pair[i][j]);
+        } else {
+          pair[j][i] = pair[i][j].status();
+        }
+      }
+    }
+    size_t best = 0;
+    double best_score = -1;
+    for (size_t i = 0; i < n; ++i) {
+      double score = 1;
+      for (size_t j = 0; j < n; ++j) {
+        if (j != i) score = std::min(score, pair[i][j].ok() ? pair[i][j]->confidence : 0.0);
+      }
+      if (score > best_score) {
+        best_score = score;
+        best = i;
+      }
+    }
+    for (size_t j = 0; j < n; ++j) {
+      if (j == best) {
+        to_ref[j].confidence = 1;
+        continue;
+      }
+      if (!pair[best][j].ok()) return pair[best][j].status();
+      to_ref[j] = *pair[best][j];
+    }
+    sync.audio = opened[best].input->path;
+    sync.reference = opened[best].input->camera;
+  }
+  // Each camera's first frame on the reference's clock; the capture's zero is the earliest.
+  std::vector<double> start_s(n);
+  for (size_t i = 0; i < n; ++i) {
+    start_s[i] = to_ref[i].offset_s + (1 + to_ref[i].drift_ppm * 1e-6) * video_start_s[i];
+  }
+  const double zero_s = *std::min_element(start_s.begin(), start_s.end());
+  for (size_t i = 0; i < n; ++i) {
+    sync.offset_s.push_back(start_s[i] - zero_s);
+    sync.drift_ppm.push_back(to_ref[i].drift_ppm);
+    sync.confidence.push_back(to_ref[i].confidence);
+    sync.lowest_confidence = std::min(sync.lowest_confidence, to_ref[i].confidence);
+  }
+  sync.audio_offset_s = zero_s;
+  return sync;
+}
+
 }  // namespace
 
 Status CaptureNewOptions::Validate() const {
@@ -94,6 +209,7 @@ Status CaptureNewOptions::Validate() const {
                            "; must be 0, 90, 180 or 270 (clockwise)");
     }
   }
+  ARCO_RETURN_IF_ERROR(CheckInRange("sync_max_seconds", sync_max_seconds, Closed(1, 86400)));
   if (!dropped_frames.empty() && !spd_summary.empty()) {
     return Status::Error("dropped_frames and spd_summary: give one or the other");
   }
@@ -214,6 +330,13 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
     std::sort(in.drops.begin(), in.drops.end());
     in.drops.erase(std::unique(in.drops.begin(), in.drops.end()), in.drops.end());
   }
+  std::vector<std::string> warnings;
+  for (const OpenedInput& in : opened) {
+    if (in.properties.frame_count_source == media::FrameCountSource::kImageFiles) continue;
+    ARCO_ASSIGN_OR_RETURN(const media::FrameTimes times, media::ReadFrameTimes(in.input->path));
+    const std::string jumps = media::DescribeTimestampJumps(in.input->path, times);
+    if (!jumps.empty()) warnings.push_back(jumps);
+  }
   if (fps <= 0) {
     return Status::Error(opened.front().input->path +
                          ": images carry no frame rate and no video gives one; give fps");
@@ -225,11 +348,17 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
     return in.properties.frame_count + static_cast<int64_t>(in.drops.size());
   };
   const OpenedInput& reference = opened.front();
-  const int64_t total = recording(reference);
+  int64_t total = recording(reference);
+  AudioSync sync;
+  if (o.sync == CaptureSync::kAudio) {
+    ARCO_ASSIGN_OR_RETURN(sync, SyncByAudio(opened, o));
+    // Cameras started and stopped apart: the capture is as long as the shortest.
+    for (const OpenedInput& in : opened) total = std::min(total, recording(in));
+  }
   const bool any_drops = std::any_of(
       opened.begin(), opened.end(), [](const OpenedInput& in) { return !in.drops.empty(); });
   for (const OpenedInput& in : opened) {
-    if (recording(in) == total) continue;
+    if (recording(in) == total || o.sync == CaptureSync::kAudio) continue;
     const auto count = [&](const OpenedInput& x) {
       std::string text = std::to_string(x.properties.frame_count) + " frames";
       if (any_drops) {
@@ -245,7 +374,18 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
                                     : "; cameras that dropped frames need dropped_frames or an "
                                       "SPD summary"));
   }
-  for (const OpenedInput& in : opened) {
+  for (OpenedInput& in : opened) {
+    if (o.sync == CaptureSync::kAudio) {
+      if (!in.drops.empty() && in.drops.back() > recording(in)) {
+        const std::string source = o.spd_summary.empty() ? "dropped_frames" : o.spd_summary;
+        return Status::Error(source + ": camera " + in.input->camera + " drops frame " +
+                             std::to_string(in.drops.back()) + ", after its recording's last (" +
+                             std::to_string(recording(in)) + ")");
+      }
+      // Drops after the capture's last frame are outside it.
+      in.drops.erase(std::upper_bound(in.drops.begin(), in.drops.end(), total), in.drops.end());
+      continue;
+    }
     if (!in.drops.empty() && in.drops.back() > total) {
       const std::string source = o.spd_summary.empty() ? "dropped_frames" : o.spd_summary;
       return Status::Error(source + ": camera " + in.input->camera + " drops frame " +
@@ -267,12 +407,24 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
   m.calibration = "calibration" + fs::path(o.calibration).extension().string();
   if (!o.audio.empty()) m.audio = PathRelativeTo(o.audio, o.output_dir);
   CaptureNewSummary out;
+  out.warnings = warnings;
+  if (o.sync == CaptureSync::kAudio) {
+    m.audio = PathRelativeTo(sync.audio, o.output_dir);
+    m.audio_offset_s = sync.audio_offset_s;
+    m.audio_sync_confidence = sync.lowest_confidence;
+    out.sync_reference = sync.reference;
+  }
   out.fps = fps;
   out.frames = total;
   ARCO_ASSIGN_OR_RETURN(out.layout, DetectionLayoutName(m.instrument));
-  for (const OpenedInput& in : opened) {
+  for (size_t i = 0; i < opened.size(); ++i) {
+    const OpenedInput& in = opened[i];
     const Camera& cam = rig.cameras[static_cast<size_t>(in.calibration_camera)];
     CaptureCamera cc;
+    if (o.sync == CaptureSync::kAudio) {
+      cc.offset_s = sync.offset_s[i];
+      cc.drift_ppm = sync.drift_ppm[i];
+    }
     cc.name = cam.name;
     cc.serial = cam.serial;
     cc.video = PathRelativeTo(in.input->path, o.output_dir);
@@ -286,7 +438,10 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
                            in.properties.coded_width,
                            in.properties.coded_height,
                            in.rotate_deg,
-                           static_cast<int64_t>(in.drops.size())});
+                           static_cast<int64_t>(in.drops.size()),
+                           cc.offset_s,
+                           cc.drift_ppm,
+                           o.sync == CaptureSync::kAudio ? sync.confidence[i] : NAN});
   }
   // The manifest we write must read back.
   ARCO_RETURN_IF_ERROR(

@@ -17,10 +17,29 @@
 // recording's length, which must be the same for every camera. The capture covers the
 // whole recording: frames.first = 1, frames.count = that length.
 //
+// Sync (`sync` = kAudio, docs/capture.md): the cameras' clocks are found from their
+// sound. Each video's audio track (and the recorder `audio`, when given) is aligned by
+// GCC-PHAT (audio/align.h): the clock reference is the recorder when given, else the
+// camera whose track aligns best with every other (the highest lowest confidence). The
+// capture's clock runs at the reference's rate with its zero at the first frame of the
+// camera that started first; each camera's start on it (cameras[].offset_s) and its
+// clock's drift (cameras[].drift_ppm) go into capture.json, and the stages sample its 2D
+// keypoints at the capture's frame times. The capture's audio is the recorder, else the
+// reference camera's video (its track), audio.offset_s its time of the capture's first
+// frame. Cameras may then record different lengths: frames.count is the shortest
+// recording (frames + dropped frames). Errors name the file: a video without an audio
+// track, a silent track, an ambiguous alignment.
+//
+// Frame times: a video's frames sit on the capture's regular timeline by their container
+// timestamps (media::VideoReader: frame n is the picture shown at n / fps); a video whose
+// timestamps jump by 1.5 frame periods or more is reported in the summary's warnings
+// (the picture before the jump repeats over it), never silently stretched.
+//
 // Rotation: a camera's rotate_deg is the one given, else the container's display
 // rotation (a phone's portrait video), else 0.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -34,6 +53,11 @@ struct CaptureNewInput {
   std::string camera;   // a calibration camera's name or serial
   std::string path;     // video file or single image; a folder when `images`
   bool images = false;  // a folder of images, one per frame
+};
+
+enum class CaptureSync {
+  kNone,   // the cameras are synchronised (hardware trigger): frame g is one instant
+  kAudio,  // by their sound (above)
 };
 
 struct CaptureNewOptions {
@@ -50,6 +74,8 @@ struct CaptureNewOptions {
   std::string name;        // session name (default: the output folder's name)
   std::string output_dir;  // the capture folder to create
   bool overwrite = false;  // replace an existing capture (a folder with capture.json)
+  CaptureSync sync = CaptureSync::kNone;
+  double sync_max_seconds = 900;  // kAudio: align at most this much of each recording
   // Readable message naming the field on a bad value or combination.
   Status Validate() const;
 };
@@ -61,6 +87,8 @@ struct CaptureNewCamera {
   int width = 0, height = 0;  // decoded (coded) size, before rotate_deg
   int rotate_deg = 0;
   int64_t dropped = 0;
+  double offset_s = 0, drift_ppm = 0;  // sync kAudio: its clock on the capture's
+  double sync_confidence = NAN;        // ... and the confidence of its alignment
 };
 
 struct CaptureNewSummary {
@@ -68,6 +96,9 @@ struct CaptureNewSummary {
   int64_t frames = 0;  // frames.count: the recording's length
   std::string layout;  // the layout `arco detect` will write
   std::vector<CaptureNewCamera> cameras;
+  std::string sync_reference;  // sync kAudio: the recorder's or the camera's name
+  // A video whose timestamps jump (media/frame_times.h), one line each naming the file.
+  std::vector<std::string> warnings;
 };
 
 StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& options);

@@ -318,6 +318,11 @@ TEST(CaptureNewOptions, ValidateNamesTheField) {
   o = good;
   o.output_dir.clear();
   expect_bad(o, "output_dir");
+  o = good;
+  o.sync_max_seconds = 0;
+  expect_bad(o, "sync_max_seconds");
+  o.sync_max_seconds = NAN;
+  expect_bad(o, "sync_max_seconds");
 }
 
 }  // namespace

@@ -171,7 +171,9 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
   bool kept = false;
   if (!manifest.keypoints2d.empty() && manifest.layout == layout_name) {
     ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(dir, manifest));
-    ARCO_ASSIGN_OR_RETURN(NpyArray<double> old, ReadCaptureKeypoints2d(dir, manifest));
+    // Each camera's own frames: rewritten as they are.
+    ARCO_ASSIGN_OR_RETURN(NpyArray<double> old,
+                          ReadCaptureKeypoints2d(dir, manifest, KeypointTimes::kAsRecorded));
     for (size_t i = 0; i < out.data.size(); ++i) out.data[i] = static_cast<float>(old.data[i]);
     kept = true;
   }

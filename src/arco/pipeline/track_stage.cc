@@ -403,7 +403,9 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   out.data.assign(static_cast<size_t>(manifest.frame_count * views * points * 3), kNaNf);
   if (!manifest.keypoints2d.empty() && manifest.layout == layout_name) {
     ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(dir, manifest));
-    ARCO_ASSIGN_OR_RETURN(NpyArray<double> old, ReadCaptureKeypoints2d(dir, manifest));
+    // Each camera's own frames: rewritten as they are.
+    ARCO_ASSIGN_OR_RETURN(NpyArray<double> old,
+                          ReadCaptureKeypoints2d(dir, manifest, KeypointTimes::kAsRecorded));
     for (size_t i = 0; i < out.data.size(); ++i) out.data[i] = static_cast<float>(old.data[i]);
     summary.kept_other_points = true;
   }
