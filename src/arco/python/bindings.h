@@ -28,6 +28,7 @@
 
 #include "arco/audio/pitch_tracker.h"
 #include "arco/calibration/calibration_file.h"
+#include "arco/util/json_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/status.h"
 
@@ -97,6 +98,11 @@ inline std::string ShapeString(const py::array& a) {
     s += std::to_string(a.shape(i));
   }
   return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+// A JSON value (result.json, eval.json, a summary) as Python dicts and lists.
+inline py::object JsonToPython(const Json& json) {
+  return py::module_::import("json").attr("loads")(json.dump());
 }
 
 template <typename T>

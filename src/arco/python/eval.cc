@@ -77,7 +77,7 @@ py::object EvaluatePy(const std::filesystem::path& result_dir,
   if (!report.ok()) RaiseStatus(report.status(), r.result_dir);
   Json json = report->ToJson(r.metrics);
   json["options"] = eval::ToJson(r);
-  return py::module_::import("json").attr("loads")(json.dump());
+  return JsonToPython(json);
 }
 
 void BindEval(py::module_& m) {

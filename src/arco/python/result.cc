@@ -64,7 +64,7 @@ py::dict ReadResult(const std::filesystem::path& dir_path) {
   const Json manifest = ValueOrRaise(folder.ReadManifest(), folder.ManifestPath());
   py::dict out;
   out["dir"] = dir;
-  out["result"] = py::module_::import("json").attr("loads")(manifest.dump());
+  out["result"] = JsonToPython(manifest);
   const pipeline::ResultHeader header = ValueOrRaise(folder.ReadHeader(), folder.ManifestPath());
   py::dict points3d, keypoint_names, contacts;
   for (const pipeline::PointStage& stage :

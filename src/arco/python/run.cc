@@ -11,14 +11,9 @@
 #include "arco/pipeline/run_capture.h"
 #include "arco/python/bindings.h"
 #include "arco/refine/contact_annotation.h"
-#include "arco/util/json_io.h"
 
 namespace arco::python {
 namespace {
-
-py::object JsonToPython(const Json& json) {
-  return py::module_::import("json").attr("loads")(json.dump());
-}
 
 // A method's summary as result.json records it, with its mode.
 py::object MethodSummary(const refine::RefineSummary& summary) {
