@@ -33,14 +33,19 @@ class TempDir {
   std::string path_;
 };
 
-// One temporary folder for the whole test process (created on first use, kept).
+// One temporary folder for the whole test process (created on first use and
+// removed when the process exits, so repeated test runs leave nothing behind).
 inline std::string PerProcessTempDir() {
-  static const std::string dir = [] {
-    const std::string d = ::testing::TempDir() + "/arco-" + std::to_string(::getpid());
-    std::filesystem::create_directories(d);
-    return d;
-  }();
-  return dir;
+  struct Owned {
+    std::string path = ::testing::TempDir() + "/arco-" + std::to_string(::getpid());
+    Owned() { std::filesystem::create_directories(path); }
+    ~Owned() {
+      std::error_code ec;
+      std::filesystem::remove_all(path, ec);
+    }
+  };
+  static const Owned dir;
+  return dir.path;
 }
 
 }  // namespace arco::testing
