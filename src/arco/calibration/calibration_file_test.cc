@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "arco/util/file_io.h"
+#include "arco/util/test_dir.h"
 
 namespace arco {
 namespace {
@@ -19,18 +20,11 @@ std::string SpdPath(const std::string& name) {
   return std::string(ARCO_SHARED_DATA_DIR) + "/spd/" + name;
 }
 
-class TempDir : public ::testing::Test {
+// A fresh folder per test, removed afterwards (parameterised names included).
+class WithTempDir : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("arco_calibration_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
+  std::string Path(const std::string& name) const { return dir_ / name; }
+  testing::TempDir dir_;
 };
 
 void ExpectSameRig(const Rig& a, const Rig& b, double tolerance, bool names_kept) {
@@ -82,7 +76,7 @@ TEST(LoadCalibration, ReadsTheRealFilesInEachFormat) {
   ExpectSameRig(xml->rig, json->rig, 1e-9, /*names_kept=*/false);
 }
 
-class RoundTrip : public TempDir, public ::testing::WithParamInterface<std::string> {};
+class RoundTrip : public WithTempDir, public ::testing::WithParamInterface<std::string> {};
 
 TEST_P(RoundTrip, ReadWriteReadKeepsTheRig) {
   for (const char* source :
@@ -124,7 +118,7 @@ INSTANTIATE_TEST_SUITE_P(Writers,
                            return name;
                          });
 
-using SaveCalibrationTest = TempDir;
+using SaveCalibrationTest = WithTempDir;
 
 TEST_F(SaveCalibrationTest, NamesWithYamlAndXmlSpecialCharactersRoundTrip) {
   auto cal = LoadCalibration(SpdPath("camera.xml"));
@@ -159,7 +153,7 @@ TEST_F(SaveCalibrationTest, RefusesUnknownExtensionAndInvalidRigWithoutLeavingAF
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("rotation"), std::string::npos) << s.message();
   EXPECT_FALSE(SaveCalibration(Path("rig.xml"), cal->rig, CalibrationFormat::kMetashapeXml).ok());
-  EXPECT_TRUE(fs::is_empty(dir_));
+  EXPECT_TRUE(fs::is_empty(dir_.path()));
 }
 
 TEST(CalibrationFormatFromFlag, AcceptsTheDocumentedNames) {

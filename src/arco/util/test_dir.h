@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 
@@ -15,10 +16,13 @@ class TempDir {
  public:
   TempDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ =
-        (std::filesystem::temp_directory_path() / ("arco_test_" + std::to_string(::getpid()) + "_" +
-                                                   info->test_suite_name() + "_" + info->name()))
-            .string();
+    // Parameterised tests are named "Suite/Name/0": one folder, not nested ones
+    // that the destructor would only partly remove.
+    std::string name = std::string(info->test_suite_name()) + "_" + info->name();
+    std::replace(name.begin(), name.end(), '/', '_');
+    path_ = (std::filesystem::temp_directory_path() /
+             ("arco_test_" + std::to_string(::getpid()) + "_" + name))
+                .string();
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }
