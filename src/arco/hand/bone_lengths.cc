@@ -49,7 +49,14 @@ StatusOr<BoneLengthEstimate> EstimateBoneLengths(const std::vector<HandPointsMm>
       if (std::abs(d - median) <= options.mad_gate * sigma) inliers.push_back(d);
     }
     out.inliers[k] = static_cast<int>(inliers.size());
-    out.lengths_mm[k] = Median(inliers);
+    const double m = Median(inliers);
+    out.lengths_mm[k] = m;
+    if (options.correct_noise_bias) {
+      const double tau = kMadToSigma * MedianAbsDeviation(inliers, m);
+      // At most half the median: a spread comparable with the bone says the
+      // samples are noise, and the prior bounds below take over.
+      out.lengths_mm[k] = m - std::min(tau * tau / m, 0.5 * m);
+    }
     out.from_data[k] = 1;
     ratios.push_back(out.lengths_mm[k] / prior_mm);
   }

@@ -1,7 +1,8 @@
 // Per-performer bone lengths from a capture: for every bone, the median over
 // frames of the triangulated distance between its two keypoints, after
 // rejecting gross samples (outside [0.3, 3] x the prior length) and outliers
-// (beyond mad_gate robust standard deviations from the median). Bones with too
+// (beyond mad_gate robust standard deviations from the median), optionally less
+// the upward bias of a distance between two noisy points (below). Bones with too
 // few samples take the prior length times the hand's overall scale; every
 // length is finally clamped to [min_ratio, max_ratio] x the prior length.
 #pragma once
@@ -22,6 +23,19 @@ struct BoneLengthOptions {
   double min_mad_mm = 1.0;  // floor of the robust deviation
   double min_ratio = 0.6;   // anatomical bounds relative to the prior bone
   double max_ratio = 1.6;
+  // Noise lengthens a measured distance on average: with independent errors of
+  // spread tau along each axis of the difference, d = |L + n| ~ L + n_par +
+  // |n_perp|^2 / (2 L), whose mean is L + tau^2 / L (the two perpendicular
+  // components add in quadrature and never cancel). tau is the inliers' robust
+  // spread along the bone (n_par), so the length is taken as m - tau^2 / m
+  // (m: the inliers' median). On SPD's real cellist re-captured by arco synth the
+  // phalanges came out 1.5-2.9 mm too long on average without it, -0.5 to +0.4 mm
+  // with it (docs/hand.md), and every joint group of the fitted hand got closer.
+  // Off by default: with the hand not moved (refine.h, move_hand) the truer,
+  // shorter fingers leave more contacts out of the playing finger's reach, and
+  // arco's contact deviation on its synthetic captures rose by 0.16-0.79 mm
+  // (docs/accuracy.md), past the bar run_capture_test checks.
+  bool correct_noise_bias = false;
   Status Validate() const;
 };
 
