@@ -242,10 +242,10 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
         w.tracker->Reset();
         // Decode ahead: frame g + 1 is read on its own thread while the tracker works on
         // frame g, so a worker's decoding overlaps its inference where a core is free
-        // (docs/performance.md, "Detect: decoding ahead"). The tracker sees the same
-        // frames in the same order, so the output does not change. Two buffers take
-        // turns; the reader is used by one read at a time (each is waited for before
-        // the next starts).
+        // (docs/performance.md, "Issue 28, part 1: decoding ahead"). The tracker sees the
+        // same frames in the same order, so the output does not change. Two buffers take
+        // turns; the reader is used by one read at a time (each is waited for before the
+        // next starts).
         struct Decoded {
           StatusOr<bool> read = false;
           double decode_s = 0;
