@@ -11,10 +11,16 @@
 //   preprocess_ms (cutting and converting crops) and postprocess_ms (decoding), which
 //   the tracker times separately;
 // - BM_DecodeFrame: reading frames with media::VideoReader (decoding is not part of
-//   the tracker's time): opencv-doc's vtest.avi (768 x 576 MPEG-4) and the cellist JPEG.
+//   the tracker's time): opencv-doc's vtest.avi (768 x 576 MPEG-4) and the cellist JPEG;
+// - BM_DetectStagePlane: `arco detect` (pipeline::RunDetectStage, default models) on
+//   pipeline_detect_plane_test's scene (8 views x 12 frames of 1152 x 1328 FFV1, rendered
+//   once, untimed), wall time per view-frame with decoding, for --threads 1 and 2 and
+//   with frames decoded ahead on a thread beside each worker or in turn (issue 28).
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <random>
 #include <string>
 #include <vector>
@@ -22,6 +28,9 @@
 #include "arco/detect/network.h"
 #include "arco/detect/wholebody.h"
 #include "arco/media/video_reader.h"
+#include "arco/pipeline/capture_new.h"
+#include "arco/pipeline/detect_stage.h"
+#include "arco/synth/plane_scene.h"
 
 namespace arco::detect {
 namespace {
@@ -145,6 +154,120 @@ void BM_DecodeFrame(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_DecodeFrame)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// pipeline_detect_plane_test's capture (same photo, rig and motion), made once per
+// process in a temporary folder removed at exit; empty with the reason on failure.
+struct PlaneCapture {
+  std::string dir, error;
+  int64_t view_frames = 0;
+  ~PlaneCapture() {
+    if (!dir.empty()) std::filesystem::remove_all(dir);
+  }
+};
+const PlaneCapture& GetPlaneCapture() {
+  static PlaneCapture capture = [] {
+    PlaneCapture c;
+    char pattern[] = "/tmp/arco_detect_bench_XXXXXX";
+    if (mkdtemp(pattern) == nullptr) {
+      c.error = "cannot make a temporary folder";
+      return c;
+    }
+    c.dir = pattern;
+    StatusOr<media::VideoReader> reader = media::VideoReader::Open(kCellist);
+    if (!reader.ok()) {
+      c.error = reader.status().message();
+      return c;
+    }
+    StatusOr<media::Image> image = reader->ReadFrame(0);
+    if (!image.ok()) {
+      c.error = image.status().message();
+      return c;
+    }
+    constexpr double kPhotoMmPerPx = 0.778;
+    synth::PlaneScene scene;
+    scene.texture.image = *image;
+    scene.texture.width_mm = image->width * kPhotoMmPerPx;
+    scene.texture.height_mm = image->height * kPhotoMmPerPx;
+    synth::BuildMipmaps(&scene.texture);
+    synth::PlaneRigOptions rig;
+    rig.cameras = 8;
+    rig.width = 1152;
+    rig.height = 1328;
+    rig.focal_px = 1130;
+    rig.distance_mm = 2500;
+    rig.arc_deg = 100;
+    scene.rig = synth::MakePlaneRig(rig);
+    synth::PlaneMotionOptions motion;
+    motion.frames = 12;
+    motion.fps_hz = 30;
+    motion.max_translation_mm = 150;
+    motion.max_rotation_deg = 10;
+    scene.world_from_plane = synth::MakePlaneMotion(motion);
+    scene.fps = {30, 1};
+    synth::PlaneSceneWriteOptions write;
+    write.render.supersampling = 1;
+    const std::string scene_dir = c.dir + "/scene";
+    const Status written = synth::WritePlaneScene(scene, scene_dir, write);
+    if (!written.ok()) {
+      c.error = written.message();
+      return c;
+    }
+    pipeline::CaptureNewOptions o;
+    o.calibration = scene_dir + "/calibration.json";
+    for (const Camera& cam : scene.rig.cameras) {
+      o.inputs.push_back({cam.name, scene_dir + "/videos/" + cam.name + ".mkv", false});
+    }
+    o.output_dir = c.dir + "/capture";
+    auto made = pipeline::CreateCapture(o);
+    if (!made.ok()) {
+      c.error = made.status().message();
+      return c;
+    }
+    c.view_frames = static_cast<int64_t>(rig.cameras) * motion.frames;
+    return c;
+  }();
+  return capture;
+}
+
+// range(0): --threads; range(1): 1 decode ahead, 0 decode and track in turn.
+void BM_DetectStagePlane(benchmark::State& state) {
+  const PlaneCapture& capture = GetPlaneCapture();
+  if (!capture.error.empty()) {
+    state.SkipWithError(capture.error.c_str());
+    return;
+  }
+  pipeline::DetectStageOptions o;
+  o.capture_dir = capture.dir + "/capture";
+  o.num_threads = static_cast<int>(state.range(0));
+  o.decode_ahead = state.range(1) != 0;
+  state.SetLabel(std::string(o.decode_ahead ? "decode ahead" : "decode in turn") + ", " +
+                 std::to_string(o.num_threads) + " threads");
+  double decode_s = 0, wait_s = 0, inference_s = 0;
+  int64_t runs = 0;
+  for (auto _ : state) {
+    StatusOr<pipeline::DetectStageSummary> s = pipeline::RunDetectStage(o);
+    if (!s.ok()) {
+      state.SkipWithError(s.status().message().c_str());
+      return;
+    }
+    decode_s += s->decode_s;
+    wait_s += s->decode_wait_s;
+    inference_s += s->total.inference_s;
+    ++runs;
+  }
+  // Per view-frame: the wall time is the benchmark's own (Time / view_frames); the
+  // counters are summed over workers.
+  const double per_view_frame = 1e3 / static_cast<double>(runs * capture.view_frames);
+  state.counters["view_frames"] = static_cast<double>(capture.view_frames);
+  state.counters["decode_ms"] = decode_s * per_view_frame;
+  state.counters["decode_wait_ms"] = wait_s * per_view_frame;
+  state.counters["inference_ms"] = inference_s * per_view_frame;
+}
+BENCHMARK(BM_DetectStagePlane)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace arco::detect

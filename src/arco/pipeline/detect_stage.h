@@ -34,6 +34,10 @@ struct DetectStageOptions {
   int64_t first_frame = -1;
   int64_t last_frame = -1;
   int chunk_frames = 150;
+  // Read and decode each worker's next frame on a thread of its own while the worker's
+  // tracker runs on the current one (one extra thread per worker, mostly waiting). The
+  // output is the same either way; false: decode and track in turn, as before issue 28.
+  bool decode_ahead = true;
   Status Validate() const;
 };
 
@@ -54,6 +58,9 @@ struct DetectStageSummary {
   std::vector<DetectCameraSummary> cameras;
   detect::WholeBodySummary total;
   double decode_s = 0;  // reading, decoding and rotating frames (all workers)
+  // Of decode_s, what the trackers waited for (the rest overlapped inference: frames
+  // are decoded ahead on a thread beside each worker).
+  double decode_wait_s = 0;
   double wall_s = 0;
   bool kept_other_points = false;  // instrument/bow slots kept from the old keypoints2d.npy
 };

@@ -7,13 +7,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "arco/calibration/calibration_file.h"
 #include "arco/detect/models_for_test.h"
+#include "arco/detect/wholebody.h"
 #include "arco/media/video_reader.h"
 #include "arco/media/video_writer.h"
 #include "arco/mocap/capture.h"
@@ -164,6 +167,83 @@ TEST_F(DetectStageTest, SameBytesForAnyThreadCount) {
   }
   ASSERT_FALSE(bytes[0].empty());
   EXPECT_EQ(bytes[0], bytes[1]);
+}
+
+// Frames are decoded ahead on a thread beside each worker (detect_stage.cc): the
+// tracker must still see every frame once, in order, in a buffer the next read does not
+// touch. Frames that differ (the photo shifted further right each time) make a frame
+// given twice, skipped, swapped or overwritten while tracked show in the keypoints.
+TEST_F(DetectStageTest, DecodingAheadGivesTheTrackerEveryFrameInOrder) {
+  constexpr int kFrames = 5;
+  fs::create_directories(dir_ / "moving");
+  std::vector<media::Image> frames;
+  for (int k = 0; k < kFrames; ++k) {
+    media::Image shifted = media::MakeImage(photo_.width, photo_.height, photo_.format);
+    const size_t shift = static_cast<size_t>(12 * k) * photo_.channels();
+    for (int y = 0; y < photo_.height; ++y) {
+      std::memcpy(shifted.row(y) + shift, photo_.row(y), photo_.row_bytes() - shift);
+    }
+    ASSERT_TRUE(
+        media::WriteImageFile(dir_ / ("moving/f" + std::to_string(k + 1) + ".png"), shifted).ok());
+    frames.push_back(std::move(shifted));
+  }
+  Rig rig;
+  rig.units = "mm";
+  rig.cameras = {MakeCamera("cam0", photo_.width, photo_.height)};
+  ASSERT_TRUE(SaveCalibration(dir_ / "cal1.json", rig).ok());
+  CaptureNewOptions c;
+  c.calibration = dir_ / "cal1.json";
+  c.inputs = {{"cam0", dir_ / "moving", true}};
+  c.fps = 30;
+  c.output_dir = dir_ / "capture";
+  ASSERT_TRUE(CreateCapture(c).ok());
+  DetectStageOptions o;
+  o.capture_dir = c.output_dir;
+  o.num_threads = 1;
+  auto summary = RunDetectStage(o);
+  ASSERT_TRUE(summary.ok()) << summary.status().message();
+  const NpyArray<float> k = Keypoints(c.output_dir);
+  ASSERT_EQ(k.shape, (std::vector<int64_t>{kFrames, 1, wholebody::kNumPoints, 3}));
+
+  // The same frames through one tracker, one after the other, without the stage.
+  detect::WholeBodyOptions d;
+  auto tracker = detect::WholeBodyTracker::Create(d);
+  ASSERT_TRUE(tracker.ok()) << tracker.status().message();
+  int found = 0;
+  for (int f = 0; f < kFrames; ++f) {
+    auto expected = tracker->Track(frames[f]);
+    ASSERT_TRUE(expected.ok());
+    for (int p = 0; p < wholebody::kNumPoints; ++p) {
+      const float* got = &k.data[(static_cast<size_t>(f) * wholebody::kNumPoints + p) * 3];
+      const detect::ScoredPoint& e = expected->points[p];
+      if (std::isnan(e.x_px)) {
+        EXPECT_TRUE(std::isnan(got[0])) << "frame " << f << " point " << p;
+        continue;
+      }
+      ++found;
+      EXPECT_EQ(got[0], e.x_px) << "frame " << f << " point " << p;
+      EXPECT_EQ(got[1], e.y_px) << "frame " << f << " point " << p;
+      EXPECT_EQ(got[2], e.score) << "frame " << f << " point " << p;
+    }
+  }
+  EXPECT_GT(found, kFrames * 17);
+
+  // Decoding in turn (the option off) writes the same bytes.
+  const std::string ahead = ReadBytes(c.output_dir + "/keypoints2d.npy");
+  o.decode_ahead = false;
+  auto in_turn = RunDetectStage(o);
+  ASSERT_TRUE(in_turn.ok()) << in_turn.status().message();
+  EXPECT_EQ(ReadBytes(c.output_dir + "/keypoints2d.npy"), ahead);
+  EXPECT_GE(in_turn->decode_wait_s, in_turn->decode_s);  // all of it waited for
+  o.decode_ahead = true;
+
+  // A frame that cannot be decoded, read ahead while the one before it is tracked: the
+  // error reaches the caller and nothing is written.
+  const std::string npy_before = ReadBytes(c.output_dir + "/keypoints2d.npy");
+  std::ofstream(dir_ / "moving/f4.png", std::ios::binary | std::ios::trunc) << "not a png";
+  auto broken = RunDetectStage(o);
+  EXPECT_FALSE(broken.ok());
+  EXPECT_EQ(ReadBytes(c.output_dir + "/keypoints2d.npy"), npy_before);
 }
 
 TEST_F(DetectStageTest, KeepsInstrumentSlotsAndFramesOutsideTheRange) {
