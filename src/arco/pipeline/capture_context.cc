@@ -1,5 +1,7 @@
 #include "arco/pipeline/capture_context.h"
 
+#include <stdexcept>
+
 #include "arco/hand/hand_model.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
@@ -38,6 +40,25 @@ StatusOr<CaptureContext> OpenCapture(const std::string& capture_dir) {
     return Status::Error(where + ": layout " + c.layout.name + " has no whole-body hands");
   }
   return c;
+}
+
+NpyArray<double> PointsInMm(const NpyArray<double>& points_in_world, double world_units_per_mm) {
+  NpyArray<double> mm = points_in_world;
+  for (double& v : mm.data) v /= world_units_per_mm;
+  return mm;
+}
+
+std::vector<Camera> ViewCamerasInMm(const CaptureContext& capture, double world_units_per_mm) {
+  if (capture.view_to_camera.size() != capture.manifest.cameras.size()) {
+    throw std::invalid_argument("ViewCamerasInMm: the capture's calibration is not loaded");
+  }
+  std::vector<Camera> cameras;
+  for (const int c : capture.view_to_camera) {
+    Camera camera = capture.calibration.rig.cameras.at(static_cast<size_t>(c));
+    camera.cam_from_world_translation /= world_units_per_mm;
+    cameras.push_back(camera);
+  }
+  return cameras;
 }
 
 StatusOr<std::shared_ptr<const NpyArray<double>>> ReadKeypoints2d(const CaptureContext& capture) {
