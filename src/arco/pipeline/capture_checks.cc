@@ -67,19 +67,22 @@ Status CheckCaptureCalibration(const std::string& capture_dir, const CaptureMani
   return LoadCaptureCalibration(&capture);
 }
 
-Status LoadCaptureCalibration(CaptureContext* capture, const std::string* text) {
+Status LoadCaptureCalibration(CaptureContext* capture) {
   const std::string& capture_dir = capture->capture_dir;
   const CaptureManifest& manifest = capture->manifest;
   const std::string path = ResolveCapturePath(capture_dir, manifest.calibration);
   ARCO_RETURN_IF_ERROR(CheckInputFile(capture_dir, "calibration", manifest.calibration, path));
+  // Read once: parsed here, and its fingerprint taken of the same bytes.
+  StatusOr<std::string> text = ReadFileToString(path);
   StatusOr<Calibration> calibration =
-      text != nullptr ? ParseCalibration(*text, path) : LoadCalibration(path);
+      text.ok() ? ParseCalibration(*text, path) : StatusOr<Calibration>(text.status());
   if (!calibration.ok()) {
     return calibration.status().WithContext(ManifestPath(capture_dir) + ": calibration");
   }
   ARCO_ASSIGN_OR_RETURN(capture->view_to_camera,
                         MatchCaptureCameras(capture_dir, manifest, calibration->rig, path));
   capture->calibration = std::move(calibration).value();
+  capture->inputs[kCalibrationInput] = {manifest.calibration, FingerprintBytes(*text)};
   return Status::Ok();
 }
 

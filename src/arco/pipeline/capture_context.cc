@@ -16,8 +16,11 @@ constexpr int kLeftHandFirst = wholebody::kLeftHandFirst;
 StatusOr<CaptureContext> OpenCapture(const std::string& capture_dir) {
   CaptureContext c;
   c.capture_dir = capture_dir;
-  ARCO_ASSIGN_OR_RETURN(c.manifest, ReadCaptureManifest(capture_dir));
   const std::string where = JoinPath(capture_dir, kCaptureManifestName);
+  // Read once: parsed here, and its fingerprint taken of the same bytes.
+  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(where));
+  ARCO_ASSIGN_OR_RETURN(c.manifest, ParseCaptureManifest(text, where));
+  c.inputs[kManifestInput] = {kCaptureManifestName, FingerprintBytes(text)};
   ARCO_RETURN_IF_ERROR(CheckCaptureHasKeypoints2d(capture_dir, c.manifest));
   ARCO_ASSIGN_OR_RETURN(c.layout, c.manifest.Layout());
   if (c.manifest.instrument == "none" || c.manifest.instrument.empty()) {

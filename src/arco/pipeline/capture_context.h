@@ -49,6 +49,7 @@ std::vector<Camera> ViewCamerasInMm(const CaptureContext& capture, double world_
 // capture.keypoints2d when set, else the file read (ReadCaptureKeypoints2d).
 StatusOr<std::shared_ptr<const NpyArray<double>>> ReadKeypoints2d(const CaptureContext& capture);
 
+// Reads capture.json once (inputs["capture.json"]: the fingerprint of the bytes parsed).
 // Errors name capture.json: an unreadable manifest, no instrument ("none"), a layout
 // without the instrument's points or without whole-body hands.
 StatusOr<CaptureContext> OpenCapture(const std::string& capture_dir);

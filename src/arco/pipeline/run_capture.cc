@@ -192,12 +192,12 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
                                 m.fps,
                                 JoinPath(options.capture_dir, kCaptureManifestName)));
   ARCO_RETURN_IF_ERROR(CheckCaptureAudio(options.capture_dir, m).status());
-  // After the checks, so that a bad file gets its own message rather than the hash's.
-  ARCO_ASSIGN_OR_RETURN(capture.inputs,
-                        FingerprintCaptureInputs(
-                            options.capture_dir,
-                            m,
-                            {kManifestInput, kCalibrationInput, kKeypoints2dInput, kAudioInput}));
+  // After the checks, so that a bad file gets its own message rather than the hash's. The
+  // manifest's and the calibration's were taken of the bytes parsed.
+  ARCO_ASSIGN_OR_RETURN(
+      const CaptureInputs rest,
+      FingerprintCaptureInputs(options.capture_dir, m, {kKeypoints2dInput, kAudioInput}));
+  capture.inputs.insert(rest.begin(), rest.end());
   return capture;
 }
 

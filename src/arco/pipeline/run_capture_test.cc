@@ -272,6 +272,19 @@ TEST(RunCapture, TheStagesTakeTheOpenedCaptureAndTheRecordsInMemory) {
   ASSERT_EQ(opened->view_to_camera.size(), opened->manifest.cameras.size());
   ASSERT_FALSE(opened->calibration.rig.cameras.empty());
   ASSERT_TRUE(opened->keypoints2d != nullptr);
+  // The manifest's and the calibration's fingerprints were taken of the bytes parsed: the
+  // same as the files'.
+  auto files =
+      FingerprintCaptureInputs(capture,
+                               opened->manifest,
+                               {kManifestInput, kCalibrationInput, kKeypoints2dInput, kAudioInput});
+  ASSERT_TRUE(files.ok());
+  ASSERT_EQ(files->size(), 4u);
+  ASSERT_EQ(opened->inputs.size(), 4u);
+  for (const auto& [role, input] : *files) {
+    EXPECT_EQ(opened->inputs.at(role).file, input.file) << role;
+    EXPECT_EQ(opened->inputs.at(role).fingerprint, input.fingerprint) << role;
+  }
   fs::remove(JoinPath(capture, opened->manifest.calibration));
   fs::remove(JoinPath(capture, opened->manifest.keypoints2d));
 
