@@ -251,6 +251,10 @@ int GmProgramForInstrument(const std::string& instrument) {
 }
 
 Status WriteNotesCsv(const std::string& path, const NoteAnalysis& analysis) {
+  return AtomicWriteFile(path, FormatNotesCsv(analysis));
+}
+
+std::string FormatNotesCsv(const NoteAnalysis& analysis) {
   struct Row {
     double onset;
     std::string text;
@@ -283,19 +287,23 @@ Status WriteNotesCsv(const std::string& path, const NoteAnalysis& analysis) {
   }
   std::stable_sort(
       rows.begin(), rows.end(), [](const Row& x, const Row& y) { return x.onset < y.onset; });
-  return AtomicWriteWith(path, [&](std::ostream& out) {
-    out << kNotesCsvHeader << '\n';
-    for (const Row& r : rows) out << r.text;
-    return Status::Ok();
-  });
+  std::string out = std::string(kNotesCsvHeader) + "\n";
+  for (const Row& r : rows) out += r.text;
+  return out;
 }
 
 StatusOr<std::vector<Note>> ReadNotesCsv(const std::string& path) {
+  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
+  return ParseNotesCsv(text, path);
+}
+
+StatusOr<std::vector<Note>> ParseNotesCsv(const std::string& text, const std::string& source) {
   // The columns read back: kind, onset_s, offset_s, median_f0_hz; every row must still have
   // all of the header's cells (a row cut short is an error, as in pitch.csv).
   ARCO_ASSIGN_OR_RETURN(
       const CsvTable table,
-      ReadCsvTable(path, {"kind", "onset_s", "offset_s", "median_f0_hz"}, kNotesCsvHeader));
+      ParseCsvTable(
+          text, source, {"kind", "onset_s", "offset_s", "median_f0_hz"}, kNotesCsvHeader));
   const int kind_col = table.Column("kind"), onset_col = table.Column("onset_s"),
             offset_col = table.Column("offset_s"), f0_col = table.Column("median_f0_hz");
   std::vector<Note> notes;

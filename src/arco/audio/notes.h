@@ -85,10 +85,15 @@ inline constexpr char kNotesCsvHeader[] =
     "kind,onset_s,offset_s,median_f0_hz,midi_note,note_name,cents_from_et,vibrato_rate_hz,"
     "vibrato_extent_cents,start_f0_hz,end_f0_hz";
 Status WriteNotesCsv(const std::string& path, const NoteAnalysis& analysis);
+// The file's text.
+std::string FormatNotesCsv(const NoteAnalysis& analysis);
 // The note rows of a notes.csv: onset_s, offset_s and median_f0_hz (the other columns and
 // the glides are not read back). The header must start with those columns. Errors name the
 // file and line: a malformed number, offset before onset, a non-positive pitch, onsets out
 // of order.
 StatusOr<std::vector<Note>> ReadNotesCsv(const std::string& path);
+// The same on the file's text; `source` names it in messages (ParseNotesCsv(
+// FormatNotesCsv(analysis)): the notes as a reader of the file gets them).
+StatusOr<std::vector<Note>> ParseNotesCsv(const std::string& text, const std::string& source);
 
 }  // namespace arco::audio

@@ -150,6 +150,34 @@ TEST(ReadNotesCsv, ReadsBackTheNotesOfWriteNotesCsv) {
   EXPECT_DOUBLE_EQ((*back)[1].median_f0_hz, 246.9);
 }
 
+// What `arco run` hands to the refinement (ParseNotesCsv(FormatNotesCsv(...))) is the
+// file's notes, value for value.
+TEST(ParseNotesCsv, OfFormatNotesCsvIsWhatTheFileReadsBackAs) {
+  arco::testing::TempDir dir;
+  NoteAnalysis a;
+  for (int i = 0; i < 10; ++i) {
+    Note n;
+    n.onset_s = 0.123456789 * i;
+    n.offset_s = n.onset_s + 0.1 / 3;
+    n.median_f0_hz = 110.0 * std::pow(2.0, i / 12.0);
+    n.midi_note = 45 + i;
+    a.notes.push_back(n);
+  }
+  a.glides.push_back({0.2, 0.25, 220.0, 246.9});
+  const std::string path = dir / "notes.csv";
+  ASSERT_TRUE(WriteNotesCsv(path, a).ok());
+  EXPECT_EQ(*ReadFileToString(path), FormatNotesCsv(a));
+  const auto file = ReadNotesCsv(path);
+  const auto memory = ParseNotesCsv(FormatNotesCsv(a), path);
+  ASSERT_TRUE(file.ok() && memory.ok());
+  ASSERT_EQ(file->size(), memory->size());
+  for (size_t i = 0; i < file->size(); ++i) {
+    EXPECT_EQ((*file)[i].onset_s, (*memory)[i].onset_s);
+    EXPECT_EQ((*file)[i].offset_s, (*memory)[i].offset_s);
+    EXPECT_EQ((*file)[i].median_f0_hz, (*memory)[i].median_f0_hz);
+  }
+}
+
 TEST(ReadNotesCsv, MalformedFilesNameTheFileAndLine) {
   arco::testing::TempDir dir;
   const std::string path = dir / "notes.csv";

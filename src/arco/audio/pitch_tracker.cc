@@ -177,30 +177,39 @@ StatusOr<PitchTrack> TrackPitchFile(const std::string& path,
   return track;
 }
 
+std::string FormatPitchCsv(const std::vector<PitchFrame>& frames) {
+  std::string out = "frame,time_s,f0_hz,confidence,voiced\n";
+  char line[160];
+  for (const auto& f : frames) {
+    std::snprintf(line,
+                  sizeof(line),
+                  "%lld,%.6f,%.4f,%.4f,%d\n",
+                  static_cast<long long>(f.frame),
+                  f.time_s,
+                  f.voiced ? f.f0_hz : 0.0,
+                  f.confidence,
+                  f.voiced ? 1 : 0);
+    out += line;
+  }
+  return out;
+}
+
 Status WritePitchCsv(const std::string& path, const std::vector<PitchFrame>& frames) {
-  return AtomicWriteWith(path, [&](std::ostream& out) {
-    out << "frame,time_s,f0_hz,confidence,voiced\n";
-    char line[160];
-    for (const auto& f : frames) {
-      std::snprintf(line,
-                    sizeof(line),
-                    "%lld,%.6f,%.4f,%.4f,%d\n",
-                    static_cast<long long>(f.frame),
-                    f.time_s,
-                    f.voiced ? f.f0_hz : 0.0,
-                    f.confidence,
-                    f.voiced ? 1 : 0);
-      out << line;
-    }
-    return Status::Ok();
-  });
+  return AtomicWriteFile(path, FormatPitchCsv(frames));
 }
 
 StatusOr<std::vector<PitchFrame>> ReadPitchCsv(const std::string& path) {
+  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
+  return ParsePitchCsv(text, path);
+}
+
+StatusOr<std::vector<PitchFrame>> ParsePitchCsv(const std::string& text,
+                                                const std::string& source) {
   ARCO_ASSIGN_OR_RETURN(const CsvTable table,
-                        ReadCsvTable(path,
-                                     {"frame", "time_s", "f0_hz", "confidence", "voiced"},
-                                     "frame,time_s,f0_hz,confidence,voiced"));
+                        ParseCsvTable(text,
+                                      source,
+                                      {"frame", "time_s", "f0_hz", "confidence", "voiced"},
+                                      "frame,time_s,f0_hz,confidence,voiced"));
   const int frame_col = table.Column("frame"), time_col = table.Column("time_s"),
             f0_col = table.Column("f0_hz"), confidence_col = table.Column("confidence"),
             voiced_col = table.Column("voiced");

@@ -105,7 +105,13 @@ StatusOr<PitchTrack> TrackPitchFile(const std::string& path,
 
 // pitch.csv: header `frame,time_s,f0_hz,confidence,voiced`, written atomically.
 Status WritePitchCsv(const std::string& path, const std::vector<PitchFrame>& frames);
+// The file's text (time_s to 1 us, f0_hz and confidence to 1e-4, f0_hz 0 when unvoiced).
+std::string FormatPitchCsv(const std::vector<PitchFrame>& frames);
 // Reads a file written by WritePitchCsv (tests, tools).
 StatusOr<std::vector<PitchFrame>> ReadPitchCsv(const std::string& path);
+// The same on the file's text; `source` names it in messages. ParsePitchCsv(
+// FormatPitchCsv(frames)) is what a reader of the file gets: `arco run` hands the pitch
+// to the refinement that way, so that it refines what `arco refine` reads.
+StatusOr<std::vector<PitchFrame>> ParsePitchCsv(const std::string& text, const std::string& source);
 
 }  // namespace arco::audio

@@ -313,6 +313,28 @@ TEST(WritePitchCsv, RoundTrips) {
   EXPECT_FALSE((*back)[0].voiced);
 }
 
+// `arco run` hands its pitch to the refinement as ParsePitchCsv(FormatPitchCsv(...)):
+// exactly what ReadPitchCsv gives for the file WritePitchCsv writes, value for value.
+TEST(ParsePitchCsv, OfFormatPitchCsvIsWhatTheFileReadsBackAs) {
+  std::vector<PitchFrame> frames;
+  for (int i = 0; i < 50; ++i) {
+    frames.push_back({i, 0.1 + i / 29.97, 100.0 + i * 3.14159265, 0.01 * i + 1e-5, i % 3 != 0});
+  }
+  const std::string path = testing::TempPath("p.csv");
+  ASSERT_TRUE(WritePitchCsv(path, frames).ok());
+  EXPECT_EQ(*ReadFileToString(path), FormatPitchCsv(frames));
+  auto file = ReadPitchCsv(path);
+  auto memory = ParsePitchCsv(FormatPitchCsv(frames), path);
+  ASSERT_TRUE(file.ok() && memory.ok());
+  ASSERT_EQ(file->size(), memory->size());
+  for (size_t i = 0; i < file->size(); ++i) {
+    EXPECT_EQ((*file)[i].time_s, (*memory)[i].time_s);
+    EXPECT_EQ((*file)[i].f0_hz, (*memory)[i].f0_hz);
+    EXPECT_EQ((*file)[i].confidence, (*memory)[i].confidence);
+    EXPECT_EQ((*file)[i].voiced, (*memory)[i].voiced);
+  }
+}
+
 TEST(ReadPitchCsv, MalformedRowsNameTheFileAndLine) {
   const std::string path = testing::TempPath("bad_pitch.csv");
   const std::string header = "frame,time_s,f0_hz,confidence,voiced\n";

@@ -61,13 +61,29 @@ StatusOr<std::vector<int>> MatchCaptureCameras(const std::string& capture_dir,
 }
 
 Status CheckCaptureCalibration(const std::string& capture_dir, const CaptureManifest& manifest) {
+  CaptureContext capture;
+  capture.capture_dir = capture_dir;
+  capture.manifest = manifest;
+  return LoadCaptureCalibration(&capture);
+}
+
+Status LoadCaptureCalibration(CaptureContext* capture) {
+  const std::string& capture_dir = capture->capture_dir;
+  const CaptureManifest& manifest = capture->manifest;
   const std::string path = ResolveCapturePath(capture_dir, manifest.calibration);
   ARCO_RETURN_IF_ERROR(CheckInputFile(capture_dir, "calibration", manifest.calibration, path));
-  StatusOr<Calibration> calibration = LoadCalibration(path);
+  // Read once: parsed here, and its fingerprint taken of the same bytes.
+  StatusOr<std::string> text = ReadFileToString(path);
+  StatusOr<Calibration> calibration =
+      text.ok() ? ParseCalibration(*text, path) : StatusOr<Calibration>(text.status());
   if (!calibration.ok()) {
     return calibration.status().WithContext(ManifestPath(capture_dir) + ": calibration");
   }
-  return MatchCaptureCameras(capture_dir, manifest, calibration->rig, path).status();
+  ARCO_ASSIGN_OR_RETURN(capture->view_to_camera,
+                        MatchCaptureCameras(capture_dir, manifest, calibration->rig, path));
+  capture->calibration = std::move(calibration).value();
+  capture->inputs[kCalibrationInput] = {manifest.calibration, FingerprintBytes(*text)};
+  return Status::Ok();
 }
 
 StatusOr<CaptureAudioCheck> CheckCaptureAudio(const std::string& capture_dir,

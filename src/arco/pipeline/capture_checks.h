@@ -25,6 +25,10 @@ StatusOr<std::vector<int>> MatchCaptureCameras(const std::string& capture_dir,
 // The capture's calibration (`calibration` in capture.json) is readable and holds every
 // capture camera.
 Status CheckCaptureCalibration(const std::string& capture_dir, const CaptureManifest& manifest);
+// The same check, keeping what it read: capture->calibration, view_to_camera and the
+// fingerprint of the bytes it parsed (capture->inputs["calibration"]): the file is read
+// once.
+Status LoadCaptureCalibration(CaptureContext* capture);
 
 // What the audio check learnt (for messages and tests).
 struct CaptureAudioCheck {

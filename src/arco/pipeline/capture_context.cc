@@ -1,5 +1,7 @@
 #include "arco/pipeline/capture_context.h"
 
+#include <stdexcept>
+
 #include "arco/hand/hand_model.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
@@ -14,8 +16,11 @@ constexpr int kLeftHandFirst = wholebody::kLeftHandFirst;
 StatusOr<CaptureContext> OpenCapture(const std::string& capture_dir) {
   CaptureContext c;
   c.capture_dir = capture_dir;
-  ARCO_ASSIGN_OR_RETURN(c.manifest, ReadCaptureManifest(capture_dir));
   const std::string where = JoinPath(capture_dir, kCaptureManifestName);
+  // Read once: parsed here, and its fingerprint taken of the same bytes.
+  ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(where));
+  ARCO_ASSIGN_OR_RETURN(c.manifest, ParseCaptureManifest(text, where));
+  c.inputs[kManifestInput] = {kCaptureManifestName, FingerprintBytes(text)};
   ARCO_RETURN_IF_ERROR(CheckCaptureHasKeypoints2d(capture_dir, c.manifest));
   ARCO_ASSIGN_OR_RETURN(c.layout, c.manifest.Layout());
   if (c.manifest.instrument == "none" || c.manifest.instrument.empty()) {
@@ -38,6 +43,25 @@ StatusOr<CaptureContext> OpenCapture(const std::string& capture_dir) {
     return Status::Error(where + ": layout " + c.layout.name + " has no whole-body hands");
   }
   return c;
+}
+
+NpyArray<double> PointsInMm(const NpyArray<double>& points_in_world, double world_units_per_mm) {
+  NpyArray<double> mm = points_in_world;
+  for (double& v : mm.data) v /= world_units_per_mm;
+  return mm;
+}
+
+std::vector<Camera> ViewCamerasInMm(const CaptureContext& capture, double world_units_per_mm) {
+  if (capture.view_to_camera.size() != capture.manifest.cameras.size()) {
+    throw std::invalid_argument("ViewCamerasInMm: the capture's calibration is not loaded");
+  }
+  std::vector<Camera> cameras;
+  for (const int c : capture.view_to_camera) {
+    Camera camera = capture.calibration.rig.cameras.at(static_cast<size_t>(c));
+    camera.cam_from_world_translation /= world_units_per_mm;
+    cameras.push_back(camera);
+  }
+  return cameras;
 }
 
 StatusOr<std::shared_ptr<const NpyArray<double>>> ReadKeypoints2d(const CaptureContext& capture) {

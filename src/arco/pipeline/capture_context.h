@@ -1,10 +1,16 @@
-// A capture folder opened for the stages after triangulation: its manifest, keypoint
-// layout and instrument model (mocap/capture.h owns the capture folder's format).
+// A capture folder opened once for every stage of `arco run`: its manifest, keypoint
+// layout, calibration (with each view's camera), 2D keypoints and instrument model, and
+// the fingerprints of the files they came from (mocap/capture.h owns the capture folder's
+// format). PreflightRun (run_capture.h) fills it; the stages read the capture only
+// through it, so no capture file is opened twice (docs/architecture.md, "The pipeline").
 #pragma once
 
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "arco/camera/calibration_io.h"
+#include "arco/camera/camera.h"
 #include "arco/instrument/instrument_model.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/capture_inputs.h"
@@ -19,6 +25,11 @@ struct CaptureContext {
   CaptureManifest manifest;
   KeypointLayout layout;
   std::shared_ptr<const InstrumentModel> instrument;
+  // The capture's calibration (capture.json "calibration") and the calibration camera of
+  // each view, in the manifest's order (MatchCaptureCameras, capture_checks.h); empty
+  // until loaded (LoadCaptureCalibration).
+  Calibration calibration;
+  std::vector<int> view_to_camera;
   // keypoints2d.npy as doubles, once read (PreflightRun reads it, and `arco run`'s stages
   // use it instead of reading the file again: 2 x 59 MB for a one-minute 20-camera take);
   // null: not read yet (ReadKeypoints2d reads the file).
@@ -28,9 +39,17 @@ struct CaptureContext {
   CaptureInputs inputs;
 };
 
+// The one conversion of world coordinates to millimetres (the instrument stage's metric
+// scale, world units per mm): every coordinate divided by it. Cameras keep their
+// projection (cam_from_world translation / s: the same pixels for points / s).
+NpyArray<double> PointsInMm(const NpyArray<double>& points_in_world, double world_units_per_mm);
+// The cameras of the capture's views (view_to_camera) with the world in mm.
+std::vector<Camera> ViewCamerasInMm(const CaptureContext& capture, double world_units_per_mm);
+
 // capture.keypoints2d when set, else the file read (ReadCaptureKeypoints2d).
 StatusOr<std::shared_ptr<const NpyArray<double>>> ReadKeypoints2d(const CaptureContext& capture);
 
+// Reads capture.json once (inputs["capture.json"]: the fingerprint of the bytes parsed).
 // Errors name capture.json: an unreadable manifest, no instrument ("none"), a layout
 // without the instrument's points or without whole-body hands.
 StatusOr<CaptureContext> OpenCapture(const std::string& capture_dir);

@@ -6,7 +6,6 @@
 #include <optional>
 #include <vector>
 
-#include "arco/calibration/calibration_file.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/parallel.h"
@@ -56,34 +55,40 @@ StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
                                         const CaptureContext& capture,
                                         Progress& progress) {
   ARCO_RETURN_IF_ERROR(options.Validate());
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   const ResultFolder result(options.result_dir);
   // The stages read here must come from the capture given.
   ARCO_RETURN_IF_ERROR(result.CheckInputsMatch(capture.inputs));
-  ARCO_ASSIGN_OR_RETURN(const double s, result.ReadWorldUnitsPerMm());
-  ARCO_ASSIGN_OR_RETURN(NpyArray<double> points, result.ReadPoints3d(kTriangulationStage));
-  const CaptureManifest& m = capture.manifest;
-  const std::string calibration_path = ResolveCapturePath(capture.capture_dir, m.calibration);
-  ARCO_ASSIGN_OR_RETURN(Calibration calibration, LoadCalibration(calibration_path));
-  // The views' cameras with the world scaled to mm (projection is unchanged: t / s).
-  std::vector<Camera> cameras;
-  for (const CaptureCamera& cam : m.cameras) {
-    int c = calibration.rig.FindCamera(cam.name);
-    if (c < 0 && !cam.serial.empty()) c = calibration.rig.FindCamera(cam.serial);
-    if (c < 0) return Status::Error(calibration_path + ": no camera \"" + cam.name + "\"");
-    Camera camera = calibration.rig.cameras[static_cast<size_t>(c)];
-    camera.cam_from_world_translation /= s;
-    cameras.push_back(camera);
-  }
+  InstrumentRecord instrument;
+  ARCO_ASSIGN_OR_RETURN(instrument.world_units_per_mm, result.ReadWorldUnitsPerMm());
+  TriangulateStageResult triangulation;
+  ARCO_ASSIGN_OR_RETURN(triangulation.points3d, result.ReadPoints3d(kTriangulationStage));
+  ARCO_ASSIGN_OR_RETURN(HandRecord record,
+                        RunHandStage(options, capture, triangulation, instrument, progress));
+  return std::move(record.summary);
+}
+
+StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
+                                  const CaptureContext& capture,
+                                  const TriangulateStageResult& triangulation,
+                                  const InstrumentRecord& instrument,
+                                  Progress& progress) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  const ResultFolder result(options.result_dir);
+  const double s = instrument.world_units_per_mm;
+  if (!(s > 0)) return Status::Error("hand stage: the instrument has no world_units_per_mm");
+  // The triangulation and the views' cameras with the world in mm (the same pixels).
+  const NpyArray<double> points_mm = PointsInMm(triangulation.points3d, s);
+  const std::vector<Camera> cameras = ViewCamerasInMm(capture, s);
   ARCO_ASSIGN_OR_RETURN(const std::shared_ptr<const NpyArray<double>> k2d_read,
                         ReadKeypoints2d(capture));
   const NpyArray<double>& k2d = *k2d_read;
-  const int64_t frames = points.shape[0];
+  const int64_t frames = points_mm.shape[0];
   const int64_t views = static_cast<int64_t>(cameras.size());
   std::vector<hand::HandPointsMm> left(static_cast<size_t>(frames));
   for (int64_t f = 0; f < frames; ++f) {
     for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
-      left[static_cast<size_t>(f)][k] = PointAt(points, f, kLeftHandFirst + k) / s;
+      left[static_cast<size_t>(f)][k] = PointAt(points_mm, f, kLeftHandFirst + k);
     }
   }
   HandStageSummary summary;
@@ -159,7 +164,7 @@ StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
   record.inputs =
       SelectInputs(capture.inputs, {kManifestInput, kCalibrationInput, kKeypoints2dInput});
   ARCO_RETURN_IF_ERROR(result.WriteHand(record));
-  return summary;
+  return record;
 }
 
 }  // namespace arco::pipeline

@@ -9,7 +9,9 @@
 #include "arco/hand/bone_lengths.h"
 #include "arco/hand/fit.h"
 #include "arco/pipeline/capture_context.h"
+#include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/summaries.h"
+#include "arco/pipeline/triangulate_stage.h"
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
 
@@ -31,6 +33,16 @@ struct HandStageOptions {
 // Every option but result_dir, as result.json records it ("options"."hands").
 Json ToJson(const HandStageOptions& options);
 
+// Fits the hand of every frame to the triangulation and the instrument's scale made from
+// `capture` (as `arco run` holds them, not read back), with the capture's 2D keypoints
+// and calibration (capture_context.h), and writes hand/; returns what it wrote
+// (record.summary: the stage's summary).
+StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
+                                  const CaptureContext& capture,
+                                  const TriangulateStageResult& triangulation,
+                                  const InstrumentRecord& instrument,
+                                  Progress& progress = NoProgress());
+// The same on the stages in options.result_dir, which must come from `capture`.
 StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
                                         const CaptureContext& capture,
                                         Progress& progress = NoProgress());

@@ -58,13 +58,27 @@ Json ToJson(const InstrumentStageOptions& o) {
 
 StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions& options,
                                                     const CaptureContext& capture,
-                                                    Progress& /*progress*/) {
+                                                    Progress& progress) {
   ARCO_RETURN_IF_ERROR(options.Validate());
   const ResultFolder result(options.result_dir);
   // The triangulation read here must come from the capture given.
   ARCO_RETURN_IF_ERROR(result.CheckInputsMatch(capture.inputs));
   ARCO_ASSIGN_OR_RETURN(Json manifest, result.ReadManifest());
-  ARCO_ASSIGN_OR_RETURN(NpyArray<double> points, result.ReadPoints3d(kTriangulationStage));
+  TriangulateStageResult triangulation;
+  triangulation.summary.units = manifest.value("units", "unknown");
+  ARCO_ASSIGN_OR_RETURN(triangulation.points3d, result.ReadPoints3d(kTriangulationStage));
+  ARCO_ASSIGN_OR_RETURN(InstrumentRecord record,
+                        RunInstrumentStage(options, capture, triangulation, progress));
+  return std::move(record.summary);
+}
+
+StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& options,
+                                              const CaptureContext& capture,
+                                              const TriangulateStageResult& triangulation,
+                                              Progress& /*progress*/) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  const ResultFolder result(options.result_dir);
+  const NpyArray<double>& points = triangulation.points3d;
   const InstrumentModel& model = *capture.instrument;
   const int64_t frames = points.shape[0];
   const int num_k = static_cast<int>(model.keypoint_names().size());
@@ -84,8 +98,8 @@ StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions
         0.5 * (PointAt(points, f, kLeftShoulder) + PointAt(points, f, kRightShoulder));
   }
   InstrumentFitOptions fit_options = options.fit;
-  const std::string units = manifest.value("units", "unknown");
-  if (units == "mm") fit_options.scale = InstrumentFitOptions::Scale::kWorldIsMillimetres;
+  if (triangulation.summary.units == "mm")
+    fit_options.scale = InstrumentFitOptions::Scale::kWorldIsMillimetres;
   fit_options.num_threads = options.num_threads;
   StatusOr<InstrumentFit> fit = FitInstrument(model, keypoints, hints, fit_options);
   // FitInstrument's messages start "instrument fit: "; the context is the file it fitted.
@@ -143,7 +157,7 @@ StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions
   record.summary = summary;
   record.inputs = SelectInputs(capture.inputs, {kManifestInput});
   ARCO_RETURN_IF_ERROR(result.WriteInstrument(record));
-  return summary;
+  return record;
 }
 
 }  // namespace arco::pipeline

@@ -10,7 +10,9 @@
 #include "arco/instrument/pose_smoothing.h"
 #include "arco/instrument/template_fit.h"
 #include "arco/pipeline/capture_context.h"
+#include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/summaries.h"
+#include "arco/pipeline/triangulate_stage.h"
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
 
@@ -33,6 +35,14 @@ struct InstrumentStageOptions {
 // Every option but result_dir, as result.json records it ("options"."instrument").
 Json ToJson(const InstrumentStageOptions& options);
 
+// Fits the instrument to the triangulation made from `capture` (as `arco run` holds it,
+// not read back) and writes instrument/; returns what it wrote (record.summary: the
+// stage's summary).
+StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& options,
+                                              const CaptureContext& capture,
+                                              const TriangulateStageResult& triangulation,
+                                              Progress& progress = NoProgress());
+// The same on the triangulation in options.result_dir, which must come from `capture`.
 StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions& options,
                                                     const CaptureContext& capture,
                                                     Progress& progress = NoProgress());

@@ -5,6 +5,7 @@
 
 #include "arco/audio/notes.h"
 #include "arco/audio/pitch_tracker.h"
+#include "arco/pipeline/pitch_sync.h"
 #include "arco/pipeline/result_folder.h"
 
 namespace arco::pipeline {
@@ -14,34 +15,33 @@ Status PitchStageOptions::Validate() const {
   return Status::Ok();
 }
 
-StatusOr<PitchStageSummary> RunPitchStage(const PitchStageOptions& options,
-                                          const CaptureContext& capture,
-                                          Progress& progress) {
+StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
+                                    const CaptureContext& capture,
+                                    Progress& progress) {
   ARCO_RETURN_IF_ERROR(options.Validate());
   // The result it joins must come from the capture given.
   ARCO_RETURN_IF_ERROR(ResultFolder(options.result_dir).CheckInputsMatch(capture.inputs));
   const CaptureManifest& m = capture.manifest;
-  PitchStageSummary summary;
+  PitchRecord record;
+  PitchStageSummary& summary = record.summary;
   if (m.audio.empty()) {
     summary.warnings.push_back(
         "pitch: the capture has no audio; only the vision method is written");
-    return summary;
+    return record;
   }
-  ARCO_ASSIGN_OR_RETURN(audio::InstrumentRange range,
-                        audio::InstrumentRangeByName(capture.instrument->name()));
-  audio::PitchTrackerOptions po;
-  po.range = range;
-  po.fps = m.fps;
-  po.start_s = m.audio_offset_s;
-  po.max_frames = m.frame_count;
-  po.a4_hz = m.tuning_a4_hz;
-  ARCO_RETURN_IF_ERROR(po.Validate());
+  // The capture's values, as `arco pitch --capture` takes them from capture.json.
+  PitchRunOptions run;
+  run.instrument = capture.instrument->name();
+  run.fps = m.fps;
+  run.start_s = m.audio_offset_s;
+  run.frames = m.frame_count;
+  run.a4_hz = m.tuning_a4_hz;
+  ARCO_ASSIGN_OR_RETURN(const audio::PitchTrackerOptions po, PitchTrackerOptionsFor(run));
   const std::string audio_path = ResolveCapturePath(capture.capture_dir, m.audio);
   audio::PitchSummary tracked;
   ARCO_ASSIGN_OR_RETURN(audio::PitchTrack track,
                         audio::TrackPitchFile(audio_path, po, &tracked, progress));
   // One row per video frame of the capture (audio shorter than the video: unvoiced).
-  PitchRecord record;
   std::vector<audio::PitchFrame>& frames = record.frames;
   frames = track.frames;
   frames.resize(static_cast<size_t>(std::max<int64_t>(0, m.frame_count)));
@@ -62,10 +62,9 @@ StatusOr<PitchStageSummary> RunPitchStage(const PitchStageOptions& options,
   summary.voiced_fraction = tracked.voiced_fraction;
   summary.notes = static_cast<int64_t>(record.notes.notes.size());
   record.a4_hz = m.tuning_a4_hz;
-  record.summary = summary;
   record.inputs = SelectInputs(capture.inputs, {kManifestInput, kAudioInput});
   ARCO_RETURN_IF_ERROR(ResultFolder(options.result_dir).WritePitch(record));
-  return summary;
+  return record;
 }
 
 }  // namespace arco::pipeline

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "arco/pipeline/capture_context.h"
+#include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/summaries.h"
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
@@ -18,9 +19,12 @@ struct PitchStageOptions {
   Status Validate() const;
 };
 
-// Progress: a total of 1000, advanced as the audio is read.
-StatusOr<PitchStageSummary> RunPitchStage(const PitchStageOptions& options,
-                                          const CaptureContext& capture,
-                                          Progress& progress = NoProgress());
+// Progress: a total of 1000, advanced as the audio is read. Returns what it wrote
+// (record.summary: the stage's summary; without audio only the summary, nothing written).
+// The tracker's options are `arco pitch --capture`'s (PitchTrackerOptionsFor): one way to
+// pitch a capture.
+StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
+                                    const CaptureContext& capture,
+                                    Progress& progress = NoProgress());
 
 }  // namespace arco::pipeline

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "arco/body/skeleton_fit.h"
+#include "arco/pipeline/capture_context.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
@@ -83,27 +84,53 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
   if (!has_hand) {
     return Status::Error(result.ManifestPath() + ": no hand stage (run `arco run` first)");
   }
-  ARCO_ASSIGN_OR_RETURN(const double s, result.ReadWorldUnitsPerMm());
   ARCO_ASSIGN_OR_RETURN(const ResultHeader header, result.ReadHeader());
-  ARCO_ASSIGN_OR_RETURN(InstrumentRecord instrument, result.ReadInstrument());
-  ARCO_ASSIGN_OR_RETURN(InstrumentKind kind, ParseInstrumentKind(instrument.instrument));
-  InstrumentOptions io;
-  io.kind = kind;
-  io.tuning.a4_hz = instrument.a4_hz;
-  StatusOr<InstrumentModel> model = InstrumentModel::Create(io);
-  if (!model.ok()) return model.status().WithContext(result.ManifestPath());
+  ARCO_ASSIGN_OR_RETURN(const InstrumentRecord instrument, result.ReadInstrument());
+  ARCO_ASSIGN_OR_RETURN(const NpyArray<double> base, result.ReadPoints3d(kTriangulationStage));
+  ARCO_ASSIGN_OR_RETURN(const HandRecord hand, result.ReadHand());
+  StageRecords records;
+  records.fps = header.fps;
+  records.points3d_in_world = &base;
+  records.instrument = &instrument;
+  records.hand = &hand;
+  ARCO_ASSIGN_OR_RETURN(const bool has_pitch, result.HasStage(kPitchStage));
+  std::vector<audio::PitchFrame> pitch;
+  if (has_pitch) {
+    ARCO_ASSIGN_OR_RETURN(pitch, result.ReadPitch());
+    records.pitch = &pitch;
+    // notes.csv: the onsets for arco's note boundaries (result folders of older versions
+    // have none: frames are then assigned by their own pitch).
+    ARCO_ASSIGN_OR_RETURN(records.notes, result.ReadNotes());
+  }
+  return MakeRefineInputs(result_dir, records);
+}
+
+StatusOr<RefineInputs> MakeRefineInputs(const std::string& result_dir,
+                                        const StageRecords& records) {
+  const ResultFolder result(result_dir);
+  const InstrumentRecord& instrument = *records.instrument;
+  const double s = instrument.world_units_per_mm;
   RefineInputs out;
-  out.instrument = std::make_shared<const InstrumentModel>(std::move(model).value());
+  out.instrument = records.model;
+  if (!out.instrument) {
+    ARCO_ASSIGN_OR_RETURN(InstrumentKind kind, ParseInstrumentKind(instrument.instrument));
+    InstrumentOptions io;
+    io.kind = kind;
+    io.tuning.a4_hz = instrument.a4_hz;
+    StatusOr<InstrumentModel> model = InstrumentModel::Create(io);
+    if (!model.ok()) return model.status().WithContext(result.ManifestPath());
+    out.instrument = std::make_shared<const InstrumentModel>(std::move(model).value());
+  }
   const InstrumentModel& m = *out.instrument;
 
   // Triangulated points (world units) -> mm; the instrument keypoints from the template.
-  ARCO_ASSIGN_OR_RETURN(NpyArray<double> base, result.ReadPoints3d(kTriangulationStage));
+  const NpyArray<double>& base = *records.points3d_in_world;
   const NpyArray<double>& strings = instrument.strings_mm;
   const NpyArray<double>& placed = instrument.keypoints_mm;
   const std::string strings_path = result.InstrumentStringsPath();
   const std::string placed_path = result.InstrumentKeypointsPath();
   const std::string hands_path = result.HandParamsPath();
-  ARCO_ASSIGN_OR_RETURN(HandRecord hand, result.ReadHand());
+  const HandRecord& hand = *records.hand;
   const int64_t frames = base.shape.empty() ? 0 : base.shape[0];
   const int64_t num_k = static_cast<int64_t>(m.keypoint_names().size());
   const int64_t num_base = kNumWholeBody + num_k;
@@ -120,15 +147,14 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
   ARCO_RETURN_IF_ERROR(Expect(static_cast<int64_t>(hand.hands.size()) == frames,
                               hands_path,
                               "frame count differs from the triangulation's"));
-  out.input.vision_hand = std::move(hand.hands);
+  out.input.vision_hand = hand.hands;
   StatusOr<hand::HandModel> hand_model =
       hand::HandModel::Default(hand::HandSide::kLeft).WithBoneLengths(hand.bone_lengths_mm);
   if (!hand_model.ok()) {
     return hand_model.status().WithContext(result.BoneLengthsPath());
   }
 
-  NpyArray<double> base_mm = base;
-  for (double& v : base_mm.data) v /= s;
+  NpyArray<double> base_mm = PointsInMm(base, s);
   for (int64_t f = 0; f < frames; ++f) {
     for (int64_t k = 0; k < num_k; ++k) {
       if (!std::isfinite(placed.at(f, k, 0))) continue;  // bow points, frames without a pose
@@ -164,16 +190,16 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
     if (finite) seg[static_cast<size_t>(f)] = std::move(frame_strings);
   }
 
-  const double fps = header.fps;
+  const double fps = records.fps;
   out.input.instrument = out.instrument;
   out.input.hand_model = *hand_model;
   out.input.strings_in_world_mm = seg;
   out.input.fps = fps > 0 ? fps : 30.0;
-  out.input.a4_hz = io.tuning.a4_hz;
+  out.input.a4_hz = instrument.a4_hz;
   out.input.pitch.assign(static_cast<size_t>(frames), refine::FramePitch{});
-  ARCO_ASSIGN_OR_RETURN(out.has_pitch, result.HasStage(kPitchStage));
+  out.has_pitch = records.pitch != nullptr;
   if (out.has_pitch) {
-    ARCO_ASSIGN_OR_RETURN(std::vector<audio::PitchFrame> pitch, result.ReadPitch());
+    const std::vector<audio::PitchFrame>& pitch = *records.pitch;
     ARCO_RETURN_IF_ERROR(Expect(
         static_cast<int64_t>(pitch.size()) == frames,
         result.PitchPath(),
@@ -183,10 +209,7 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
       out.input.pitch[static_cast<size_t>(f)] = {p.voiced ? p.f0_hz : 0.0, p.confidence};
     }
     if (!pitch.empty()) out.input.start_s = pitch.front().time_s;
-    // notes.csv: the onsets for arco's note boundaries (result folders of older versions
-    // have none: frames are then assigned by their own pitch).
-    ARCO_ASSIGN_OR_RETURN(const std::vector<audio::Note> notes, result.ReadNotes());
-    for (const audio::Note& n : notes) {
+    for (const audio::Note& n : records.notes) {
       out.input.audio_notes.push_back({n.onset_s, n.offset_s, n.median_f0_hz});
     }
   }

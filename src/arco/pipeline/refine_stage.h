@@ -8,6 +8,7 @@
 #include <string>
 
 #include "arco/instrument/instrument_model.h"
+#include "arco/pipeline/result_folder.h"
 #include "arco/refine/bowing.h"
 #include "arco/refine/method_result.h"
 #include "arco/refine/refine.h"
@@ -31,6 +32,23 @@ struct RefineInputs {
 };
 // Errors name the file: no hand or instrument stage, shapes that disagree.
 StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir);
+
+// What the refinement reads of stages 1-4, as their files hold it: `arco run` passes
+// the records it made (hands, pitch and notes through their files' encodings, in
+// memory), LoadRefineInputs the records it read, so both refine the same data.
+struct StageRecords {
+  double fps = 30;                                      // the capture's (result.json "fps")
+  const NpyArray<double>* points3d_in_world = nullptr;  // triangulation/points3d.npy
+  const InstrumentRecord* instrument = nullptr;
+  const HandRecord* hand = nullptr;
+  const std::vector<audio::PitchFrame>* pitch = nullptr;  // null: no pitch stage
+  std::vector<audio::Note> notes;                         // notes.csv's notes
+  // The instrument's model when already built (the run's CaptureContext); null: built
+  // from the instrument record (its name and A4).
+  std::shared_ptr<const InstrumentModel> model;
+};
+// `result_dir` names the files in messages (shapes that disagree).
+StatusOr<RefineInputs> MakeRefineInputs(const std::string& result_dir, const StageRecords& records);
 
 // Refines one method (options.mode) and writes its folder; arco's also gets the bow arm
 // (refine/bowing.h: bowing.csv, bowing_notes.csv). Errors: a method that needs audio on a

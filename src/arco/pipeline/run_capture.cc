@@ -3,6 +3,7 @@
 #include <chrono>
 #include <utility>
 
+#include "arco/hand/hand_params.h"
 #include "arco/pipeline/capture_checks.h"
 #include "arco/pipeline/capture_context.h"
 #include "arco/pipeline/result_folder.h"
@@ -101,32 +102,61 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
     return Clock::now();
   };
 
+  // Each stage takes the records of the stages before it as made, not read back from
+  // the result folder (the files hold the same values).
   auto start = stage(1, "triangulate");
-  ARCO_ASSIGN_OR_RETURN(
-      summary.triangulate,
-      RunTriangulateStage(options.ForTriangulate(), progress, capture.keypoints2d));
+  ARCO_ASSIGN_OR_RETURN(const TriangulateStageResult triangulation,
+                        RunTriangulateStage(options.ForTriangulate(), capture, progress));
+  summary.triangulate = triangulation.summary;
   summary.timings.push_back({"triangulate", SecondsSince(start)});
 
   start = stage(2, "instrument");
-  ARCO_ASSIGN_OR_RETURN(summary.instrument,
-                        RunInstrumentStage(options.ForInstrument(), capture, progress));
+  ARCO_ASSIGN_OR_RETURN(
+      const InstrumentRecord instrument,
+      RunInstrumentStage(options.ForInstrument(), capture, triangulation, progress));
+  summary.instrument = instrument.summary;
   summary.timings.push_back({"instrument", SecondsSince(start)});
   Append(&summary.warnings, summary.instrument.warnings);
 
   start = stage(3, "hands");
-  ARCO_ASSIGN_OR_RETURN(summary.hands, RunHandStage(options.ForHands(), capture, progress));
+  ARCO_ASSIGN_OR_RETURN(
+      HandRecord hand,
+      RunHandStage(options.ForHands(), capture, triangulation, instrument, progress));
+  summary.hands = hand.summary;
   summary.timings.push_back({"hands", SecondsSince(start)});
   capture.keypoints2d.reset();  // the last stage that reads the 2D keypoints
   Append(&summary.warnings, summary.hands.warnings);
 
   start = stage(4, "pitch");
-  ARCO_ASSIGN_OR_RETURN(summary.pitch, RunPitchStage(options.ForPitch(), capture, progress));
+  ARCO_ASSIGN_OR_RETURN(const PitchRecord pitch,
+                        RunPitchStage(options.ForPitch(), capture, progress));
+  summary.pitch = pitch.summary;
   if (summary.pitch.ran) summary.timings.push_back({"pitch", SecondsSince(start)});
   Append(&summary.warnings, summary.pitch.warnings);
 
-  // Refinement: vision, then paper and arco when there is pitch.
+  // Refinement: vision, then paper and arco when there is pitch. The hands, pitch and
+  // notes go through their files' encodings (in memory), so that the run refines exactly
+  // what `arco refine` reads from the folder.
   start = stage(5, "refine");
-  ARCO_ASSIGN_OR_RETURN(const RefineInputs inputs, LoadRefineInputs(options.result_dir));
+  const std::string pitch_path = ResultFolder(options.result_dir).PitchPath();
+  ARCO_ASSIGN_OR_RETURN(hand.hands,
+                        hand::HandsFromParams(hand::HandParams(hand.hands),
+                                              ResultFolder(options.result_dir).HandParamsPath()));
+  StageRecords records;
+  records.fps = capture.manifest.fps;
+  records.points3d_in_world = &triangulation.points3d;
+  records.instrument = &instrument;
+  records.hand = &hand;
+  records.model = capture.instrument;
+  std::vector<audio::PitchFrame> pitch_as_written;
+  if (summary.pitch.ran) {
+    ARCO_ASSIGN_OR_RETURN(pitch_as_written,
+                          audio::ParsePitchCsv(audio::FormatPitchCsv(pitch.frames), pitch_path));
+    records.pitch = &pitch_as_written;
+    ARCO_ASSIGN_OR_RETURN(records.notes,
+                          audio::ParseNotesCsv(audio::FormatNotesCsv(pitch.notes), pitch_path));
+  }
+  ARCO_ASSIGN_OR_RETURN(const RefineInputs inputs, MakeRefineInputs(options.result_dir, records));
   std::vector<refine::RefineMode> modes = {refine::RefineMode::kVision};
   if (inputs.has_pitch) {
     modes.push_back(refine::RefineMode::kPaper);
@@ -151,7 +181,7 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
   ARCO_RETURN_IF_ERROR(CheckOutputFolder(options.result_dir, options.Replace()));
   ARCO_ASSIGN_OR_RETURN(CaptureContext capture, OpenCapture(options.capture_dir));
   const CaptureManifest& m = capture.manifest;
-  ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(options.capture_dir, m));
+  ARCO_RETURN_IF_ERROR(LoadCaptureCalibration(&capture));
   ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(options.capture_dir, m));
   // Read once here; the stages of the run use it (CaptureContext::keypoints2d).
   ARCO_ASSIGN_OR_RETURN(capture.keypoints2d, ReadKeypoints2d(capture));
@@ -162,12 +192,12 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
                                 m.fps,
                                 JoinPath(options.capture_dir, kCaptureManifestName)));
   ARCO_RETURN_IF_ERROR(CheckCaptureAudio(options.capture_dir, m).status());
-  // After the checks, so that a bad file gets its own message rather than the hash's.
-  ARCO_ASSIGN_OR_RETURN(capture.inputs,
-                        FingerprintCaptureInputs(
-                            options.capture_dir,
-                            m,
-                            {kManifestInput, kCalibrationInput, kKeypoints2dInput, kAudioInput}));
+  // After the checks, so that a bad file gets its own message rather than the hash's. The
+  // manifest's and the calibration's were taken of the bytes parsed.
+  ARCO_ASSIGN_OR_RETURN(
+      const CaptureInputs rest,
+      FingerprintCaptureInputs(options.capture_dir, m, {kKeypoints2dInput, kAudioInput}));
+  capture.inputs.insert(rest.begin(), rest.end());
   return capture;
 }
 

@@ -4,12 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <vector>
 
 #include "arco/calibration/calibration_file.h"
 #include "arco/eval/evaluate.h"
+#include "arco/hand/hand_params.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/capture_checks.h"
 #include "arco/pipeline/hand_stage.h"
@@ -17,6 +19,7 @@
 #include "arco/pipeline/pitch_stage.h"
 #include "arco/pipeline/refine_stage.h"
 #include "arco/pipeline/result_folder.h"
+#include "arco/pipeline/triangulate_stage.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"
 #include "arco/util/file_io.h"
@@ -249,6 +252,73 @@ TEST(RunCapture, EveryStageRefusesAResultWhoseCaptureChanged) {
     EXPECT_EQ(RunRefineStage(o.ForRefine(refine::RefineMode::kArco)).status().message(), expected);
     EXPECT_EQ(*ReadFileToString(result_json), before);
   }
+}
+
+// A capture is opened once (issue 25): PreflightRun reads the manifest, the calibration
+// and the 2D keypoints into the CaptureContext, and the stages take it and the records of
+// the stages before them, not the files: with the calibration and the keypoints gone
+// after the preflight, triangulation, instrument and hands still run, and what they hand
+// on is what they wrote.
+TEST(RunCapture, TheStagesTakeTheOpenedCaptureAndTheRecordsInMemory) {
+  arco::testing::TempDir out;
+  const std::string capture = out / "capture";
+  fs::copy(SyntheticCapture(), capture, fs::copy_options::recursive);
+  RunOptions o;
+  o.capture_dir = capture;
+  o.result_dir = out / "result";
+  o.num_threads = 2;
+  auto opened = PreflightRun(o);
+  ASSERT_TRUE(opened.ok()) << opened.status().message();
+  ASSERT_EQ(opened->view_to_camera.size(), opened->manifest.cameras.size());
+  ASSERT_FALSE(opened->calibration.rig.cameras.empty());
+  ASSERT_TRUE(opened->keypoints2d != nullptr);
+  // The manifest's and the calibration's fingerprints were taken of the bytes parsed: the
+  // same as the files'.
+  auto files =
+      FingerprintCaptureInputs(capture,
+                               opened->manifest,
+                               {kManifestInput, kCalibrationInput, kKeypoints2dInput, kAudioInput});
+  ASSERT_TRUE(files.ok());
+  ASSERT_EQ(files->size(), 4u);
+  ASSERT_EQ(opened->inputs.size(), 4u);
+  for (const auto& [role, input] : *files) {
+    EXPECT_EQ(opened->inputs.at(role).file, input.file) << role;
+    EXPECT_EQ(opened->inputs.at(role).fingerprint, input.fingerprint) << role;
+  }
+  fs::remove(JoinPath(capture, opened->manifest.calibration));
+  fs::remove(JoinPath(capture, opened->manifest.keypoints2d));
+
+  auto triangulation = RunTriangulateStage(o.ForTriangulate(), *opened);
+  ASSERT_TRUE(triangulation.ok()) << triangulation.status().message();
+  auto instrument = RunInstrumentStage(o.ForInstrument(), *opened, *triangulation);
+  ASSERT_TRUE(instrument.ok()) << instrument.status().message();
+  auto hand = RunHandStage(o.ForHands(), *opened, *triangulation, *instrument);
+  ASSERT_TRUE(hand.ok()) << hand.status().message();
+  EXPECT_GT(hand->summary.frames_fitted, 0);
+
+  // Bit for bit what the files hold (NaN where there is no point: compare the bytes).
+  auto same_bytes = [](const NpyArray<double>& a, const NpyArray<double>& b) {
+    return a.shape == b.shape && a.data.size() == b.data.size() &&
+           std::memcmp(a.data.data(), b.data.data(), a.data.size() * sizeof(double)) == 0;
+  };
+  const ResultFolder result(o.result_dir);
+  auto points = result.ReadPoints3d(kTriangulationStage);
+  ASSERT_TRUE(points.ok());
+  EXPECT_TRUE(same_bytes(triangulation->points3d, *points));
+  auto read_instrument = result.ReadInstrument();
+  ASSERT_TRUE(read_instrument.ok());
+  EXPECT_TRUE(same_bytes(instrument->strings_mm, read_instrument->strings_mm));
+  EXPECT_TRUE(same_bytes(instrument->keypoints_mm, read_instrument->keypoints_mm));
+  EXPECT_EQ(instrument->world_units_per_mm, read_instrument->world_units_per_mm);
+  EXPECT_EQ(instrument->a4_hz, read_instrument->a4_hz);
+  auto read_hand = result.ReadHand();
+  ASSERT_TRUE(read_hand.ok());
+  EXPECT_EQ(hand->bone_lengths_mm, read_hand->bone_lengths_mm);
+  // The file holds the poses' rows; their angle-axis does not round-trip to the same
+  // rotation bits, so `arco run` hands the refinement the hands decoded from those rows.
+  auto rows = ReadNpy<double>(result.HandParamsPath());
+  ASSERT_TRUE(rows.ok());
+  EXPECT_TRUE(same_bytes(hand::HandParams(hand->hands), *rows));
 }
 
 }  // namespace

@@ -26,66 +26,97 @@ Json ToJson(const TriangulateStageOptions& o) {
   return j;
 }
 
-StatusOr<TriangulateStageSummary> RunTriangulateStage(
-    const TriangulateStageOptions& o,
-    Progress& progress,
-    std::shared_ptr<const NpyArray<double>> keypoints2d) {
-  ARCO_RETURN_IF_ERROR(o.Validate());
-  ARCO_RETURN_IF_ERROR(ResultFolder(o.result_dir).CheckWritable());  // before the work
-  ARCO_ASSIGN_OR_RETURN(CaptureManifest manifest, ReadCaptureManifest(o.capture_dir));
+namespace {
+
+// The capture as `arco triangulate` needs it, checked in the order the stage always has:
+// the manifest, its keypoints and layout, the filters, the calibration, the keypoints'
+// data, the fingerprints.
+StatusOr<CaptureContext> OpenForTriangulation(const TriangulateStageOptions& o) {
+  CaptureContext capture;
+  capture.capture_dir = o.capture_dir;
+  ARCO_ASSIGN_OR_RETURN(capture.manifest, ReadCaptureManifest(o.capture_dir));
+  const CaptureManifest& manifest = capture.manifest;
   const std::string manifest_path = JoinPath(o.capture_dir, kCaptureManifestName);
-  ARCO_ASSIGN_OR_RETURN(KeypointLayout layout, [&]() -> StatusOr<KeypointLayout> {
+  ARCO_ASSIGN_OR_RETURN(capture.layout, [&]() -> StatusOr<KeypointLayout> {
     ARCO_RETURN_IF_ERROR(CheckCaptureHasKeypoints2d(o.capture_dir, manifest));
     auto l = manifest.Layout();
     if (!l.ok()) return l.status().WithContext(manifest_path);
     return l;
   }());
   // Filters refer to groups of the layout; checked before any work (pipeline/capture_checks.h).
-  ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(o, layout, manifest.fps, manifest_path));
-  std::vector<const std::vector<int>*> filter_groups;
-  for (const auto& entry : o.filters) filter_groups.push_back(layout.Group(entry.first));
+  ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(o, capture.layout, manifest.fps, manifest_path));
   const std::string calibration_path = ResolveCapturePath(o.capture_dir, manifest.calibration);
   StatusOr<Calibration> calibration = LoadCalibration(calibration_path);
   if (!calibration.ok()) return calibration.status().WithContext(manifest_path + ": calibration");
   ARCO_ASSIGN_OR_RETURN(
-      const std::vector<int> view_to_camera,
+      capture.view_to_camera,
       MatchCaptureCameras(o.capture_dir, manifest, calibration->rig, calibration_path));
-  if (!keypoints2d) {
-    ARCO_ASSIGN_OR_RETURN(NpyArray<double> read, ReadCaptureKeypoints2d(o.capture_dir, manifest));
-    keypoints2d = std::make_shared<const NpyArray<double>>(std::move(read));
-  }
-  const NpyArray<double>& keypoints = *keypoints2d;
-  TriangulationRecord record;
+  capture.calibration = std::move(calibration).value();
+  ARCO_ASSIGN_OR_RETURN(capture.keypoints2d, ReadKeypoints2d(capture));
   ARCO_ASSIGN_OR_RETURN(
-      record.inputs,
+      capture.inputs,
       FingerprintCaptureInputs(
           o.capture_dir, manifest, {kManifestInput, kCalibrationInput, kKeypoints2dInput}));
+  return capture;
+}
+
+}  // namespace
+
+StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptions& o,
+                                                     const CaptureContext& capture,
+                                                     Progress& progress) {
+  ARCO_RETURN_IF_ERROR(o.Validate());
+  ARCO_RETURN_IF_ERROR(ResultFolder(o.result_dir).CheckWritable());  // before the work
+  const CaptureManifest& manifest = capture.manifest;
+  const KeypointLayout& layout = capture.layout;
+  const std::string manifest_path = JoinPath(capture.capture_dir, kCaptureManifestName);
+  ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(o, layout, manifest.fps, manifest_path));
+  std::vector<const std::vector<int>*> filter_groups;
+  for (const auto& entry : o.filters) filter_groups.push_back(layout.Group(entry.first));
+  ARCO_ASSIGN_OR_RETURN(const std::shared_ptr<const NpyArray<double>> keypoints2d,
+                        ReadKeypoints2d(capture));
+  TriangulationRecord record;
+  record.inputs =
+      SelectInputs(capture.inputs, {kManifestInput, kCalibrationInput, kKeypoints2dInput});
   progress.SetTotal(manifest.frame_count);
   ARCO_ASSIGN_OR_RETURN(
       SequenceTriangulation raw,
-      TriangulateSequence(calibration->rig,
-                          view_to_camera,
-                          keypoints,
+      TriangulateSequence(capture.calibration.rig,
+                          capture.view_to_camera,
+                          *keypoints2d,
                           o.triangulation,
                           &progress,
-                          ResolveCapturePath(o.capture_dir, manifest.keypoints2d)));
-  NpyArray<double> filtered = raw.points3d;
+                          ResolveCapturePath(capture.capture_dir, manifest.keypoints2d)));
+  TriangulateStageResult out;
+  NpyArray<double>& filtered = out.points3d;
+  filtered = raw.points3d;
   for (size_t i = 0; i < filter_groups.size(); ++i) {
     FilterPoints(o.filters[i].second, manifest.fps, *filter_groups[i], &filtered);
   }
+  // The result names the capture as the options do (the run's capture_dir is the
+  // capture's).
   record.capture_dir = o.capture_dir;
-  record.units = calibration->rig.units;
+  record.units = capture.calibration.rig.units;
   record.summary = Summarize(raw);
   record.options = ToJson(o);
-  TriangulateStageSummary summary;
+  TriangulateStageSummary& summary = out.summary;
   ARCO_ASSIGN_OR_RETURN(
       summary.removed_stages,
       ResultFolder(o.result_dir).WriteTriangulation(manifest, layout, raw, filtered, record));
   summary.triangulation = record.summary;
   summary.units = record.units;
-  summary.views = static_cast<int64_t>(view_to_camera.size());
+  summary.views = static_cast<int64_t>(capture.view_to_camera.size());
   summary.keypoints = layout.size();
-  return summary;
+  return out;
+}
+
+StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOptions& o,
+                                                      Progress& progress) {
+  ARCO_RETURN_IF_ERROR(o.Validate());
+  ARCO_RETURN_IF_ERROR(ResultFolder(o.result_dir).CheckWritable());  // before the work
+  ARCO_ASSIGN_OR_RETURN(const CaptureContext capture, OpenForTriangulation(o));
+  ARCO_ASSIGN_OR_RETURN(TriangulateStageResult out, RunTriangulateStage(o, capture, progress));
+  return std::move(out.summary);
 }
 
 }  // namespace arco::pipeline

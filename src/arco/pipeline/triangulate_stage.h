@@ -9,6 +9,7 @@
 
 #include "arco/mocap/temporal_filter.h"
 #include "arco/mocap/triangulate_sequence.h"
+#include "arco/pipeline/capture_context.h"
 #include "arco/pipeline/summaries.h"
 #include "arco/util/json_io.h"
 #include "arco/util/npy.h"
@@ -31,12 +32,24 @@ struct TriangulateStageOptions {
 // filter, max_gap_frames}].
 Json ToJson(const TriangulateStageOptions& options);
 
-// Reads CAPTURE_DIR, triangulates every frame, filters, writes RESULT_DIR. Progress: the
-// total is the frame count, advanced per frame from worker threads. keypoints2d: the
-// capture's keypoints2d.npy already read (`arco run` reads it once); null: read here.
-StatusOr<TriangulateStageSummary> RunTriangulateStage(
-    const TriangulateStageOptions& options,
-    Progress& progress = NoProgress(),
-    std::shared_ptr<const NpyArray<double>> keypoints2d = nullptr);
+// What the stage made, as the later stages of `arco run` take it: the values
+// triangulation/ holds, without reading them back.
+struct TriangulateStageResult {
+  TriangulateStageSummary summary;
+  NpyArray<double> points3d;  // (F, P, 3) filtered, world units (triangulation/points3d.npy)
+};
+
+// Triangulates every frame of an opened capture (capture_context.h: its calibration,
+// view_to_camera, 2D keypoints (read here when null) and fingerprints), filters, writes
+// RESULT_DIR. options.capture_dir is not read: the capture is. Progress: the total is the
+// frame count, advanced per frame from worker threads.
+StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptions& options,
+                                                     const CaptureContext& capture,
+                                                     Progress& progress = NoProgress());
+
+// `arco triangulate CAPTURE`: opens options.capture_dir (no instrument needed) and runs
+// the stage on it.
+StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOptions& options,
+                                                      Progress& progress = NoProgress());
 
 }  // namespace arco::pipeline

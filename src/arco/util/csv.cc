@@ -59,6 +59,13 @@ StatusOr<CsvTable> ReadCsvTable(const std::string& path,
                                 const std::vector<std::string>& required_columns,
                                 const std::string& expected_header) {
   ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(path));
+  return ParseCsvTable(text, path, required_columns, expected_header);
+}
+
+StatusOr<CsvTable> ParseCsvTable(const std::string& text,
+                                 const std::string& path,
+                                 const std::vector<std::string>& required_columns,
+                                 const std::string& expected_header) {
   CsvTable table;
   table.path = path;
   std::istringstream in(text);

@@ -45,5 +45,10 @@ struct CsvTable {
 StatusOr<CsvTable> ReadCsvTable(const std::string& path,
                                 const std::vector<std::string>& required_columns,
                                 const std::string& expected_header = "");
+// The same on a file's text already in memory; `path` names it in messages.
+StatusOr<CsvTable> ParseCsvTable(const std::string& text,
+                                 const std::string& path,
+                                 const std::vector<std::string>& required_columns,
+                                 const std::string& expected_header = "");
 
 }  // namespace arco
