@@ -118,11 +118,15 @@ class SndfileReader : public AudioReader {
     reader->info_.source = name;
     // A header promising more than the file holds: the promise is the length, so the
     // reader's shortfall is reported (TruncationWarning).
+    // The header walk reads a few chunk headers: one stream for all of them (a file
+    // opened once per read made `arco run` open audio.wav five times per reader).
+    std::ifstream in;
     const int64_t promised = bytes != nullptr ? WavPromisedFrames([&](int64_t at, int64_t n) {
       return at < static_cast<int64_t>(bytes->size()) ? bytes->substr(at, n) : std::string();
     })
                                               : WavPromisedFrames([&](int64_t at, int64_t n) {
-                                                  std::ifstream in(name, std::ios::binary);
+                                                  if (!in.is_open()) in.open(name, std::ios::binary);
+                                                  in.clear();
                                                   std::string out(static_cast<size_t>(n), '\0');
                                                   in.seekg(at);
                                                   in.read(out.data(), n);

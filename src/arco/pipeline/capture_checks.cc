@@ -88,12 +88,21 @@ Status LoadCaptureCalibration(CaptureContext* capture) {
 
 StatusOr<CaptureAudioCheck> CheckCaptureAudio(const std::string& capture_dir,
                                               const CaptureManifest& manifest) {
+  CaptureContext capture;
+  capture.capture_dir = capture_dir;
+  capture.manifest = manifest;
+  return CheckCaptureAudio(capture);
+}
+
+StatusOr<CaptureAudioCheck> CheckCaptureAudio(const CaptureContext& capture) {
+  const std::string& capture_dir = capture.capture_dir;
+  const CaptureManifest& manifest = capture.manifest;
   CaptureAudioCheck check;
   if (manifest.audio.empty()) return check;
   const std::string where = ManifestPath(capture_dir);
   check.path = ResolveCapturePath(capture_dir, manifest.audio);
   ARCO_RETURN_IF_ERROR(CheckInputFile(capture_dir, "audio.file", manifest.audio, check.path));
-  auto opened = audio::OpenAudio(check.path);
+  auto opened = OpenCaptureAudio(capture, check.path);
   if (!opened.ok()) return opened.status().WithContext(where + ": audio.file");
   audio::AudioReader& reader = **opened;
   check.format = reader.info().format;

@@ -45,6 +45,8 @@ struct CaptureAudioCheck {
 // A capture without audio passes.
 StatusOr<CaptureAudioCheck> CheckCaptureAudio(const std::string& capture_dir,
                                               const CaptureManifest& manifest);
+// The same, decoding capture.audio_bytes when read (OpenCaptureAudio).
+StatusOr<CaptureAudioCheck> CheckCaptureAudio(const CaptureContext& capture);
 
 // The temporal filters of the triangulation options name groups of `layout` and suit the
 // capture's frame rate.

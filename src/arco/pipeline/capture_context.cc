@@ -1,5 +1,6 @@
 #include "arco/pipeline/capture_context.h"
 
+#include <filesystem>
 #include <stdexcept>
 
 #include "arco/hand/hand_model.h"
@@ -12,6 +13,26 @@ namespace {
 constexpr int kLeftHandFirst = wholebody::kLeftHandFirst;
 
 }  // namespace
+
+void ReadCaptureAudioBytes(CaptureContext* capture) {
+  if (capture->manifest.audio.empty()) return;
+  const std::string path = ResolveCapturePath(capture->capture_dir, capture->manifest.audio);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return;
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec || size == 0 || size > static_cast<uintmax_t>(kMaxAudioInMemoryBytes)) return;
+  StatusOr<std::string> bytes = ReadFileToString(path);
+  if (bytes.ok()) capture->audio_bytes = std::make_shared<const std::string>(*std::move(bytes));
+}
+
+StatusOr<std::unique_ptr<audio::AudioReader>> OpenCaptureAudio(const CaptureContext& capture,
+                                                               const std::string& path) {
+  if (capture.audio_bytes) {
+    auto reader = audio::OpenAudioFromMemory(capture.audio_bytes.get(), path);
+    if (reader.ok()) return reader;
+  }
+  return audio::OpenAudio(path);
+}
 
 StatusOr<CaptureContext> OpenCapture(const std::string& capture_dir) {
   CaptureContext c;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "arco/audio/audio_reader.h"
 #include "arco/camera/calibration_io.h"
 #include "arco/camera/camera.h"
 #include "arco/instrument/instrument_model.h"
@@ -34,6 +35,10 @@ struct CaptureContext {
   // use it instead of reading the file again: 2 x 59 MB for a one-minute 20-camera take);
   // null: not read yet (ReadKeypoints2d reads the file).
   std::shared_ptr<const NpyArray<double>> keypoints2d;
+  // audio.file's bytes, once read (PreflightRun, files up to kMaxAudioInMemoryBytes): the
+  // audio check, the fingerprint and the pitch stage decode these instead of opening the
+  // file again; null: not read (OpenCaptureAudio opens the file).
+  std::shared_ptr<const std::string> audio_bytes;
   // The fingerprints of the capture's files as checked and read (PreflightRun): what the
   // stages record in result.json and compare with the triangulation's (capture_inputs.h).
   CaptureInputs inputs;
@@ -48,6 +53,21 @@ std::vector<Camera> ViewCamerasInMm(const CaptureContext& capture, double world_
 
 // capture.keypoints2d when set, else the file read (ReadCaptureKeypoints2d).
 StatusOr<std::shared_ptr<const NpyArray<double>>> ReadKeypoints2d(const CaptureContext& capture);
+
+// Larger audio files are streamed from disk by each reader instead (a one-hour 48 kHz
+// 24-bit stereo take is about 1 GB).
+inline constexpr int64_t kMaxAudioInMemoryBytes = int64_t{256} << 20;
+
+// Reads the capture's audio.file into capture->audio_bytes when it is a regular file no
+// larger than kMaxAudioInMemoryBytes (else leaves it null; a missing or unreadable file
+// is the audio check's error, not this one's).
+void ReadCaptureAudioBytes(CaptureContext* capture);
+
+// A reader of the capture's audio: decoded from audio_bytes when libsndfile reads them,
+// else the file opened by audio::OpenAudio (FFmpeg's containers, large files). `path` is
+// the resolved audio.file, which messages name either way.
+StatusOr<std::unique_ptr<audio::AudioReader>> OpenCaptureAudio(const CaptureContext& capture,
+                                                               const std::string& path);
 
 // Reads capture.json once (inputs["capture.json"]: the fingerprint of the bytes parsed).
 // Errors name capture.json: an unreadable manifest, no instrument ("none"), a layout

@@ -39,8 +39,10 @@ StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
   ARCO_ASSIGN_OR_RETURN(const audio::PitchTrackerOptions po, PitchTrackerOptionsFor(run));
   const std::string audio_path = ResolveCapturePath(capture.capture_dir, m.audio);
   audio::PitchSummary tracked;
+  ARCO_RETURN_IF_ERROR(po.Validate());
+  ARCO_ASSIGN_OR_RETURN(auto reader, OpenCaptureAudio(capture, audio_path));
   ARCO_ASSIGN_OR_RETURN(audio::PitchTrack track,
-                        audio::TrackPitchFile(audio_path, po, &tracked, progress));
+                        audio::TrackPitch(std::move(reader), po, &tracked, progress));
   // One row per video frame of the capture (audio shorter than the video: unvoiced).
   std::vector<audio::PitchFrame>& frames = record.frames;
   frames = track.frames;

@@ -9,6 +9,7 @@
 #include "arco/pipeline/result_folder.h"
 #include "arco/util/atomic_dir.h"
 #include "arco/util/file_io.h"
+#include "arco/util/fingerprint.h"
 
 namespace arco::pipeline {
 namespace {
@@ -191,13 +192,20 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
                                 capture.layout,
                                 m.fps,
                                 JoinPath(options.capture_dir, kCaptureManifestName)));
-  ARCO_RETURN_IF_ERROR(CheckCaptureAudio(options.capture_dir, m).status());
+  // The audio is read once; the check, its fingerprint and the pitch stage use the bytes.
+  ReadCaptureAudioBytes(&capture);
+  ARCO_RETURN_IF_ERROR(CheckCaptureAudio(capture).status());
   // After the checks, so that a bad file gets its own message rather than the hash's. The
-  // manifest's and the calibration's were taken of the bytes parsed.
-  ARCO_ASSIGN_OR_RETURN(
-      const CaptureInputs rest,
-      FingerprintCaptureInputs(options.capture_dir, m, {kKeypoints2dInput, kAudioInput}));
+  // manifest's, the calibration's and the audio's were taken of the bytes parsed.
+  ARCO_ASSIGN_OR_RETURN(const CaptureInputs rest,
+                        capture.audio_bytes
+                            ? FingerprintCaptureInputs(options.capture_dir, m, {kKeypoints2dInput})
+                            : FingerprintCaptureInputs(
+                                  options.capture_dir, m, {kKeypoints2dInput, kAudioInput}));
   capture.inputs.insert(rest.begin(), rest.end());
+  if (capture.audio_bytes) {
+    capture.inputs[kAudioInput] = {m.audio, FingerprintBytes(*capture.audio_bytes)};
+  }
   return capture;
 }
 

@@ -9,6 +9,8 @@
 #include <functional>
 #include <vector>
 
+#include "arco/audio/notes.h"
+#include "arco/audio/pitch_tracker.h"
 #include "arco/calibration/calibration_file.h"
 #include "arco/eval/evaluate.h"
 #include "arco/hand/hand_params.h"
@@ -258,7 +260,8 @@ TEST(RunCapture, EveryStageRefusesAResultWhoseCaptureChanged) {
 // and the 2D keypoints into the CaptureContext, and the stages take it and the records of
 // the stages before them, not the files: with the calibration and the keypoints gone
 // after the preflight, triangulation, instrument and hands still run, and what they hand
-// on is what they wrote.
+// on is what they wrote; with the audio gone, the pitch stage still runs (from the bytes
+// the preflight read).
 TEST(RunCapture, TheStagesTakeTheOpenedCaptureAndTheRecordsInMemory) {
   arco::testing::TempDir out;
   const std::string capture = out / "capture";
@@ -285,8 +288,25 @@ TEST(RunCapture, TheStagesTakeTheOpenedCaptureAndTheRecordsInMemory) {
     EXPECT_EQ(opened->inputs.at(role).file, input.file) << role;
     EXPECT_EQ(opened->inputs.at(role).fingerprint, input.fingerprint) << role;
   }
+  // The audio was read once: the check, its fingerprint (above) and the pitch stage decode
+  // the bytes. The pitch of the bytes is the pitch of the file, to the bit.
+  ASSERT_TRUE(opened->audio_bytes != nullptr);
+  CaptureContext from_file = *opened;
+  from_file.audio_bytes = nullptr;
+  PitchStageOptions pitch_from_file;
+  pitch_from_file.result_dir = out / "result_pitch_from_file";
+  fs::create_directories(pitch_from_file.result_dir);
+  auto pitch_file = RunPitchStage(pitch_from_file, from_file);
+  ASSERT_TRUE(pitch_file.ok()) << pitch_file.status().message();
+
   fs::remove(JoinPath(capture, opened->manifest.calibration));
   fs::remove(JoinPath(capture, opened->manifest.keypoints2d));
+  fs::remove(JoinPath(capture, opened->manifest.audio));
+  auto pitch = RunPitchStage(o.ForPitch(), *opened);
+  ASSERT_TRUE(pitch.ok()) << pitch.status().message();
+  ASSERT_FALSE(pitch->frames.empty());
+  EXPECT_EQ(audio::FormatPitchCsv(pitch->frames), audio::FormatPitchCsv(pitch_file->frames));
+  EXPECT_EQ(audio::FormatNotesCsv(pitch->notes), audio::FormatNotesCsv(pitch_file->notes));
 
   auto triangulation = RunTriangulateStage(o.ForTriangulate(), *opened);
   ASSERT_TRUE(triangulation.ok()) << triangulation.status().message();
