@@ -372,11 +372,14 @@ Status CheckKeypoints2dDtype(const std::string& source, const std::string& dtype
                        "missing)");
 }
 
-Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureManifest& m) {
+namespace {
+
+// The header rules of CheckCaptureKeypoints2d (`path`: the file the header came from).
+Status CheckKeypoints2dHeader(const std::string& capture_dir,
+                              const CaptureManifest& m,
+                              const std::string& path,
+                              const NpyHeader& header) {
   const std::string manifest_path = JoinPath(capture_dir, kCaptureManifestName);
-  ARCO_RETURN_IF_ERROR(CheckCaptureHasKeypoints2d(capture_dir, m));
-  const std::string path = ResolveCapturePath(capture_dir, m.keypoints2d);
-  ARCO_ASSIGN_OR_RETURN(const NpyHeader header, ReadNpyHeader(path));
   ARCO_RETURN_IF_ERROR(CheckKeypoints2dDtype(path, header.dtype, header.is_float));
   StatusOr<KeypointLayout> layout = m.Layout();
   if (!layout.ok()) return layout.status().WithContext(manifest_path);
@@ -390,12 +393,11 @@ Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureMani
   return Status::Ok();
 }
 
-StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,
-                                                  const CaptureManifest& m,
-                                                  KeypointTimes times) {
-  ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(capture_dir, m));
-  const std::string path = ResolveCapturePath(capture_dir, m.keypoints2d);
-  ARCO_ASSIGN_OR_RETURN(NpyArray<double> k, ReadNpy<double>(path));
+// Dropped frames to NaN, then (kCaptureFrames) every camera at the capture's frame times.
+StatusOr<NpyArray<double>> FinishKeypoints2d(const std::string& path,
+                                             const CaptureManifest& m,
+                                             KeypointTimes times,
+                                             NpyArray<double> k) {
   ARCO_ASSIGN_OR_RETURN(KeypointLayout layout, m.Layout());
   if (k.shape.size() != 4) return Status::Error(path + ": changed while being read");
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -413,6 +415,49 @@ StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir
       ResampleCameraKeypoints(m, static_cast<int>(v), &k);
   }
   return k;
+}
+
+}  // namespace
+
+Status CheckCaptureKeypoints2d(const std::string& capture_dir, const CaptureManifest& m) {
+  ARCO_RETURN_IF_ERROR(CheckCaptureHasKeypoints2d(capture_dir, m));
+  const std::string path = ResolveCapturePath(capture_dir, m.keypoints2d);
+  ARCO_ASSIGN_OR_RETURN(const NpyHeader header, ReadNpyHeader(path));
+  return CheckKeypoints2dHeader(capture_dir, m, path, header);
+}
+
+StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir,
+                                                  const CaptureManifest& m,
+                                                  KeypointTimes times) {
+  ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(capture_dir, m));
+  const std::string path = ResolveCapturePath(capture_dir, m.keypoints2d);
+  ARCO_ASSIGN_OR_RETURN(NpyArray<double> k, ReadNpy<double>(path));
+  return FinishKeypoints2d(path, m, times, std::move(k));
+}
+
+StatusOr<std::string> ReadCaptureKeypoints2dBytes(const std::string& capture_dir,
+                                                  const CaptureManifest& m) {
+  ARCO_RETURN_IF_ERROR(CheckCaptureHasKeypoints2d(capture_dir, m));
+  const std::string path = ResolveCapturePath(capture_dir, m.keypoints2d);
+  // ReadNpyHeader's messages for a missing file and a folder.
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return Status::Error(path + ": file not found");
+  if (std::filesystem::is_directory(path, ec)) {
+    return Status::Error(path + ": is a directory, expected a file");
+  }
+  return ReadFileToString(path);
+}
+
+StatusOr<NpyArray<double>> ParseCaptureKeypoints2d(const std::string& bytes,
+                                                   const std::string& capture_dir,
+                                                   const CaptureManifest& m,
+                                                   KeypointTimes times) {
+  ARCO_RETURN_IF_ERROR(CheckCaptureHasKeypoints2d(capture_dir, m));
+  const std::string path = ResolveCapturePath(capture_dir, m.keypoints2d);
+  ARCO_ASSIGN_OR_RETURN(const NpyHeader header, ParseNpyHeader(bytes, path));
+  ARCO_RETURN_IF_ERROR(CheckKeypoints2dHeader(capture_dir, m, path, header));
+  ARCO_ASSIGN_OR_RETURN(NpyArray<double> k, ParseNpy<double>(bytes, path));
+  return FinishKeypoints2d(path, m, times, std::move(k));
 }
 
 void ResampleCameraKeypoints(const CaptureManifest& m, int view, NpyArray<double>* keypoints) {

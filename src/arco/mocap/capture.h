@@ -123,6 +123,18 @@ StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(
     const std::string& capture_dir,
     const CaptureManifest& manifest,
     KeypointTimes times = KeypointTimes::kCaptureFrames);
+// The file's bytes, read once (CheckCaptureHasKeypoints2d first; a missing file or a
+// folder is an error naming it), for ParseCaptureKeypoints2d and a fingerprint of the
+// same bytes.
+StatusOr<std::string> ReadCaptureKeypoints2dBytes(const std::string& capture_dir,
+                                                  const CaptureManifest& manifest);
+// CheckCaptureKeypoints2d and ReadCaptureKeypoints2d on those bytes: the same checks,
+// messages and array.
+StatusOr<NpyArray<double>> ParseCaptureKeypoints2d(
+    const std::string& bytes,
+    const std::string& capture_dir,
+    const CaptureManifest& manifest,
+    KeypointTimes times = KeypointTimes::kCaptureFrames);
 
 // Row f of `keypoints` (F, V, P, 3) for view `view` holds the camera's own global frame
 // frame_first + f; afterwards it holds the camera at the capture's frame

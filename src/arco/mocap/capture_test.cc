@@ -256,6 +256,66 @@ TEST(CaptureKeypoints, ShapeIsCheckedAndDroppedFramesBecomeNaN) {
   EXPECT_NE(r.status().message().find("(4, 2, 142, 3)"), std::string::npos);
 }
 
+// `arco run` reads the file once and parses the bytes (issue 25): the same array, bit for
+// bit, and the same one-line errors, as reading the file.
+TEST(CaptureKeypoints, ParsingTheBytesIsReadingTheFile) {
+  TempDir dir;
+  CaptureManifest m = SampleManifest();
+  ASSERT_TRUE(WriteCaptureManifest(dir.path(), m).ok());
+  NpyArray<float> k;
+  k.shape = {4, 2, 142, 3};
+  k.data.resize(4 * 2 * 142 * 3);
+  for (size_t i = 0; i < k.data.size(); ++i) k.data[i] = 0.25f * static_cast<float>(i % 977);
+  ASSERT_TRUE(WriteNpy(dir / "keypoints2d.npy", k).ok());
+  auto bytes = ReadCaptureKeypoints2dBytes(dir.path(), m);
+  ASSERT_TRUE(bytes.ok()) << bytes.status().message();
+  auto parsed = ParseCaptureKeypoints2d(*bytes, dir.path(), m);
+  auto read = ReadCaptureKeypoints2d(dir.path(), m);
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  ASSERT_TRUE(read.ok());
+  ASSERT_EQ(parsed->shape, read->shape);
+  ASSERT_EQ(parsed->data.size(), read->data.size());
+  EXPECT_EQ(std::memcmp(parsed->data.data(), read->data.data(), read->data.size() * 8), 0);
+  EXPECT_TRUE(std::isnan(parsed->at(1, 0, 7, 0)));  // dropped by cam0, as when read
+
+  // A wrong shape, a wrong dtype, a truncated file: the messages of the file's reader.
+  k.shape = {4, 2, 133, 3};
+  k.data.resize(4 * 2 * 133 * 3);
+  ASSERT_TRUE(WriteNpy(dir / "keypoints2d.npy", k).ok());
+  bytes = ReadCaptureKeypoints2dBytes(dir.path(), m);
+  ASSERT_TRUE(bytes.ok());
+  EXPECT_EQ(ParseCaptureKeypoints2d(*bytes, dir.path(), m).status().message(),
+            ReadCaptureKeypoints2d(dir.path(), m).status().message());
+  NpyArray<int32_t> ints;
+  ints.shape = {4, 2, 142, 3};
+  ints.data.assign(4 * 2 * 142 * 3, 5);
+  ASSERT_TRUE(WriteNpy(dir / "keypoints2d.npy", ints).ok());
+  bytes = ReadCaptureKeypoints2dBytes(dir.path(), m);
+  ASSERT_TRUE(bytes.ok());
+  const Status dtype = ParseCaptureKeypoints2d(*bytes, dir.path(), m).status();
+  EXPECT_FALSE(dtype.ok());
+  EXPECT_EQ(dtype.message(), ReadCaptureKeypoints2d(dir.path(), m).status().message());
+  k.shape = {4, 2, 142, 3};
+  k.data.resize(4 * 2 * 142 * 3);
+  ASSERT_TRUE(WriteNpy(dir / "keypoints2d.npy", k).ok());
+  bytes = ReadCaptureKeypoints2dBytes(dir.path(), m);
+  ASSERT_TRUE(bytes.ok());
+  ASSERT_TRUE(
+      AtomicWriteFile(dir / "keypoints2d.npy", bytes->substr(0, bytes->size() - 100)).ok());
+  const Status truncated =
+      ParseCaptureKeypoints2d(bytes->substr(0, bytes->size() - 100), dir.path(), m).status();
+  EXPECT_FALSE(truncated.ok());
+  EXPECT_EQ(truncated.message(), ReadCaptureKeypoints2d(dir.path(), m).status().message());
+
+  // No file, or a folder in its place: one line naming it.
+  std::filesystem::remove(dir / "keypoints2d.npy");
+  EXPECT_EQ(ReadCaptureKeypoints2dBytes(dir.path(), m).status().message(),
+            (dir / "keypoints2d.npy") + ": file not found");
+  std::filesystem::create_directory(dir / "keypoints2d.npy");
+  EXPECT_EQ(ReadCaptureKeypoints2dBytes(dir.path(), m).status().message(),
+            (dir / "keypoints2d.npy") + ": is a directory, expected a file");
+}
+
 // A camera's clock on the capture's (cameras[].offset_s, drift_ppm) round-trips; 0 is
 // not written, so a hardware-synced capture's manifest is unchanged.
 TEST(CaptureManifest, CameraClockRoundTripsAndIsCheckedForRange) {

@@ -183,9 +183,16 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
   ARCO_ASSIGN_OR_RETURN(CaptureContext capture, OpenCapture(options.capture_dir));
   const CaptureManifest& m = capture.manifest;
   ARCO_RETURN_IF_ERROR(LoadCaptureCalibration(&capture));
-  ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(options.capture_dir, m));
-  // Read once here; the stages of the run use it (CaptureContext::keypoints2d).
-  ARCO_ASSIGN_OR_RETURN(capture.keypoints2d, ReadKeypoints2d(capture));
+  // Read once here, checked, parsed and fingerprinted from the same bytes; the stages of
+  // the run use the array (CaptureContext::keypoints2d).
+  {
+    ARCO_ASSIGN_OR_RETURN(const std::string bytes,
+                          ReadCaptureKeypoints2dBytes(options.capture_dir, m));
+    ARCO_ASSIGN_OR_RETURN(NpyArray<double> k,
+                          ParseCaptureKeypoints2d(bytes, options.capture_dir, m));
+    capture.keypoints2d = std::make_shared<const NpyArray<double>>(std::move(k));
+    capture.inputs[kKeypoints2dInput] = {m.keypoints2d, FingerprintBytes(bytes)};
+  }
   ARCO_RETURN_IF_ERROR(CheckCaptureInstrumentPoints(capture));
   ARCO_RETURN_IF_ERROR(
       CheckTriangulationFilters(options.ForTriangulate(),
@@ -195,16 +202,15 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
   // The audio is read once; the check, its fingerprint and the pitch stage use the bytes.
   ReadCaptureAudioBytes(&capture);
   ARCO_RETURN_IF_ERROR(CheckCaptureAudio(capture).status());
-  // After the checks, so that a bad file gets its own message rather than the hash's. The
-  // manifest's, the calibration's and the audio's were taken of the bytes parsed.
-  ARCO_ASSIGN_OR_RETURN(const CaptureInputs rest,
-                        capture.audio_bytes
-                            ? FingerprintCaptureInputs(options.capture_dir, m, {kKeypoints2dInput})
-                            : FingerprintCaptureInputs(
-                                  options.capture_dir, m, {kKeypoints2dInput, kAudioInput}));
-  capture.inputs.insert(rest.begin(), rest.end());
+  // The manifest's, the calibration's, the keypoints' and the audio's fingerprints were
+  // taken of the bytes parsed; an audio file too large to hold is hashed from disk, after
+  // its check (so that a bad file gets its own message rather than the hash's).
   if (capture.audio_bytes) {
     capture.inputs[kAudioInput] = {m.audio, FingerprintBytes(*capture.audio_bytes)};
+  } else {
+    ARCO_ASSIGN_OR_RETURN(const CaptureInputs audio,
+                          FingerprintCaptureInputs(options.capture_dir, m, {kAudioInput}));
+    capture.inputs.insert(audio.begin(), audio.end());
   }
   return capture;
 }

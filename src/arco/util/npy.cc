@@ -180,9 +180,13 @@ StatusOr<NpyHeader> ReadNpyHeader(const std::string& path) {
   in.read(rest.data(), static_cast<std::streamsize>(more));
   rest.resize(static_cast<size_t>(in.gcount()));
   bytes += rest;
+  return ParseNpyHeader(bytes, path);
+}
+
+StatusOr<NpyHeader> ParseNpyHeader(const std::string& bytes, const std::string& source) {
   Header header;
   size_t data_offset = 0;
-  ARCO_RETURN_IF_ERROR(ParsePreamble(bytes, path, &header, &data_offset));
+  ARCO_RETURN_IF_ERROR(ParsePreamble(bytes, source, &header, &data_offset));
   NpyHeader out;
   out.descr = header.descr;
   out.dtype = NpyDtypeName(header.descr);

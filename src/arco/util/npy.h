@@ -44,6 +44,8 @@ struct NpyHeader {
   std::vector<int64_t> shape;
 };
 StatusOr<NpyHeader> ReadNpyHeader(const std::string& path);
+// The same of a whole file's bytes already read (errors name `source`).
+StatusOr<NpyHeader> ParseNpyHeader(const std::string& bytes, const std::string& source);
 // "float32", "int32", ... for a stored descr ("'<c8'" quoted for others).
 std::string NpyDtypeName(const std::string& descr);
 
