@@ -183,27 +183,7 @@ const PlaneCapture& GetPlaneCapture() {
       c.error = image.status().message();
       return c;
     }
-    constexpr double kPhotoMmPerPx = 0.778;
-    synth::PlaneScene scene;
-    scene.texture.image = *image;
-    scene.texture.width_mm = image->width * kPhotoMmPerPx;
-    scene.texture.height_mm = image->height * kPhotoMmPerPx;
-    synth::BuildMipmaps(&scene.texture);
-    synth::PlaneRigOptions rig;
-    rig.cameras = 8;
-    rig.width = 1152;
-    rig.height = 1328;
-    rig.focal_px = 1130;
-    rig.distance_mm = 2500;
-    rig.arc_deg = 100;
-    scene.rig = synth::MakePlaneRig(rig);
-    synth::PlaneMotionOptions motion;
-    motion.frames = 12;
-    motion.fps_hz = 30;
-    motion.max_translation_mm = 150;
-    motion.max_rotation_deg = 10;
-    scene.world_from_plane = synth::MakePlaneMotion(motion);
-    scene.fps = {30, 1};
+    const synth::PlaneScene scene = synth::DetectPlaneScene(*image);
     synth::PlaneSceneWriteOptions write;
     write.render.supersampling = 1;
     const std::string scene_dir = c.dir + "/scene";
@@ -223,7 +203,8 @@ const PlaneCapture& GetPlaneCapture() {
       c.error = made.status().message();
       return c;
     }
-    c.view_frames = static_cast<int64_t>(rig.cameras) * motion.frames;
+    c.view_frames =
+        static_cast<int64_t>(scene.rig.cameras.size() * scene.world_from_plane.size());
     return c;
   }();
   return capture;

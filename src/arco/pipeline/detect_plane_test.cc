@@ -33,10 +33,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The photo's scale: its nut-to-bridge distance (about 895 px) is a cello's 695 mm
-// string, so about 0.78 mm per pixel; 2300 x 2656 px is then about 1.79 x 2.07 m.
-constexpr double kPhotoMmPerPx = 0.778;
-
 TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
   ARCO_REQUIRE_MODELS();
   const std::string photo = std::string(ARCO_SHARED_DATA_DIR) + "/spd/example.jpg";
@@ -48,26 +44,8 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
   ASSERT_TRUE(reader.ok()) << reader.status().message();
   auto image = reader->ReadFrame(0);
   ASSERT_TRUE(image.ok());
-  synth::PlaneScene scene;
-  scene.texture.image = *image;
-  scene.texture.width_mm = image->width * kPhotoMmPerPx;
-  scene.texture.height_mm = image->height * kPhotoMmPerPx;
-  synth::BuildMipmaps(&scene.texture);
-  synth::PlaneRigOptions rig;
-  rig.cameras = 8;
-  rig.width = 1152;
-  rig.height = 1328;
-  rig.focal_px = 1130;
-  rig.distance_mm = 2500;
-  rig.arc_deg = 100;
-  scene.rig = synth::MakePlaneRig(rig);
-  synth::PlaneMotionOptions motion;
-  motion.frames = 12;
-  motion.fps_hz = 30;
-  motion.max_translation_mm = 150;
-  motion.max_rotation_deg = 10;
-  scene.world_from_plane = synth::MakePlaneMotion(motion);
-  scene.fps = {30, 1};
+  const synth::PlaneScene scene = synth::DetectPlaneScene(*image);
+  const int frames = static_cast<int>(scene.world_from_plane.size());
   const std::string scene_dir = dir / "scene";
   const auto start = std::chrono::steady_clock::now();
   const auto seconds = [&] {
@@ -96,8 +74,8 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
   std::printf(
       "rendered %d views x %d frames in %.1f s, detected in %.1f s (per view-frame: "
       "inference %.1f ms, preprocessing %.1f ms, postprocessing %.1f ms, decoding %.1f ms)\n",
-      rig.cameras,
-      motion.frames,
+      static_cast<int>(scene.rig.cameras.size()),
+      frames,
       render_s,
       detect_s,
       1e3 * total.inference_s / total.frames,
@@ -105,7 +83,7 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
       1e3 * total.postprocess_s / total.frames,
       1e3 * detected->decode_s / total.frames);
   for (const auto& cam : detected->cameras) {
-    EXPECT_EQ(cam.tracker.frames_with_person, motion.frames) << cam.camera;
+    EXPECT_EQ(cam.tracker.frames_with_person, frames) << cam.camera;
   }
   TriangulateStageOptions t;
   t.capture_dir = c.output_dir;
@@ -114,7 +92,7 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
   ASSERT_TRUE(triangulated.ok()) << triangulated.status().message();
   auto points = ReadNpy<double>(t.result_dir + "/triangulation/points3d_raw.npy");
   ASSERT_TRUE(points.ok()) << points.status().message();
-  ASSERT_EQ(points->shape[0], motion.frames);
+  ASSERT_EQ(points->shape[0], frames);
   const int64_t num_points = points->shape[1];
 
   // Every triangulated body and hand point in plane coordinates.
@@ -123,7 +101,7 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
   int hand_points_seen = 0;
   for (int64_t p = 0; p < std::min<int64_t>(num_points, wholebody::kNumPoints); ++p) {
     std::vector<Eigen::Vector2d> on_plane;
-    for (int64_t f = 0; f < motion.frames; ++f) {
+    for (int64_t f = 0; f < frames; ++f) {
       const double* x = &points->data[static_cast<size_t>((f * num_points + p) * 3)];
       if (!std::isfinite(x[0])) continue;
       const Eigen::Vector3d in_plane =
@@ -131,7 +109,7 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
       off_plane_mm.push_back(std::abs(in_plane.z()));
       on_plane.push_back(in_plane.head<2>());
     }
-    if (on_plane.size() < static_cast<size_t>(motion.frames) / 2) continue;
+    if (on_plane.size() < static_cast<size_t>(frames) / 2) continue;
     // Median distance from the point's median position on the plane.
     std::vector<double> xs, ys;
     for (const auto& q : on_plane) {

@@ -376,6 +376,31 @@ Status PlaneRigOptions::Validate() const {
   return Status::Ok();
 }
 
+PlaneScene DetectPlaneScene(const media::Image& photo) {
+  constexpr double kPhotoMmPerPx = 0.778;
+  PlaneScene scene;
+  scene.texture.image = photo;
+  scene.texture.width_mm = photo.width * kPhotoMmPerPx;
+  scene.texture.height_mm = photo.height * kPhotoMmPerPx;
+  BuildMipmaps(&scene.texture);
+  PlaneRigOptions rig;
+  rig.cameras = 8;
+  rig.width = 1152;
+  rig.height = 1328;
+  rig.focal_px = 1130;
+  rig.distance_mm = 2500;
+  rig.arc_deg = 100;
+  scene.rig = MakePlaneRig(rig);
+  PlaneMotionOptions motion;
+  motion.frames = 12;
+  motion.fps_hz = 30;
+  motion.max_translation_mm = 150;
+  motion.max_rotation_deg = 10;
+  scene.world_from_plane = MakePlaneMotion(motion);
+  scene.fps = {30, 1};
+  return scene;
+}
+
 Rig MakePlaneRig(const PlaneRigOptions& o) {
   if (Status valid = o.Validate(); !valid.ok()) throw std::invalid_argument(valid.message());
   Rig rig;
