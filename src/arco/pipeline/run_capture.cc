@@ -132,6 +132,7 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
   ARCO_ASSIGN_OR_RETURN(const PitchRecord pitch,
                         RunPitchStage(options.ForPitch(), capture, progress));
   summary.pitch = pitch.summary;
+  capture.audio_bytes.reset();  // the last stage that decodes the audio (up to 256 MiB)
   if (summary.pitch.ran) summary.timings.push_back({"pitch", SecondsSince(start)});
   Append(&summary.warnings, summary.pitch.warnings);
 
