@@ -26,6 +26,22 @@ Eigen::Vector3d AxisAngleFromQuaternion(const Eigen::Quaterniond& rotation) {
   return k * q.vec();
 }
 
+Eigen::Matrix3d CrossMatrix(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d k;
+  k << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return k;
+}
+
+Eigen::Matrix3d RightJacobianSO3(const Eigen::Vector3d& rotation_vector) {
+  const double a2 = rotation_vector.squaredNorm();
+  const double a = std::sqrt(a2);
+  // (1 - cos a)/a^2 = 1/2 - a^2/24 + ..., (a - sin a)/a^3 = 1/6 - a^2/120 + ...
+  const double c1 = a < 1e-4 ? 0.5 - a2 / 24.0 : (1.0 - std::cos(a)) / a2;
+  const double c2 = a < 1e-4 ? 1.0 / 6.0 - a2 / 120.0 : (a - std::sin(a)) / (a2 * a);
+  const Eigen::Matrix3d k = CrossMatrix(rotation_vector);
+  return Eigen::Matrix3d::Identity() - c1 * k + c2 * k * k;
+}
+
 Eigen::Matrix3d RotationFromAxisAngle(const Eigen::Vector3d& rotation_vector) {
   return QuaternionFromAxisAngle(rotation_vector).toRotationMatrix();
 }

@@ -13,6 +13,13 @@ namespace arco {
 Eigen::Matrix3d RotationFromAxisAngle(const Eigen::Vector3d& rotation_vector);
 // Inverse of the above with angle in [0, pi]; accurate near 0 and near pi.
 Eigen::Vector3d AxisAngleFromRotation(const Eigen::Matrix3d& rotation);
+// The right Jacobian of SO(3), J_r(w) = I - (1 - cos a)/a^2 [w]x + (a - sin a)/a^3 [w]x^2
+// (a = |w|; Sola, Deray & Atchuthan 2018, "A micro Lie theory", eq. 143): for small d,
+// Exp(w + d) = Exp(w) Exp(J_r(w) d), so d/dw (Exp(w) p) = -Exp(w) [p]x J_r(w). Series
+// coefficients near a = 0.
+Eigen::Matrix3d RightJacobianSO3(const Eigen::Vector3d& rotation_vector);
+// [v]x, the cross-product matrix: [v]x p = v x p.
+Eigen::Matrix3d CrossMatrix(const Eigen::Vector3d& v);
 
 Eigen::Quaterniond QuaternionFromAxisAngle(const Eigen::Vector3d& rotation_vector);
 // Angle in [0, pi] (q and -q give the same vector).

@@ -109,6 +109,26 @@ TEST(AxisAngle, RoundTripsIncludingNearZeroAndNearPi) {
   EXPECT_NEAR(std::abs(half_turn.y()), kPi, 1e-12);
 }
 
+// d/dw (Exp(w) p) = -Exp(w) [p]x J_r(w), against central differences, from tiny angles
+// (the series branch) to nearly pi.
+TEST(RightJacobianSO3, GivesTheDerivativeOfARotatedPoint) {
+  const Eigen::Vector3d p(30.0, -12.0, 55.0);
+  for (const double angle : {0.0, 1e-6, 5e-5, 2e-4, 0.3, 1.7, 3.1}) {
+    const Eigen::Vector3d w = angle * Eigen::Vector3d(0.48, -0.6, 0.64);
+    const Eigen::Matrix3d analytic =
+        -RotationFromAxisAngle(w) * CrossMatrix(p) * RightJacobianSO3(w);
+    const double h = 1e-6;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d e = h * Eigen::Vector3d::Unit(k);
+      const Eigen::Vector3d numeric =
+          (RotationFromAxisAngle(w + e) * p - RotationFromAxisAngle(w - e) * p) / (2 * h);
+      EXPECT_NEAR((analytic.col(k) - numeric).norm(), 0.0, 1e-6) << angle << " " << k;
+    }
+  }
+  EXPECT_EQ(CrossMatrix(Eigen::Vector3d(1, 2, 3)) * Eigen::Vector3d(-4, 5, 0.5),
+            Eigen::Vector3d(1, 2, 3).cross(Eigen::Vector3d(-4, 5, 0.5)));
+}
+
 TEST(RotationAngleBetween, MatchesTheAngleOfTheRelativeRotation) {
   const Eigen::Matrix3d a = RotationFromAxisAngle(Eigen::Vector3d(0.3, -0.2, 0.5));
   const Eigen::Matrix3d delta = RotationFromAxisAngle(Eigen::Vector3d(0, 0.25, 0));

@@ -435,8 +435,8 @@ StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(const std::string& capture_dir
   return FinishKeypoints2d(path, m, times, std::move(k));
 }
 
-StatusOr<std::string> ReadCaptureKeypoints2dBytes(const std::string& capture_dir,
-                                                  const CaptureManifest& m) {
+StatusOr<FileBytes> ReadCaptureKeypoints2dBytes(const std::string& capture_dir,
+                                                const CaptureManifest& m) {
   ARCO_RETURN_IF_ERROR(CheckCaptureHasKeypoints2d(capture_dir, m));
   const std::string path = ResolveCapturePath(capture_dir, m.keypoints2d);
   // ReadNpyHeader's messages for a missing file and a folder.
@@ -445,10 +445,10 @@ StatusOr<std::string> ReadCaptureKeypoints2dBytes(const std::string& capture_dir
   if (std::filesystem::is_directory(path, ec)) {
     return Status::Error(path + ": is a directory, expected a file");
   }
-  return ReadFileToString(path);
+  return FileBytes::Open(path);
 }
 
-StatusOr<NpyArray<double>> ParseCaptureKeypoints2d(const std::string& bytes,
+StatusOr<NpyArray<double>> ParseCaptureKeypoints2d(std::string_view bytes,
                                                    const std::string& capture_dir,
                                                    const CaptureManifest& m,
                                                    KeypointTimes times) {

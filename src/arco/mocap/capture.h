@@ -19,6 +19,7 @@
 
 #include "arco/mocap/triangulate_sequence.h"
 #include "arco/registry/keypoint_layout.h"
+#include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/status.h"
@@ -126,12 +127,12 @@ StatusOr<NpyArray<double>> ReadCaptureKeypoints2d(
 // The file's bytes, read once (CheckCaptureHasKeypoints2d first; a missing file or a
 // folder is an error naming it), for ParseCaptureKeypoints2d and a fingerprint of the
 // same bytes.
-StatusOr<std::string> ReadCaptureKeypoints2dBytes(const std::string& capture_dir,
-                                                  const CaptureManifest& manifest);
+StatusOr<FileBytes> ReadCaptureKeypoints2dBytes(const std::string& capture_dir,
+                                                const CaptureManifest& manifest);
 // CheckCaptureKeypoints2d and ReadCaptureKeypoints2d on those bytes: the same checks,
 // messages and array.
 StatusOr<NpyArray<double>> ParseCaptureKeypoints2d(
-    const std::string& bytes,
+    std::string_view bytes,
     const std::string& capture_dir,
     const CaptureManifest& manifest,
     KeypointTimes times = KeypointTimes::kCaptureFrames);

@@ -269,7 +269,7 @@ TEST(CaptureKeypoints, ParsingTheBytesIsReadingTheFile) {
   ASSERT_TRUE(WriteNpy(dir / "keypoints2d.npy", k).ok());
   auto bytes = ReadCaptureKeypoints2dBytes(dir.path(), m);
   ASSERT_TRUE(bytes.ok()) << bytes.status().message();
-  auto parsed = ParseCaptureKeypoints2d(*bytes, dir.path(), m);
+  auto parsed = ParseCaptureKeypoints2d(bytes->view(), dir.path(), m);
   auto read = ReadCaptureKeypoints2d(dir.path(), m);
   ASSERT_TRUE(parsed.ok()) << parsed.status().message();
   ASSERT_TRUE(read.ok());
@@ -284,7 +284,7 @@ TEST(CaptureKeypoints, ParsingTheBytesIsReadingTheFile) {
   ASSERT_TRUE(WriteNpy(dir / "keypoints2d.npy", k).ok());
   bytes = ReadCaptureKeypoints2dBytes(dir.path(), m);
   ASSERT_TRUE(bytes.ok());
-  EXPECT_EQ(ParseCaptureKeypoints2d(*bytes, dir.path(), m).status().message(),
+  EXPECT_EQ(ParseCaptureKeypoints2d(bytes->view(), dir.path(), m).status().message(),
             ReadCaptureKeypoints2d(dir.path(), m).status().message());
   NpyArray<int32_t> ints;
   ints.shape = {4, 2, 142, 3};
@@ -292,7 +292,7 @@ TEST(CaptureKeypoints, ParsingTheBytesIsReadingTheFile) {
   ASSERT_TRUE(WriteNpy(dir / "keypoints2d.npy", ints).ok());
   bytes = ReadCaptureKeypoints2dBytes(dir.path(), m);
   ASSERT_TRUE(bytes.ok());
-  const Status dtype = ParseCaptureKeypoints2d(*bytes, dir.path(), m).status();
+  const Status dtype = ParseCaptureKeypoints2d(bytes->view(), dir.path(), m).status();
   EXPECT_FALSE(dtype.ok());
   EXPECT_EQ(dtype.message(), ReadCaptureKeypoints2d(dir.path(), m).status().message());
   k.shape = {4, 2, 142, 3};
@@ -300,10 +300,9 @@ TEST(CaptureKeypoints, ParsingTheBytesIsReadingTheFile) {
   ASSERT_TRUE(WriteNpy(dir / "keypoints2d.npy", k).ok());
   bytes = ReadCaptureKeypoints2dBytes(dir.path(), m);
   ASSERT_TRUE(bytes.ok());
-  ASSERT_TRUE(
-      AtomicWriteFile(dir / "keypoints2d.npy", bytes->substr(0, bytes->size() - 100)).ok());
-  const Status truncated =
-      ParseCaptureKeypoints2d(bytes->substr(0, bytes->size() - 100), dir.path(), m).status();
+  const std::string_view cut = bytes->view().substr(0, bytes->view().size() - 100);
+  ASSERT_TRUE(AtomicWriteFile(dir / "keypoints2d.npy", std::string(cut)).ok());
+  const Status truncated = ParseCaptureKeypoints2d(cut, dir.path(), m).status();
   EXPECT_FALSE(truncated.ok());
   EXPECT_EQ(truncated.message(), ReadCaptureKeypoints2d(dir.path(), m).status().message());
 

@@ -187,12 +187,12 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
   // Read once here, checked, parsed and fingerprinted from the same bytes; the stages of
   // the run use the array (CaptureContext::keypoints2d).
   {
-    ARCO_ASSIGN_OR_RETURN(const std::string bytes,
+    ARCO_ASSIGN_OR_RETURN(const FileBytes bytes,
                           ReadCaptureKeypoints2dBytes(options.capture_dir, m));
     ARCO_ASSIGN_OR_RETURN(NpyArray<double> k,
-                          ParseCaptureKeypoints2d(bytes, options.capture_dir, m));
+                          ParseCaptureKeypoints2d(bytes.view(), options.capture_dir, m));
     capture.keypoints2d = std::make_shared<const NpyArray<double>>(std::move(k));
-    capture.inputs[kKeypoints2dInput] = {m.keypoints2d, FingerprintBytes(bytes)};
+    capture.inputs[kKeypoints2dInput] = {m.keypoints2d, FingerprintBytes(bytes.view())};
   }
   ARCO_RETURN_IF_ERROR(CheckCaptureInstrumentPoints(capture));
   ARCO_RETURN_IF_ERROR(

@@ -1,5 +1,10 @@
 #include "arco/util/file_io.h"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cctype>
 #include <cerrno>
 #include <cstring>
@@ -37,6 +42,55 @@ StatusOr<std::string> ReadFileToString(const std::string& path) {
   ss << in.rdbuf();
   if (in.bad()) return Status::Error(path + ": read error");
   return bytes + ss.str();
+}
+
+struct FileBytes::Mapping {
+  void* address = nullptr;
+  size_t size = 0;
+  ~Mapping() {
+    if (address != nullptr) munmap(address, size);
+  }
+};
+
+StatusOr<FileBytes> FileBytes::Open(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return Status::Error(path + ": file not found");
+  if (fs::is_directory(path, ec)) return Status::Error(path + ": is a directory, expected a file");
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return Status::Error(path + ": cannot open: " + std::strerror(errno));
+  FileBytes out;
+  struct stat st {};
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+    void* a = ::mmap(nullptr, static_cast<size_t>(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0);
+    if (a != MAP_FAILED) {
+      ::close(fd);
+      auto m = std::make_shared<Mapping>();
+      m->address = a;
+      m->size = static_cast<size_t>(st.st_size);
+      out.view_ = std::string_view(static_cast<const char*>(a), m->size);
+      out.mapping_ = std::move(m);
+      return out;
+    }
+  }
+  // Not mappable (a pipe, an empty file, a file system without mmap): read from the same
+  // descriptor to its end (a pipe's bytes would be lost by opening it again).
+  auto copy = std::make_shared<std::string>();
+  char buffer[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof(buffer));
+    if (n == 0) break;
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int err = errno;
+      ::close(fd);
+      return Status::Error(path + ": read error: " + std::strerror(err));
+    }
+    copy->append(buffer, static_cast<size_t>(n));
+  }
+  ::close(fd);
+  out.view_ = *copy;
+  out.copy_ = std::move(copy);
+  return out;
 }
 
 Status AtomicWriteWith(const std::string& path,

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "arco/util/status.h"
@@ -34,7 +35,7 @@ template <typename T>
 StatusOr<NpyArray<T>> ReadNpy(const std::string& path);
 // Parses .npy bytes; `source` names the file in messages (used by the fuzzer).
 template <typename T>
-StatusOr<NpyArray<T>> ParseNpy(const std::string& bytes, const std::string& source);
+StatusOr<NpyArray<T>> ParseNpy(std::string_view bytes, const std::string& source);
 
 // The header of an .npy file, read without its data (checks before the work).
 struct NpyHeader {
@@ -45,7 +46,7 @@ struct NpyHeader {
 };
 StatusOr<NpyHeader> ReadNpyHeader(const std::string& path);
 // The same of a whole file's bytes already read (errors name `source`).
-StatusOr<NpyHeader> ParseNpyHeader(const std::string& bytes, const std::string& source);
+StatusOr<NpyHeader> ParseNpyHeader(std::string_view bytes, const std::string& source);
 // "float32", "int32", ... for a stored descr ("'<c8'" quoted for others).
 std::string NpyDtypeName(const std::string& descr);
 
