@@ -221,6 +221,7 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
     cam.cx = 0.5 * (cam.width - 1);
     cam.cy = 0.5 * (cam.height - 1);
     report.initial_focal_px = cam.fx;
+    report.width = cam.width, report.height = cam.height;
     rig.cameras.push_back(cam);
     summary.cameras.push_back(report);
   }
