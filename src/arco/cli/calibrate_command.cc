@@ -169,10 +169,14 @@ int RunFromInstrument(const pipeline::CalibrationFromInstrumentOptions& options)
                 c.focal_px);
   }
   std::printf(
-      "string length %.1f mm in the PnP rig's scale (model %.1f mm); reprojection rms %.2f px "
-      "-> %.2f px after the bundle adjustment\n",
-      result->string_length_initial_mm,
+      "string length (model %.1f mm): %.1f mm in the PnP rig's scale, %.1f mm +- %.1f "
+      "triangulated with the result (%d frames); reprojection rms %.2f px -> %.2f px after the "
+      "bundle adjustment\n",
       result->string_length_mm,
+      result->string_length_initial_mm,
+      result->string_length_measured_mm,
+      result->string_length_spread_mm,
+      result->string_length_frames,
       result->rms_initial_px,
       result->rms_px);
   for (const auto& w : result->warnings) PrintWarning(w);

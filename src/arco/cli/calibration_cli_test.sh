@@ -212,6 +212,7 @@ assert deg < 1 and mm < 50, (deg, mm)
 r = json.load(open(sys.argv[3]))
 assert r["world"].startswith("the first camera") and r["rms_px"] < 3, r
 assert abs(r["string_length_mm"] - 695) < 1e-9 and r["cameras"][0]["pnp_frames"] > 0, r
+assert abs(r["string_length_measured"]["error_mm"]) < 3, r["string_length_measured"]
 PY' "from-instrument recovers the pair: $(tail -2 "$tmp/fi.out") $(cat "$tmp/err")"
 for bad in "--min-score 1:keypoints2d.npy: camera .* never shows 5 of the cello" \
            ":capture.json: camera .* has no video to read its image size from" \

@@ -14,6 +14,7 @@
 #include "arco/instrument/nominal_keypoints.h"
 #include "arco/media/video_reader.h"
 #include "arco/mocap/capture.h"
+#include "arco/mocap/triangulate_point.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/output_set.h"
 
@@ -131,6 +132,10 @@ Json CalibrationFromInstrumentSummary::ToJson() const {
   j["string_length_mm"] = string_length_mm;
   j["string_length_initial_mm"] = string_length_initial_mm;
   j["string_length_error_initial_mm"] = string_length_initial_mm - string_length_mm;
+  j["string_length_measured"] = {{"median_mm", string_length_measured_mm},
+                                 {"error_mm", string_length_measured_mm - string_length_mm},
+                                 {"spread_mm", string_length_spread_mm},
+                                 {"frames", string_length_frames}};
   j["rms_initial_px"] = rms_initial_px;
   j["rms_px"] = rms_px;
   j["cameras"] = Json::array();
@@ -355,6 +360,39 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
   summary.rms_initial_px = summary.refinement.rms_before_px;
   summary.rms_px = summary.refinement.rms_after_px;
   for (int v = 0; v < num_views; ++v) summary.cameras[v].focal_px = summary.rig.cameras[v].fx;
+  // The string length as the refined rig measures it frame by frame (triangulated nut and
+  // bridge edges, not the template the bundle adjustment held at the model's length).
+  {
+    TriangulationOptions triangulation;
+    triangulation.min_score = options.min_score;
+    const Triangulator triangulator(summary.rig, triangulation);
+    const int columns[4] = {layout->Find("nut_l"),
+                            layout->Find("nut_r"),
+                            layout->Find("bridge_l"),
+                            layout->Find("bridge_r")};
+    std::vector<double> lengths;
+    std::vector<PointObservation> observations;
+    for (int64_t f = 0; f < frames; ++f) {
+      Eigen::Vector3d p[4];
+      bool all = true;
+      for (int k = 0; k < 4 && all; ++k) {
+        observations.clear();
+        for (int v = 0; v < num_views && columns[k] >= 0; ++v)
+          observations.push_back({v,
+                                  Eigen::Vector2d(keypoints.at(f, v, columns[k], 0),
+                                                  keypoints.at(f, v, columns[k], 1)),
+                                  keypoints.at(f, v, columns[k], 2)});
+        const auto point = triangulator.Triangulate(observations);
+        all = point.has_value();
+        if (all) p[k] = point->point_in_world;
+      }
+      if (all) lengths.push_back((0.5 * (p[0] + p[1]) - 0.5 * (p[2] + p[3])).norm());
+    }
+    summary.string_length_frames = static_cast<int>(lengths.size());
+    summary.string_length_measured_mm = Median(lengths);
+    for (double& l : lengths) l = std::abs(l - summary.string_length_measured_mm);
+    summary.string_length_spread_mm = 1.4826 * Median(lengths);
+  }
   summary.warnings = summary.refinement.warnings;
   if (options.focal_px == 0 && options.fov_deg == 0)
     summary.warnings.push_back("focal lengths started from a phone's default (" +

@@ -85,6 +85,11 @@ struct CalibrationFromInstrumentSummary {
   // The template's nut-to-bridge distance in the initial rig's scale (before the
   // refinement holds it at the model's): how far off the PnP scale was.
   double string_length_initial_mm = 0;
+  // The nut-centre to bridge-centre distance triangulated with the refined rig in every
+  // frame where both cameras see all four points: median, robust spread (1.4826 MAD) and
+  // frames. An independent check of the scale (the template is held at the model's).
+  double string_length_measured_mm = 0, string_length_spread_mm = 0;
+  int string_length_frames = 0;
   double rms_initial_px = 0, rms_px = 0;  // reprojection RMS, initial rig and refined
   CalibrationRefineSummary refinement;
   std::vector<std::string> warnings;
