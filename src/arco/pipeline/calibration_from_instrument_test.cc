@@ -12,6 +12,7 @@
 #include "arco/calibration/calibration_file.h"
 #include "arco/eval/evaluate.h"
 #include "arco/geometry/rotation.h"
+#include "arco/media/test_video.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/run_capture.h"
 #include "arco/synth/capture_writer.h"
@@ -190,6 +191,36 @@ TEST(CalibrateFromInstrument, RecoversTwoCamerasWithTheTrueAndAWrongFocal) {
   // the baseline's (0.45 %); the hand's error, wrist-relative, is as good as with the truth.
   EXPECT_LE(m_estimate.mpjpe_body_mm, 45.0);
   EXPECT_LE(m_estimate.mpjpe_hand_mm, 1.1 * m_truth.mpjpe_hand_mm);
+}
+
+// Without --image-size the size comes from each camera's video, turned by its rotate_deg
+// (a portrait phone video: coded 2656 x 2304, turned 90 degrees to 2304 x 2656).
+TEST(CalibrateFromInstrument, ReadsTheImageSizeFromTheVideos) {
+  TempDir dir;
+  const std::string capture = dir / "capture";
+  WriteTwoCameraCapture(capture);
+  media::testing::IndexVideo video;
+  video.width = 2656;
+  video.height = 2304;
+  video.frames = 2;
+  ASSERT_TRUE(media::testing::WriteIndexVideo(capture + "/cam.mkv", video).ok());
+  auto manifest = ReadCaptureManifest(capture);
+  ASSERT_TRUE(manifest.ok());
+  for (CaptureCamera& cam : manifest->cameras) cam.video = "cam.mkv", cam.rotate_deg = 90;
+  ASSERT_TRUE(WriteCaptureManifest(capture, *manifest).ok());
+  CalibrationFromInstrumentOptions options = Options(capture, dir / "rig.json");
+  options.image_width = options.image_height = 0;
+  options.fov_deg = 60;
+  auto result = CalibrateFromInstrument(options);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_EQ(result->focal_source, "--fov-deg 60");
+  for (const FromInstrumentCamera& c : result->cameras) {
+    EXPECT_EQ(c.width, 2304);
+    EXPECT_EQ(c.height, 2656);
+    EXPECT_EQ(c.size_source, "video");
+    EXPECT_NEAR(c.initial_focal_px, 0.5 * 2656 / std::tan(M_PI / 6), 1e-9);
+  }
+  EXPECT_NEAR(result->rig.cameras[1].cx, 0.5 * 2303, 1e-9);
 }
 
 TEST(CalibrateFromInstrument, BadInputIsOneErrorAndNothingWritten) {
