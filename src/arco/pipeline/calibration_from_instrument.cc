@@ -394,6 +394,13 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
     summary.string_length_spread_mm = 1.4826 * Median(lengths);
   }
   summary.warnings = summary.refinement.warnings;
+  for (const FromInstrumentCamera& c : summary.cameras)
+    if (std::abs(c.focal_px / c.initial_focal_px - 1) > 0.03)
+      summary.warnings.push_back(
+          "camera " + c.name + "'s focal length moved by " +
+          NumberText(std::round(1000 * (c.focal_px / c.initial_focal_px - 1)) / 10) +
+          " % in the bundle adjustment: two views fix it poorly (docs/calibration.md); "
+          "if it is known, give --focal-px with --fix-focal");
   if (options.focal_px == 0 && options.fov_deg == 0)
     summary.warnings.push_back("focal lengths started from a phone's default (" +
                                NumberText(kPhoneFovDeg) +

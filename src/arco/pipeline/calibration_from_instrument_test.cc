@@ -112,10 +112,13 @@ TEST(CalibrateFromInstrument, RecoversTwoCamerasWithTheTrueAndAWrongFocal) {
   ASSERT_TRUE(truth.ok());
   const double true_focal = truth->rig.cameras[0].fx;
   Rig wrong_focal_rig;
-  for (const double scale : {1.0, 1.1}) {
-    const std::string output = dir / ("focal" + std::to_string(int(scale * 100)) + ".json");
+  // The true focal length held (--fix-focal), then the true one and one 10 % long refined.
+  for (const auto& [scale, refine_focal] : {std::pair{1.0, false}, {1.0, true}, {1.1, true}}) {
+    const std::string output = dir / ("focal" + std::to_string(int(scale * 100)) +
+                                      (refine_focal ? "" : "_fixed") + ".json");
     CalibrationFromInstrumentOptions options = Options(capture, output);
     options.focal_px = scale * true_focal;
+    options.refine_focal = refine_focal;
     auto result = CalibrateFromInstrument(options);
     ASSERT_TRUE(result.ok()) << result.status().message();
     ASSERT_TRUE(FileExists(output));
@@ -127,11 +130,12 @@ TEST(CalibrateFromInstrument, RecoversTwoCamerasWithTheTrueAndAWrongFocal) {
     const RelativeError e = CompareRelative(truth->rig, written->rig);
     const double focal_error = written->rig.cameras[1].fx / true_focal - 1;
     std::printf(
-        "[ from-instrument ] focal x%.2f: PnP in %d/%d frames (rms %.2f/%.2f px), %d shared; "
+        "[ from-instrument ] focal x%.2f%s: PnP in %d/%d frames (rms %.2f/%.2f px), %d shared; "
         "relative pose error %.3f deg, %.2f mm (baseline %+.3f %%); focal %+.2f %%; string "
         "%.1f mm initial vs %.1f mm, triangulated %.1f +- %.1f mm (%d frames); reprojection "
         "%.2f -> %.2f px\n",
         scale,
+        refine_focal ? " refined" : " held",
         result->cameras[0].pnp_frames,
         result->cameras[1].pnp_frames,
         result->cameras[0].pnp_rms_px,
@@ -148,13 +152,23 @@ TEST(CalibrateFromInstrument, RecoversTwoCamerasWithTheTrueAndAWrongFocal) {
         result->string_length_frames,
         result->rms_initial_px,
         result->rms_px);
-    // Measured: 0.37 deg, 26 mm, baseline -0.45 %, focal +0.15 % from either focal length
-    // (the same minimum); another pair of the rig (cameras 0 and 4) 0.47 deg, 57 mm,
-    // +1.7 %: the scale, from one string length, is what limits the position.
-    EXPECT_LE(e.rotation_deg, 1.0);
-    EXPECT_LE(e.position_mm, 50.0);
-    EXPECT_LE(std::abs(e.baseline_rel), 0.015);
-    EXPECT_LE(std::abs(focal_error), 0.02);
+    if (!refine_focal) {
+      // Measured: the true focal length held, 0.4 deg and 15 mm (seeds 0-3 of the CLI:
+      // 0.39-0.44 deg, 14.9-15.9 mm).
+      EXPECT_LE(e.rotation_deg, 1.0);
+      EXPECT_LE(e.position_mm, 20.0);
+      EXPECT_LE(std::abs(e.baseline_rel), 0.005);
+    } else {
+      // Measured on this take (seed 0): 0.37 deg, 26 mm, baseline -0.45 %, focal +0.15 %
+      // from either focal length (the same minimum). NOT a property of the method: on
+      // seeds 1-3 the refined focal lengths end 0.7-11 % off and the pair 0.8-5.5 deg,
+      // 59-466 mm (docs/calibration.md): two views hardly fix a focal length. This
+      // checks that the refinement does not get worse on this take.
+      EXPECT_LE(e.rotation_deg, 1.0);
+      EXPECT_LE(e.position_mm, 50.0);
+      EXPECT_LE(std::abs(e.baseline_rel), 0.015);
+      EXPECT_LE(std::abs(focal_error), 0.02);
+    }
     EXPECT_LE(result->rms_px, 4.0);  // 2 px detector noise
     // Measured: 694.9 +- 1.3 mm over 92 frames (the model's 695).
     EXPECT_NEAR(result->string_length_measured_mm, result->string_length_mm, 3.0);
