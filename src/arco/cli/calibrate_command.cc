@@ -12,6 +12,7 @@
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
 #include "arco/pipeline/calibration_check.h"
+#include "arco/pipeline/calibration_from_instrument.h"
 #include "arco/pipeline/calibration_refine.h"
 
 namespace arco::cli {
@@ -121,6 +122,68 @@ int RunRefine(const pipeline::CalibrationRefineOptions& options) {
   return 0;
 }
 
+inline constexpr FieldFlag kFromInstrumentFlags[] = {{"focal_px", "--focal-px"},
+                                                     {"fov_deg", "--fov-deg"},
+                                                     {"image_width", "--image-size"},
+                                                     {"image_height", "--image-size"},
+                                                     {"min_score", "--min-score"},
+                                                     {"min_points", "--min-points"},
+                                                     {"pnp_gate_px", "--pnp-gate-px"},
+                                                     {"max_frames", "--max-frames"},
+                                                     {"max_iterations", "--max-iterations"}};
+
+int RunFromInstrument(const pipeline::CalibrationFromInstrumentOptions& options) {
+  ProgressBar bar("from-instrument");
+  auto result = pipeline::CalibrateFromInstrument(options, bar);
+  bar.Finish();
+  if (!result.ok())
+    return PrintError(WithFlagNames(result.status().message(), kFromInstrumentFlags));
+  std::printf(
+      "calibrated %zu cameras of %s from the %s: focal from %s; PnP poses in %d shared "
+      "frames, initial rig from frame %lld; world: camera %s's frame, mm\n",
+      result->cameras.size(),
+      options.capture_dir.c_str(),
+      result->instrument.c_str(),
+      result->focal_source.c_str(),
+      result->shared_frames,
+      static_cast<long long>(result->reference_frame),
+      result->rig.cameras[0].name.c_str());
+  std::printf("%-20s %11s %8s %10s %10s %10s %10s\n",
+              "camera",
+              "size",
+              "PnP fr.",
+              "PnP px",
+              "spread",
+              "focal in",
+              "focal out");
+  for (const auto& c : result->cameras) {
+    const std::string size = std::to_string(c.width) + "x" + std::to_string(c.height);
+    std::printf("%-20s %11s %8d %10.2f %5.2f° %3.0fmm %10.1f %10.1f\n",
+                c.name.c_str(),
+                size.c_str(),
+                c.pnp_frames,
+                c.pnp_rms_px,
+                c.relative_spread_deg,
+                c.relative_spread_mm,
+                c.initial_focal_px,
+                c.focal_px);
+  }
+  std::printf(
+      "string length (model %.1f mm): %.1f mm in the PnP rig's scale, %.1f mm +- %.1f "
+      "triangulated with the result (%d frames); reprojection rms %.2f px -> %.2f px after the "
+      "bundle adjustment\n",
+      result->string_length_mm,
+      result->string_length_initial_mm,
+      result->string_length_measured_mm,
+      result->string_length_spread_mm,
+      result->string_length_frames,
+      result->rms_initial_px,
+      result->rms_px);
+  for (const auto& w : result->warnings) PrintWarning(w);
+  std::printf("wrote %s and its .report.json\n", options.output.c_str());
+  return 0;
+}
+
 struct CalibrateArgs {
   calibration::CalibrateOptions options;
   std::vector<std::string> videos, images;
@@ -191,8 +254,9 @@ std::string FormatReport(const calibration::CalibrateResult& result, const std::
 void ApplyAndValidate(CalibrateArgs& a,
                       const CLI::App& cmd,
                       const CLI::App& check,
-                      const CLI::App& refine) {
-  if (check.parsed() || refine.parsed()) return;
+                      const CLI::App& refine,
+                      const CLI::App& from_instrument) {
+  if (check.parsed() || refine.parsed() || from_instrument.parsed()) return;
   if (a.options.board.empty()) ThrowIfInvalid(Status::Error("--board is required"));
   if (a.options.output.empty()) ThrowIfInvalid(Status::Error("--output is required"));
   a.options.inputs.clear();
@@ -428,13 +492,103 @@ CommandRun SetupCalibrate(CLI::App& app) {
     const Status valid = r->Validate();
     if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kRefineFlags)));
   });
-  cmd->parse_complete_callback(
-      [a, cmd, check, refine] { ApplyAndValidate(*a, *cmd, *check, *refine); });
+  auto fi = std::make_shared<pipeline::CalibrationFromInstrumentOptions>();
+  auto image_size = std::make_shared<std::string>();
+  auto fix_focal = std::make_shared<bool>(false);
+  auto* from_instrument = cmd->add_subcommand(
+      "from-instrument",
+      "Calibrate two or more cameras without a board, from the take itself: each camera's "
+      "pose by PnP of the instrument's 2D points against its model (whose real size gives "
+      "the scale), then refined by bundle adjustment with the performer and the instrument");
+  from_instrument
+      ->add_option("capture",
+                   fi->capture_dir,
+                   "Capture folder (capture.json with the instrument, keypoints2d with its "
+                   "points in every camera); its own calibration is not used")
+      ->required();
+  from_instrument
+      ->add_option("-o,--output",
+                   fi->output,
+                   "Calibration to write: .json arco JSON, .yaml/.yml OpenCV YAML, .xml OpenCV "
+                   "XML; the report goes beside it as NAME.report.json; required")
+      ->required();
+  from_instrument->add_flag("--overwrite", fi->overwrite, "Replace an existing output file");
+  AddNumber(from_instrument,
+            "--focal-px",
+            fi->focal_px,
+            "Every camera's focal length to start from (px); default: from --fov-deg",
+            pipeline::kFromInstrumentFocalRangePx);
+  AddNumber(from_instrument,
+            "--fov-deg",
+            fi->fov_deg,
+            "Field of view across the image's longer side to start from (degrees); default: a "
+            "phone's main camera, 67 (26 mm equivalent)",
+            pipeline::kFromInstrumentFovRangeDeg);
+  from_instrument->add_option(
+      "--image-size",
+      *image_size,
+      "WIDTHxHEIGHT of every camera's image (px); default: read from each camera's video");
+  from_instrument->add_flag(
+      "--fix-focal", *fix_focal, "Keep the focal lengths in the bundle adjustment");
+  AddNumber(from_instrument,
+            "--min-score",
+            fi->min_score,
+            "Ignore detections below this confidence",
+            kFractionRange)
+      ->capture_default_str();
+  AddNumber(from_instrument,
+            "--min-points",
+            fi->min_points,
+            "Instrument points a camera needs in a frame for a PnP pose",
+            pipeline::kFromInstrumentPointsRange)
+      ->capture_default_str();
+  AddNumber(from_instrument,
+            "--pnp-gate-px",
+            fi->pnp_gate_px,
+            "RANSAC inlier threshold of the PnP (px)",
+            pipeline::kFromInstrumentGateRangePx)
+      ->capture_default_str();
+  AddNumber(from_instrument,
+            "--max-frames",
+            fi->max_frames,
+            "Bundle adjustment: use at most this many frames, evenly spread",
+            pipeline::kRefineMaxFramesRange)
+      ->capture_default_str();
+  AddNumber(from_instrument,
+            "--max-iterations",
+            fi->max_iterations,
+            "Bundle adjustment iterations per pass at most",
+            pipeline::kRefineIterationsRange)
+      ->capture_default_str();
+  from_instrument->parse_complete_callback([fi, image_size, fix_focal] {
+    fi->refine_focal = !*fix_focal;
+    if (!image_size->empty()) {
+      int w = 0, h = 0;
+      char x = 0, extra = 0;
+      if (std::sscanf(image_size->c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' ||
+          w <= 0 || h <= 0)
+        ThrowIfInvalid(Status::Error("--image-size: '" + *image_size +
+                                     "' is not WIDTHxHEIGHT in pixels (e.g. 1920x1080)"));
+      fi->image_width = w, fi->image_height = h;
+    }
+    const Status valid = fi->Validate();
+    if (!valid.ok())
+      ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kFromInstrumentFlags)));
+  });
+  cmd->parse_complete_callback([a, cmd, check, refine, from_instrument] {
+    ApplyAndValidate(*a, *cmd, *check, *refine, *from_instrument);
+  });
   // calibrate check writes nothing; calibrate and calibrate refine write a calibration and
   // its report beside it.
-  auto paths = [a, r, check, refine] {
+  auto paths = [a, r, fi, check, refine, from_instrument] {
     PathRoles roles;
-    if (refine->parsed()) {
+    if (from_instrument->parsed()) {
+      AddCaptureInputs(&roles, "CAPTURE", fi->capture_dir);
+      roles.AddOutput("-o", fi->output);
+      if (!fi->output.empty()) {
+        roles.AddOutput("-o's report", calibration::ReportPath(fi->output));
+      }
+    } else if (refine->parsed()) {
       AddCaptureInputs(&roles, "CAPTURE", r->capture_dir);
       roles.AddInput("--calibration", r->calibration);
       roles.AddOutput("-o", r->output);
@@ -453,8 +607,9 @@ CommandRun SetupCalibrate(CLI::App& app) {
     return roles;
   };
   return CommandRun(
-      [a, c, r, json, check, refine] {
+      [a, c, r, fi, json, check, refine, from_instrument] {
         if (check->parsed()) return RunCheck(*c, *json);
+        if (from_instrument->parsed()) return RunFromInstrument(*fi);
         if (refine->parsed()) return RunRefine(*r);
         ProgressBar bar("calibrate");
         auto result = calibration::RunCalibrate(a->options, bar);

@@ -122,9 +122,25 @@ double Rms(const std::vector<double>& v) {
 
 }  // namespace
 
+StatusOr<CalibrationFormat> CalibrationOutputFormat(const std::string& path) {
+  const std::string extension = std::filesystem::path(path).extension().string();
+  if (extension == ".yaml" || extension == ".yml") return CalibrationFormat::kOpenCvYaml;
+  if (extension == ".xml") return CalibrationFormat::kOpenCvXml;
+  if (extension == ".json") return CalibrationFormat::kArcoJson;
+  return Status::Error(path +
+                       ": unknown calibration extension (.json arco JSON, .yaml/.yml OpenCV "
+                       "YAML, .xml OpenCV XML)");
+}
+
+std::string RefineReportPath(const std::string& output) {
+  std::filesystem::path report_path(output);
+  report_path.replace_extension();
+  return report_path.string() + ".report.json";
+}
+
 Status CalibrationRefineOptions::Validate() const {
   if (capture_dir.empty()) return Status::Error("capture_dir: no capture folder given");
-  if (output.empty()) return Status::Error("output: no calibration file given");
+  if (write && output.empty()) return Status::Error("output: no calibration file given");
   ARCO_RETURN_IF_ERROR(CheckInRange("min_score", min_score, Closed(0, 1)));
   ARCO_RETURN_IF_ERROR(CheckInRange("min_views", min_views, Closed(2, 1000)));
   ARCO_RETURN_IF_ERROR(CheckInRange("max_frames", max_frames, kRefineMaxFramesRange));
@@ -174,36 +190,34 @@ Json CalibrationRefineSummary::ToJson() const {
 StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOptions& options,
                                                      Progress& progress) {
   ARCO_RETURN_IF_ERROR(options.Validate());
-  const std::string extension = std::filesystem::path(options.output).extension().string();
   CalibrationFormat format = CalibrationFormat::kArcoJson;
-  if (extension == ".yaml" || extension == ".yml")
-    format = CalibrationFormat::kOpenCvYaml;
-  else if (extension == ".xml")
-    format = CalibrationFormat::kOpenCvXml;
-  else if (extension != ".json")
-    return Status::Error(options.output +
-                         ": unknown calibration extension (.json arco JSON, .yaml/.yml OpenCV "
-                         "YAML, .xml OpenCV XML)");
-  std::filesystem::path report_path(options.output);
-  report_path.replace_extension();
-  const std::string report_file = report_path.string() + ".report.json";
-  for (const std::string& path : {options.output, report_file}) {
-    ARCO_RETURN_IF_ERROR(CheckOutputFile(path));
-    if (!options.overwrite && std::filesystem::exists(path))
-      return Status::Error(path + ": exists; give --overwrite to replace it");
+  std::string report_file;
+  if (options.write) {
+    ARCO_ASSIGN_OR_RETURN(format, CalibrationOutputFormat(options.output));
+    report_file = RefineReportPath(options.output);
+    for (const std::string& path : {options.output, report_file}) {
+      ARCO_RETURN_IF_ERROR(CheckOutputFile(path));
+      if (!options.overwrite && std::filesystem::exists(path))
+        return Status::Error(path + ": exists; give --overwrite to replace it");
+    }
   }
 
   ARCO_ASSIGN_OR_RETURN(const CaptureManifest manifest, ReadCaptureManifest(options.capture_dir));
   if (manifest.keypoints2d.empty())
     return Status::Error(options.capture_dir + "/capture.json: no keypoints2d to refine with");
   CalibrationRefineSummary summary;
-  summary.calibration = options.calibration.empty()
+  summary.calibration = options.calibration.empty() && !options.input_rig
                             ? ResolveCapturePath(options.capture_dir, manifest.calibration)
                             : options.calibration;
   summary.output = options.output;
-  if (options.calibration.empty())
-    ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(options.capture_dir, manifest));
-  ARCO_ASSIGN_OR_RETURN(const Calibration calibration, LoadCalibration(summary.calibration));
+  Calibration calibration;
+  if (options.input_rig) {
+    calibration.rig = *options.input_rig;
+  } else {
+    if (options.calibration.empty())
+      ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(options.capture_dir, manifest));
+    ARCO_ASSIGN_OR_RETURN(calibration, LoadCalibration(summary.calibration));
+  }
   const Rig& input = calibration.rig;
   summary.units = input.units;
   ARCO_ASSIGN_OR_RETURN(
@@ -595,6 +609,7 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
       summary.warnings.push_back("a bundle adjustment pass ended with " + p.termination +
                                  " after " + std::to_string(p.iterations) + " iterations");
   summary.rig = rig;
+  if (!options.write) return summary;
 
   OutputSet outputs;
   ARCO_ASSIGN_OR_RETURN(const std::string calibration_tmp, outputs.AddFile(options.output));

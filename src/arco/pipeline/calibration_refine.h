@@ -21,9 +21,11 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "arco/camera/calibration_io.h"
 #include "arco/camera/rig.h"
 #include "arco/util/json_io.h"
 #include "arco/util/number_range.h"
@@ -40,7 +42,11 @@ inline constexpr NumberRange kRefineIterationsRange = Closed(1, 10000);
 struct CalibrationRefineOptions {
   std::string capture_dir;
   std::string calibration;       // "" = the capture's own; else this file is refined
+  // Set: this rig is refined (calibration, if set, only names it in messages), as
+  // `arco calibrate from-instrument` does with the rig it made.
+  std::optional<Rig> input_rig;
   std::string output;            // calibration to write (.json, .yaml/.yml, .xml)
+  bool write = true;             // false: nothing is written, the summary only (output unused)
   bool overwrite = false;        // replace an existing output file
   std::string reference_camera;  // "" = the calibration's first capture camera: held fixed
   bool refine_focal = false;     // also fx, fy of every camera
@@ -92,6 +98,11 @@ struct CalibrationRefineSummary {
   Rig rig;  // the refined calibration (what was written)
   Json ToJson() const;
 };
+
+// The format a calibration output's extension names; an error naming `path` otherwise.
+StatusOr<CalibrationFormat> CalibrationOutputFormat(const std::string& path);
+// OUTPUT.report.json beside a calibration output (its extension replaced).
+std::string RefineReportPath(const std::string& output);
 
 // Writes options.output (and OUTPUT.report.json beside it) through OutputSet: nothing is
 // written on an error. Errors: the capture or calibration cannot be read, an output that

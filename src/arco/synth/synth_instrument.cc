@@ -4,12 +4,12 @@
 #include <limits>
 
 #include "arco/instrument/contact.h"
+#include "arco/instrument/nominal_keypoints.h"
 
 namespace arco::synth {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kReferenceCelloMm = 695.0;
 
 }  // namespace
 
@@ -34,7 +34,7 @@ int GmProgramFor(InstrumentKind kind) { return GetInstrumentInfo(kind).gm_progra
 StatusOr<InstrumentTemplate> MakeInstrumentTemplate(const InstrumentModel& model) {
   InstrumentTemplate t;
   const double length = model.string_length_mm();
-  t.scale = length / kReferenceCelloMm;
+  t.scale = length / kNominalReferenceCelloMm;
   const double s = t.scale;
   // Edge points at the real outer-string spacing; the low string on +y.
   StringEdges edges;
@@ -50,20 +50,7 @@ StatusOr<InstrumentTemplate> MakeInstrumentTemplate(const InstrumentModel& model
   auto geometry = GeometryFromEdges(model, edges, hint, options);
   if (!geometry.ok()) return geometry.status().WithContext("instrument template");
   t.strings_mm = geometry->strings;
-  const auto& names = model.keypoint_names();
-  t.keypoints_mm.assign(names.size(), Eigen::Vector3d::Constant(kNaN));
-  for (size_t i = 0; i < names.size(); ++i) {
-    const std::string& n = names[i];
-    Eigen::Vector3d p = Eigen::Vector3d::Constant(kNaN);
-    if (n == "scroll_top") p = {length + 186 * s, 0, -25 * s};
-    if (n == "nut_l") p = edges.nut_l;
-    if (n == "nut_r") p = edges.nut_r;
-    if (n == "bridge_l") p = edges.bridge_l;
-    if (n == "bridge_r") p = edges.bridge_r;
-    if (n == "tail_gut") p = {-377 * s, 0, -75 * s};
-    if (n == "end_pin") p = {-(377 + 314) * s, 0, -120 * s};
-    t.keypoints_mm[i] = p;
-  }
+  t.keypoints_mm = NominalKeypointsInInstrument(model);
   // The body: about 755 mm long on a cello, its lower end near the tail gut; the
   // top plate about 90 mm (bridge height) below the strings at the bridge.
   t.body_half_length_mm = 0.5 * 755 * s;

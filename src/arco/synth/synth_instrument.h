@@ -6,10 +6,10 @@
 // bridge towards the nut, z the top-plate normal pointing to the front (away from
 // the performer), y = z x x towards the LOW-string side. Millimetres.
 //
-// Template offsets not given by the model (scroll, tail gut, end pin, body) come
-// from the real SPD frame-128 labels of a cello (DOMAIN.md section 5: scroll_top
-// 186 mm beyond the nut, tail_gut 377 mm below the bridge, end_pin 314 mm beyond
-// the tail gut), scaled by string length for the other instruments.
+// The keypoints are instrument/nominal_keypoints.h's (what `arco calibrate
+// from-instrument` solves PnP against); the body outline's offsets, like theirs, come
+// from the real SPD frame-128 labels of a cello (DOMAIN.md section 5), scaled by string
+// length for the other instruments.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,0 +1,108 @@
+// `arco calibrate from-instrument CAPTURE -o CALIBRATION`: a calibration from the take
+// itself, without a board (two phones; docs/calibration.md "Calibrating from the
+// instrument").
+//
+// 1. Intrinsics: the image size from each camera's video (or image_size), fx = fy = the
+//    focal length given (focal_px), or from a horizontal field of view (fov_deg), or a
+//    phone's main camera by default (kPhoneFovDeg: a 26 mm-equivalent lens on a 4:3
+//    sensor, whose width a video keeps); principal point at the image centre, no
+//    distortion. The summary says which.
+// 2. Per camera and frame, cam_from_instrument by PnP of the instrument's rigid keypoints
+//    against their nominal places (instrument/nominal_keypoints.h: the model's real
+//    dimensions give the metric scale): EPnP (Lepetit, Moreno-Noguer, Fua, IJCV 2009)
+//    inside RANSAC, then Levenberg-Marquardt on the inliers (cv::solvePnPRansac,
+//    cv::solvePnP SOLVEPNP_ITERATIVE).
+// 3. The instrument moves, but in a frame every camera sees it in, camera c's pose
+//    relative to the first camera, cam_c_from_cam_0 = cam_c_from_instrument *
+//    inverse(cam_0_from_instrument), is what stays constant: the frame whose relative poses
+//    are the medoid of all frames' (smallest median distance to the others, degrees plus
+//    centimetres) gives the initial rig.
+// 4. RefineCalibration (calibration_refine.h: bundle adjustment in Ceres over the
+//    performer's keypoints and the instrument as a rigid body whose string length is held
+//    at the model's) from that rig, with min_views 2 and the focal lengths free unless
+//    fixed.
+// World frame: the first capture camera's (cam_from_world of the first camera is the
+// identity), millimetres.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "arco/camera/rig.h"
+#include "arco/pipeline/calibration_refine.h"
+#include "arco/util/json_io.h"
+#include "arco/util/number_range.h"
+#include "arco/util/progress.h"
+#include "arco/util/status.h"
+
+namespace arco::pipeline {
+
+inline constexpr double kPhoneFovDeg = 67.0;
+inline constexpr NumberRange kFromInstrumentFocalRangePx = AboveZero(100000);
+inline constexpr NumberRange kFromInstrumentFovRangeDeg = Closed(10, 150);
+inline constexpr NumberRange kFromInstrumentPointsRange = Closed(4, 64);
+inline constexpr NumberRange kFromInstrumentGateRangePx = AboveZero(1000);
+inline constexpr NumberRange kFromInstrumentImageSideRange = Closed(0, 100000);
+
+struct CalibrationFromInstrumentOptions {
+  std::string capture_dir;
+  std::string output;        // calibration to write (.json, .yaml/.yml, .xml)
+  bool overwrite = false;    // replace an existing output file
+  double focal_px = 0;       // fx = fy of every camera; 0 = from fov_deg
+  double fov_deg = 0;        // horizontal field of view; 0 = kPhoneFovDeg (both 0: default)
+  int image_width = 0;       // 0 = from each camera's video
+  int image_height = 0;      // given with image_width
+  double min_score = 0.6;    // instrument detections below this confidence are ignored
+  int min_points = 5;        // instrument points a view needs for a PnP
+  double pnp_gate_px = 12;   // RANSAC inlier threshold of the PnP
+  bool refine_focal = true;  // the bundle adjustment also refines fx, fy
+  // Frames the bundle adjustment uses (RefineCalibration): more than refine's 60, as two
+  // views constrain each point less (docs/calibration.md's figures).
+  int max_frames = 300;
+  int max_iterations = 100;  // per bundle adjustment pass
+  Status Validate() const;   // messages name the fields
+};
+
+struct FromInstrumentCamera {
+  std::string name;
+  int width = 0, height = 0;
+  std::string size_source;                    // "video" or "--image-size"
+  double initial_focal_px = 0, focal_px = 0;  // given / default, and after the refinement
+  int pnp_frames = 0;                         // frames with a PnP pose of the instrument
+  double pnp_rms_px = 0;                      // median over those frames of the PnP's inlier RMS
+  // Spread of the per-frame relative poses about the one chosen (median; not the first
+  // camera's).
+  double relative_spread_deg = 0, relative_spread_mm = 0;
+};
+
+struct CalibrationFromInstrumentSummary {
+  std::string capture_dir, output, instrument;
+  std::string focal_source;  // "--focal-px", "--fov-deg", or "phone default (67 deg)"
+  std::vector<FromInstrumentCamera> cameras;
+  int shared_frames = 0;        // frames where every camera has a PnP pose
+  int64_t reference_frame = 0;  // the capture frame (index) the initial rig comes from
+  double string_length_mm = 0;  // the model's
+  // The template's nut-to-bridge distance in the initial rig's scale (before the
+  // refinement holds it at the model's): how far off the PnP scale was.
+  double string_length_initial_mm = 0;
+  // The nut-centre to bridge-centre distance triangulated with the refined rig in every
+  // frame where both cameras see all four points: median, robust spread (1.4826 MAD) and
+  // frames. An independent check of the scale (the template is held at the model's).
+  double string_length_measured_mm = 0, string_length_spread_mm = 0;
+  int string_length_frames = 0;
+  double rms_initial_px = 0, rms_px = 0;  // reprojection RMS, initial rig and refined
+  CalibrationRefineSummary refinement;
+  std::vector<std::string> warnings;
+  Rig rig;
+  Json ToJson() const;
+};
+
+// Writes options.output and OUTPUT.report.json beside it through OutputSet: nothing is
+// written on an error. Errors (one line naming the file): an unreadable capture, no
+// instrument, an image size that cannot be read, a camera that never sees min_points
+// instrument points, no frame where every camera has a pose, fewer than two cameras, and
+// RefineCalibration's.
+StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
+    const CalibrationFromInstrumentOptions& options, Progress& progress = NoProgress());
+
+}  // namespace arco::pipeline
