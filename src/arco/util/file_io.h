@@ -18,8 +18,10 @@ StatusOr<std::string> ReadFileToString(const std::string& path);
 // A file's bytes, read-only, for as long as the object lives: a regular file is mapped
 // into memory (mmap), so a 118 MB keypoints2d.npy is neither copied into a string nor
 // zero-filled first (that was 4% of `arco run`'s CPU on the one-minute 20-camera take);
-// anything else (a pipe, an empty file) is read into memory with ReadFileToString. The
+// anything else (a pipe, an empty file) is read into memory from the same descriptor. The
 // messages for a missing file and a folder are ReadFileToString's. Moving keeps the view.
+// arco replaces files by renaming a new one over them (AtomicWriteFile), which leaves a
+// mapping's bytes as they were; a file truncated in place while mapped would fault.
 class FileBytes {
  public:
   static StatusOr<FileBytes> Open(const std::string& path);
