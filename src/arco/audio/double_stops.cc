@@ -275,6 +275,25 @@ int DoubleStopAnalyzer::Analyze(const float* x, std::array<PolyNote, 2>* notes) 
   return 2;
 }
 
+std::vector<double> SecondNoteHz(const std::vector<PitchFrame>& frames,
+                                 const std::vector<PolyPitchFrame>& poly,
+                                 double match_cents) {
+  std::vector<double> second(frames.size(), 0.0);
+  for (size_t i = 0; i < frames.size() && i < poly.size(); ++i) {
+    const PitchFrame& f = frames[i];
+    const PolyPitchFrame& p = poly[i];
+    if (!f.voiced || f.f0_hz <= 0 || p.count < 2) continue;
+    for (int j = 0; j < 2; ++j) {
+      const double cents = 1200.0 * std::log2(p.notes[j].f0_hz / f.f0_hz);
+      if (std::abs(cents) <= match_cents) {
+        second[i] = p.notes[1 - j].f0_hz;
+        break;
+      }
+    }
+  }
+  return second;
+}
+
 StatusOr<std::vector<PolyPitchFrame>> TrackDoubleStops(std::unique_ptr<AudioReader> reader,
                                                        const DoubleStopOptions& options,
                                                        DoubleStopSummary* summary) {

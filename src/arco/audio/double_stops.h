@@ -129,6 +129,14 @@ class DoubleStopAnalyzer {
   void* plan_ = nullptr;
 };
 
+// The second note beside the single-note tracker's f0, one per tracker frame (poly[i] must
+// be frame i at the same time; rows past the end of `poly` get 0): when frame i has two
+// notes and one lies within match_cents of the tracker's voiced f0, the other's f0; else 0
+// (the tracker's f0 stays what it was).
+std::vector<double> SecondNoteHz(const std::vector<PitchFrame>& frames,
+                                 const std::vector<PolyPitchFrame>& poly,
+                                 double match_cents = 50.0);
+
 // Frames at start_s + i / fps (the tracker's video rows) from an open reader.
 StatusOr<std::vector<PolyPitchFrame>> TrackDoubleStops(std::unique_ptr<AudioReader> reader,
                                                        const DoubleStopOptions& options,

@@ -84,6 +84,54 @@ TEST(DoubleStopAnalyzer, FindsOneNoteAloneAndBothOfAPair) {
   }
 }
 
+TEST(SecondNoteHz, TheNoteBesideTheTrackersF0) {
+  std::vector<PitchFrame> frames(4);
+  for (auto& f : frames) f.voiced = true, f.f0_hz = 440.0;
+  frames[3].voiced = false;
+  std::vector<PolyPitchFrame> poly(4);
+  poly[0].count = 2,
+  poly[0].notes = {PolyNote{293.7, 1}, PolyNote{441.0, 1}};  // tracker on the upper
+  poly[1].count = 2, poly[1].notes = {PolyNote{440.5, 1}, PolyNote{659.3, 1}};  // on the lower
+  poly[2].count = 2, poly[2].notes = {PolyNote{261.6, 1}, PolyNote{349.2, 1}};  // neither matches
+  poly[3] = poly[0];                                                            // unvoiced
+  const auto second = SecondNoteHz(frames, poly);
+  ASSERT_EQ(second.size(), 4u);
+  EXPECT_DOUBLE_EQ(second[0], 293.7);
+  EXPECT_DOUBLE_EQ(second[1], 659.3);
+  EXPECT_EQ(second[2], 0.0);
+  EXPECT_EQ(second[3], 0.0);
+  EXPECT_EQ(SecondNoteHz(frames, {}).size(), 4u);  // frames past poly's end: 0
+}
+
+TEST(PitchCsv, SecondNoteColumnIsOptionalAndRoundTrips) {
+  std::vector<PitchFrame> frames(2);
+  frames[0] = {0, 0.0, 220.0, 0.9, true};
+  frames[1] = {1, 1.0 / 30, 0.0, 0.1, false};
+  const std::string plain = FormatPitchCsv(frames);
+  EXPECT_EQ(FormatPitchCsv(frames, nullptr), plain);
+  EXPECT_EQ(plain.substr(0, plain.find('\n')), "frame,time_s,f0_hz,confidence,voiced");
+  const std::vector<double> second = {329.6276, 0.0};
+  const std::string text = FormatPitchCsv(frames, &second);
+  EXPECT_EQ(text.substr(0, text.find('\n')), "frame,time_s,f0_hz,confidence,voiced,f0_2_hz");
+  std::vector<double> read;
+  auto rows = ParsePitchCsv(text, "test", &read);
+  ASSERT_TRUE(rows.ok()) << rows.status().message();
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_DOUBLE_EQ(read[0], 329.6276);
+  EXPECT_EQ(read[1], 0.0);
+  EXPECT_EQ(FormatPitchCsv(*rows), plain);  // the five columns unchanged
+  // A reader that does not ask for the column still reads the file.
+  EXPECT_TRUE(ParsePitchCsv(text, "test").ok());
+  // Without the column: zeros.
+  ASSERT_TRUE(ParsePitchCsv(plain, "test", &read).ok());
+  EXPECT_EQ(read, std::vector<double>(2, 0.0));
+  const std::vector<double> short_second = {1.0};
+  EXPECT_THROW(FormatPitchCsv(frames, &short_second), std::invalid_argument);
+  std::string bad = text;
+  bad.replace(bad.find("329.6276"), 8, "-1");
+  EXPECT_FALSE(ParsePitchCsv(bad, "test", &read).ok());
+}
+
 struct MusicScore {
   int64_t double_frames = 0, double_hits = 0;  // sixths, thirds, fifths
   int64_t octave_frames = 0, octave_hits = 0;

@@ -28,6 +28,9 @@ struct PitchRunOptions {
   double min_f0_hz = 0, max_f0_hz = 0;  // overrides of the instrument range
   std::string output = "pitch.csv";
   std::string fine_output, notes_output, midi_output;
+  // Double stops (audio/double_stops.h): pitch.csv gains the column f0_2_hz, the second
+  // note beside f0_hz (0 when none). Off: pitch.csv is the five-column file.
+  bool double_stops = false;
 
   // The overrides' ranges (audio::kF0OverrideRangeHz) and min below max when both are
   // given; the rest is checked by the tracker once the manifest's values are in.
@@ -40,6 +43,7 @@ struct PitchRunResult {
   audio::PitchSummary summary;
   double fine_fps = 0;
   int notes = 0, notes_with_vibrato = 0, glides = 0;
+  int64_t double_stop_frames = 0;  // video frames with a second note (double_stops on)
 };
 
 // The tracker's options for `o` without a capture folder (its manifest already applied):
