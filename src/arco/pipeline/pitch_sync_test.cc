@@ -92,13 +92,14 @@ TEST(RunPitch, DoubleStopsAddTheSecondNoteColumn) {
   ASSERT_TRUE(rows2.ok()) << rows2.status().message();
   ASSERT_EQ(rows2->size(), rows->size());
   ASSERT_EQ(second.size(), rows->size());
-  int64_t doubles = 0, found = 0, singles = 0, clean = 0, ghosts = 0;
+  int64_t doubles = 0, found = 0, singles = 0, clean = 0, ghosts = 0, unvoiced = 0;
   for (size_t i = 0; i < rows->size(); ++i) {
     // The single-note columns do not change.
     EXPECT_EQ((*rows2)[i].f0_hz, (*rows)[i].f0_hz);
     EXPECT_EQ((*rows2)[i].voiced, (*rows)[i].voiced);
     double lo = 0, hi = 0;
     const int truth = music.Truth((*rows)[i].time_s, &lo, &hi, 0.1);
+    unvoiced += truth == 2 && !(*rows)[i].voiced;
     if (truth == 2 && (*rows)[i].voiced) {
       // Scored where the tracker follows one of the two notes; the second column holds the
       // other. (On some double stops the single-note tracker reports their common
@@ -124,11 +125,12 @@ TEST(RunPitch, DoubleStopsAddTheSecondNoteColumn) {
   EXPECT_GE(found, 0.75 * doubles);  // measured 0.83, octaves included (docs/audio.md)
   std::printf(
       "double-stop frames with the tracker on a note: %lld, second note found on "
-      "%lld; tracker on neither: %lld; single-note frames without a second: %lld of "
+      "%lld; tracker on neither: %lld, unvoiced: %lld; single-note frames without a second: %lld of "
       "%lld\n",
       static_cast<long long>(doubles),
       static_cast<long long>(found),
       static_cast<long long>(ghosts),
+      static_cast<long long>(unvoiced),
       static_cast<long long>(clean),
       static_cast<long long>(singles));
   EXPECT_GE(clean, 0.95 * singles);
