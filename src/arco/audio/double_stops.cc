@@ -116,6 +116,8 @@ DoubleStopAnalyzer::DoubleStopAnalyzer(const DoubleStopOptions& options) : optio
   plan_ = fftw_plan_dft_r2c_1d(fft_size_, time_, spectrum, FFTW_ESTIMATE);
   magnitude_.assign(fft_size_ / 2 + 1, 0.0);
   residual_ = magnitude_;
+  for (auto* v : {&partial_hz_, &partial_amplitude_}) v->reserve(harmonics + 2);
+  partial_index_.reserve(harmonics + 2);
 }
 
 DoubleStopAnalyzer::~DoubleStopAnalyzer() {
@@ -182,9 +184,11 @@ DoubleStopAnalyzer::Best DoubleStopAnalyzer::Search(const std::vector<double>& s
 // two neighbours, then f0 = sum(A_m^2 m f_m) / sum(A_m^2 m^2), the least-squares fit of
 // f_m = m f0 weighted by A_m^2 (as HarmonicPeakFit, harmonic_fit.h); partials below 10% of
 // the strongest are left out.
-double DoubleStopAnalyzer::Refine(int c, const std::vector<double>& spectrum) const {
-  std::vector<double> freq, amp;
-  std::vector<int> harmonic;
+double DoubleStopAnalyzer::Refine(int c, const std::vector<double>& spectrum) {
+  std::vector<double>& freq = partial_hz_;
+  std::vector<double>& amp = partial_amplitude_;
+  std::vector<int>& harmonic = partial_index_;
+  freq.clear(), amp.clear(), harmonic.clear();
   for (int m = 1; m <= options_.harmonics; ++m) {
     int k = -1;
     if (BandMax(c, m, spectrum, &k) < 0) break;
@@ -211,13 +215,17 @@ double DoubleStopAnalyzer::Refine(int c, const std::vector<double>& spectrum) co
 }
 
 // Cancels the partials of candidate c from residual_ after the spectral-smoothness rule
-// (Klapuri 2003): partial m keeps min(A_m, (A_{m-1} + A_{m+1}) / 2) as this note's, and
+// (Klapuri 2003): partial m keeps min(A_m, sqrt(A_{m-1} A_{m+1})) as this note's (the
+// geometric mean of its neighbours: the arithmetic one, above a k^-1 envelope, took all of
+// an octave's shared partials), and
 // its main lobe is scaled by the share left to other notes, 1 - that / A_m. Returns the
 // salience of what it cancelled (eq. 3 on the note's own partials).
 double DoubleStopAnalyzer::Cancel(int c) {
   const int harmonics = options_.harmonics;
-  std::vector<double> amplitude(harmonics + 2, 0.0);
-  std::vector<int> at(harmonics + 2, -1);
+  std::vector<double>& amplitude = partial_amplitude_;
+  std::vector<int>& at = partial_index_;
+  amplitude.assign(harmonics + 2, 0.0);
+  at.assign(harmonics + 2, -1);
   int count = 0;
   for (int m = 1; m <= harmonics; ++m) {
     const double a = BandMax(c, m, residual_, &at[m]);

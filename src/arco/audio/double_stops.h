@@ -8,8 +8,9 @@
 // amplitudes", eq. 3, a = 52 Hz, b = 320 Hz); the best candidate whose fundamental is
 // present is the first note; its partials are cancelled from the spectrum after the
 // spectral-smoothness rule (Klapuri 2003, "Multiple fundamental frequency estimation based
-// on harmonicity and spectral smoothness": a partial's amplitude is limited to the mean of
-// its neighbours, so a partial shared with a second note keeps that note's share); the
+// on harmonicity and spectral smoothness": a partial's amplitude is limited to the
+// geometric mean of its neighbours', so a partial shared with a second note keeps that
+// note's share); the
 // best candidate on the residual is the second note when
 //   (1) it forms a playable double stop with the first: the two notes lie on adjacent
 //       strings, each at or above its open string, and their stops lie within
@@ -113,7 +114,7 @@ class DoubleStopAnalyzer {
   double Salience(int candidate, const std::vector<double>& spectrum) const;
   double BandMax(int candidate, int m, const std::vector<double>& spectrum, int* at) const;
   Best Search(const std::vector<double>& spectrum, int first) const;
-  double Refine(int candidate, const std::vector<double>& spectrum) const;
+  double Refine(int candidate, const std::vector<double>& spectrum);
   double Cancel(int candidate);
 
   DoubleStopOptions options_;
@@ -124,6 +125,9 @@ class DoubleStopAnalyzer {
   std::vector<double> candidates_hz_, candidates_midi_, hann_;
   std::vector<std::array<int, 2>> bands_;  // [candidate * M + m - 1]: bins lo, hi (-1: none)
   std::vector<double> magnitude_, residual_;
+  // Per-partial scratch of Refine and Cancel (sized once: no allocation per frame).
+  std::vector<double> partial_hz_, partial_amplitude_;
+  std::vector<int> partial_index_;
   double* time_ = nullptr;
   void* spectrum_ = nullptr;
   void* plan_ = nullptr;
