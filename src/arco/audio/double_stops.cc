@@ -302,6 +302,21 @@ std::vector<double> SecondNoteHz(const std::vector<PitchFrame>& frames,
   return second;
 }
 
+NoteAnalysis SecondVoiceNotes(const std::vector<PitchFrame>& frames,
+                              const std::vector<double>& second_f0_hz,
+                              double fps,
+                              const NoteOptions& options) {
+  std::vector<PitchFrame> voice = frames;
+  for (size_t i = 0; i < voice.size(); ++i) {
+    const double f0 = i < second_f0_hz.size() ? second_f0_hz[i] : 0.0;
+    voice[i].voiced = f0 > 0;
+    voice[i].f0_hz = f0;
+  }
+  NoteAnalysis notes = SegmentNotes(voice, fps, options);
+  notes.glides.clear();  // a second voice's glides are not told apart from its notes' edges
+  return notes;
+}
+
 StatusOr<std::vector<PolyPitchFrame>> TrackDoubleStops(std::unique_ptr<AudioReader> reader,
                                                        const DoubleStopOptions& options,
                                                        DoubleStopSummary* summary) {

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "arco/audio/audio_reader.h"
+#include "arco/audio/notes.h"
 #include "arco/audio/pitch_tracker.h"
 #include "arco/util/number_range.h"
 #include "arco/util/status.h"
@@ -140,6 +141,14 @@ class DoubleStopAnalyzer {
 std::vector<double> SecondNoteHz(const std::vector<PitchFrame>& frames,
                                  const std::vector<PolyPitchFrame>& poly,
                                  double match_cents = 50.0);
+
+// Notes of the second voice: SegmentNotes on the frames with f0 = second_f0_hz (voiced
+// where > 0) at `fps`. Merged with the first voice's notes by onset they overlap them
+// (notes.csv holds overlapping notes: its rows are only sorted by onset).
+NoteAnalysis SecondVoiceNotes(const std::vector<PitchFrame>& frames,
+                              const std::vector<double>& second_f0_hz,
+                              double fps,
+                              const NoteOptions& options);
 
 // Frames at start_s + i / fps (the tracker's video rows) from an open reader.
 StatusOr<std::vector<PolyPitchFrame>> TrackDoubleStops(std::unique_ptr<AudioReader> reader,

@@ -119,7 +119,21 @@ StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, Progress& progress) 
   ARCO_RETURN_IF_ERROR(
       audio::WritePitchCsv(pitch_tmp, track.frames, o.double_stops ? &second_f0_hz : nullptr));
   if (!fine_tmp.empty()) ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(fine_tmp, track.fine));
-  if (!notes_tmp.empty()) ARCO_RETURN_IF_ERROR(audio::WriteNotesCsv(notes_tmp, notes));
+  if (!notes_tmp.empty() && o.double_stops) {
+    // The second voice's notes merged by onset (the MIDI file keeps the first voice).
+    audio::NoteAnalysis both = notes;
+    const audio::NoteAnalysis second =
+        audio::SecondVoiceNotes(track.frames, second_f0_hz, t.fps, note_options);
+    result.second_voice_notes = static_cast<int>(second.notes.size());
+    both.notes.insert(both.notes.end(), second.notes.begin(), second.notes.end());
+    std::stable_sort(
+        both.notes.begin(), both.notes.end(), [](const audio::Note& a, const audio::Note& b) {
+          return a.onset_s < b.onset_s;
+        });
+    ARCO_RETURN_IF_ERROR(audio::WriteNotesCsv(notes_tmp, both));
+  } else if (!notes_tmp.empty()) {
+    ARCO_RETURN_IF_ERROR(audio::WriteNotesCsv(notes_tmp, notes));
+  }
   if (!midi_tmp.empty()) {
     ARCO_RETURN_IF_ERROR(audio::WriteMidiFile(
         midi_tmp,

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "arco/audio/double_stop_music.h"
+#include "arco/audio/notes.h"
 #include "arco/audio/test_media.h"
 #include "arco/audio/test_signals.h"
 #include "arco/mocap/capture.h"
@@ -70,6 +71,7 @@ TEST(RunPitch, DoubleStopsAddTheSecondNoteColumn) {
   o.input = wav;
   o.instrument = "violin";
   o.output = testing::TempPath("pitch_single.csv");
+  o.notes_output = testing::TempPath("notes_single.csv");
   auto single = RunPitch(o);
   ASSERT_TRUE(single.ok()) << single.status().message();
   auto text = ReadFileToString(o.output);
@@ -82,6 +84,7 @@ TEST(RunPitch, DoubleStopsAddTheSecondNoteColumn) {
 
   o.double_stops = true;
   o.output = testing::TempPath("pitch_double.csv");
+  o.notes_output = testing::TempPath("notes_double.csv");
   auto both = RunPitch(o);
   ASSERT_TRUE(both.ok()) << both.status().message();
   auto text2 = ReadFileToString(o.output);
@@ -137,6 +140,44 @@ TEST(RunPitch, DoubleStopsAddTheSecondNoteColumn) {
   int64_t with_second = 0;
   for (double f : second) with_second += f > 0;
   EXPECT_EQ(both->double_stop_frames, with_second);
+
+  // notes.csv: the second voice's notes overlap the first voice's, rows by onset.
+  auto notes1 = audio::ReadNotesCsv(testing::TempPath("notes_single.csv"));
+  auto notes2 = audio::ReadNotesCsv(o.notes_output);
+  ASSERT_TRUE(notes1.ok() && notes2.ok()) << notes2.status().message();
+  EXPECT_EQ(single->second_voice_notes, 0);
+  EXPECT_GT(both->second_voice_notes, 0);
+  EXPECT_EQ(notes2->size(), notes1->size() + both->second_voice_notes);
+  int overlaps = 0;
+  for (size_t i = 0; i + 1 < notes2->size(); ++i) {
+    overlaps += (*notes2)[i + 1].onset_s < (*notes2)[i].offset_s;
+  }
+  EXPECT_GT(overlaps, 0);
+  std::printf("notes.csv: %zu first-voice notes, %d second-voice notes (%d generated double "
+              "stops), %d overlapping neighbours\n",
+              notes1->size(),
+              both->second_voice_notes,
+              static_cast<int>(music.notes.size() / 2),
+              overlaps);
+  // Every second-voice note lies inside a generated double stop, at its other note.
+  for (const audio::Note& n : *notes2) {
+    bool first_voice = false;
+    for (const audio::Note& m : *notes1) first_voice = first_voice || m.onset_s == n.onset_s;
+    if (first_voice) continue;
+    const double mid_s = 0.5 * (n.onset_s + n.offset_s);
+    const testing::DoubleStopNote* played = nullptr;
+    for (const auto& g : music.notes) {
+      if (g.onset_s <= mid_s && mid_s <= g.offset_s) played = &g;
+    }
+    ASSERT_NE(played, nullptr) << n.onset_s;
+    EXPECT_NE(played->high_midi, 0) << n.onset_s;  // a double stop
+    const double cents_lo = std::abs(1200 * std::log2(n.median_f0_hz / 440.0) + 6900 -
+                                     100 * played->low_midi),
+                 cents_hi = std::abs(1200 * std::log2(n.median_f0_hz / 440.0) + 6900 -
+                                     100 * played->high_midi);
+    EXPECT_LT(std::min(cents_lo, cents_hi), 50)
+        << n.onset_s;
+  }
 }
 
 TEST(RunPitch, BadInputIsOneErrorAndNoOutput) {
