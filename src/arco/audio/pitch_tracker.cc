@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <ctime>
 #include <sstream>
+#include <stdexcept>
 
 #include "arco/audio/sample_stream.h"
 #include "arco/registry/instruments.h"
@@ -178,9 +179,19 @@ StatusOr<PitchTrack> TrackPitchFile(const std::string& path,
 }
 
 std::string FormatPitchCsv(const std::vector<PitchFrame>& frames) {
-  std::string out = "frame,time_s,f0_hz,confidence,voiced\n";
+  return FormatPitchCsv(frames, nullptr);
+}
+
+std::string FormatPitchCsv(const std::vector<PitchFrame>& frames,
+                           const std::vector<double>* second_f0_hz) {
+  if (second_f0_hz != nullptr && second_f0_hz->size() != frames.size()) {
+    throw std::invalid_argument("FormatPitchCsv: one second f0 per frame");
+  }
+  std::string out = second_f0_hz != nullptr ? "frame,time_s,f0_hz,confidence,voiced,f0_2_hz\n"
+                                            : "frame,time_s,f0_hz,confidence,voiced\n";
   char line[160];
-  for (const auto& f : frames) {
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const PitchFrame& f = frames[i];
     std::snprintf(line,
                   sizeof(line),
                   "%lld,%.6f,%.4f,%.4f,%d\n",
@@ -190,12 +201,23 @@ std::string FormatPitchCsv(const std::vector<PitchFrame>& frames) {
                   f.confidence,
                   f.voiced ? 1 : 0);
     out += line;
+    if (second_f0_hz != nullptr) {
+      out.pop_back();  // the newline
+      std::snprintf(line, sizeof(line), ",%.4f\n", (*second_f0_hz)[i]);
+      out += line;
+    }
   }
   return out;
 }
 
 Status WritePitchCsv(const std::string& path, const std::vector<PitchFrame>& frames) {
   return AtomicWriteFile(path, FormatPitchCsv(frames));
+}
+
+Status WritePitchCsv(const std::string& path,
+                     const std::vector<PitchFrame>& frames,
+                     const std::vector<double>* second_f0_hz) {
+  return AtomicWriteFile(path, FormatPitchCsv(frames, second_f0_hz));
 }
 
 StatusOr<std::vector<PitchFrame>> ReadPitchCsv(const std::string& path) {
@@ -205,6 +227,12 @@ StatusOr<std::vector<PitchFrame>> ReadPitchCsv(const std::string& path) {
 
 StatusOr<std::vector<PitchFrame>> ParsePitchCsv(const std::string& text,
                                                 const std::string& source) {
+  return ParsePitchCsv(text, source, nullptr);
+}
+
+StatusOr<std::vector<PitchFrame>> ParsePitchCsv(const std::string& text,
+                                                const std::string& source,
+                                                std::vector<double>* second_f0_hz) {
   ARCO_ASSIGN_OR_RETURN(const CsvTable table,
                         ParseCsvTable(text,
                                       source,
@@ -213,6 +241,8 @@ StatusOr<std::vector<PitchFrame>> ParsePitchCsv(const std::string& text,
   const int frame_col = table.Column("frame"), time_col = table.Column("time_s"),
             f0_col = table.Column("f0_hz"), confidence_col = table.Column("confidence"),
             voiced_col = table.Column("voiced");
+  const int second_col = table.Column("f0_2_hz");  // optional (-1 when absent)
+  if (second_f0_hz != nullptr) second_f0_hz->clear();
   std::vector<PitchFrame> frames;
   for (const CsvTable::Row& row : table.rows) {
     PitchFrame f;
@@ -228,6 +258,12 @@ StatusOr<std::vector<PitchFrame>> ParsePitchCsv(const std::string& text,
                            "malformed row (frame, time_s, f0_hz, confidence: "
                            "numbers; voiced: 0 or 1)");
     }
+    double second = 0;
+    if (second_col >= 0 &&
+        (!ParseCsvDouble(row.cells[second_col], &second) || !std::isfinite(second) || second < 0)) {
+      return Status::Error(table.Where(row) + "malformed f0_2_hz (a number >= 0)");
+    }
+    if (second_f0_hz != nullptr) second_f0_hz->push_back(second);
     f.frame = frame;
     f.voiced = voiced != 0;
     frames.push_back(f);

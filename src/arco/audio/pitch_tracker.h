@@ -107,11 +107,25 @@ StatusOr<PitchTrack> TrackPitchFile(const std::string& path,
 Status WritePitchCsv(const std::string& path, const std::vector<PitchFrame>& frames);
 // The file's text (time_s to 1 us, f0_hz and confidence to 1e-4, f0_hz 0 when unvoiced).
 std::string FormatPitchCsv(const std::vector<PitchFrame>& frames);
+// The same with the optional second-note column (double stops, double_stops.h):
+// `frame,time_s,f0_hz,confidence,voiced,f0_2_hz`, f0_2_hz to 1e-4 and 0 on frames without
+// a second note; `second_f0_hz` holds one value per frame (std::invalid_argument
+// otherwise). Without it (nullptr) the text is exactly the five-column one above.
+std::string FormatPitchCsv(const std::vector<PitchFrame>& frames,
+                           const std::vector<double>* second_f0_hz);
+Status WritePitchCsv(const std::string& path,
+                     const std::vector<PitchFrame>& frames,
+                     const std::vector<double>* second_f0_hz);
 // Reads a file written by WritePitchCsv (tests, tools).
 StatusOr<std::vector<PitchFrame>> ReadPitchCsv(const std::string& path);
 // The same on the file's text; `source` names it in messages. ParsePitchCsv(
 // FormatPitchCsv(frames)) is what a reader of the file gets: `arco run` hands the pitch
 // to the refinement that way, so that it refines what `arco refine` reads.
 StatusOr<std::vector<PitchFrame>> ParsePitchCsv(const std::string& text, const std::string& source);
+// The same, also reading the optional f0_2_hz column into `second_f0_hz` (one per row; all 0
+// when the file has no such column).
+StatusOr<std::vector<PitchFrame>> ParsePitchCsv(const std::string& text,
+                                                const std::string& source,
+                                                std::vector<double>* second_f0_hz);
 
 }  // namespace arco::audio

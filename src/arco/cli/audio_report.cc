@@ -48,6 +48,11 @@ std::string FormatPitchReport(const pipeline::PitchRunOptions& o,
   out += "\n";
   out +=
       Format("notes: %d (%d with vibrato), glides: %d\n", r.notes, r.notes_with_vibrato, r.glides);
+  if (o.double_stops) {
+    out += Format("double stops: a second note on %lld frames (f0_2_hz), %d second-voice notes\n",
+                  static_cast<long long>(r.double_stop_frames),
+                  r.second_voice_notes);
+  }
   out += Format("wrote %s; %.3f s CPU (%.0fx real time)\n",
                 o.output.c_str(),
                 s.cpu_seconds,

@@ -72,6 +72,9 @@ CommandRun SetupPitch(CLI::App& app) {
                   o->notes_output,
                   "Write notes.csv: notes (onset, offset, median f0, MIDI, cents vs ET at A4, "
                   "vibrato rate Hz and extent cents) and glides");
+  cmd->add_flag("--double-stops",
+                o->double_stops,
+                "Also estimate a second simultaneous note: pitch.csv gains f0_2_hz (0 when none)");
   cmd->add_option("--midi",
                   o->midi_output,
                   "Write the notes as a standard MIDI file with pitch bends (+-2 semitones)");

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <utility>
 
+#include "arco/audio/double_stops.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/capture_checks.h"
 #include "arco/util/file_io.h"
@@ -102,9 +103,37 @@ StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, Progress& progress) 
   result.notes = static_cast<int>(notes.notes.size());
   result.glides = static_cast<int>(notes.glides.size());
   for (const auto& n : notes.notes) result.notes_with_vibrato += n.vibrato_rate_hz > 0;
-  ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(pitch_tmp, track.frames));
+  std::vector<double> second_f0_hz;
+  if (o.double_stops) {
+    audio::DoubleStopOptions d;
+    d.range = t.range;
+    d.fps = t.fps;
+    d.start_s = t.start_s;
+    d.max_frames = static_cast<int64_t>(track.frames.size());
+    d.a4_hz = t.a4_hz;
+    // A second pass over the audio (the tracker's stream is gone by now).
+    ARCO_ASSIGN_OR_RETURN(const auto poly, audio::TrackDoubleStopsFile(result.input, d, nullptr));
+    second_f0_hz = audio::SecondNoteHz(track.frames, poly);
+    for (double f : second_f0_hz) result.double_stop_frames += f > 0;
+  }
+  ARCO_RETURN_IF_ERROR(
+      audio::WritePitchCsv(pitch_tmp, track.frames, o.double_stops ? &second_f0_hz : nullptr));
   if (!fine_tmp.empty()) ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(fine_tmp, track.fine));
-  if (!notes_tmp.empty()) ARCO_RETURN_IF_ERROR(audio::WriteNotesCsv(notes_tmp, notes));
+  if (!notes_tmp.empty() && o.double_stops) {
+    // The second voice's notes merged by onset (the MIDI file keeps the first voice).
+    audio::NoteAnalysis both = notes;
+    const audio::NoteAnalysis second =
+        audio::SecondVoiceNotes(track.frames, second_f0_hz, t.fps, note_options);
+    result.second_voice_notes = static_cast<int>(second.notes.size());
+    both.notes.insert(both.notes.end(), second.notes.begin(), second.notes.end());
+    std::stable_sort(
+        both.notes.begin(), both.notes.end(), [](const audio::Note& a, const audio::Note& b) {
+          return a.onset_s < b.onset_s;
+        });
+    ARCO_RETURN_IF_ERROR(audio::WriteNotesCsv(notes_tmp, both));
+  } else if (!notes_tmp.empty()) {
+    ARCO_RETURN_IF_ERROR(audio::WriteNotesCsv(notes_tmp, notes));
+  }
   if (!midi_tmp.empty()) {
     ARCO_RETURN_IF_ERROR(audio::WriteMidiFile(
         midi_tmp,

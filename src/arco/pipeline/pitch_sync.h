@@ -28,6 +28,10 @@ struct PitchRunOptions {
   double min_f0_hz = 0, max_f0_hz = 0;  // overrides of the instrument range
   std::string output = "pitch.csv";
   std::string fine_output, notes_output, midi_output;
+  // Double stops (audio/double_stops.h): pitch.csv gains the column f0_2_hz, the second
+  // note beside f0_hz (0 when none), and notes.csv its notes, overlapping the first
+  // voice's (rows by onset). Off: both files are as without double stops.
+  bool double_stops = false;
 
   // The overrides' ranges (audio::kF0OverrideRangeHz) and min below max when both are
   // given; the rest is checked by the tracker once the manifest's values are in.
@@ -40,6 +44,8 @@ struct PitchRunResult {
   audio::PitchSummary summary;
   double fine_fps = 0;
   int notes = 0, notes_with_vibrato = 0, glides = 0;
+  int64_t double_stop_frames = 0;  // video frames with a second note (double_stops on)
+  int second_voice_notes = 0;      // notes of the second voice in notes.csv
 };
 
 // The tracker's options for `o` without a capture folder (its manifest already applied):

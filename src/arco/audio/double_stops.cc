@@ -1,0 +1,367 @@
+#include "arco/audio/double_stops.h"
+
+#include <fftw3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <stdexcept>
+
+#include "arco/audio/sample_stream.h"
+#include "arco/registry/instruments.h"
+
+namespace arco::audio {
+namespace {
+
+// Klapuri 2006, eq. 3: the weight of partial m of f0 f (alpha, beta in Hz).
+constexpr double kAlphaHz = 52.0, kBetaHz = 320.0;
+// A partial is looked for within +-25 cents of m f (the grid is finer; bowed strings are
+// harmonic to a few cents).
+constexpr double kPartialCents = 25.0;
+// Notes closer than this are one note (the residual of a vibrato's smeared peak).
+constexpr double kMinIntervalSemitones = 0.8;
+
+// Auto window: periods of the lowest f0, so that the partials of a third on the lowest
+// strings (4 Hz apart at the double bass's 40 Hz) are at least a Hann main lobe apart.
+constexpr double kAutoWindowPeriods = 8.0;
+
+double Weight(double f_hz, int m) { return (f_hz + kAlphaHz) / (m * f_hz + kBetaHz); }
+
+}  // namespace
+
+Status DoubleStopOptions::Validate() const {
+  ARCO_RETURN_IF_ERROR(CheckInRange("fps", fps, kTrackerFpsRange));
+  ARCO_RETURN_IF_ERROR(CheckInRange("start_s", start_s, kTrackerStartRangeS));
+  if (max_frames < -1) return Status::Error("max_frames must be >= -1");
+  ARCO_RETURN_IF_ERROR(CheckInRange("a4_hz", a4_hz, kA4RangeHz));
+  ARCO_RETURN_IF_ERROR(CheckInRange("window_s", window_s, kDoubleStopWindowRangeS));
+  ARCO_RETURN_IF_ERROR(CheckInRange("harmonics", harmonics, kDoubleStopHarmonicsRange));
+  ARCO_RETURN_IF_ERROR(CheckInRange("grid_cents", grid_cents, kDoubleStopGridRangeCents));
+  ARCO_RETURN_IF_ERROR(CheckInRange("second_min_ratio", second_min_ratio, kDoubleStopRatioRange));
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("min_fundamental_ratio", min_fundamental_ratio, kDoubleStopRatioRange));
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("max_span_semitones", max_span_semitones, kDoubleStopSpanRangeSemitones));
+  ARCO_RETURN_IF_ERROR(CheckInRange("silence_db", silence_db, kDoubleStopSilenceRangeDb));
+  const double top_hz = range.analysis_rate_hz / 4.0;
+  if (!(range.min_f0_hz >= 20 && range.min_f0_hz < range.max_f0_hz && range.max_f0_hz <= top_hz)) {
+    return Status::Error("double stops: min_f0_hz = " + NumberText(range.min_f0_hz) +
+                         " and max_f0_hz = " + NumberText(range.max_f0_hz) +
+                         " Hz must satisfy 20 <= min_f0_hz < max_f0_hz <= " + NumberText(top_hz));
+  }
+  return Status::Ok();
+}
+
+double DoubleStopWindowS(const DoubleStopOptions& options) {
+  return options.window_s > 0 ? options.window_s
+                              : std::max(0.1, kAutoWindowPeriods / options.range.min_f0_hz);
+}
+
+bool PlayableDoubleStop(const std::array<double, 4>& open_midi_low_to_high,
+                        double low_midi,
+                        double high_midi,
+                        double max_span_semitones) {
+  if (!(high_midi > low_midi)) return false;
+  for (int s = 0; s + 1 < 4; ++s) {
+    const double low_stop = low_midi - open_midi_low_to_high[s];
+    const double high_stop = high_midi - open_midi_low_to_high[s + 1];
+    if (low_stop < -0.5 || high_stop < -0.5) continue;
+    if (std::abs(high_stop - low_stop) <= max_span_semitones) return true;
+  }
+  return false;
+}
+
+DoubleStopAnalyzer::DoubleStopAnalyzer(const DoubleStopOptions& options) : options_(options) {
+  const Status valid = options.Validate();
+  if (!valid.ok()) throw std::invalid_argument(valid.message());
+  const double rate = options.range.analysis_rate_hz;
+  window_ = static_cast<int>(std::lround(DoubleStopWindowS(options) * rate));
+  fft_size_ = 1;
+  while (fft_size_ < 2 * window_) fft_size_ *= 2;
+  bin_hz_ = rate / fft_size_;
+  // Hann main lobe: +-2 bins of the unpadded transform.
+  lobe_bins_ = static_cast<int>(std::ceil(2.0 * fft_size_ / window_));
+  floor_ = std::pow(10.0, options.silence_db / 20.0);
+  hann_.resize(window_);
+  for (int j = 0; j < window_; ++j) {
+    const double s = std::sin(M_PI * (j + 0.5) / window_);
+    hann_[j] = s * s;
+  }
+  const StatusOr<InstrumentKind> kind = ParseInstrumentKind(options.range.name);
+  has_strings_ = kind.ok();
+  if (has_strings_) {
+    const auto& open = GetInstrumentInfo(*kind).open_midi_low_to_high;
+    for (int s = 0; s < 4; ++s) open_midi_[s] = open[s];
+  }
+  const int harmonics = options.harmonics;
+  const double spread = std::exp2(kPartialCents / 1200.0);
+  for (double f = options.range.min_f0_hz; f <= options.range.max_f0_hz;
+       f *= std::exp2(options.grid_cents / 1200.0)) {
+    candidates_hz_.push_back(f);
+    candidates_midi_.push_back(69.0 + 12.0 * std::log2(f / options.a4_hz));
+    for (int m = 1; m <= harmonics; ++m) {
+      const double hi_hz = m * f * spread;
+      if (hi_hz >= 0.45 * rate) {
+        bands_.push_back({-1, -1});
+        continue;
+      }
+      const int lo = std::max(1, static_cast<int>(std::floor(m * f / spread / bin_hz_)));
+      const int hi = std::max(lo, static_cast<int>(std::ceil(hi_hz / bin_hz_)));
+      bands_.push_back({lo, hi});
+    }
+  }
+  time_ = fftw_alloc_real(fft_size_);
+  auto* spectrum = fftw_alloc_complex(fft_size_ / 2 + 1);
+  spectrum_ = spectrum;
+  plan_ = fftw_plan_dft_r2c_1d(fft_size_, time_, spectrum, FFTW_ESTIMATE);
+  magnitude_.assign(fft_size_ / 2 + 1, 0.0);
+  residual_ = magnitude_;
+  for (auto* v : {&partial_hz_, &partial_amplitude_}) v->reserve(harmonics + 2);
+  partial_index_.reserve(harmonics + 2);
+}
+
+DoubleStopAnalyzer::~DoubleStopAnalyzer() {
+  fftw_destroy_plan(static_cast<fftw_plan>(plan_));
+  fftw_free(time_);
+  fftw_free(spectrum_);
+}
+
+double DoubleStopAnalyzer::BandMax(int candidate,
+                                   int m,
+                                   const std::vector<double>& spectrum,
+                                   int* at) const {
+  const auto& band = bands_[static_cast<size_t>(candidate) * options_.harmonics + m - 1];
+  if (band[0] < 0) return -1.0;
+  int best = band[0];
+  for (int k = band[0] + 1; k <= band[1]; ++k) {
+    if (spectrum[k] > spectrum[best]) best = k;
+  }
+  if (at != nullptr) *at = best;
+  return spectrum[best];
+}
+
+double DoubleStopAnalyzer::Salience(int candidate, const std::vector<double>& spectrum) const {
+  double s = 0;
+  for (int m = 1; m <= options_.harmonics; ++m) {
+    const double a = BandMax(candidate, m, spectrum, nullptr);
+    if (a < 0) break;
+    s += Weight(candidates_hz_[candidate], m) * a;
+  }
+  return s;
+}
+
+// The best candidate of `spectrum` whose fundamental is present; with first >= 0, only
+// candidates that form a playable double stop with it.
+DoubleStopAnalyzer::Best DoubleStopAnalyzer::Search(const std::vector<double>& spectrum,
+                                                    int first) const {
+  const double peak = *std::max_element(magnitude_.begin(), magnitude_.end());
+  const double min_fundamental = options_.min_fundamental_ratio * peak;
+  Best best;
+  for (int c = 0; c < static_cast<int>(candidates_hz_.size()); ++c) {
+    if (first >= 0) {
+      const double a = candidates_midi_[first], b = candidates_midi_[c];
+      if (std::abs(a - b) < kMinIntervalSemitones) continue;
+      if (has_strings_ &&
+          !PlayableDoubleStop(
+              open_midi_, std::min(a, b), std::max(a, b), options_.max_span_semitones)) {
+        continue;
+      }
+    }
+    // (2): the fundamental is present; an octave above the first note is exempt, its
+    // fundamental is the first note's 2nd partial, which may have interfered away.
+    const bool octave = first >= 0 && std::abs(candidates_midi_[c] - candidates_midi_[first] -
+                                               12.0) < kPartialCents / 100.0;
+    if (!octave && BandMax(c, 1, spectrum, nullptr) < min_fundamental) continue;
+    const double s = Salience(c, spectrum);
+    if (s > best.salience) best = {c, s};
+  }
+  return best;
+}
+
+// f0 of candidate c from the frequencies of its partials in `spectrum` (the salience is flat
+// to within the +-25 cent partial band, so the grid maximum alone is biased): each partial's
+// peak refined by the vertex of a parabola through the log magnitudes of its bin and the
+// two neighbours, then f0 = sum(A_m^2 m f_m) / sum(A_m^2 m^2), the least-squares fit of
+// f_m = m f0 weighted by A_m^2 (as HarmonicPeakFit, harmonic_fit.h); partials below 10% of
+// the strongest are left out.
+double DoubleStopAnalyzer::Refine(int c, const std::vector<double>& spectrum) {
+  std::vector<double>& freq = partial_hz_;
+  std::vector<double>& amp = partial_amplitude_;
+  std::vector<int>& harmonic = partial_index_;
+  freq.clear(), amp.clear(), harmonic.clear();
+  for (int m = 1; m <= options_.harmonics; ++m) {
+    int k = -1;
+    if (BandMax(c, m, spectrum, &k) < 0) break;
+    if (k <= 0 || k >= fft_size_ / 2) continue;
+    const double a = std::log(spectrum[k - 1] + 1e-12), b = std::log(spectrum[k] + 1e-12),
+                 d = std::log(spectrum[k + 1] + 1e-12);
+    const double den = a - 2.0 * b + d;
+    if (!(den < 0) || a > b || d > b) continue;  // no peak at k
+    const double delta = 0.5 * (a - d) / den;
+    freq.push_back((k + delta) * bin_hz_);
+    amp.push_back(spectrum[k]);
+    harmonic.push_back(m);
+  }
+  if (freq.empty()) return candidates_hz_[c];
+  const double strongest = *std::max_element(amp.begin(), amp.end());
+  double num = 0, den = 0;
+  for (size_t i = 0; i < freq.size(); ++i) {
+    if (amp[i] < 0.1 * strongest) continue;
+    const double w = amp[i] * amp[i], m = harmonic[i];
+    num += w * m * freq[i];
+    den += w * m * m;
+  }
+  return den > 0 ? num / den : candidates_hz_[c];
+}
+
+// Cancels the partials of candidate c from residual_ after the spectral-smoothness rule
+// (Klapuri 2003): partial m keeps min(A_m, sqrt(A_{m-1} A_{m+1})) as this note's (the
+// geometric mean of its neighbours: the arithmetic one, above a k^-1 envelope, took all of
+// an octave's shared partials), and
+// its main lobe is scaled by the share left to other notes, 1 - that / A_m. Returns the
+// salience of what it cancelled (eq. 3 on the note's own partials).
+double DoubleStopAnalyzer::Cancel(int c) {
+  const int harmonics = options_.harmonics;
+  std::vector<double>& amplitude = partial_amplitude_;
+  std::vector<int>& at = partial_index_;
+  amplitude.assign(harmonics + 2, 0.0);
+  at.assign(harmonics + 2, -1);
+  int count = 0;
+  for (int m = 1; m <= harmonics; ++m) {
+    const double a = BandMax(c, m, residual_, &at[m]);
+    if (a < 0) break;
+    amplitude[m] = a;
+    count = m;
+  }
+  double own_salience = 0;
+  for (int m = 1; m <= count; ++m) {
+    double own = amplitude[m];
+    if (m > 1) {
+      const double next = m < count ? amplitude[m + 1] : amplitude[m - 1];
+      own = std::min(own, std::sqrt(amplitude[m - 1] * next));
+    }
+    own_salience += Weight(candidates_hz_[c], m) * own;
+    const double keep = amplitude[m] > 0 ? 1.0 - own / amplitude[m] : 0.0;
+    const int lo = std::max(0, at[m] - lobe_bins_),
+              hi = std::min(fft_size_ / 2, at[m] + lobe_bins_);
+    for (int k = lo; k <= hi; ++k) residual_[k] *= keep;
+  }
+  return own_salience;
+}
+
+int DoubleStopAnalyzer::Analyze(const float* x, std::array<PolyNote, 2>* notes) {
+  *notes = {};
+  double mean = 0;
+  for (int j = 0; j < window_; ++j) mean += x[j];
+  mean /= window_;
+  double energy = 0;
+  for (int j = 0; j < window_; ++j) {
+    const double v = x[j] - mean;
+    energy += v * v;
+    time_[j] = v * hann_[j];
+  }
+  if (std::sqrt(energy / window_) < floor_) return 0;
+  std::fill(time_ + window_, time_ + fft_size_, 0.0);
+  fftw_execute(static_cast<fftw_plan>(plan_));
+  const auto* spectrum = static_cast<const fftw_complex*>(spectrum_);
+  for (int k = 0; k <= fft_size_ / 2; ++k)
+    magnitude_[k] = std::hypot(spectrum[k][0], spectrum[k][1]);
+  const Best first = Search(magnitude_, -1);
+  if (first.index < 0) return 0;
+  PolyNote one{Refine(first.index, magnitude_), first.salience};
+  residual_ = magnitude_;
+  const double own_salience = Cancel(first.index);
+  const Best second = Search(residual_, first.index);
+  if (second.index < 0 || second.salience < options_.second_min_ratio * own_salience) {
+    (*notes)[0] = one;
+    return 1;
+  }
+  PolyNote two{Refine(second.index, residual_), second.salience};
+  if (two.f0_hz < one.f0_hz) std::swap(one, two);
+  (*notes)[0] = one;
+  (*notes)[1] = two;
+  return 2;
+}
+
+std::vector<double> SecondNoteHz(const std::vector<PitchFrame>& frames,
+                                 const std::vector<PolyPitchFrame>& poly,
+                                 double match_cents) {
+  std::vector<double> second(frames.size(), 0.0);
+  for (size_t i = 0; i < frames.size() && i < poly.size(); ++i) {
+    const PitchFrame& f = frames[i];
+    const PolyPitchFrame& p = poly[i];
+    if (!f.voiced || f.f0_hz <= 0 || p.count < 2) continue;
+    for (int j = 0; j < 2; ++j) {
+      const double cents = 1200.0 * std::log2(p.notes[j].f0_hz / f.f0_hz);
+      if (std::abs(cents) <= match_cents) {
+        second[i] = p.notes[1 - j].f0_hz;
+        break;
+      }
+    }
+  }
+  return second;
+}
+
+NoteAnalysis SecondVoiceNotes(const std::vector<PitchFrame>& frames,
+                              const std::vector<double>& second_f0_hz,
+                              double fps,
+                              const NoteOptions& options) {
+  std::vector<PitchFrame> voice = frames;
+  for (size_t i = 0; i < voice.size(); ++i) {
+    const double f0 = i < second_f0_hz.size() ? second_f0_hz[i] : 0.0;
+    voice[i].voiced = f0 > 0;
+    voice[i].f0_hz = f0;
+  }
+  NoteAnalysis notes = SegmentNotes(voice, fps, options);
+  notes.glides.clear();  // a second voice's glides are not told apart from its notes' edges
+  return notes;
+}
+
+StatusOr<std::vector<PolyPitchFrame>> TrackDoubleStops(std::unique_ptr<AudioReader> reader,
+                                                       const DoubleStopOptions& options,
+                                                       DoubleStopSummary* summary) {
+  const std::clock_t cpu_start = std::clock();
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  DoubleStopAnalyzer analyzer(options);
+  const double rate = options.range.analysis_rate_hz;
+  SampleStream stream(std::move(reader), options.range.analysis_rate_hz);
+  const int window = analyzer.window_length();
+  std::vector<float> buffer(static_cast<size_t>(window));
+  std::vector<PolyPitchFrame> frames;
+  ARCO_ASSIGN_OR_RETURN(const bool has_audio, stream.Has(0));
+  for (int64_t i = 0; has_audio && (options.max_frames < 0 || i < options.max_frames); ++i) {
+    // Time from i directly, window centred on the nearest sample (as the tracker).
+    const double time_s = options.start_s + static_cast<double>(i) / options.fps;
+    const int64_t centre = std::llround(time_s * rate);
+    if (centre >= 0) {
+      ARCO_ASSIGN_OR_RETURN(const bool inside, stream.Has(centre));
+      if (!inside) break;
+    }
+    ARCO_RETURN_IF_ERROR(stream.Read(centre - window / 2, window, buffer.data()));
+    PolyPitchFrame f;
+    f.frame = i;
+    f.time_s = time_s;
+    f.count = analyzer.Analyze(buffer.data(), &f.notes);
+    frames.push_back(f);
+  }
+  if (summary != nullptr) {
+    *summary = DoubleStopSummary();
+    summary->frames = static_cast<int64_t>(frames.size());
+    for (const auto& f : frames) {
+      (f.count == 0 ? summary->silent_frames
+                    : (f.count == 1 ? summary->single_frames : summary->double_frames))++;
+    }
+    summary->cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+  }
+  return frames;
+}
+
+StatusOr<std::vector<PolyPitchFrame>> TrackDoubleStopsFile(const std::string& path,
+                                                           const DoubleStopOptions& options,
+                                                           DoubleStopSummary* summary) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  ARCO_ASSIGN_OR_RETURN(auto reader, OpenAudio(path));
+  return TrackDoubleStops(std::move(reader), options, summary);
+}
+
+}  // namespace arco::audio

