@@ -15,6 +15,7 @@
 #include "arco/media/test_video.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/run_capture.h"
+#include "arco/pipeline/run_with_rig_test_support.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"
 #include "arco/util/file_io.h"
@@ -24,6 +25,7 @@ namespace arco::pipeline {
 namespace {
 
 namespace fs = std::filesystem;
+using arco::pipeline::testing::RunWithRig;
 using arco::testing::TempDir;
 
 constexpr int kImageWidth = 2300, kImageHeight = 2656;  // the SPD cameras'
@@ -80,28 +82,6 @@ CalibrationFromInstrumentOptions Options(const std::string& capture, const std::
   o.image_width = kImageWidth;
   o.image_height = kImageHeight;
   return o;
-}
-
-eval::MethodMetrics RunWith(const std::string& capture, const Rig& rig, const std::string& dir) {
-  const std::string copy = dir + "/capture";
-  fs::copy(capture, copy, fs::copy_options::recursive);
-  EXPECT_TRUE(SaveCalibration(copy + "/calibration.json", rig).ok());
-  RunOptions o;
-  o.capture_dir = copy;
-  o.result_dir = dir + "/result";
-  o.num_threads = 2;
-  auto summary = RunCapture(o);
-  EXPECT_TRUE(summary.ok()) << summary.status().message();
-  if (!summary.ok()) return {};
-  eval::EvalRequest request;
-  request.result_dir = o.result_dir;
-  request.truth = copy + "/truth";
-  auto report = eval::Evaluate(request);
-  EXPECT_TRUE(report.ok()) << report.status().message();
-  for (const auto& m : report->methods)
-    if (m.method == "arco") return m;
-  ADD_FAILURE() << "no arco method";
-  return {};
 }
 
 TEST(CalibrateFromInstrument, RecoversTwoCamerasWithTheTrueAndAWrongFocal) {
@@ -188,8 +168,8 @@ TEST(CalibrateFromInstrument, RecoversTwoCamerasWithTheTrueAndAWrongFocal) {
   }
   fs::create_directories(dir / "truth_run");
   fs::create_directories(dir / "estimate_run");
-  const eval::MethodMetrics m_truth = RunWith(capture, truth->rig, dir / "truth_run");
-  const eval::MethodMetrics m_estimate = RunWith(capture, wrong_focal_rig, dir / "estimate_run");
+  const eval::MethodMetrics m_truth = RunWithRig(capture, truth->rig, dir / "truth_run");
+  const eval::MethodMetrics m_estimate = RunWithRig(capture, wrong_focal_rig, dir / "estimate_run");
   std::printf(
       "[ from-instrument ] arco run, body MPJPE / hand MPJPE / contact deviation (mm): truth "
       "%.2f / %.2f / %.2f, estimated %.2f / %.2f / %.2f\n",

@@ -16,6 +16,7 @@
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/calibration_check.h"
 #include "arco/pipeline/run_capture.h"
+#include "arco/pipeline/run_with_rig_test_support.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"
 #include "arco/util/file_io.h"
@@ -26,6 +27,7 @@ namespace arco::pipeline {
 namespace {
 
 namespace fs = std::filesystem;
+using arco::pipeline::testing::RunWithRig;
 using arco::testing::TempDir;
 
 // A 4-second cello scale (no audio rendering needed by refine; run's pitch stage reads it).
@@ -80,28 +82,6 @@ RigError Compare(const Rig& truth, const Rig& estimate) {
                  (truth.cameras[c].CenterInWorld() - estimate.cameras[c].CenterInWorld()).norm());
   }
   return e;
-}
-
-// `arco run` on a copy of the capture with `rig` as its calibration; eval's arco method.
-eval::MethodMetrics RunWith(const std::string& capture, const Rig& rig, const std::string& dir) {
-  const std::string copy = dir + "/capture";
-  fs::copy(capture, copy, fs::copy_options::recursive);
-  EXPECT_TRUE(SaveCalibration(copy + "/calibration.json", rig).ok());
-  RunOptions o;
-  o.capture_dir = copy;
-  o.result_dir = dir + "/result";
-  o.num_threads = 2;
-  auto summary = RunCapture(o);
-  EXPECT_TRUE(summary.ok()) << summary.status().message();
-  eval::EvalRequest request;
-  request.result_dir = o.result_dir;
-  request.truth = copy + "/truth";
-  auto report = eval::Evaluate(request);
-  EXPECT_TRUE(report.ok()) << report.status().message();
-  for (const auto& m : report->methods)
-    if (m.method == "arco") return m;
-  ADD_FAILURE() << "no arco method";
-  return {};
 }
 
 TEST(RefineCalibration, RecoversAPerturbedRigAndTheRunsAccuracy) {
@@ -169,9 +149,9 @@ TEST(RefineCalibration, RecoversAPerturbedRigAndTheRunsAccuracy) {
   fs::create_directories(dir / "truth_run");
   fs::create_directories(dir / "perturbed_run");
   fs::create_directories(dir / "refined_run");
-  const eval::MethodMetrics m_truth = RunWith(capture, truth->rig, dir / "truth_run");
-  const eval::MethodMetrics m_perturbed = RunWith(capture, perturbed, dir / "perturbed_run");
-  const eval::MethodMetrics m_refined = RunWith(capture, written->rig, dir / "refined_run");
+  const eval::MethodMetrics m_truth = RunWithRig(capture, truth->rig, dir / "truth_run");
+  const eval::MethodMetrics m_perturbed = RunWithRig(capture, perturbed, dir / "perturbed_run");
+  const eval::MethodMetrics m_refined = RunWithRig(capture, written->rig, dir / "refined_run");
   std::printf(
       "[ refine ] arco run, body MPJPE / hand MPJPE / contact deviation (mm): truth "
       "%.2f / %.2f / %.2f, perturbed %.2f / %.2f / %.2f, refined %.2f / %.2f / %.2f\n",
