@@ -53,6 +53,10 @@ CommandRun SetupRun(CLI::App& app) {
       ->required();
   sub->add_option("-o,--output", a->o.result_dir, "Result folder to write")->required();
   sub->add_flag("--overwrite", a->o.overwrite, "Replace an existing result folder");
+  sub->add_flag("--performer-palm",
+                a->o.hands.palm.enabled,
+                "Fit the hand with the performer's palm estimated from the take, not the average "
+                "hand's (docs/hand.md)");
   AddNumber(sub,
             "--threads",
             a->o.num_threads,

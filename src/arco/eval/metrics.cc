@@ -76,8 +76,17 @@ void HandFlexionDeg(const Eigen::Vector3d hand[kNumHand], bool left, double angl
     const Eigen::Vector3d& b = hand[HandJoint(f, 1)];
     const Eigen::Vector3d& c = hand[HandJoint(f, 2)];
     const Eigen::Vector3d& d = hand[HandJoint(f, 3)];
-    if (Finite(a) && Finite(b) && Finite(c)) angles[f][0] = SignedBendDeg(b - a, c - b, lateral);
-    if (Finite(b) && Finite(c) && Finite(d)) angles[f][1] = SignedBendDeg(c - b, d - c, lateral);
+    // Each bend about the lateral axis made orthogonal to its proximal bone: a hinge
+    // perpendicular to the bone it turns (hand_model.cc, RightHandAxes), so an abducted
+    // finger or a palm whose MCP line is not square to the fingers (a performer's own
+    // palm, hand/palm_shape.h) does not tilt the measured bend.
+    const auto bend = [&](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+      Eigen::Vector3d axis = lateral - lateral.dot(u.normalized()) * u.normalized();
+      if (!(axis.norm() > 1e-9)) return kNaN;
+      return SignedBendDeg(u, v, axis.normalized());
+    };
+    if (Finite(a) && Finite(b) && Finite(c)) angles[f][0] = bend(b - a, c - b);
+    if (Finite(b) && Finite(c) && Finite(d)) angles[f][1] = bend(c - b, d - c);
   }
 }
 

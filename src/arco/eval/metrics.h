@@ -137,7 +137,8 @@ void ScoreBowing(const std::vector<refine::BowingFrame>& truth,
 // keypoints, signed: positive bends towards the palm. The flexion axis is the
 // hand's lateral axis, x = (index MCP - little MCP) for a right hand and its
 // negative for a left hand (hand/hand_model.h: +x = distal x palmar in both
-// hands), made orthogonal to the wrist -> middle MCP direction. NaN when a
+// hands), made orthogonal to the wrist -> middle MCP direction and, for each joint, to
+// the bone proximal to it (the hinge is perpendicular to the bone it turns). NaN when a
 // keypoint is missing. angles[finger][0] = PIP, [1] = DIP; thumb = MCP, IP.
 void HandFlexionDeg(const Eigen::Vector3d hand[kNumHand], bool left, double angles[5][2]);
 

@@ -196,6 +196,26 @@ StatusOr<HandModel> HandModel::WithBoneLengths(const BoneLengthsMm& lengths_mm) 
   return Create(side_, points, limits_deg_);
 }
 
+StatusOr<HandModel> HandModel::WithRestPoints(const RestPointsMm& points_in_wrist_mm) const {
+  // Back to the right-hand convention Create takes (x mirrored for a left hand).
+  const Eigen::Vector3d m =
+      side_ == HandSide::kLeft ? Eigen::Vector3d(-1, 1, 1) : Eigen::Vector3d(1, 1, 1);
+  RestPointsMm right;
+  for (int k = 0; k < kNumHandKeypoints; ++k) right[k] = m.cwiseProduct(points_in_wrist_mm[k]);
+  return Create(side_, right, limits_deg_);
+}
+
+StatusOr<HandModel> HandModel::WithBasePoints(
+    const std::array<Eigen::Vector3d, kNumFingers>& base_in_wrist_mm) const {
+  RestPointsMm points = rest_points_mm();
+  for (int f = 0; f < kNumFingers; ++f) {
+    const int k0 = KeypointIndex(static_cast<Finger>(f), 0);
+    const Eigen::Vector3d shift = base_in_wrist_mm[f] - points[k0];
+    for (int j = 0; j < 4; ++j) points[k0 + j] += shift;
+  }
+  return WithRestPoints(points);
+}
+
 HandModel HandModel::Mirrored() const {
   StatusOr<HandModel> model = Create(side_ == HandSide::kLeft ? HandSide::kRight : HandSide::kLeft,
                                      right_rest_points_mm_,
@@ -214,6 +234,15 @@ BoneLengthsMm HandModel::bone_lengths_mm() const {
   BoneLengthsMm lengths{};
   for (int k = 1; k < kNumHandKeypoints; ++k) lengths[k] = bone_length_mm(k);
   return lengths;
+}
+
+RestPointsMm HandModel::rest_points_mm() const {
+  // Mirroring is exact, so WithRestPoints(rest_points_mm()) is this model bit for bit.
+  const Eigen::Vector3d m =
+      side_ == HandSide::kLeft ? Eigen::Vector3d(-1, 1, 1) : Eigen::Vector3d(1, 1, 1);
+  RestPointsMm points;
+  for (int k = 0; k < kNumHandKeypoints; ++k) points[k] = m.cwiseProduct(right_rest_points_mm_[k]);
+  return points;
 }
 
 Eigen::Vector3d HandPose::WristAngleAxis() const {

@@ -84,6 +84,15 @@ class HandModel {
                                     const JointLimitsDeg& limits_deg);
   // Same directions and limits, new bone lengths (per-performer model).
   StatusOr<HandModel> WithBoneLengths(const BoneLengthsMm& lengths_mm) const;
+  // Same side and limits, the rest pose given as points in this model's own wrist frame
+  // (for a left model, the mirrored points rest_point_mm gives): the per-performer model
+  // a result folder stores (hand/rest_points_mm.npy). Errors as Create.
+  StatusOr<HandModel> WithRestPoints(const RestPointsMm& points_in_wrist_mm) const;
+  // Same fingers and limits, each finger's base (thumb CMC, index..little MCP) moved to
+  // `base_in_wrist_mm` (this model's wrist frame) with its chain: the performer's palm
+  // (palm_shape.h). The joint axes depend on the finger bones only, so they are kept.
+  StatusOr<HandModel> WithBasePoints(
+      const std::array<Eigen::Vector3d, kNumFingers>& base_in_wrist_mm) const;
   HandModel Mirrored() const;  // the other hand, same lengths and limits
 
   HandSide side() const { return side_; }
@@ -92,6 +101,9 @@ class HandModel {
   Eigen::Vector3d rest_point_mm(int k) const;  // rest-pose position, wrist frame
   double bone_length_mm(int k) const { return rest_offset_mm_[k].norm(); }
   BoneLengthsMm bone_lengths_mm() const;
+  // The rest points this model was made from, in its own wrist frame (the right-hand
+  // points, mirrored for a left hand): WithRestPoints(rest_points_mm()) is this model.
+  RestPointsMm rest_points_mm() const;
   // Unit joint axis of a dof in its parent's rest frame (= wrist frame at rest).
   const Eigen::Vector3d& axis(int dof) const { return axis_[dof]; }
   double min_rad(int dof) const { return min_rad_[dof]; }

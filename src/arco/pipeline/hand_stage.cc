@@ -23,6 +23,7 @@ Status HandStageOptions::Validate() const {
   if (chunk_frames < 1) return Status::Error("chunk_frames must be >= 1");
   if (num_threads < 0) return Status::Error("num_threads must be >= 0");
   ARCO_RETURN_IF_ERROR(bones.Validate().WithContext("bones"));
+  ARCO_RETURN_IF_ERROR(palm.Validate().WithContext("palm"));
   return fit.Validate().WithContext("fit");
 }
 
@@ -35,6 +36,12 @@ Json ToJson(const HandStageOptions& o) {
             {"min_ratio", o.bones.min_ratio},
             {"max_ratio", o.bones.max_ratio},
             {"correct_noise_bias", o.bones.correct_noise_bias}}},
+          {"palm",
+           {{"enabled", o.palm.enabled},
+            {"min_frames", o.palm.min_frames},
+            {"rounds", o.palm.rounds},
+            {"gate", o.palm.gate},
+            {"max_shift_mm", o.palm.max_shift_mm}}},
           {"fit",
            {{"min_score", f.min_score},
             {"weight_by_score", f.weight_by_score},
@@ -101,6 +108,22 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
   } else {
     summary.warnings.push_back("hand: default bone lengths (" + bones.status().message() + ")");
   }
+  if (options.palm.enabled) {
+    StatusOr<hand::PalmShapeEstimate> palm = hand::EstimatePalmShape(left, model, options.palm);
+    StatusOr<hand::HandModel> palmed =
+        palm.ok() ? model.WithBasePoints(palm->base_in_wrist_mm) : palm.status();
+    if (palmed.ok()) {
+      model = *palmed;
+      summary.palm_from_data = true;
+      summary.palm_frames = palm->frames_used;
+      for (int f = 0; f < hand::kNumFingers; ++f) {
+        summary.palm_max_shift_mm = std::max(summary.palm_max_shift_mm, palm->shift_mm[f]);
+        summary.palm_bases_kept += palm->kept_model[f];
+      }
+    } else {
+      summary.warnings.push_back("hand: the average palm (" + palmed.status().message() + ")");
+    }
+  }
   const int chunk = options.chunk_frames;
   const int64_t num_chunks = (frames + chunk - 1) / chunk;
   HandRecord record;
@@ -160,6 +183,7 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
   for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
     record.bone_lengths_mm[static_cast<size_t>(k)] = k == 0 ? 0.0 : model.bone_length_mm(k);
   }
+  record.rest_points_mm = model.rest_points_mm();
   record.summary = summary;
   record.inputs =
       SelectInputs(capture.inputs, {kManifestInput, kCalibrationInput, kKeypoints2dInput});

@@ -1,13 +1,14 @@
-// Stage 3: the left hand. Per-performer bone lengths from the triangulated hand
-// (hand/bone_lengths.h), then the multi-view hand model fit (hand/fit.h) of every frame;
-// writes RESULT_DIR/hand/ hand_params.npy (F, 26) and bone_lengths_mm.npy
-// (pipeline/result_folder.h).
+// Stage 3: the left hand. Per-performer bone lengths and palm from the triangulated hand
+// (hand/bone_lengths.h, hand/palm_shape.h), then the multi-view hand model fit (hand/fit.h) of
+// every frame; writes RESULT_DIR/hand/ hand_params.npy (F, 26), bone_lengths_mm.npy and
+// rest_points_mm.npy, the fitted model (pipeline/result_folder.h).
 #pragma once
 
 #include <string>
 
 #include "arco/hand/bone_lengths.h"
 #include "arco/hand/fit.h"
+#include "arco/hand/palm_shape.h"
 #include "arco/pipeline/capture_context.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/summaries.h"
@@ -20,6 +21,7 @@ namespace arco::pipeline {
 struct HandStageOptions {
   std::string result_dir;  // holds the triangulation and the instrument (the metric scale)
   hand::BoneLengthOptions bones;
+  hand::PalmShapeOptions palm;  // the performer's palm (after the bone lengths)
   hand::HandFitOptions fit;
   // The fit carries a temporal prior from frame to frame; the clip is cut into chunks of
   // this many frames that are fitted in parallel (each starts from its own 3D keypoints),

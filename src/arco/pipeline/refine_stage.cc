@@ -149,7 +149,7 @@ StatusOr<RefineInputs> MakeRefineInputs(const std::string& result_dir,
                               "frame count differs from the triangulation's"));
   out.input.vision_hand = hand.hands;
   StatusOr<hand::HandModel> hand_model =
-      hand::HandModel::Default(hand::HandSide::kLeft).WithBoneLengths(hand.bone_lengths_mm);
+      hand::HandModel::Default(hand::HandSide::kLeft).WithRestPoints(hand.rest_points_mm);
   if (!hand_model.ok()) {
     return hand_model.status().WithContext(result.BoneLengthsPath());
   }

@@ -30,6 +30,7 @@ constexpr char kStringsFile[] = "strings.npy";
 constexpr char kKeypointsFile[] = "keypoints.npy";
 constexpr char kHandParamsFile[] = "hand_params.npy";
 constexpr char kBoneLengthsFile[] = "bone_lengths_mm.npy";
+constexpr char kRestPointsFile[] = "rest_points_mm.npy";
 constexpr char kPitchCsvFile[] = "pitch.csv";
 constexpr char kNotesCsvFile[] = "notes.csv";
 constexpr char kContactsCsvFile[] = "contacts.csv";
@@ -614,16 +615,23 @@ Status ResultFolder::WriteHand(const HandRecord& r) const {
   NpyArray<double> lengths;
   lengths.shape = {hand::kNumHandKeypoints};
   lengths.data.assign(r.bone_lengths_mm.begin(), r.bone_lengths_mm.end());
-  Json entry = {
-      {"files", {{"hand_params", kHandParamsFile}, {"bone_lengths_mm", kBoneLengthsFile}}},
-      {"side", "left"},
-      {"units", "mm"},
-      {"summary", ToJson(r.summary)}};
+  NpyArray<double> rest;
+  rest.shape = {hand::kNumHandKeypoints, 3};
+  for (const Eigen::Vector3d& p : r.rest_points_mm)
+    rest.data.insert(rest.data.end(), {p.x(), p.y(), p.z()});
+  Json entry = {{"files",
+                 {{"hand_params", kHandParamsFile},
+                  {"bone_lengths_mm", kBoneLengthsFile},
+                  {"rest_points_mm", kRestPointsFile}}},
+                {"side", "left"},
+                {"units", "mm"},
+                {"summary", ToJson(r.summary)}};
   return WriteStageFolder(
       kHandStage,
       [&](const std::string& dir) -> Status {
         ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, kHandParamsFile), hand::HandParams(r.hands)));
-        return WriteNpy(JoinPath(dir, kBoneLengthsFile), lengths);
+        ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, kBoneLengthsFile), lengths));
+        return WriteNpy(JoinPath(dir, kRestPointsFile), rest);
       },
       entry,
       r.inputs);
@@ -641,6 +649,23 @@ StatusOr<HandRecord> ResultFolder::ReadHand() const {
   ARCO_ASSIGN_OR_RETURN(r.hands, hand::HandsFromParams(params, hands_path));
   for (int k = 0; k < hand::kNumHandKeypoints; ++k)
     r.bone_lengths_mm[static_cast<size_t>(k)] = bones.data[static_cast<size_t>(k)];
+  const hand::HandModel left = hand::HandModel::Default(hand::HandSide::kLeft);
+  const std::string rest_path = StagePath(kHandStage, kRestPointsFile);
+  if (!FileExists(rest_path)) {  // results of versions before the performer's palm
+    StatusOr<hand::HandModel> sized = left.WithBoneLengths(r.bone_lengths_mm);
+    if (!sized.ok()) return sized.status().WithContext(bones_path);
+    r.rest_points_mm = sized->rest_points_mm();
+    return r;
+  }
+  ARCO_ASSIGN_OR_RETURN(NpyArray<double> rest, ReadNpy<double>(rest_path));
+  ARCO_RETURN_IF_ERROR(Expect(rest.shape == std::vector<int64_t>{hand::kNumHandKeypoints, 3},
+                              rest_path,
+                              "expected (21, 3) rest points"));
+  for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
+    for (int c = 0; c < 3; ++c) r.rest_points_mm[static_cast<size_t>(k)][c] = rest.at(k, c);
+  }
+  StatusOr<hand::HandModel> model = left.WithRestPoints(r.rest_points_mm);
+  if (!model.ok()) return model.status().WithContext(rest_path);
   return r;
 }
 

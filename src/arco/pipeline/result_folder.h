@@ -12,7 +12,8 @@
 //                               view_count.npy, inlier_mask.npy (F, P, V); world units
 //   instrument/                 strings.npy (F, S, 2, 3) nut and bridge of each string,
 //                               keypoints.npy (F, K, 3) the placed template; mm
-//   hand/                       hand_params.npy (F, 26), bone_lengths_mm.npy (21)
+//   hand/                       hand_params.npy (F, 26), bone_lengths_mm.npy (21),
+//                               rest_points_mm.npy (21, 3)
 //   pitch.csv, notes.csv        the audio layer's formats (audio/pitch_tracker.h,
 //                               audio/notes.h), in the folder itself
 //   vision/ paper/ arco/        points3d.npy (refine/method_result.h), hand_params.npy,
@@ -103,6 +104,11 @@ struct InstrumentRecord {
 struct HandRecord {
   std::vector<std::optional<hand::HandPose>> hands;  // per frame
   hand::BoneLengthsMm bone_lengths_mm{};             // index = keypoint, [0] unused (0)
+  // The fitted hand model's rest pose in its wrist frame (hand_model.h,
+  // HandModel::rest_points_mm): the bone lengths and the performer's palm. Read from
+  // rest_points_mm.npy, or made from the bone lengths for results without one.
+  hand::RestPointsMm rest_points_mm =
+      hand::HandModel::Default(hand::HandSide::kLeft).rest_points_mm();
   HandStageSummary summary;                          // written, not read back
   CaptureInputs inputs;  // the capture files read; written, not read back
 };
@@ -216,7 +222,8 @@ class ResultFolder {
   StatusOr<InstrumentRecord> ReadInstrument() const;
 
   Status WriteHand(const HandRecord& record) const;
-  // Errors: a hand_params.npy not (F, 26), a bone_lengths_mm.npy not (21).
+  // Errors: a hand_params.npy not (F, 26), a bone_lengths_mm.npy not (21), a
+  // rest_points_mm.npy not (21, 3) or not a valid hand.
   StatusOr<HandRecord> ReadHand() const;
 
   Status WritePitch(const PitchRecord& record) const;

@@ -14,6 +14,7 @@
 #include "arco/calibration/calibration_file.h"
 #include "arco/eval/evaluate.h"
 #include "arco/hand/hand_params.h"
+#include "arco/hand/kinematics.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/capture_checks.h"
 #include "arco/pipeline/hand_stage.h"
@@ -22,6 +23,7 @@
 #include "arco/pipeline/refine_stage.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/triangulate_stage.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"
 #include "arco/util/file_io.h"
@@ -151,6 +153,63 @@ TEST(RunCapture, EveryStageAndThreeMethodsThatEvalScores) {
   EXPECT_NE(bad.status().message().find("notes.csv:2: malformed note row"), std::string::npos)
       << bad.status().message();
   EXPECT_EQ(*arco_before, *ReadFileToString(JoinPath(result, "arco/contacts.csv")));
+}
+
+// The performer's palm (hand/palm_shape.h): estimated, stored in hand/rest_points_mm.npy
+// and used by every reader, so the refinement's vision hand is the stored model's
+// forward kinematics; off, the stored model is the average hand sized by the bones.
+TEST(RunCapture, ThePerformersPalmIsFittedStoredAndReadBack) {
+  for (const bool palm : {false, true}) {
+    SCOPED_TRACE(palm ? "palm" : "average palm");
+    arco::testing::TempDir out;
+    RunOptions o;
+    o.capture_dir = SyntheticCapture();
+    o.result_dir = out / "result";
+    o.num_threads = 2;
+    o.hands.palm.enabled = palm;
+    auto summary = RunCapture(o);
+    ASSERT_TRUE(summary.ok()) << summary.status().message();
+    EXPECT_EQ(summary->hands.palm_from_data, palm);
+    EXPECT_EQ(summary->hands.palm_frames > 30, palm) << summary->hands.palm_frames;
+    EXPECT_LT(summary->hands.palm_max_shift_mm, palm ? 12.0 : 1e-12);
+    const ResultFolder result(o.result_dir);
+    auto hand = result.ReadHand();
+    ASSERT_TRUE(hand.ok()) << hand.status().message();
+    auto sized =
+        hand::HandModel::Default(hand::HandSide::kLeft).WithBoneLengths(hand->bone_lengths_mm);
+    auto stored =
+        hand::HandModel::Default(hand::HandSide::kLeft).WithRestPoints(hand->rest_points_mm);
+    ASSERT_TRUE(sized.ok() && stored.ok());
+    double base_move_mm = 0;
+    for (int f = 0; f < hand::kNumFingers; ++f) {
+      const int k = hand::KeypointIndex(static_cast<hand::Finger>(f), 0);
+      base_move_mm =
+          std::max(base_move_mm, (stored->rest_point_mm(k) - sized->rest_point_mm(k)).norm());
+    }
+    if (palm) {
+      // (bone_lengths_mm holds the palm's base lengths, so only the directions differ.)
+      EXPECT_GT(base_move_mm, 0.05);
+      EXPECT_LE(base_move_mm, o.hands.palm.max_shift_mm);
+    } else {
+      EXPECT_LT(base_move_mm, 1e-9);
+    }
+    // vision/points3d.npy is the stored model at the fitted poses.
+    auto vision = result.ReadPoints3d("vision");
+    ASSERT_TRUE(vision.ok());
+    int checked = 0;
+    for (size_t f = 0; f < hand->hands.size(); ++f) {
+      if (!hand->hands[f]) continue;
+      const hand::HandPointsMm p = hand::ForwardKinematics(*stored, *hand->hands[f]);
+      for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_NEAR(
+              vision->at(static_cast<int64_t>(f), wholebody::kLeftHandFirst + k, c), p[k][c], 1e-9);
+        }
+      }
+      ++checked;
+    }
+    EXPECT_GT(checked, 60);
+  }
 }
 
 TEST(RunCapture, BadInputIsOneClearError) {

@@ -17,7 +17,11 @@ Json ToJson(const HandStageSummary& s) {
           {"frames_fitted", s.frames_fitted},
           {"median_rms_residual_px", JsonFromDouble(s.median_rms_residual_px)},
           {"median_residual_px", JsonFromDouble(s.median_residual_px)},
-          {"bone_lengths_from_data", s.bone_lengths_from_data}};
+          {"bone_lengths_from_data", s.bone_lengths_from_data},
+          {"palm_from_data", s.palm_from_data},
+          {"palm_frames", s.palm_frames},
+          {"palm_max_shift_mm", s.palm_max_shift_mm},
+          {"palm_bases_kept", s.palm_bases_kept}};
 }
 
 Json ToJson(const PitchStageSummary& s) {

@@ -46,10 +46,15 @@ struct HandStageSummary {
   double median_rms_residual_px = 0;
   double median_residual_px = 0;
   bool bone_lengths_from_data = false;  // false: the default hand's lengths
+  bool palm_from_data = false;          // false: the average hand's palm
+  int palm_frames = 0;                  // frames the palm was estimated from
+  double palm_max_shift_mm = 0;         // largest base move from the average palm
+  int palm_bases_kept = 0;              // bases beyond max_shift_mm, left where they were
   std::vector<std::string> warnings;
 };
 // {frames, frames_fitted, median_rms_residual_px, median_residual_px,
-// bone_lengths_from_data}.
+// bone_lengths_from_data, palm_from_data, palm_frames, palm_max_shift_mm,
+// palm_bases_kept}.
 Json ToJson(const HandStageSummary& summary);
 
 struct PitchStageSummary {

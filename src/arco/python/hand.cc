@@ -19,7 +19,9 @@ namespace arco::python {
 using PyHandModel = std::shared_ptr<const hand::HandModel>;
 using HandParamsArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-PyHandModel MakeHandModel(const std::string& side, const py::object& bone_lengths_mm) {
+PyHandModel MakeHandModel(const std::string& side,
+                          const py::object& bone_lengths_mm,
+                          const py::object& rest_points_mm) {
   hand::HandSide s;
   if (side == "left") {
     s = hand::HandSide::kLeft;
@@ -29,6 +31,22 @@ PyHandModel MakeHandModel(const std::string& side, const py::object& bone_length
     RaiseValueError("side must be left or right, got '" + side + "'");
   }
   hand::HandModel model = hand::HandModel::Default(s);
+  if (!bone_lengths_mm.is_none() && !rest_points_mm.is_none()) {
+    RaiseValueError("give bone_lengths_mm or rest_points_mm, not both");
+  }
+  if (!rest_points_mm.is_none()) {
+    const auto points = rest_points_mm.cast<HandParamsArray>();
+    if (points.ndim() != 2 || points.shape(0) != hand::kNumHandKeypoints || points.shape(1) != 3) {
+      RaiseValueError("rest_points_mm must be (21, 3), got " + ShapeString(points));
+    }
+    hand::RestPointsMm p;
+    for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
+      p[k] = Eigen::Vector3d(points.at(k, 0), points.at(k, 1), points.at(k, 2));
+    }
+    StatusOr<hand::HandModel> made = model.WithRestPoints(p);
+    CheckValid(made.status());
+    model = std::move(*made);
+  }
   if (!bone_lengths_mm.is_none()) {
     const auto lengths = bone_lengths_mm.cast<HandParamsArray>();
     if (lengths.ndim() != 1 || lengths.shape(0) != hand::kNumHandKeypoints) {
@@ -159,12 +177,28 @@ py::dict FingertipIkPy(const hand::HandModel& model,
 void BindHand(py::module_& m) {
   py::class_<hand::HandModel, std::shared_ptr<hand::HandModel>>(
       m, "HandModel", "arco's 21-keypoint hand model (docs/hand.md)")
-      .def(py::init([](const std::string& side, const py::object& bone_lengths_mm) {
-             return std::const_pointer_cast<hand::HandModel>(MakeHandModel(side, bone_lengths_mm));
+      .def(py::init([](const std::string& side,
+                       const py::object& bone_lengths_mm,
+                       const py::object& rest_points_mm) {
+             return std::const_pointer_cast<hand::HandModel>(
+                 MakeHandModel(side, bone_lengths_mm, rest_points_mm));
            }),
            "side"_a = "left",
            "bone_lengths_mm"_a = py::none(),
-           "The average adult hand, or one with these (21,) bone lengths (entry 0 unused)")
+           "rest_points_mm"_a = py::none(),
+           "The average adult hand, one with these (21,) bone lengths (entry 0 unused), or the "
+           "performer's hand of a result (rest_points_mm (21, 3): read_result's, the fitted "
+           "model's rest pose with the performer's palm)")
+      .def_property_readonly("rest_points_mm",
+                             [](const hand::HandModel& h) {
+                               const hand::RestPointsMm p = h.rest_points_mm();
+                               py::array_t<double> out({hand::kNumHandKeypoints, 3});
+                               auto o = out.mutable_unchecked<2>();
+                               for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
+                                 for (int c = 0; c < 3; ++c) o(k, c) = p[k][c];
+                               }
+                               return out;
+                             })
       .def_property_readonly("side",
                              [](const hand::HandModel& h) { return hand::HandSideName(h.side()); })
       .def_property_readonly("bone_lengths_mm",

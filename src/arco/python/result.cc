@@ -100,7 +100,16 @@ py::dict ReadResult(const std::filesystem::path& dir_path) {
   }
   out["hand_params"] = py::none();
   out["bone_lengths_mm"] = py::none();
+  out["rest_points_mm"] = py::none();
   if (std::filesystem::exists(folder.HandParamsPath(), ec)) {
+    // The fitted model's rest pose (made from the bone lengths for older results).
+    const pipeline::HandRecord hand = ValueOrRaise(folder.ReadHand(), folder.HandParamsPath());
+    py::array_t<double> rest({hand::kNumHandKeypoints, 3});
+    auto o = rest.mutable_unchecked<2>();
+    for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
+      for (int c = 0; c < 3; ++c) o(k, c) = hand.rest_points_mm[static_cast<size_t>(k)][c];
+    }
+    out["rest_points_mm"] = rest;
     out["hand_params"] =
         ToArray(ValueOrRaise(ReadNpy<double>(folder.HandParamsPath()), folder.HandParamsPath()));
     out["bone_lengths_mm"] =
@@ -118,8 +127,9 @@ void BindResult(py::module_& m) {
 Returns a dict: result (result.json), points3d {stage: (F, P, 3)}, keypoint_names {stage: the
 P names}, contacts {method: columns},
 pitch (columns of pitch.csv or None), instrument (strings_mm (F, S, 2, 3), keypoints_mm,
-name, a4_hz, world_units_per_mm; or None), hand_params ((F, 26)) and bone_lengths_mm ((21,)) of
-the fitted left hand (or None).)");
+name, a4_hz, world_units_per_mm; or None), hand_params ((F, 26)), bone_lengths_mm ((21,)) and
+rest_points_mm ((21, 3): HandModel("left", rest_points_mm=...) is the fitted model) of the
+fitted left hand (or None).)");
 }
 
 }  // namespace arco::python

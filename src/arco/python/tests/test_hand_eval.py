@@ -11,8 +11,12 @@ LEFT_HAND = slice(91, 112)  # COCO-WholeBody left hand in the result's points
 
 def test_forward_kinematics_reproduces_the_result(result):
     r = arco.read_result(result)
-    model = arco.HandModel("left", r["bone_lengths_mm"])
+    model = arco.HandModel("left", rest_points_mm=r["rest_points_mm"])
     np.testing.assert_allclose(model.bone_lengths_mm[1:], r["bone_lengths_mm"][1:], rtol=1e-12)
+    np.testing.assert_array_equal(model.rest_points_mm, r["rest_points_mm"])
+    # Without `arco run --performer-palm` the fitted model is the average hand sized by the bones.
+    sized = arco.HandModel("left", r["bone_lengths_mm"])
+    np.testing.assert_allclose(sized.rest_points_mm, r["rest_points_mm"], atol=1e-9)
     for method in ["vision", "paper", "arco"]:
         params = np.load(result / method / "hand_params.npy")
         points = model.forward_kinematics(params)
@@ -66,6 +70,10 @@ def test_hand_bad_inputs():
         arco.HandModel("middle")
     with pytest.raises(ValueError, match=r"bone_lengths_mm must be \(21,\)"):
         arco.HandModel("left", np.ones(20))
+    with pytest.raises(ValueError, match=r"rest_points_mm must be \(21, 3\)"):
+        arco.HandModel("left", rest_points_mm=np.ones((20, 3)))
+    with pytest.raises(ValueError, match="not both"):
+        arco.HandModel("left", np.ones(21) * 30, rest_points_mm=np.zeros((21, 3)))
 
 
 def test_evaluate_pitch():
