@@ -178,6 +178,13 @@ std::function<int()> SetupRefine(CLI::App& app) {
             refine::kCostWeightRange)
       ->capture_default_str();
   AddNumber(sub,
+            "--below-margin-mm",
+            r.decode.below_margin_mm,
+            "arco decoding: a fingertip deeper than this under the string plane counts its "
+            "depth beyond it in full (it is beside the fingerboard, not on the string)",
+            refine::kCostWeightRange)
+      ->capture_default_str();
+  AddNumber(sub,
             "--hand-lateral-weight",
             r.decode.hand_lateral_weight,
             "arco decoding: weight of the hand's median fingertip offset across the "

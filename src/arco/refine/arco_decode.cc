@@ -20,42 +20,6 @@ struct State {
   double cost = 0;                // emission
 };
 
-// Distance and finger-order cost of finger k at a candidate (header comment).
-void FrameCosts(const hand::HandPointsMm& points,
-                const StringFrame& sf,
-                const Eigen::Vector3d& contact,
-                int finger,
-                const ArcoDecodeOptions& options,
-                double* distance,
-                double* order) {
-  const Eigen::Vector3d v = points[hand::TipKeypoint(static_cast<hand::Finger>(finger))] - contact;
-  const double a = v.dot(sf.along);
-  const double n = v.dot(sf.normal);
-  const double l = (v - a * sf.along - n * sf.normal).norm();
-  // Which string: where the hand is across the neck, the median over the four fingertips of
-  // their signed offsets across the strings (one finger's lift-induced error cannot move it).
-  const Eigen::Vector3d across = sf.along.cross(sf.normal);
-  std::array<double, 4> offsets{};
-  for (int j = 1; j <= 4; ++j) {
-    offsets[static_cast<size_t>(j - 1)] =
-        (points[hand::TipKeypoint(static_cast<hand::Finger>(j))] - contact).dot(across);
-  }
-  const double hand_across = MedianInPlace(offsets.begin(), offsets.end());
-  const double wl = options.lateral_weight, wn = options.normal_weight;
-  const double wh = options.hand_lateral_weight;
-  *distance =
-      std::sqrt(a * a + wl * wl * l * l + wn * wn * n * n + wh * wh * hand_across * hand_across);
-  double violation = 0;
-  for (int j = 1; j <= 4; ++j) {
-    if (j == finger) continue;
-    const double aj =
-        (points[hand::TipKeypoint(static_cast<hand::Finger>(j))] - contact).dot(sf.along);
-    violation += j < finger ? std::max(0.0, -aj - options.order_margin_mm)
-                            : std::max(0.0, aj - options.order_margin_mm);
-  }
-  *order = violation;
-}
-
 // The states of one note and their emission costs.
 std::vector<State> NoteStates(const DecodeContext& context,
                               const NoteSpan& note,
@@ -194,6 +158,42 @@ void AssignFrame(const DecodeContext& context,
 }
 
 }  // namespace
+
+void FrameCosts(const hand::HandPointsMm& points,
+                const StringFrame& sf,
+                const Eigen::Vector3d& contact,
+                int finger,
+                const ArcoDecodeOptions& options,
+                double* distance,
+                double* order) {
+  const Eigen::Vector3d v = points[hand::TipKeypoint(static_cast<hand::Finger>(finger))] - contact;
+  const double a = v.dot(sf.along);
+  const double n = v.dot(sf.normal);
+  const double l = (v - a * sf.along - n * sf.normal).norm();
+  // Which string: where the hand is across the neck, the median over the four fingertips of
+  // their signed offsets across the strings (one finger's lift-induced error cannot move it).
+  const Eigen::Vector3d across = sf.along.cross(sf.normal);
+  std::array<double, 4> offsets{};
+  for (int j = 1; j <= 4; ++j) {
+    offsets[static_cast<size_t>(j - 1)] =
+        (points[hand::TipKeypoint(static_cast<hand::Finger>(j))] - contact).dot(across);
+  }
+  const double hand_across = MedianInPlace(offsets.begin(), offsets.end());
+  const double wl = options.lateral_weight, wn = options.normal_weight;
+  const double wh = options.hand_lateral_weight;
+  const double below = std::max(0.0, -n - options.below_margin_mm);  // n > 0: off the board
+  *distance = std::sqrt(a * a + wl * wl * l * l + wn * wn * n * n + below * below +
+                        wh * wh * hand_across * hand_across);
+  double violation = 0;
+  for (int j = 1; j <= 4; ++j) {
+    if (j == finger) continue;
+    const double aj =
+        (points[hand::TipKeypoint(static_cast<hand::Finger>(j))] - contact).dot(sf.along);
+    violation += j < finger ? std::max(0.0, -aj - options.order_margin_mm)
+                            : std::max(0.0, aj - options.order_margin_mm);
+  }
+  *order = violation;
+}
 
 std::vector<FrameContact> DecodeArco(const DecodeContext& context,
                                      const ArcoDecodeOptions& options,

@@ -5,8 +5,11 @@
 //
 // Emission cost of a note for state (string s, finger k), in mm-equivalents: the median
 // over the note's trusted frames (not boundary frames, note_boundaries.h) of
-//   D = sqrt(a^2 + (w_l l)^2 + (w_n n)^2 + (w_h H)^2),  (a, l, n) = tip_k - contact on that
-//       frame's string s along the string, across it and along the string plane's normal;
+//   D = sqrt(a^2 + (w_l l)^2 + (w_n n)^2 + b^2 + (w_h H)^2),  (a, l, n) = tip_k - contact on
+//       that frame's string s along the string, across it and along the string plane's
+//       normal (positive away from the fingerboard); b = max(0, -n - below_margin_mm), the
+//       depth under the strings beyond a margin, counted in full (a tip there is beside
+//       the fingerboard: a stopping tip sits above its string, the detector's lift errs up);
 //       H = the median over the four fingertips of their signed offsets across the
 //       strings from the contact. Which finger plays is told along the string; the tip's
 //       own l and n are mostly detector error (a lifted, unloaded finger that the hand fit
@@ -51,6 +54,17 @@
 namespace arco::refine {
 
 // The hand position of a state uses FingerOffsetSemitones (registry/instruments.h).
+
+// One frame's emission of finger k (1..4) at a candidate contact on the string whose frame
+// is `sf`: *distance = D above, *order = the finger-order violation (mm, before
+// order_weight). `points`: the vision hand in world mm.
+void FrameCosts(const hand::HandPointsMm& points,
+                const StringFrame& sf,
+                const Eigen::Vector3d& contact,
+                int finger,
+                const ArcoDecodeOptions& options,
+                double* distance,
+                double* order);
 
 // lift_max_mm[k] for finger k = 1..4 (entry 0 unused). One FrameContact per frame (before
 // IK). Frames of a note whose contact fails the lift test come back kUncertain with

@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "arco/refine/arco_decode.h"
 #include "arco/refine/refine.h"
 #include "arco/refine/test_scene.h"
 
@@ -248,6 +249,39 @@ TEST(ArcoEmission, ALateralTipErrorDoesNotMoveTheFingerToItsNeighbour) {
   old.decode.hand_lateral_weight = 0.0;
   const Score o = Identification(scene, Refine(scene.input, old));
   EXPECT_LT(o.right, o.pressed - 20);
+}
+
+// A fingertip under the string plane is beside the fingerboard, not on the string: its
+// depth beyond below_margin_mm counts in full, while a tip as far above (the detector's
+// lift) counts at normal_weight. On SPD's real take the little finger curled 18-29 mm
+// under the strings tied with the ring finger that played (real_take_behind4_cli_test).
+TEST(ArcoEmission, ATipUnderTheStringsCountsItsDepthInFull) {
+  StringFrame sf;  // along +x, normal +z (away from the fingerboard)
+  const Eigen::Vector3d contact(100, 0, 0);
+  hand::HandPointsMm points;
+  for (auto& p : points) p = Eigen::Vector3d(0, 0, 500);  // other tips far away along z
+  const int little = hand::TipKeypoint(hand::Finger::kLittle);
+  ArcoDecodeOptions o;
+  double d = 0, order = 0;
+  points[little] = contact + Eigen::Vector3d(0, 0, 25);  // lifted 25 mm
+  FrameCosts(points, sf, contact, 4, o, &d, &order);
+  EXPECT_NEAR(d, std::hypot(o.normal_weight * 25, o.hand_lateral_weight * 0), 1e-9);
+  points[little] = contact + Eigen::Vector3d(0, 0, -25);  // 25 mm under the strings
+  FrameCosts(points, sf, contact, 4, o, &d, &order);
+  EXPECT_NEAR(d, std::hypot(o.normal_weight * 25, 25 - o.below_margin_mm), 1e-9);
+  points[little] = contact + Eigen::Vector3d(0, 0, -8);  // within the margin: as above it
+  FrameCosts(points, sf, contact, 4, o, &d, &order);
+  EXPECT_NEAR(d, o.normal_weight * 8, 1e-9);
+  ArcoDecodeOptions off = o;
+  off.below_margin_mm = 1e6;
+  points[little] = contact + Eigen::Vector3d(0, 0, -25);
+  FrameCosts(points, sf, contact, 4, off, &d, &order);
+  EXPECT_NEAR(d, o.normal_weight * 25, 1e-9);
+  EXPECT_FALSE([] {
+    ArcoDecodeOptions bad;
+    bad.below_margin_mm = -1;
+    return bad.Validate().ok();
+  }());
 }
 
 // The fitted hand lags a fast shift: along one note the fitted wrist trails by 12 mm (the

@@ -85,6 +85,13 @@ struct ArcoDecodeOptions {
   // finger plays is told by the position along the string; across it the fitted tips
   // scatter with the detector's lift (the string plane is tilted against the top plate).
   double lateral_weight = 0.25;
+  // ... except below the string plane: a fingertip deeper than this under the strings is
+  // beside the fingerboard, not on the string (the detector's lift errs upward, a stopping
+  // tip sits above its string), and its depth beyond the margin counts in full. On SPD's
+  // real take the little finger curled beside the neck, 18-29 mm under the string plane,
+  // tied with the ring finger that played (docs/refine.md, "Finger decisions on real
+  // playing").
+  double below_margin_mm = 10.0;
   // Which string is told by the whole hand: the median over the four fingertips of their
   // offsets across the strings from the contact counts this much.
   double hand_lateral_weight = 1.0;

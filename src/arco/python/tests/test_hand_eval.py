@@ -14,9 +14,9 @@ def test_forward_kinematics_reproduces_the_result(result):
     model = arco.HandModel("left", rest_points_mm=r["rest_points_mm"])
     np.testing.assert_allclose(model.bone_lengths_mm[1:], r["bone_lengths_mm"][1:], rtol=1e-12)
     np.testing.assert_array_equal(model.rest_points_mm, r["rest_points_mm"])
-    # Without `arco run --performer-palm` the fitted model is the average hand sized by the bones.
+    # The performer's palm: the bases are not the average hand's, even sized to the bones.
     sized = arco.HandModel("left", r["bone_lengths_mm"])
-    np.testing.assert_allclose(sized.rest_points_mm, r["rest_points_mm"], atol=1e-9)
+    assert np.abs(sized.rest_points_mm[[1, 5, 9, 13, 17]] - r["rest_points_mm"][[1, 5, 9, 13, 17]]).max() > 0.05
     for method in ["vision", "paper", "arco"]:
         params = np.load(result / method / "hand_params.npy")
         points = model.forward_kinematics(params)
