@@ -350,6 +350,8 @@ StatusOr<std::vector<PointStage>> ResultFolder::PointStages() const {
       s.keypoint_names = sj["keypoint_names"].get<std::vector<std::string>>();
     if (sj["files"].contains("contact"))
       s.contacts_path = JoinPath(dir, sj["files"]["contact"].get<std::string>());
+    if (sj["files"].contains("contact_2"))
+      s.second_contacts_path = JoinPath(dir, sj["files"]["contact_2"].get<std::string>());
     if (sj["files"].contains("bowing"))
       s.bowing_path = JoinPath(dir, sj["files"]["bowing"].get<std::string>());
     out.push_back(std::move(s));

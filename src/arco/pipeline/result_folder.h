@@ -136,6 +136,7 @@ struct PointStage {
   std::string points3d_path;
   std::vector<std::string> keypoint_names;  // empty: the result's
   std::string contacts_path;                // empty: none
+  std::string second_contacts_path;         // contacts_2.csv, double stops; empty: none
   std::string bowing_path;                  // empty: none (refine/bowing.h)
 };
 

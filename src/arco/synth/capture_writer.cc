@@ -88,7 +88,7 @@ TruthFolder MakeTruthFolder(const SyntheticCapture& c,
     refine::ContactRow r;
     r.frame = f;
     r.state = !truth.double_stop ? "rest" : (truth.second_finger > 0 ? "pressed" : "open_string");
-    r.string = truth.double_stop ? truth.second_string : 0;
+    r.string = truth.second_finger > 0 ? truth.second_string : 0;  // as contact.csv: pressed
     r.finger = truth.second_finger;
     r.note = truth.double_stop ? truth.note_index : -1;
     r.f0_hz = truth.second_f0_hz;
