@@ -53,6 +53,10 @@ CommandRun SetupRun(CLI::App& app) {
       ->required();
   sub->add_option("-o,--output", a->o.result_dir, "Result folder to write")->required();
   sub->add_flag("--overwrite", a->o.overwrite, "Replace an existing result folder");
+  sub->add_flag("--double-stops",
+                a->o.double_stops,
+                "Double stops: track two simultaneous notes and give arco a second string, "
+                "finger and contact per frame (arco/contacts_2.csv; docs/refine.md)");
   AddNumber(sub,
             "--threads",
             a->o.num_threads,

@@ -33,6 +33,7 @@ constexpr char kBoneLengthsFile[] = "bone_lengths_mm.npy";
 constexpr char kPitchCsvFile[] = "pitch.csv";
 constexpr char kNotesCsvFile[] = "notes.csv";
 constexpr char kContactsCsvFile[] = "contacts.csv";
+constexpr char kSecondContactsCsvFile[] = "contacts_2.csv";  // double stops' upper notes
 constexpr char kFingeringCsvFile[] = "fingering.csv";
 constexpr char kBowingCsvFile[] = "bowing.csv";
 constexpr char kBowingNotesCsvFile[] = "bowing_notes.csv";
@@ -691,6 +692,7 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
     files["contact"] = kContactsCsvFile;
     files["fingering"] = kFingeringCsvFile;
   }
+  if (!r.second_contacts.empty()) files["contact_2"] = kSecondContactsCsvFile;
   if (r.bowing) {
     files["bowing"] = kBowingCsvFile;
     files["bowing_notes"] = kBowingNotesCsvFile;
@@ -702,6 +704,10 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
     if (!r.contacts.empty()) {
       ARCO_RETURN_IF_ERROR(refine::WriteContactsCsv(JoinPath(dir, kContactsCsvFile), r.contacts));
       ARCO_RETURN_IF_ERROR(WriteFingeringCsv(JoinPath(dir, kFingeringCsvFile), r.fingering));
+    }
+    if (!r.second_contacts.empty()) {
+      ARCO_RETURN_IF_ERROR(
+          refine::WriteContactsCsv(JoinPath(dir, kSecondContactsCsvFile), r.second_contacts));
     }
     if (r.bowing) {
       ARCO_RETURN_IF_ERROR(refine::WriteBowingCsv(JoinPath(dir, kBowingCsvFile), r.bowing->frames));

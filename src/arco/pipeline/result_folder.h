@@ -123,6 +123,9 @@ struct MethodRecord {
   NpyArray<double> points3d;
   std::vector<std::optional<hand::HandPose>> hands;
   std::vector<refine::FrameContact> contacts;    // empty: no contacts.csv (vision)
+  // The upper notes of double stops (arco with double stops): contacts_2.csv, in
+  // contacts.csv's format; empty: none.
+  std::vector<refine::FrameContact> second_contacts;
   std::vector<refine::NoteFingering> fingering;  // written with contacts
   refine::RefineOptions options;                 // as applied (refine::ToJson)
   refine::RefineSummary summary;
