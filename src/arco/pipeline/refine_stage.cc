@@ -247,11 +247,14 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
   refine::RefineResult r = refine::Refine(inputs.input, options);
   // arco with double stops: the upper notes' strings, fingers and the second finger's IK.
   std::vector<refine::FrameContact> second;
+  const refine::DoubleStopRefineOptions double_stop_options;
+  refine::DoubleStopRefineSummary double_stop_summary;
   if (options.mode == refine::RefineMode::kArco && !inputs.upper_f0_hz.empty()) {
     refine::DoubleStopRefineResult ds =
-        refine::RefineSecondVoice(inputs.input, r, inputs.upper_f0_hz, {});
+        refine::RefineSecondVoice(inputs.input, r, inputs.upper_f0_hz, double_stop_options);
     r.hand = std::move(ds.hand);
     second = std::move(ds.second);
+    double_stop_summary = ds.summary;
   }
   MethodRecord out;
   out.method = refine::RefineModeName(options.mode);
@@ -272,6 +275,8 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
   out.hands = r.hand;
   out.contacts = r.contacts;
   out.second_contacts = std::move(second);
+  out.double_stop_options = double_stop_options;
+  out.double_stop_summary = double_stop_summary;
   out.fingering = r.fingering;
   // Recorded as applied: without the audio's notes there are no onsets to use.
   out.options = options;

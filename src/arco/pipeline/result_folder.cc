@@ -722,6 +722,23 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
                 {"units", "mm"},
                 {"options", refine::ToJson(r.options)},
                 {"summary", refine::ToJson(r.summary)}};
+  if (!r.second_contacts.empty()) {
+    const refine::DoubleStopRefineOptions& o = r.double_stop_options;
+    const refine::DoubleStopRefineSummary& d = r.double_stop_summary;
+    entry["double_stops"] = {{"options",
+                              {{"open_tolerance_cents", o.open_tolerance_cents},
+                               {"max_span_semitones", o.max_span_semitones},
+                               {"fifth_semitones", o.fifth_semitones},
+                               {"max_tip_distance_mm", o.max_tip_distance_mm},
+                               {"max_iterations", o.max_iterations}}},
+                             {"summary",
+                              {{"frames", d.frames},
+                               {"pressed", d.pressed},
+                               {"open_string", d.open_string},
+                               {"one_finger_fifths", d.one_finger_fifths},
+                               {"uncertain", d.uncertain},
+                               {"joint_limit_violations", d.joint_limit_violations}}}};
+  }
   if (r.bowing) {
     entry["bowing"] = {{"options", refine::ToJson(r.bowing_options)},
                        {"summary", refine::ToJson(r.bowing->summary)}};

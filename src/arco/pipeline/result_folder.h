@@ -49,6 +49,7 @@
 #include "arco/pipeline/summaries.h"
 #include "arco/refine/bowing.h"
 #include "arco/refine/contact_annotation.h"
+#include "arco/refine/double_stop_refine.h"
 #include "arco/refine/refine.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/json_io.h"
@@ -126,6 +127,9 @@ struct MethodRecord {
   // The upper notes of double stops (arco with double stops): contacts_2.csv, in
   // contacts.csv's format; empty: none.
   std::vector<refine::FrameContact> second_contacts;
+  // Recorded as the stage's "double_stops" (options and counts) when second_contacts is.
+  refine::DoubleStopRefineOptions double_stop_options;
+  refine::DoubleStopRefineSummary double_stop_summary;
   std::vector<refine::NoteFingering> fingering;  // written with contacts
   refine::RefineOptions options;                 // as applied (refine::ToJson)
   refine::RefineSummary summary;

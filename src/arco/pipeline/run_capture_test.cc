@@ -184,6 +184,10 @@ TEST(RunCapture, DoubleStopsGiveArcoASecondVoiceThatEvalScores) {
   ASSERT_TRUE(summary.ok()) << summary.status().message();
   EXPECT_TRUE(FileExists(JoinPath(o.result_dir, "arco/contacts_2.csv")));
   EXPECT_FALSE(FileExists(JoinPath(o.result_dir, "paper/contacts_2.csv")));
+  auto manifest = ReadFileToString(JoinPath(o.result_dir, "result.json"));
+  ASSERT_TRUE(manifest.ok());
+  EXPECT_NE(manifest->find("\"double_stops\""), std::string::npos);
+  EXPECT_NE(manifest->find("\"contact_2\": \"contacts_2.csv\""), std::string::npos);
   eval::EvalRequest request;
   request.result_dir = o.result_dir;
   request.truth = JoinPath(capture, "truth");
