@@ -1,6 +1,8 @@
 #include "arco/refine/double_stop_refine.h"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 #include "arco/hand/ik.h"
@@ -51,9 +53,30 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
   ik.seed_levels = 0;
   ik.restarts = 0;
   ik.max_iterations = options.max_iterations;
+  // A note of the first voice whose frames mostly have an upper note keeps it on the rest
+  // of its frames (the polyphonic tracker's window holds two notes only well inside a
+  // double stop): its median upper f0, where that lies above the frame's own pitch.
+  std::map<int, std::vector<double>> note_upper;
+  std::map<int, int> note_frames;
+  for (size_t f = 0; f < frames; ++f) {
+    const int note = first.contacts[f].note;
+    if (note < 0) continue;
+    ++note_frames[note];
+    if (upper_f0_hz[f] > 0) note_upper[note].push_back(upper_f0_hz[f]);
+  }
+  std::map<int, double> note_median;
+  for (auto& [note, values] : note_upper) {
+    if (2 * static_cast<int>(values.size()) < note_frames[note]) continue;
+    std::sort(values.begin(), values.end());
+    note_median[note] = values[values.size() / 2];
+  }
   for (size_t f = 0; f < frames; ++f) {
     const FrameContact& c1 = first.contacts[f];
-    const double upper = upper_f0_hz[f];
+    double upper = upper_f0_hz[f];
+    if (!(upper > 0) && options.fill_notes) {
+      const auto it = note_median.find(c1.note);
+      if (it != note_median.end() && it->second > 1.03 * c1.f0_hz) upper = it->second;
+    }
     const bool sounding =
         c1.state == ContactState::kPressed || c1.state == ContactState::kOpenString;
     if (!(upper > 0) || !sounding || c1.string < 1) continue;

@@ -19,6 +19,9 @@
 //      nearest the contact (index .. little), but not the first voice's finger unless the
 //      two stops lie within fifth_semitones of each other, where the same finger stops both
 //      strings (a fifth), and not one farther than max_tip_distance_mm (uncertain).
+//   0. A first-voice note (FrameContact::note) with an upper note on at least half its
+//      frames gets their median on its frames without one, where it lies above the frame's
+//      pitch (fill_notes).
 //   4. IK: that finger's tip to the contact by the hand layer's bounded IK (MCP, PIP, DIP
 //      within the joint limits, regularised toward the refined pose); a fifth's finger is
 //      left where the first voice put it (its pad covers both strings).
@@ -47,6 +50,9 @@ struct DoubleStopRefineOptions {
   double fifth_semitones = 0.5;        // stops this close: one finger may stop both strings
   double max_tip_distance_mm = 60.0;   // the chosen fingertip's distance to its contact
   int max_iterations = 15;             // of the second finger's IK
+  // A first-voice note with an upper note on at least half its frames keeps the median of
+  // them on its other frames (the tracker's window misses the second note near the ends).
+  bool fill_notes = true;
   Status Validate() const;
 };
 

@@ -40,7 +40,9 @@ TEST(RefineSecondVoice, SixthFifthAndOpenStringOnTheNextHigherString) {
   for (size_t f = 5; f < 10; ++f) upper[f] = fx.UpperHz(4);
   for (size_t f = 10; f < 15; ++f) upper[f] = fx.UpperHz(2);
   for (size_t f = 15; f < 18; ++f) upper[f] = fx.UpperHz(0.1);
-  const DoubleStopRefineResult r = RefineSecondVoice(fx.scene.input, fx.first, upper, {});
+  DoubleStopRefineOptions per_frame;
+  per_frame.fill_notes = false;
+  const DoubleStopRefineResult r = RefineSecondVoice(fx.scene.input, fx.first, upper, per_frame);
   ASSERT_EQ(r.second.size(), n);
   EXPECT_EQ(r.second[2].state, ContactState::kRest);
   for (size_t f = 5; f < 10; ++f) {
@@ -71,6 +73,13 @@ TEST(RefineSecondVoice, SixthFifthAndOpenStringOnTheNextHigherString) {
   EXPECT_EQ(r.summary.one_finger_fifths, 5);
   EXPECT_EQ(r.summary.open_string, 3);
   EXPECT_EQ(r.summary.joint_limit_violations, 0);
+  // fill_notes: 13 of the note's 20 frames have an upper note, so the others get their
+  // median (2 semitones on the E string: the fifth).
+  const DoubleStopRefineResult filled = RefineSecondVoice(fx.scene.input, fx.first, upper, {});
+  EXPECT_EQ(filled.summary.frames, 20);
+  EXPECT_TRUE(filled.second[2].pressed());
+  EXPECT_EQ(filled.second[2].string, 1);
+  EXPECT_NEAR(filled.second[2].f0_hz, fx.UpperHz(2), 1e-9);
 }
 
 TEST(RefineSecondVoice, NoHigherStringOrAnUnplayableSpanIsUncertain) {
