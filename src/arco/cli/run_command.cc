@@ -58,6 +58,10 @@ CommandRun SetupRun(CLI::App& app) {
                 a->average_palm,
                 "Fit the hand with the average hand's palm instead of the performer's, estimated "
                 "from the take (docs/hand.md)");
+  sub->add_flag("--double-stops",
+                a->o.double_stops,
+                "Double stops: track two simultaneous notes and give arco a second string, "
+                "finger and contact per frame (arco/contacts_2.csv; docs/refine.md)");
   AddNumber(sub,
             "--threads",
             a->o.num_threads,

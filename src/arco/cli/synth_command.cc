@@ -224,6 +224,11 @@ int Run(Args& a) {
   std::printf(
       "  left hand     largest whole-hand correction %.1f mm (fingertips exact on the strings)\n",
       c.max_residual_shift_mm);
+  if (c.double_stops > 0) {
+    std::printf("  double stops  %d, both fingertips within %.1f mm of their contacts\n",
+                c.double_stops,
+                c.max_second_residual_mm);
+  }
   std::printf("  detections    %.1f%% of keypoint slots in view, %.1f%% with score >= 0.5\n",
               100.0 * detected / std::max<int64_t>(1, slots),
               100.0 * confident / std::max<int64_t>(1, slots));

@@ -94,6 +94,51 @@ ContactTrack ContactTrackFromRows(const std::vector<refine::ContactRow>& rows, i
   return t;
 }
 
+// The voices of a method's contacts.csv (first) and contacts_2.csv (second, may be null):
+// a pressed row sounds its string, an open row its open_string with finger 0.
+std::vector<FrameVoices> MethodVoices(const std::vector<refine::ContactRow>& first,
+                                      const std::vector<refine::ContactRow>& second,
+                                      int num_frames) {
+  std::vector<FrameVoices> v(static_cast<size_t>(num_frames));
+  for (int k = 0; k < 2; ++k) {
+    for (const refine::ContactRow& row : k == 0 ? first : second) {
+      if (row.frame >= num_frames) continue;
+      FrameVoices& fv = v[static_cast<size_t>(row.frame)];
+      if (row.state == "pressed") {
+        fv.string[k] = row.string;
+        fv.finger[k] = row.finger;
+      } else if (row.state == "open" || row.state == "open_string") {
+        fv.string[k] = row.open_string;
+      }
+    }
+  }
+  return v;
+}
+
+// The voices of a truth with double stops: contact.csv's row (an open string's from
+// notes.csv) and contact_2.csv's (an open upper note on the string above the lower's).
+std::vector<FrameVoices> TruthVoices(const synth::TruthFolder& tf, int num_frames) {
+  std::vector<FrameVoices> v(static_cast<size_t>(num_frames));
+  auto note_string = [&](int note) {
+    return note >= 0 && note < static_cast<int>(tf.notes.size())
+               ? tf.notes[static_cast<size_t>(note)].string
+               : 0;
+  };
+  for (int k = 0; k < 2; ++k) {
+    for (const refine::ContactRow& row : k == 0 ? tf.contacts : tf.second_contacts) {
+      if (row.frame >= num_frames) continue;
+      FrameVoices& fv = v[static_cast<size_t>(row.frame)];
+      if (row.state == "pressed") {
+        fv.string[k] = row.string;
+        fv.finger[k] = row.finger;
+      } else if (row.state == "open_string") {
+        fv.string[k] = std::max(0, note_string(row.note) - k);
+      }
+    }
+  }
+  return v;
+}
+
 StatusOr<ContactTrack> ReadContactCsv(const std::string& path, int num_frames) {
   ARCO_ASSIGN_OR_RETURN(const std::vector<refine::ContactRow> rows, refine::ReadContactsCsv(path));
   return ContactTrackFromRows(rows, num_frames);
@@ -131,6 +176,7 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
   std::vector<double> truth_f0;
   std::vector<bool> truth_scored;
   std::vector<refine::BowingFrame> truth_bowing;  // empty: no bow-arm truth
+  std::vector<FrameVoices> truth_voices;          // empty: no double stops in the truth
   EvalOptions options = r.metrics;
   const bool folder = r.labels.empty();
   if (folder && !std::filesystem::is_directory(r.truth)) {
@@ -150,6 +196,7 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
         truth,
         ToSequence(tf.points3d, truth_names, truth_names, synth::TruthPoints3dPath(r.truth)));
     truth_contact = ContactTrackFromRows(tf.contacts, truth.num_frames);
+    if (tf.HasDoubleStops()) truth_voices = TruthVoices(tf, truth.num_frames);
     const KeypointLayout* capture_layout = FindKeypointLayout(tf.manifest.layout);
     options.num_instrument_points = capture_layout ? capture_layout->size() - kNumWholeBody : 0;
     options.instrument_first = kNumWholeBody;
@@ -255,11 +302,22 @@ StatusOr<EvalReport> Evaluate(const EvalRequest& r) {
                            " frames but the truth has " + std::to_string(truth.num_frames));
     }
     std::optional<ContactTrack> contact;
+    std::vector<refine::ContactRow> contact_rows, second_rows;
     if (!stage->contacts_path.empty()) {
-      ARCO_ASSIGN_OR_RETURN(contact, ReadContactCsv(stage->contacts_path, truth.num_frames));
+      ARCO_ASSIGN_OR_RETURN(contact_rows, refine::ReadContactsCsv(stage->contacts_path));
+      contact = ContactTrackFromRows(contact_rows, truth.num_frames);
     }
     report.methods.push_back(EvaluateMethod(
         stage->name, truth, truth_contact, rs, contact ? &*contact : nullptr, options));
+    // Both notes of double stops, when the truth has some (and the method a second voice).
+    if (!truth_voices.empty()) {
+      std::optional<std::vector<FrameVoices>> voices;
+      if (!stage->second_contacts_path.empty()) {
+        ARCO_ASSIGN_OR_RETURN(second_rows, refine::ReadContactsCsv(stage->second_contacts_path));
+        voices = MethodVoices(contact_rows, second_rows, truth.num_frames);
+      }
+      ScoreDoubleStops(truth_voices, voices ? &*voices : nullptr, &report.methods.back());
+    }
     if (!stage->bowing_path.empty() && !truth_bowing.empty()) {
       ARCO_ASSIGN_OR_RETURN(const std::vector<refine::BowingFrame> bowing,
                             refine::ReadBowingCsv(stage->bowing_path));
@@ -349,6 +407,11 @@ Json EvalReport::ToJson(const EvalOptions& options) const {
     mj["bow_direction_accuracy"] = JsonFromDouble(m.bow_direction_accuracy);
     mj["bow_string_accuracy"] = JsonFromDouble(m.bow_string_accuracy);
     mj["sounding_point_error_mm"] = JsonFromDouble(m.sounding_point_error_mm);
+    if (m.double_stop_truth) {  // only for a truth with double stops: other reports as before
+      mj["double_stop_frames"] = m.double_stop_frames;
+      mj["double_stop_string_accuracy"] = JsonFromDouble(m.double_stop_string_accuracy);
+      mj["double_stop_finger_accuracy"] = JsonFromDouble(m.double_stop_finger_accuracy);
+    }
     j["methods"][m.method] = mj;
   }
   if (pitch) {

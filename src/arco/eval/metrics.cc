@@ -320,4 +320,33 @@ void ScoreBowing(const std::vector<refine::BowingFrame>& truth,
   if (sp_count > 0) metrics->sounding_point_error_mm = sp_sum / sp_count;
 }
 
+void ScoreDoubleStops(const std::vector<FrameVoices>& truth,
+                      const std::vector<FrameVoices>* method,
+                      MethodMetrics* metrics) {
+  if (method && method->size() != truth.size()) {
+    throw std::invalid_argument("double stops: " + std::to_string(method->size()) +
+                                " frames but the truth has " + std::to_string(truth.size()));
+  }
+  int frames = 0, string_hits = 0, finger_hits = 0;
+  for (size_t f = 0; f < truth.size(); ++f) {
+    const FrameVoices& t = truth[f];
+    if (!t.DoubleStop()) continue;
+    ++frames;
+    if (!method) continue;
+    const FrameVoices& m = (*method)[f];
+    if (!m.DoubleStop()) continue;
+    const bool same = m.string[0] == t.string[0] && m.string[1] == t.string[1];
+    const bool swapped = m.string[0] == t.string[1] && m.string[1] == t.string[0];
+    string_hits += same || swapped;
+    finger_hits += (same && m.finger[0] == t.finger[0] && m.finger[1] == t.finger[1]) ||
+                   (swapped && m.finger[0] == t.finger[1] && m.finger[1] == t.finger[0]);
+  }
+  metrics->double_stop_truth = frames > 0;
+  metrics->double_stop_frames = frames;
+  if (method && frames > 0) {
+    metrics->double_stop_string_accuracy = static_cast<double>(string_hits) / frames;
+    metrics->double_stop_finger_accuracy = static_cast<double>(finger_hits) / frames;
+  }
+}
+
 }  // namespace arco::eval

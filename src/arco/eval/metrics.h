@@ -111,6 +111,14 @@ struct MethodMetrics {
   double bow_direction_accuracy = NAN;
   double bow_string_accuracy = NAN;
   double sounding_point_error_mm = NAN;
+  // Double stops (ScoreDoubleStops): over the truth's double-stop frames, the fraction
+  // where the method's two strings (its two string-finger pairs) are the truth's, in
+  // either voice order. NaN when the method gives no second note; written only when the
+  // truth has double stops (double_stop_truth).
+  bool double_stop_truth = false;
+  int double_stop_frames = 0;
+  double double_stop_string_accuracy = NAN;
+  double double_stop_finger_accuracy = NAN;
   // Per frame (NaN where not measured): wrist-aligned left-hand error and
   // contact deviation, for plots.
   std::vector<double> frame_hand_mm, frame_contact_mm;
@@ -132,6 +140,25 @@ MethodMetrics EvaluateMethod(const std::string& method,
 void ScoreBowing(const std::vector<refine::BowingFrame>& truth,
                  const std::vector<refine::BowingFrame>& method,
                  MethodMetrics* metrics);
+
+// The notes sounding on one frame: up to two voices, each the string it sounds on (1 =
+// highest; an open string too) and the finger stopping it (0 = open string); string 0: the
+// voice is silent.
+struct FrameVoices {
+  int string[2] = {0, 0};
+  int finger[2] = {0, 0};
+  bool DoubleStop() const { return string[0] > 0 && string[1] > 0; }
+};
+
+// Double-stop metrics over the truth's frames with two voices: a string hit when the
+// method's two strings are the truth's two, a finger hit when its two (string, finger)
+// pairs are the truth's two, in either order (a method may call either voice its first).
+// `method` null: the method gives no second note (accuracies stay NaN). Sets
+// double_stop_truth when the truth has a double-stop frame. Throws std::invalid_argument
+// when the frame counts differ.
+void ScoreDoubleStops(const std::vector<FrameVoices>& truth,
+                      const std::vector<FrameVoices>* method,
+                      MethodMetrics* metrics);
 
 // Geometric flexion of a hand's PIP and DIP joints (degrees) from its 21
 // keypoints, signed: positive bends towards the palm. The flexion axis is the

@@ -180,5 +180,47 @@ TEST(EvaluatePitch, HandComputedAccuracyAndVoicing) {
   EXPECT_NEAR(masked.voicing_false_alarm, 0.0, 1e-12);
 }
 
+TEST(ScoreDoubleStops, BothNotesInEitherVoiceOrderOverDoubleStopFramesOnly) {
+  auto voices = [](int s1, int f1, int s2, int f2) {
+    FrameVoices v;
+    v.string[0] = s1;
+    v.finger[0] = f1;
+    v.string[1] = s2;
+    v.finger[1] = f2;
+    return v;
+  };
+  // Frames: single note, then four double stops (G string 3rd finger + D string open).
+  const std::vector<FrameVoices> truth = {voices(4, 1, 0, 0),
+                                          voices(4, 3, 3, 0),
+                                          voices(4, 3, 3, 0),
+                                          voices(4, 3, 3, 0),
+                                          voices(4, 3, 3, 0)};
+  const std::vector<FrameVoices> method = {
+      voices(2, 2, 0, 0),   // wrong, but not a double-stop frame
+      voices(4, 3, 3, 0),   // right
+      voices(3, 0, 4, 3),   // right, voices swapped
+      voices(4, 2, 3, 0),   // strings right, finger wrong
+      voices(4, 3, 0, 0)};  // no second note
+  MethodMetrics m;
+  ScoreDoubleStops(truth, &method, &m);
+  EXPECT_TRUE(m.double_stop_truth);
+  EXPECT_EQ(m.double_stop_frames, 4);
+  EXPECT_DOUBLE_EQ(m.double_stop_string_accuracy, 3.0 / 4);
+  EXPECT_DOUBLE_EQ(m.double_stop_finger_accuracy, 2.0 / 4);
+  // No second voice from the method: NaN, never 0; no double stops in the truth: unset.
+  MethodMetrics none;
+  ScoreDoubleStops(truth, nullptr, &none);
+  EXPECT_TRUE(none.double_stop_truth);
+  EXPECT_TRUE(std::isnan(none.double_stop_string_accuracy));
+  EXPECT_TRUE(std::isnan(none.double_stop_finger_accuracy));
+  MethodMetrics single;
+  const std::vector<FrameVoices> single_truth = {voices(4, 1, 0, 0)};
+  const std::vector<FrameVoices> single_method = {voices(4, 1, 0, 0)};
+  ScoreDoubleStops(single_truth, &single_method, &single);
+  EXPECT_FALSE(single.double_stop_truth);
+  EXPECT_TRUE(std::isnan(single.double_stop_string_accuracy));
+  EXPECT_THROW(ScoreDoubleStops(truth, &single_method, &m), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace arco::eval

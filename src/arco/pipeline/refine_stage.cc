@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 #include "arco/body/skeleton_fit.h"
 #include "arco/pipeline/capture_context.h"
 #include "arco/pipeline/result_folder.h"
+#include "arco/refine/double_stop_refine.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
 
@@ -220,6 +222,19 @@ StatusOr<RefineInputs> MakeRefineInputs(const std::string& result_dir,
   return out;
 }
 
+void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly, RefineInputs* inputs) {
+  std::vector<refine::FramePitch>& pitch = inputs->input.pitch;
+  if (poly.size() > pitch.size()) {
+    throw std::invalid_argument("AddDoubleStops: more polyphonic frames than video frames");
+  }
+  inputs->upper_f0_hz.assign(pitch.size(), 0.0);
+  for (size_t f = 0; f < poly.size(); ++f) {
+    if (poly[f].count != 2) continue;
+    pitch[f] = {poly[f].notes[0].f0_hz, 1.0};
+    inputs->upper_f0_hz[f] = poly[f].notes[1].f0_hz;
+  }
+}
+
 StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
                                                const RefineInputs& inputs,
                                                const refine::RefineOptions& options,
@@ -229,7 +244,18 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
     return Status::Error(result.ManifestPath() +
                          ": no pitch stage (the capture has no audio); only vision can be written");
   }
-  const refine::RefineResult r = refine::Refine(inputs.input, options);
+  refine::RefineResult r = refine::Refine(inputs.input, options);
+  // arco with double stops: the upper notes' strings, fingers and the second finger's IK.
+  std::vector<refine::FrameContact> second;
+  const refine::DoubleStopRefineOptions double_stop_options;
+  refine::DoubleStopRefineSummary double_stop_summary;
+  if (options.mode == refine::RefineMode::kArco && !inputs.upper_f0_hz.empty()) {
+    refine::DoubleStopRefineResult ds =
+        refine::RefineSecondVoice(inputs.input, r, inputs.upper_f0_hz, double_stop_options);
+    r.hand = std::move(ds.hand);
+    second = std::move(ds.second);
+    double_stop_summary = ds.summary;
+  }
   MethodRecord out;
   out.method = refine::RefineModeName(options.mode);
   out.layout = refine::SpdContactLayoutName(*inputs.instrument);
@@ -248,6 +274,9 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
       *spd, r.hand, options.mode == refine::RefineMode::kVision ? nullptr : &r.contacts);
   out.hands = r.hand;
   out.contacts = r.contacts;
+  out.second_contacts = std::move(second);
+  out.double_stop_options = double_stop_options;
+  out.double_stop_summary = double_stop_summary;
   out.fingering = r.fingering;
   // Recorded as applied: without the audio's notes there are no onsets to use.
   out.options = options;

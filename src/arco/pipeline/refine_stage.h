@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "arco/audio/double_stops.h"
 #include "arco/instrument/instrument_model.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/refine/bowing.h"
@@ -29,7 +30,17 @@ struct RefineInputs {
   refine::RefineInput input;  // input.pitch all unvoiced when the result has no pitch stage
   refine::SpdSources spd;
   bool has_pitch = false;
+  // Double stops (refine/double_stop_refine.h; `arco run --double-stops`): the upper note
+  // per frame (0 = none), input.pitch then holding the lower one on those frames (see
+  // AddDoubleStops). Empty: off, and arco writes no contacts_2.csv.
+  std::vector<double> upper_f0_hz;
 };
+
+// Puts a polyphonic tracker's two notes (audio/double_stops.h, one frame per video frame)
+// into the inputs: on each frame with two notes, the lower becomes the frame's pitch
+// (confidence 1: both notes were found) and the upper goes to upper_f0_hz. Throws
+// std::invalid_argument when the frame counts differ.
+void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly, RefineInputs* inputs);
 // Errors name the file: no hand or instrument stage, shapes that disagree.
 StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir);
 

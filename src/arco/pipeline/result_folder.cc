@@ -34,6 +34,7 @@ constexpr char kRestPointsFile[] = "rest_points_mm.npy";
 constexpr char kPitchCsvFile[] = "pitch.csv";
 constexpr char kNotesCsvFile[] = "notes.csv";
 constexpr char kContactsCsvFile[] = "contacts.csv";
+constexpr char kSecondContactsCsvFile[] = "contacts_2.csv";  // double stops' upper notes
 constexpr char kFingeringCsvFile[] = "fingering.csv";
 constexpr char kBowingCsvFile[] = "bowing.csv";
 constexpr char kBowingNotesCsvFile[] = "bowing_notes.csv";
@@ -351,6 +352,8 @@ StatusOr<std::vector<PointStage>> ResultFolder::PointStages() const {
       s.keypoint_names = sj["keypoint_names"].get<std::vector<std::string>>();
     if (sj["files"].contains("contact"))
       s.contacts_path = JoinPath(dir, sj["files"]["contact"].get<std::string>());
+    if (sj["files"].contains("contact_2"))
+      s.second_contacts_path = JoinPath(dir, sj["files"]["contact_2"].get<std::string>());
     if (sj["files"].contains("bowing"))
       s.bowing_path = JoinPath(dir, sj["files"]["bowing"].get<std::string>());
     out.push_back(std::move(s));
@@ -714,6 +717,7 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
     files["contact"] = kContactsCsvFile;
     files["fingering"] = kFingeringCsvFile;
   }
+  if (!r.second_contacts.empty()) files["contact_2"] = kSecondContactsCsvFile;
   if (r.bowing) {
     files["bowing"] = kBowingCsvFile;
     files["bowing_notes"] = kBowingNotesCsvFile;
@@ -725,6 +729,10 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
     if (!r.contacts.empty()) {
       ARCO_RETURN_IF_ERROR(refine::WriteContactsCsv(JoinPath(dir, kContactsCsvFile), r.contacts));
       ARCO_RETURN_IF_ERROR(WriteFingeringCsv(JoinPath(dir, kFingeringCsvFile), r.fingering));
+    }
+    if (!r.second_contacts.empty()) {
+      ARCO_RETURN_IF_ERROR(
+          refine::WriteContactsCsv(JoinPath(dir, kSecondContactsCsvFile), r.second_contacts));
     }
     if (r.bowing) {
       ARCO_RETURN_IF_ERROR(refine::WriteBowingCsv(JoinPath(dir, kBowingCsvFile), r.bowing->frames));
@@ -739,6 +747,24 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
                 {"units", "mm"},
                 {"options", refine::ToJson(r.options)},
                 {"summary", refine::ToJson(r.summary)}};
+  if (!r.second_contacts.empty()) {
+    const refine::DoubleStopRefineOptions& o = r.double_stop_options;
+    const refine::DoubleStopRefineSummary& d = r.double_stop_summary;
+    entry["double_stops"] = {{"options",
+                              {{"open_tolerance_cents", o.open_tolerance_cents},
+                               {"max_span_semitones", o.max_span_semitones},
+                               {"fifth_semitones", o.fifth_semitones},
+                               {"max_tip_distance_mm", o.max_tip_distance_mm},
+                               {"max_iterations", o.max_iterations},
+                               {"fill_notes", o.fill_notes}}},
+                             {"summary",
+                              {{"frames", d.frames},
+                               {"pressed", d.pressed},
+                               {"open_string", d.open_string},
+                               {"one_finger_fifths", d.one_finger_fifths},
+                               {"uncertain", d.uncertain},
+                               {"joint_limit_violations", d.joint_limit_violations}}}};
+  }
   if (r.bowing) {
     entry["bowing"] = {{"options", refine::ToJson(r.bowing_options)},
                        {"summary", refine::ToJson(r.bowing->summary)}};

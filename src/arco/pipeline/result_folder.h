@@ -50,6 +50,7 @@
 #include "arco/pipeline/summaries.h"
 #include "arco/refine/bowing.h"
 #include "arco/refine/contact_annotation.h"
+#include "arco/refine/double_stop_refine.h"
 #include "arco/refine/refine.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/json_io.h"
@@ -129,6 +130,12 @@ struct MethodRecord {
   NpyArray<double> points3d;
   std::vector<std::optional<hand::HandPose>> hands;
   std::vector<refine::FrameContact> contacts;    // empty: no contacts.csv (vision)
+  // The upper notes of double stops (arco with double stops): contacts_2.csv, in
+  // contacts.csv's format; empty: none.
+  std::vector<refine::FrameContact> second_contacts;
+  // Recorded as the stage's "double_stops" (options and counts) when second_contacts is.
+  refine::DoubleStopRefineOptions double_stop_options;
+  refine::DoubleStopRefineSummary double_stop_summary;
   std::vector<refine::NoteFingering> fingering;  // written with contacts
   refine::RefineOptions options;                 // as applied (refine::ToJson)
   refine::RefineSummary summary;
@@ -142,6 +149,7 @@ struct PointStage {
   std::string points3d_path;
   std::vector<std::string> keypoint_names;  // empty: the result's
   std::string contacts_path;                // empty: none
+  std::string second_contacts_path;         // contacts_2.csv, double stops; empty: none
   std::string bowing_path;                  // empty: none (refine/bowing.h)
 };
 

@@ -39,6 +39,10 @@ struct RunOptions {
   // Replace an existing non-empty result_dir (only one holding result.json). The whole
   // result folder is written under a hidden temporary name and moved in at the end.
   bool overwrite = false;
+  // Double stops (issue 27): a second pass of the polyphonic tracker over the audio
+  // (audio/double_stops.h); arco refines the lower note as the first voice and the upper
+  // one as contacts_2.csv (refine/double_stop_refine.h). Off: the outputs are as before.
+  bool double_stops = false;
 
   // Every nested option (as the stages will receive them).
   Status Validate() const;

@@ -189,24 +189,34 @@ audio::MidiFile PerformanceToMidi(const Performance& perf,
   audio::MidiTrack track;
   track.name = "arco synth";
   track.program = gm_program;
-  for (const PerformedNote& n : perf.notes) {
+  // The upper notes of double stops on a second channel: pitch bends are per channel.
+  audio::MidiTrack second = track;
+  second.name = "arco synth, double stops' upper notes";
+  second.channel = 1;
+  auto add = [&](const PerformedNote& n, int key, bool upper, audio::MidiTrack* out) {
     const double lead = o.latency_s;
     const double onset = std::max(0.0, n.note.onset_s - lead);
     const double offset = std::max(onset + 0.01, n.note.offset_s - lead);
-    auto it = contours.find(n.note.midi_note);
+    auto it = contours.find(key);
     const SampleContour* contour = it == contours.end() ? nullptr : &it->second;
-    track.controls.push_back({onset, 120, 0});
-    track.notes.push_back({onset, offset, n.note.midi_note, n.note.velocity});
+    out->controls.push_back({onset, 120, 0});
+    out->notes.push_back({onset, offset, key, n.note.velocity});
     // The first bend goes with the note-on; then every bend_step_s. The sample
     // plays at 2^(bend/12) of its speed, so its own time runs at that rate.
     double sample_time_s = 0;
     for (double t = n.note.onset_s; t < n.note.offset_s; t += o.bend_step_s) {
-      const double cents = n.CentsAt(t) - (contour ? contour->At(sample_time_s) : 0.0);
-      track.bends.push_back({std::max(0.0, t - lead), cents / 100.0});
+      const double cents = (upper ? n.SecondCentsAt(t) : n.CentsAt(t)) -
+                           (contour ? contour->At(sample_time_s) : 0.0);
+      out->bends.push_back({std::max(0.0, t - lead), cents / 100.0});
       sample_time_s += o.bend_step_s * std::pow(2.0, cents / 1200.0);
     }
+  };
+  for (const PerformedNote& n : perf.notes) {
+    add(n, n.note.midi_note, false, &track);
+    if (n.note.IsDoubleStop()) add(n, n.note.second_midi_note, true, &second);
   }
   file.tracks.push_back(track);
+  if (!second.notes.empty()) file.tracks.push_back(second);
   return file;
 }
 
@@ -224,8 +234,11 @@ Status RenderPerformanceAudio(const Performance& perf,
   if (o.tune_soundfont) {
     std::map<int, double> key_duration_s;
     for (const PerformedNote& n : perf.notes) {
-      double& d = key_duration_s[n.note.midi_note];
-      d = std::max(d, n.note.offset_s - n.note.onset_s);
+      for (int key : {n.note.midi_note, n.note.second_midi_note}) {
+        if (key <= 0) continue;
+        double& d = key_duration_s[key];
+        d = std::max(d, n.note.offset_s - n.note.onset_s);
+      }
     }
     ARCO_ASSIGN_OR_RETURN(contours,
                           MeasureContours(key_duration_s, gm_program, perf.a4_hz, o, work_dir));

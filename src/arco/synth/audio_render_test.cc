@@ -165,5 +165,32 @@ TEST(PerformanceToMidi, BendsCarryIntonationAndVibratoMinusKeyOffset) {
   EXPECT_FALSE(bad.Validate().ok());
 }
 
+TEST(PerformanceToMidi, DoubleStopsUpperNotesGoOnASecondChannel) {
+  auto score = MakeBuiltInPiece("double-stops", testing::Violin());
+  auto plan = PlanFingering(*score, testing::Violin());
+  auto perf = MakePerformance(*score, *plan, {}, 2);
+  ASSERT_TRUE(perf.ok());
+  AudioRenderOptions o;
+  o.latency_s = 0;
+  const audio::MidiFile f = PerformanceToMidi(*perf, 40, {}, o);
+  ASSERT_EQ(f.tracks.size(), 2u);
+  EXPECT_EQ(f.tracks[0].notes.size(), perf->notes.size());
+  EXPECT_EQ(f.tracks[1].channel, 1);
+  EXPECT_EQ(f.tracks[1].program, 40);
+  ASSERT_EQ(f.tracks[1].notes.size(), 12u);  // 4 intervals on 3 string pairs
+  size_t k = 0;
+  for (const PerformedNote& n : perf->notes) {
+    if (!n.note.IsDoubleStop()) continue;
+    EXPECT_EQ(f.tracks[1].notes[k].midi_note, n.note.second_midi_note);
+    EXPECT_NEAR(f.tracks[1].notes[k].onset_s, n.note.onset_s, 1e-12);
+    ++k;
+  }
+  // A single-note piece keeps one track.
+  auto single = MakeBuiltInPiece("scale-2oct", testing::Violin());
+  auto single_plan = PlanFingering(*single, testing::Violin());
+  auto single_perf = MakePerformance(*single, *single_plan, {}, 2);
+  EXPECT_EQ(PerformanceToMidi(*single_perf, 40, {}, o).tracks.size(), 1u);
+}
+
 }  // namespace
 }  // namespace arco::synth

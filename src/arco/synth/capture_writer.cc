@@ -79,6 +79,22 @@ TruthFolder MakeTruthFolder(const SyntheticCapture& c,
     r.point_mm = truth.point_mm;
     t.contacts.push_back(r);
   }
+  // The double stops' upper notes (contact_2.csv, notes_2.csv): only for a score that has
+  // some, so a single-note capture's truth is as before.
+  bool has_double_stops = false;
+  for (const PerformedNote& p : c.performance.notes) has_double_stops |= p.note.IsDoubleStop();
+  for (int f = 0; f < c.num_frames && has_double_stops; ++f) {
+    const ContactTruth& truth = c.contact[static_cast<size_t>(f)];
+    refine::ContactRow r;
+    r.frame = f;
+    r.state = !truth.double_stop ? "rest" : (truth.second_finger > 0 ? "pressed" : "open_string");
+    r.string = truth.second_finger > 0 ? truth.second_string : 0;  // as contact.csv: pressed
+    r.finger = truth.second_finger;
+    r.note = truth.double_stop ? truth.note_index : -1;
+    r.f0_hz = truth.second_f0_hz;
+    r.point_mm = truth.second_point_mm;
+    t.second_contacts.push_back(r);
+  }
   const int num_strings = 4;  // every supported instrument; string 1 = highest
   for (const PerformedNote& p : c.performance.notes) {
     TruthNote n;
@@ -93,7 +109,15 @@ TruthFolder MakeTruthFolder(const SyntheticCapture& c,
     n.vibrato_rate_hz = p.vibrato_rate_hz;
     n.vibrato_extent_cents = p.vibrato_extent_cents;
     t.notes.push_back(n);
+    if (!p.note.IsDoubleStop()) continue;
+    n.midi_note = p.note.second_midi_note;
+    n.string = num_strings - p.fingering.second_string_index;
+    n.finger = p.fingering.second_finger;
+    n.intonation_cents = p.second_intonation_cents;
+    if (n.finger == 0) n.vibrato_rate_hz = n.vibrato_extent_cents = 0;
+    t.second_notes.push_back(n);
   }
+  m.double_stops = static_cast<int64_t>(t.second_notes.size());
   if (recorded) return t;  // the recording's pitch is not known: no pitch.csv truth
   // Confidence marks what a pitch evaluation should score: 0 for the first
   // 60 ms of a note (the sample speaks) and for release tails (0.7 s after a
@@ -107,6 +131,7 @@ TruthFolder MakeTruthFolder(const SyntheticCapture& c,
       if (f0 <= 0 && time_s >= n.note.offset_s && time_s < n.note.offset_s + 0.7) scored = false;
     }
     t.pitch.push_back({f, time_s, f0, scored ? 1.0 : 0.0, f0 > 0});
+    if (has_double_stops) t.second_f0_hz.push_back(c.performance.SecondF0HzAt(time_s));
   }
   return t;
 }

@@ -46,6 +46,69 @@ double TransitionCost(const State& a,
   return c;
 }
 
+// True when two spans of one hand frame can stop the two notes of a double stop together:
+// one finger stops one place (the same finger on both strings only at the same offset, a
+// fifth), and an extended frame does not also hold a finger of the closed frame that the
+// extension moves (cello: the extended 2nd finger with the closed 2nd finger).
+bool SpansTogether(const FingerSpan& a, const FingerSpan& b, const std::vector<FingerSpan>& frame) {
+  if (a.finger == b.finger) return a.offset_semitones == b.offset_semitones;
+  if (a.offset_semitones == b.offset_semitones) return false;
+  if (a.extended == b.extended) return true;
+  const FingerSpan& closed = a.extended ? b : a;
+  for (const FingerSpan& s : frame) {
+    if (s.extended && s.finger == closed.finger) return false;
+  }
+  return true;
+}
+
+// Candidate states of a double stop: lower note on string s, upper on s + 1, one hand
+// position; an open string goes with any position.
+void DoubleStopStates(const ScoreNote& note,
+                      const ScoreInstrument& instrument,
+                      const std::vector<FingerSpan>& frame,
+                      const FingeringOptions& options,
+                      std::vector<State>* states) {
+  const int num_strings = static_cast<int>(instrument.open_string_midi.size());
+  auto add = [&](int s, int p, int finger, int a, bool ext, int finger2, int b, bool ext2) {
+    NoteFingering f{s, finger, p, a, ext || ext2};
+    f.second_string_index = s + 1;
+    f.second_finger = finger2;
+    f.second_semitone_on_string = b;
+    NoteFingering g{s + 1, finger2, p, b, ext2};
+    double cost = NoteCost(f, note, options);
+    if (finger2 > 0 && finger2 != finger) cost += NoteCost(g, note, options);
+    states->push_back({f, cost});
+  };
+  for (int s = 0; s + 1 < num_strings; ++s) {
+    const int a = note.midi_note - instrument.open_string_midi[static_cast<size_t>(s)];
+    const int b = note.second_midi_note - instrument.open_string_midi[static_cast<size_t>(s + 1)];
+    if (a < 0 || b < 0 || a > instrument.max_semitones_above_open ||
+        b > instrument.max_semitones_above_open) {
+      continue;
+    }
+    if (a == 0 && b == 0) {
+      for (int p = 1; p <= options.max_position_semitones; ++p) add(s, p, 0, 0, false, 0, 0, false);
+      continue;
+    }
+    for (const FingerSpan& sa : frame) {
+      if (a == 0 || b == 0) {
+        // One open string: the stopped note sets the position.
+        const int p = (a == 0 ? b : a) - sa.offset_semitones;
+        if (p < 1 || p > options.max_position_semitones) continue;
+        if (a == 0) add(s, p, 0, 0, false, sa.finger, b, sa.extended);
+        if (b == 0) add(s, p, sa.finger, a, sa.extended, 0, 0, false);
+        continue;
+      }
+      const int p = a - sa.offset_semitones;
+      if (p < 1 || p > options.max_position_semitones) continue;
+      for (const FingerSpan& sb : frame) {
+        if (b - sb.offset_semitones != p || !SpansTogether(sa, sb, frame)) continue;
+        add(s, p, sa.finger, a, sa.extended, sb.finger, b, sb.extended);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 Status FingeringOptions::Validate() const {
@@ -89,7 +152,8 @@ StatusOr<FingeringPlan> PlanFingering(const Score& score,
   std::vector<std::vector<State>> states(n);
   for (size_t i = 0; i < n; ++i) {
     const ScoreNote& note = score.notes[i];
-    for (int s = 0; s < num_strings; ++s) {
+    if (note.IsDoubleStop()) DoubleStopStates(note, instrument, frame, options, &states[i]);
+    for (int s = 0; s < num_strings && !note.IsDoubleStop(); ++s) {
       const int semis = note.midi_note - instrument.open_string_midi[static_cast<size_t>(s)];
       if (semis < 0 || semis > instrument.max_semitones_above_open) continue;
       if (semis == 0) {
@@ -109,11 +173,14 @@ StatusOr<FingeringPlan> PlanFingering(const Score& score,
     }
     if (states[i].empty()) {
       char buf[200];
+      const std::string name =
+          MidiNoteName(note.midi_note) +
+          (note.IsDoubleStop() ? "+" + MidiNoteName(note.second_midi_note) : std::string());
       std::snprintf(buf,
                     sizeof(buf),
                     "note %d (%s) at %.3f s cannot be fingered on the %s within position %d",
                     note.midi_note,
-                    MidiNoteName(note.midi_note).c_str(),
+                    name.c_str(),
                     note.onset_s,
                     instrument.name.c_str(),
                     options.max_position_semitones);

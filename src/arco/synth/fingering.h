@@ -56,6 +56,14 @@ struct NoteFingering {
   int position_semitones = 0;  // hand position (finger 1's semitone); kept through open strings
   int semitone_on_string = 0;  // midi_note - open string's midi note
   bool extended = false;
+  // The upper note of a double stop (ScoreNote::second_midi_note): on the next higher
+  // string, string_index + 1, in the same hand position (and frame); -1 on a single note.
+  // Two stopped notes take two fingers, except a fifth, which one finger stops across
+  // both strings (second_finger == finger).
+  int second_string_index = -1;
+  int second_finger = 0;  // 0 = open string
+  int second_semitone_on_string = 0;
+  bool IsDoubleStop() const { return second_string_index >= 0; }
 };
 
 struct FingeringPlan {
@@ -66,7 +74,8 @@ struct FingeringPlan {
   int num_string_crossings = 0;
 };
 
-// Plans the whole score. Errors when a note cannot be played on any string.
+// Plans the whole score. Errors when a note (or double stop) cannot be played on any
+// string (pair).
 StatusOr<FingeringPlan> PlanFingering(const Score& score,
                                       const ScoreInstrument& instrument,
                                       const FingeringOptions& options = {});

@@ -48,6 +48,54 @@ void ExpectPlayable(const Score& score, const FingeringPlan& plan, const ScoreIn
   }
 }
 
+// Both notes of every double stop of the built-in piece: adjacent strings, one hand
+// position, each a legal stop of the hand frame; two fingers unless one finger stops a fifth.
+TEST(PlanFingering, DoubleStopsTakeAdjacentStringsAndAPlayableHand) {
+  for (const auto& ins : {Cello(), Violin(), testing::Viola(), testing::Bass()}) {
+    auto score = MakeBuiltInPiece("double-stops", ins);
+    ASSERT_TRUE(score.ok());
+    auto plan = PlanFingering(*score, ins);
+    ASSERT_TRUE(plan.ok()) << ins.name << ": " << plan.status().message();
+    ExpectPlayable(*score, *plan, ins);
+    int fifths_one_finger = 0;
+    for (size_t i = 0; i < score->notes.size(); ++i) {
+      const ScoreNote& n = score->notes[i];
+      const NoteFingering& f = plan->notes[i];
+      ASSERT_EQ(f.IsDoubleStop(), n.IsDoubleStop());
+      if (!n.IsDoubleStop()) continue;
+      ASSERT_EQ(f.second_string_index, f.string_index + 1) << ins.name << " note " << i;
+      EXPECT_EQ(ins.open_string_midi[f.second_string_index] + f.second_semitone_on_string,
+                n.second_midi_note);
+      NoteFingering g{f.second_string_index,
+                      f.second_finger,
+                      f.position_semitones,
+                      f.second_semitone_on_string,
+                      f.extended};
+      if (g.finger > 0 && FingerOffset(g, ins.name) == -100) g.extended = !g.extended;
+      if (g.finger > 0) {
+        EXPECT_NE(FingerOffset(g, ins.name), -100) << ins.name << " note " << i;
+      }
+      if (f.finger > 0 && f.finger == f.second_finger) {
+        EXPECT_EQ(f.semitone_on_string, f.second_semitone_on_string);  // a fifth
+        ++fifths_one_finger;
+      }
+    }
+    // Strings tuned in fifths: a stopped fifth takes one finger across both strings (the
+    // double bass, tuned in fourths, has none).
+    const bool in_fifths = ins.open_string_midi[1] - ins.open_string_midi[0] == 7;
+    EXPECT_EQ(fifths_one_finger >= 1, in_fifths) << ins.name;
+  }
+}
+
+TEST(PlanFingering, DoubleStopThatNoHandSpansIsAnError) {
+  Score s;
+  s.notes.push_back({56, 0.1, 0.5, 80, 71});  // G#3 + B4: a tenth, not on adjacent strings
+  s.duration_s = 1;
+  auto plan = PlanFingering(s, Violin());
+  ASSERT_FALSE(plan.ok());
+  EXPECT_NE(plan.status().message().find("G#3+B4"), std::string::npos) << plan.status().message();
+}
+
 TEST(PlanFingering, LowScaleOnTheCStringUsesFirstPosition) {
   // C2 D2 E2 F2: open, 1, 3, 4 in first position (finger 1 on D).
   const Score s = Notes({{36, 0.5}, {38, 0.5}, {40, 0.5}, {41, 0.5}});

@@ -117,6 +117,58 @@ INSTANTIATE_TEST_SUITE_P(Pieces,
                                            std::make_tuple("viola", "open-strings"),
                                            std::make_tuple("double_bass", "arpeggios")));
 
+// Double stops: the upper note's truth contact lies on the next higher string where the
+// pitch-position law puts its f0, both fingertips are near their contacts (the hand shares
+// what the joints cannot span), and the joints stay in their limits.
+TEST(Generate, DoubleStopsPutTheSecondFingerOnTheNextString) {
+  const SyntheticCapture& c = Cached("violin", "double-stops", 0);
+  auto model = InstrumentModel::Create("violin");
+  ASSERT_TRUE(model.ok());
+  const auto left = hand::HandModel::Default(hand::HandSide::kLeft);
+  const int n_capture = static_cast<int>(c.points3d.shape[1]) - 13;
+  EXPECT_GE(c.double_stops, 2);
+  int frames = 0;
+  for (int f = 0; f < c.num_frames; ++f) {
+    const ContactTruth& ct = c.contact[static_cast<size_t>(f)];
+    if (!ct.double_stop) continue;
+    ++frames;
+    const PerformedNote& note = c.performance.notes[static_cast<size_t>(ct.note_index)];
+    ASSERT_TRUE(note.note.IsDoubleStop());
+    EXPECT_EQ(ct.second_string, model->num_strings() - note.fingering.string_index - 1);
+    EXPECT_EQ(ct.second_finger, note.fingering.second_finger);
+    EXPECT_NEAR(1200 * std::log2(ct.second_f0_hz / MidiToHz(note.note.second_midi_note)),
+                note.SecondCentsAt(f / c.options.fps),
+                1e-6);
+    EXPECT_EQ(hand::CountLimitViolations(left, c.left_hand[static_cast<size_t>(f)]), 0) << f;
+    if (ct.second_finger == 0) continue;
+    const int k = model->num_strings() - ct.second_string;
+    const Eigen::Vector3d nut = Point(c, f, n_capture + 2 * k),
+                          bridge = Point(c, f, n_capture + 2 * k + 1);
+    const Eigen::Vector3d axis = (nut - bridge).normalized();
+    const Eigen::Vector3d rel = ct.second_point_mm - bridge;
+    EXPECT_LT((rel - rel.dot(axis) * axis).norm(), 1e-6) << "frame " << f;
+    const double from_bridge_mm = rel.norm() / (nut - bridge).norm() * model->string_length_mm();
+    EXPECT_NEAR(1200 * std::log2(PitchAtContact(*model, ct.second_string, from_bridge_mm) /
+                                 ct.second_f0_hz),
+                0.0,
+                0.01);
+    const Eigen::Vector3d tip2 = Point(
+        c,
+        f,
+        wholebody::kLeftHandFirst + hand::TipKeypoint(static_cast<hand::Finger>(ct.second_finger)));
+    EXPECT_LT((tip2 - ct.second_point_mm).norm(), 15.0) << "frame " << f;
+    if (ct.finger > 0) {
+      const Eigen::Vector3d tip1 = Point(
+          c,
+          f,
+          wholebody::kLeftHandFirst + hand::TipKeypoint(static_cast<hand::Finger>(ct.finger)));
+      EXPECT_LT((tip1 - ct.point_mm).norm(), 15.0) << "frame " << f;
+    }
+  }
+  EXPECT_GT(frames, 30);
+  EXPECT_LT(c.max_second_residual_mm, 15.0);
+}
+
 TEST(Generate, VibratoRocksTheHandInPhaseWithThePitch) {
   const SyntheticCapture& c = Cached("cello", "slow-melody", 0);
   // Within one long vibrato note, the contact moves towards the bridge exactly

@@ -92,7 +92,27 @@ LeftHandAnimator::LeftHandAnimator(const hand::HandModel& model,
     const PerformedNote& note = notes[i];
     const int string = n - note.fingering.string_index;
     Eigen::Vector3d anchor;
-    if (note.fingering.finger > 0) {
+    if (note.fingering.IsDoubleStop() && note.fingering.second_finger > 0) {
+      const int f1 = note.fingering.finger, f2 = note.fingering.second_finger;
+      const Eigen::Vector3d c2 = ContactInInstrument(
+          instrument,
+          tmpl,
+          string - 1,
+          MidiToHz(note.note.second_midi_note + note.second_intonation_cents / 100.0,
+                   performance.a4_hz));
+      if (f1 == 0) {
+        anchor = c2 - tip_from_mcp_[f2];
+      } else {
+        const Eigen::Vector3d c1 = ContactInInstrument(
+            instrument,
+            tmpl,
+            string,
+            MidiToHz(note.note.midi_note + note.intonation_cents / 100.0, performance.a4_hz));
+        anchor = f1 == f2
+                     ? Eigen::Vector3d(0.5 * (c1 + c2) - tip_from_mcp_[f1])
+                     : Eigen::Vector3d(0.5 * ((c1 - tip_from_mcp_[f1]) + (c2 - tip_from_mcp_[f2])));
+      }
+    } else if (note.fingering.finger > 0) {
       const double centre_hz =
           MidiToHz(note.note.midi_note + note.intonation_cents / 100.0, performance.a4_hz);
       anchor = ContactInInstrument(instrument, tmpl, string, centre_hz) -
@@ -165,6 +185,27 @@ LeftHandFrame LeftHandAnimator::Next(double t) {
 
   Eigen::Vector3d anchor = AnchorAt(t);
   Eigen::Vector3d contact = Eigen::Vector3d::Constant(NAN);
+  // The double stop's upper note: its own string's contact; the hand rocks with it when
+  // the lower note is open.
+  const bool second_pressed =
+      out.note_index >= 0 && hn.fingering.IsDoubleStop() && hn.fingering.second_finger > 0;
+  if (out.note_index >= 0 && hn.fingering.IsDoubleStop()) {
+    out.double_stop = true;
+    out.second_string = hand_string - 1;
+    out.second_f0_hz = perf_.SecondF0HzAt(t);
+    out.second_open = hn.fingering.second_finger == 0;
+    if (second_pressed) {
+      out.second_finger = hn.fingering.second_finger;
+      out.second_contact_mm =
+          ContactInInstrument(instrument_, tmpl_, out.second_string, out.second_f0_hz);
+      if (!pressed && options_.rock_with_vibrato) {
+        const double centre_hz =
+            MidiToHz(hn.note.second_midi_note + hn.second_intonation_cents / 100.0, perf_.a4_hz);
+        anchor += out.second_contact_mm -
+                  ContactInInstrument(instrument_, tmpl_, out.second_string, centre_hz);
+      }
+    }
+  }
   if (pressed) {
     contact = ContactInInstrument(instrument_, tmpl_, hand_string, out.f0_hz);
     if (options_.rock_with_vibrato) {
@@ -187,6 +228,7 @@ LeftHandFrame LeftHandAnimator::Next(double t) {
   const double keep = options_.relax_s > 0 ? std::exp(-dt / options_.relax_s) : 0.0;
   for (int f = 0; f < 5; ++f) {
     if (pressed && f == hn.fingering.finger) continue;
+    if (second_pressed && f == hn.fingering.second_finger) continue;
     for (int d = 0; d < 4; ++d) {
       const int k = 4 * f + d;
       pose.angles_rad[k] =
@@ -218,18 +260,42 @@ LeftHandFrame LeftHandAnimator::Next(double t) {
     press.previous_pose = previous_;
     press.previous_weight_mm_per_rad = 5.0;
   }
-  if (pressed) {
-    const auto finger = static_cast<hand::Finger>(hn.fingering.finger);
+  // One finger to its target by IK from the pressing posture; returns what it misses by.
+  auto place = [&](int finger_index, const Eigen::Vector3d& target) {
+    const auto finger = static_cast<hand::Finger>(finger_index);
     hand::HandPose ref = pose;
     for (int d = 0; d < 4; ++d) {
-      ref.angles_rad[4 * hn.fingering.finger + d] =
-          press_pose_.angles_rad[4 * hn.fingering.finger + d];
+      ref.angles_rad[4 * finger_index + d] = press_pose_.angles_rad[4 * finger_index + d];
     }
-    pose = hand::SolveFingertipIk(model_, ref, finger, contact, press).pose;
+    pose = hand::SolveFingertipIk(model_, ref, finger, target, press).pose;
+    return Eigen::Vector3d(target - hand::FingertipInWorld(model_, pose, finger));
+  };
+  const bool fifth = pressed && second_pressed && hn.fingering.second_finger == hn.fingering.finger;
+  Eigen::Vector3d target_first = contact;
+  if (pressed) {
+    // A fifth under one finger: its tip midway between the two strings' contacts.
+    target_first = fifth ? Eigen::Vector3d(0.5 * (contact + out.second_contact_mm)) : contact;
     // Take up what the joints could not reach by moving the whole hand.
-    const Eigen::Vector3d residual = contact - hand::FingertipInWorld(model_, pose, finger);
+    const Eigen::Vector3d residual = place(hn.fingering.finger, target_first);
     out.residual_shift_mm = residual.norm();
     pose.wrist_in_world_mm += residual;
+  }
+  if (second_pressed && !fifth) {
+    Eigen::Vector3d residual = place(hn.fingering.second_finger, out.second_contact_mm);
+    if (pressed) {
+      // Two fingers: the hand moves by the mean of what each misses, a few rounds, so the
+      // two fingertips share the miss the joints cannot take up (the first was exact).
+      Eigen::Vector3d first = Eigen::Vector3d::Zero();
+      for (int round = 0; round < 6 && std::max(first.norm(), residual.norm()) > 0.5; ++round) {
+        pose.wrist_in_world_mm += 0.5 * (first + residual);
+        first = place(hn.fingering.finger, target_first);
+        residual = place(hn.fingering.second_finger, out.second_contact_mm);
+      }
+      out.second_residual_mm = std::max(first.norm(), residual.norm());
+    } else {
+      out.residual_shift_mm = residual.norm();
+      pose.wrist_in_world_mm += residual;
+    }
   }
   out.pose = pose;
   previous_ = pose;

@@ -22,6 +22,13 @@
 //     frame). What the IK cannot reach
 //     is taken up by translating the whole hand, so the playing fingertip lies on
 //     the string at the contact point exactly and every joint stays in its limits.
+// Double stops: the anchor lies midway between the two fingers' anchors; the first
+// finger is placed as above (the hand translated by its residual), then the second by the
+// same IK; while either misses by more than 0.5 mm (at most 6 rounds) the hand moves by the
+// mean of the two misses and both are placed again, so a span the joints cannot reach is
+// shared by the two fingertips (second_residual_mm). A fifth stopped by one finger puts its tip
+// midway between the two strings' contact points (the pad covers both); each string's contact is
+// still its own point on that string.
 #pragma once
 
 #include <Eigen/Core>
@@ -59,6 +66,14 @@ struct LeftHandFrame {
   double f0_hz = 0;     // sounding pitch, 0 in silence
   Eigen::Vector3d contact_mm = Eigen::Vector3d::Constant(NAN);  // NaN when not pressed
   double residual_shift_mm = 0;  // how far the hand was translated to reach exactly
+  // The upper note of a sounding double stop (string 0 when none or when it is open;
+  // second_open: it sounds on an open string).
+  bool double_stop = false;
+  bool second_open = false;
+  int second_string = 0, second_finger = 0;
+  double second_f0_hz = 0;
+  Eigen::Vector3d second_contact_mm = Eigen::Vector3d::Constant(NAN);
+  double second_residual_mm = 0;  // farthest a double stop's fingertip stays from its target
 };
 
 class LeftHandAnimator {

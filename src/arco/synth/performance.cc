@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "arco/registry/instruments.h"
 #include "arco/synth/random.h"
@@ -52,6 +53,11 @@ double PerformedNote::CentsAt(double time_s) const {
   return intonation_cents + VibratoCentsOnlyAt(time_s);
 }
 
+double PerformedNote::SecondCentsAt(double time_s) const {
+  if (fingering.second_finger == 0) return 0;
+  return second_intonation_cents + VibratoCentsOnlyAt(time_s);
+}
+
 int Performance::NoteIndexAt(double time_s) const {
   // Notes are sorted and disjoint: binary search on onsets.
   auto it =
@@ -73,6 +79,14 @@ double Performance::MidiPitchAt(double time_s) const {
 double Performance::F0HzAt(double time_s) const {
   const double m = MidiPitchAt(time_s);
   return std::isnan(m) ? 0.0 : MidiToHz(m, a4_hz);
+}
+
+double Performance::SecondF0HzAt(double time_s) const {
+  const int i = NoteIndexAt(time_s);
+  if (i < 0) return 0;
+  const PerformedNote& n = notes[static_cast<size_t>(i)];
+  if (!n.note.IsDoubleStop()) return 0;
+  return MidiToHz(n.note.second_midi_note + n.SecondCentsAt(time_s) / 100.0, a4_hz);
 }
 
 StatusOr<Performance> MakePerformance(const Score& score,
@@ -97,6 +111,17 @@ StatusOr<Performance> MakePerformance(const Score& score,
     const double rate = rng.Uniform(options.vibrato_rate_min_hz, options.vibrato_rate_max_hz);
     const double extent =
         rng.Uniform(options.vibrato_extent_min_cents, options.vibrato_extent_max_cents);
+    if (p.note.IsDoubleStop() != p.fingering.IsDoubleStop()) {
+      throw std::invalid_argument("MakePerformance: a double stop fingered as a single note");
+    }
+    // A double stop draws one more value (single-note scores keep their stream).
+    if (p.note.IsDoubleStop()) {
+      const double into2 = rng.Normal(0, options.intonation_sigma_cents);
+      if (p.fingering.second_finger > 0) {
+        p.second_intonation_cents =
+            std::clamp(into2, -options.max_intonation_cents, options.max_intonation_cents);
+      }
+    }
     const bool open = p.fingering.finger == 0;
     if (!open) {
       p.intonation_cents =

@@ -6,7 +6,10 @@
 //   cents(t) = intonation_cents + extent_cents * ramp(t) * sin(2 pi rate_hz (t - t_v))
 // with t_v = onset + vibrato_delay_s and ramp rising smoothly from 0 to 1 over
 // vibrato_ramp_s after t_v (a player starts a long note straight, then vibrates).
-// Open strings have neither intonation error nor vibrato.
+// Open strings have neither intonation error nor vibrato. The upper note of a double stop
+// (fingering.second_finger, score second_midi_note) has its own intonation and, when
+// stopped, the first note's vibrato (one hand rocks both fingers); a double stop whose
+// lower note is open has no vibrato.
 #pragma once
 
 #include <cstdint>
@@ -41,9 +44,12 @@ struct PerformedNote {
   double vibrato_extent_cents = 0;  // half peak-to-peak
   double vibrato_delay_s = 0;
   double vibrato_ramp_s = 0.25;
+  double second_intonation_cents = 0;  // the double stop's upper note
 
   // Cents from equal temperament at time t (t inside the note).
   double CentsAt(double time_s) const;
+  // The same for the double stop's upper note (0 on an open string).
+  double SecondCentsAt(double time_s) const;
   // d(cents)/dt, for rocking the hand in phase with the pitch.
   double VibratoCentsOnlyAt(double time_s) const;
 };
@@ -57,6 +63,8 @@ struct Performance {
   int NoteIndexAt(double time_s) const;
   // The sounding f0 in Hz at `time_s`, or 0 when silent.
   double F0HzAt(double time_s) const;
+  // The f0 of a double stop's upper note at `time_s`, or 0 when none sounds.
+  double SecondF0HzAt(double time_s) const;
   // Fractional MIDI pitch (midi_note + cents / 100) at `time_s`, or NaN.
   double MidiPitchAt(double time_s) const;
 };

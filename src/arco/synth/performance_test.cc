@@ -80,6 +80,31 @@ TEST(MakePerformance, DeterministicPerSeed) {
   EXPECT_TRUE(differs);
 }
 
+TEST(MakePerformance, DoubleStopsSoundBothNotesWithOneVibrato) {
+  const Performance p = Make("double-stops", 4);
+  int doubles = 0;
+  for (const PerformedNote& n : p.notes) {
+    const double t = n.note.onset_s + 0.6 * (n.note.offset_s - n.note.onset_s);
+    if (!n.note.IsDoubleStop()) {
+      EXPECT_EQ(p.SecondF0HzAt(t), 0.0);
+      continue;
+    }
+    ++doubles;
+    EXPECT_LE(std::abs(n.second_intonation_cents), 15.0);
+    const double cents2 = 1200 * std::log2(p.SecondF0HzAt(t) / MidiToHz(n.note.second_midi_note));
+    EXPECT_NEAR(cents2, n.SecondCentsAt(t), 1e-9);
+    if (n.fingering.second_finger == 0) {
+      EXPECT_EQ(n.SecondCentsAt(t), 0.0);  // an open string sounds in tune
+    } else {
+      EXPECT_NEAR(n.SecondCentsAt(t) - n.second_intonation_cents,
+                  n.CentsAt(t) - n.intonation_cents,
+                  1e-12);  // the same vibrato on both fingers
+    }
+  }
+  EXPECT_EQ(doubles, 12);
+  EXPECT_EQ(p.SecondF0HzAt(p.notes.back().note.offset_s + 0.1), 0.0);
+}
+
 TEST(ExpressionOptions, RejectsBadValues) {
   ExpressionOptions o;
   o.max_intonation_cents = 80;

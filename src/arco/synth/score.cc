@@ -28,6 +28,11 @@ class ScoreBuilder {
     score_.notes.push_back({midi, t_, t_ + dur - gap, velocity});
     t_ += dur;
   }
+  // Two notes sounding together (a double stop): `high` on the next higher string.
+  void DoubleStop(int low, int high, double beats, int velocity = 80) {
+    Note(low, beats, velocity);
+    score_.notes.back().second_midi_note = high;
+  }
   void Rest(double beats) { t_ += beats * beat_s_; }
   void SetBeat(double beat_s) { beat_s_ = beat_s; }
   Score Finish(const std::string& name) {
@@ -127,6 +132,35 @@ Score OpenStrings(const ScoreInstrument& ins, double k) {
   return b.Finish("open-strings");
 }
 
+// Sixths, thirds, fifths and octaves on every pair of adjacent strings, lowest pair first;
+// before each double stop its upper note sounds alone, and a rest ends each pair. The lower
+// note's stop a (semitones above its open string) is the first of kStops that keeps both
+// stops playable in one closed hand frame (|a - b| <= hand_span_semitones, or one of them
+// an open string): on the cello the octave takes an open lower string, on the double bass
+// (tuned in fourths) the sixth and the octave.
+Score DoubleStops(const ScoreInstrument& ins, double k) {
+  ScoreBuilder b(0.4 * k);
+  constexpr int kIntervals[4] = {9, 4, 7, 12};  // major sixth, major third, fifth, octave
+  constexpr int kStops[8] = {4, 2, 3, 5, 1, 6, 7, 0};
+  const size_t n = ins.open_string_midi.size();
+  for (size_t s = 0; s + 1 < n; ++s) {
+    const int low_open = ins.open_string_midi[s];
+    const int high_open = ins.open_string_midi[s + 1];
+    for (int interval : kIntervals) {
+      for (int a : kStops) {
+        const int stop_b = a + interval - (high_open - low_open);
+        const bool open = a == 0 || stop_b == 0;
+        if (stop_b < 0 || (!open && std::abs(stop_b - a) > ins.hand_span_semitones)) continue;
+        b.Note(low_open + a + interval, 1);
+        b.DoubleStop(low_open + a, low_open + a + interval, 2);
+        break;
+      }
+    }
+    b.Rest(1);
+  }
+  return b.Finish("double-stops");
+}
+
 }  // namespace
 
 int ScoreInstrument::LowestMidi() const {
@@ -146,7 +180,7 @@ bool ScoreInstrument::InRange(int midi_note) const {
 
 const std::vector<std::string>& BuiltInPieceNames() {
   static const std::vector<std::string> names = {
-      "scale-2oct", "arpeggios", "slow-melody", "fast-passage", "open-strings"};
+      "scale-2oct", "arpeggios", "slow-melody", "fast-passage", "open-strings", "double-stops"};
   return names;
 }
 
@@ -158,6 +192,9 @@ std::string DescribeBuiltInPiece(const std::string& name) {
   if (name == "fast-passage")
     return "sixteenth-note broken thirds and a scale run: shifts and string crossings";
   if (name == "open-strings") return "figures starting and ending on each open string, with rests";
+  if (name == "double-stops")
+    return "sixths, thirds, fifths and octaves on adjacent strings, each after its upper note "
+           "alone";
   return "";
 }
 
@@ -181,6 +218,8 @@ StatusOr<Score> MakeBuiltInPiece(const std::string& name,
     score = FastPassage(instrument, tempo_scale);
   } else if (name == "open-strings") {
     score = OpenStrings(instrument, tempo_scale);
+  } else if (name == "double-stops") {
+    score = DoubleStops(instrument, tempo_scale);
   } else {
     std::string list;
     for (const auto& n : BuiltInPieceNames()) list += (list.empty() ? "" : ", ") + n;
@@ -231,6 +270,19 @@ Status ValidateScore(const Score& score,
                     n.midi_note,
                     MidiNoteName(n.midi_note).c_str(),
                     n.onset_s);
+      return Status::Error(buf);
+    }
+    if (n.IsDoubleStop() &&
+        (n.second_midi_note <= n.midi_note || !instrument.InRange(n.second_midi_note))) {
+      std::snprintf(buf,
+                    sizeof(buf),
+                    "%s: double stop %s+%s at %.3f s: the second note must lie above the first, "
+                    "within the %s's range",
+                    source.c_str(),
+                    MidiNoteName(n.midi_note).c_str(),
+                    MidiNoteName(n.second_midi_note).c_str(),
+                    n.onset_s,
+                    instrument.name.c_str());
       return Status::Error(buf);
     }
     if (n.velocity < 1 || n.velocity > 127) {

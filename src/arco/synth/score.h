@@ -1,6 +1,8 @@
 // Scores for synthetic performances: what notes are played and when.
 //
-// A Score is a monophonic list of notes (MIDI numbers, onset/offset in seconds).
+// A Score is a list of notes (MIDI numbers, onset/offset in seconds), one at a time; a
+// note may carry a second, higher note sounding with it (a double stop on two adjacent
+// strings, ScoreNote::second_midi_note).
 // Built-in pieces are generated per instrument from its open strings, so the same
 // piece name gives a sensible part on cello, violin, viola or double bass. Scores
 // can also be read from a Standard MIDI File (midi_reader.h).
@@ -24,6 +26,9 @@ struct ScoreInstrument {
   std::vector<int> open_string_midi;  // lowest string first
   int max_semitones_above_open = 24;  // playable range per string (two octaves)
   int gm_program = 42;                // General MIDI program (0-based: 42 = cello)
+  // Widest distance between two stopped fingers in one closed hand frame (semitones:
+  // violin 5, cello 3, double bass 2); the double-stops piece keeps within it.
+  int hand_span_semitones = 3;
 
   int LowestMidi() const;
   int HighestMidi() const;
@@ -36,6 +41,10 @@ struct ScoreNote {
   double onset_s = 0;
   double offset_s = 0;
   int velocity = 80;  // 1..127
+  // The upper note of a double stop, played on the next higher string with the same
+  // onset and offset; 0: a single note.
+  int second_midi_note = 0;
+  bool IsDoubleStop() const { return second_midi_note > 0; }
 };
 
 struct Score {
@@ -56,9 +65,10 @@ StatusOr<Score> MakeBuiltInPiece(const std::string& name,
                                  const ScoreInstrument& instrument,
                                  double tempo_scale = 1.0);
 
-// Checks ordering, positive durations, no overlap, and that every note is in the
-// instrument's range; the error names the first offending note ("note 30 (F#1)
-// at 2.500 s is below the cello's lowest note C2 (36)"). `source` prefixes it.
+// Checks ordering, positive durations, no overlap, and that every note (and every double
+// stop's second note, above the first) is in the instrument's range; the error names the first
+// offending note ("note 30 (F#1) at 2.500 s is below the cello's lowest note C2 (36)"). `source`
+// prefixes it.
 Status ValidateScore(const Score& score,
                      const ScoreInstrument& instrument,
                      const std::string& source);

@@ -36,6 +36,37 @@ TEST(MakeBuiltInPiece, EveryPieceIsValidOnEveryInstrument) {
   }
 }
 
+TEST(MakeBuiltInPiece, DoubleStopsPlayFourIntervalsOnEveryStringPairAfterTheirUpperNote) {
+  for (const auto& ins : {Cello(), Violin(), Viola(), Bass()}) {
+    auto score = MakeBuiltInPiece("double-stops", ins);
+    ASSERT_TRUE(score.ok()) << score.status().message();
+    std::vector<int> intervals;
+    for (size_t i = 0; i < score->notes.size(); ++i) {
+      const ScoreNote& n = score->notes[i];
+      if (!n.IsDoubleStop()) continue;
+      intervals.push_back(n.second_midi_note - n.midi_note);
+      ASSERT_GT(i, 0u);
+      EXPECT_FALSE(score->notes[i - 1].IsDoubleStop());
+      EXPECT_EQ(score->notes[i - 1].midi_note, n.second_midi_note) << ins.name;
+    }
+    const std::vector<int> one_pair = {9, 4, 7, 12};
+    ASSERT_EQ(intervals.size(), 4 * (ins.open_string_midi.size() - 1)) << ins.name;
+    for (size_t k = 0; k < intervals.size(); ++k) EXPECT_EQ(intervals[k], one_pair[k % 4]);
+  }
+}
+
+TEST(ValidateScore, RejectsADoubleStopWhoseSecondNoteIsNotAbove) {
+  Score s;
+  s.notes.push_back({60, 0.1, 0.5, 80, 55});
+  s.duration_s = 1;
+  const Status status = ValidateScore(s, Violin(), "take.mid");
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("take.mid: double stop C4+G3 at 0.100 s"), std::string::npos)
+      << status.message();
+  s.notes[0].second_midi_note = 67;
+  EXPECT_TRUE(ValidateScore(s, Violin(), "take.mid").ok());
+}
+
 TEST(MakeBuiltInPiece, ScaleStartsOnLowestOpenStringAndClimbsTwoOctaves) {
   auto score = MakeBuiltInPiece("scale-2oct", Cello());
   ASSERT_TRUE(score.ok());

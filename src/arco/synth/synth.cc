@@ -80,6 +80,7 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     if (!plan.ok()) return plan.status().WithContext(cap.score.name);
     cap.fingering = *plan;
   }
+  for (const ScoreNote& n : cap.score.notes) cap.double_stops += n.IsDoubleStop() ? 1 : 0;
   ExpressionOptions expression = options.expression;
   expression.a4_hz = options.a4_hz;
   ARCO_ASSIGN_OR_RETURN(cap.performance,
@@ -146,6 +147,7 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     // Left hand (instrument frame -> world).
     const LeftHandFrame lh = left.Next(t);
     cap.max_residual_shift_mm = std::max(cap.max_residual_shift_mm, lh.residual_shift_mm);
+    cap.max_second_residual_mm = std::max(cap.max_second_residual_mm, lh.second_residual_mm);
     hand::HandPose lw = lh.pose;
     lw.world_from_wrist_rotation =
         world_from_instrument.rotation * lh.pose.world_from_wrist_rotation;
@@ -206,6 +208,13 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     ct.note_index = lh.note_index;
     ct.f0_hz = lh.f0_hz;
     ct.open_string = lh.note_index >= 0 && lh.finger == 0;
+    if (lh.double_stop) {
+      ct.double_stop = true;
+      ct.second_string = lh.second_string;
+      ct.second_finger = lh.second_finger;
+      ct.second_f0_hz = lh.second_f0_hz;
+      if (lh.second_finger > 0) ct.second_point_mm = world_from_instrument * lh.second_contact_mm;
+    }
     DetectionFrame& df = det_frames[static_cast<size_t>(fr)];
     if (lh.finger > 0) {
       ++cap.pressed_frames;

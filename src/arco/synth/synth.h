@@ -62,6 +62,13 @@ struct ContactTruth {
   double f0_hz = 0;
   Eigen::Vector3d point_mm = Eigen::Vector3d::Constant(NAN);
   bool open_string = false;
+  // The upper note of a sounding double stop (truth/contact_2.csv): its string (1 =
+  // highest), finger (0 = open), f0 and contact point (NaN unless pressed).
+  bool double_stop = false;
+  int second_string = 0;
+  int second_finger = 0;
+  double second_f0_hz = 0;
+  Eigen::Vector3d second_point_mm = Eigen::Vector3d::Constant(NAN);
 };
 
 struct SyntheticCapture {
@@ -85,6 +92,10 @@ struct SyntheticCapture {
   std::vector<Eigen::Matrix4d> world_from_instrument;  // rotation | bridge centre, mm
   NpyArray<float> keypoints2d;                         // (frames, views, capture points, 3)
   double max_residual_shift_mm = 0;  // largest whole-hand correction the IK needed
+  // Double stops: their count, and the farthest one of their fingertips stayed from its
+  // contact (left_hand.h).
+  int double_stops = 0;
+  double max_second_residual_mm = 0;
   int pressed_frames = 0;
   // A re-captured recording (motion.h): the motion and the audio it came from (the audio is
   // copied, not rendered; the performance, score and hand poses are empty) and the

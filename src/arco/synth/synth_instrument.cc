@@ -1,5 +1,6 @@
 #include "arco/synth/synth_instrument.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -26,6 +27,11 @@ ScoreInstrument ScoreInstrumentFor(const InstrumentModel& model) {
   }
   s.max_semitones_above_open = semis;
   s.gm_program = GmProgramFor(model.kind());
+  s.hand_span_semitones = 0;
+  for (const FingerSpan& span : GetInstrumentInfo(model.kind()).hand_frame) {
+    if (!span.extended)
+      s.hand_span_semitones = std::max(s.hand_span_semitones, span.offset_semitones);
+  }
   return s;
 }
 

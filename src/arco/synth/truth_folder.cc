@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <sstream>
+#include <stdexcept>
 
 #include "arco/hand/hand_params.h"
 #include "arco/synth/score.h"
@@ -20,6 +21,8 @@ constexpr char kLeftHandPoseFile[] = "left_hand_pose.npy";
 constexpr char kRightHandPoseFile[] = "right_hand_pose.npy";
 constexpr char kInstrumentPoseFile[] = "instrument_pose.npy";
 constexpr char kContactFile[] = "contact.csv";
+constexpr char kSecondContactFile[] = "contact_2.csv";  // double stops' upper notes
+constexpr char kSecondNotesFile[] = "notes_2.csv";
 constexpr char kPitchFile[] = "pitch.csv";
 constexpr char kNotesFile[] = "notes.csv";
 constexpr char kBowingFile[] = "bowing.csv";  // refine/bowing.h's format
@@ -29,7 +32,7 @@ constexpr char kNotesCsvHeader[] =
     "note,onset_s,offset_s,midi_note,name,velocity,string,finger,position_semitones,"
     "intonation_cents,vibrato_rate_hz,vibrato_extent_cents";
 
-Json ManifestJson(const TruthManifest& m, bool has_bowing) {
+Json ManifestJson(const TruthManifest& m, bool has_bowing, bool has_double_stops) {
   Json j;
   j["format"] = kTruthFormat;
   j["version"] = kTruthVersion;
@@ -75,6 +78,11 @@ Json ManifestJson(const TruthManifest& m, bool has_bowing) {
                 {"pitch", kPitchFile},
                 {"notes", kNotesFile}};
   if (has_bowing) j["files"]["bowing"] = kBowingFile;
+  if (has_double_stops) {
+    j["double_stops"] = m.double_stops;
+    j["files"]["contact_2"] = kSecondContactFile;
+    j["files"]["notes_2"] = kSecondNotesFile;
+  }
   return j;
 }
 
@@ -121,6 +129,7 @@ StatusOr<TruthManifest> ManifestFromJson(const Json& j, const std::string& path)
   get(j, "hand_model", &m.hand_model);
   get(j, "motion_source", &m.motion_source);
   get(j, "audio_source", &m.audio_source);
+  get(j, "double_stops", &m.double_stops);
   if (j.contains("error_model")) m.error_model = j["error_model"];
   const Json empty = Json::object();
   const Json& stage = j.contains("stage") && j["stage"].is_object() ? j["stage"] : empty;
@@ -161,16 +170,16 @@ StatusOr<TruthManifest> ManifestFromJson(const Json& j, const std::string& path)
   return m;
 }
 
-std::string ContactCsv(const TruthFolder& t) {
+std::string ContactCsv(const std::vector<refine::ContactRow>& rows, double fps) {
   std::ostringstream out;
   out << kContactCsvHeader << '\n';
   char line[256];
-  for (const refine::ContactRow& r : t.contacts) {
+  for (const refine::ContactRow& r : rows) {
     std::snprintf(line,
                   sizeof(line),
                   "%lld,%.6f,%s,%d,%d,%d,%.4f,%.4f,%.4f,%.4f\n",
                   static_cast<long long>(r.frame),
-                  static_cast<double>(r.frame) / t.manifest.fps,
+                  static_cast<double>(r.frame) / fps,
                   r.state.c_str(),
                   r.string,
                   r.finger,
@@ -259,16 +268,29 @@ Status WriteTruthFolder(const std::string& dir, const TruthFolder& t) {
     }
   }
   ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(dir, kInstrumentPoseFile), poses));
-  ARCO_RETURN_IF_ERROR(AtomicWriteFile(JoinPath(dir, kContactFile), ContactCsv(t)));
+  ARCO_RETURN_IF_ERROR(
+      AtomicWriteFile(JoinPath(dir, kContactFile), ContactCsv(t.contacts, t.manifest.fps)));
   ARCO_RETURN_IF_ERROR(AtomicWriteFile(JoinPath(dir, kNotesFile), NotesCsv(t.notes)));
+  const bool double_stops = t.HasDoubleStops();
+  if (double_stops) {
+    if (t.second_contacts.size() != t.contacts.size())
+      throw std::invalid_argument("WriteTruthFolder: contact_2 rows differ from contact rows");
+    ARCO_RETURN_IF_ERROR(AtomicWriteFile(JoinPath(dir, kSecondContactFile),
+                                         ContactCsv(t.second_contacts, t.manifest.fps)));
+    ARCO_RETURN_IF_ERROR(
+        AtomicWriteFile(JoinPath(dir, kSecondNotesFile), NotesCsv(t.second_notes)));
+  }
   // A recording's pitch is not known: no pitch.csv (eval reports pitch absent).
-  if (t.manifest.motion_source.empty())
-    ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(JoinPath(dir, kPitchFile), t.pitch));
+  if (t.manifest.motion_source.empty()) {
+    ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(
+        JoinPath(dir, kPitchFile), t.pitch, t.second_f0_hz.empty() ? nullptr : &t.second_f0_hz));
+  }
   // The bow arm's truth (generated performances; a recording has none).
   if (!t.bowing.empty()) {
     ARCO_RETURN_IF_ERROR(refine::WriteBowingCsv(JoinPath(dir, kBowingFile), t.bowing));
   }
-  return WriteJsonFile(JoinPath(dir, kManifestFile), ManifestJson(t.manifest, !t.bowing.empty()));
+  return WriteJsonFile(JoinPath(dir, kManifestFile),
+                       ManifestJson(t.manifest, !t.bowing.empty(), double_stops));
 }
 
 StatusOr<TruthFolder> ReadTruthFolder(const std::string& dir) {
@@ -315,8 +337,22 @@ StatusOr<TruthFolder> ReadTruthFolder(const std::string& dir) {
   // pitch.csv may be absent (a truth without audio): nothing to score.
   const std::string pitch_path = JoinPath(dir, kPitchFile);
   if (FileExists(pitch_path)) {
-    ARCO_ASSIGN_OR_RETURN(t.pitch, audio::ReadPitchCsv(pitch_path));
+    ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(pitch_path));
+    ARCO_ASSIGN_OR_RETURN(t.pitch, audio::ParsePitchCsv(text, pitch_path, &t.second_f0_hz));
   }
+  // contact_2.csv and notes_2.csv: a piece with double stops (truth.json lists them).
+  const std::string second_path = JoinPath(dir, kSecondContactFile);
+  if (FileExists(second_path)) {
+    ARCO_ASSIGN_OR_RETURN(t.second_contacts, refine::ReadContactsCsv(second_path));
+    if (t.second_contacts.size() != t.contacts.size()) {
+      return Status::Error(second_path + ": " + std::to_string(t.second_contacts.size()) +
+                           " rows, but contact.csv has " + std::to_string(t.contacts.size()));
+    }
+    ARCO_ASSIGN_OR_RETURN(t.second_notes, ReadNotesCsv(JoinPath(dir, kSecondNotesFile)));
+  }
+  bool any_second = false;
+  for (double f : t.second_f0_hz) any_second |= f > 0;
+  if (!any_second) t.second_f0_hz.clear();
   // bowing.csv may be absent (a recording, or a truth written before it existed).
   const std::string bowing_path = JoinPath(dir, kBowingFile);
   if (FileExists(bowing_path)) {

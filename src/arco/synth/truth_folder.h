@@ -13,6 +13,13 @@
 //                          contact_y_mm,contact_z_mm (time_s = frame / fps)
 //   pitch.csv              frame,time_s,f0_hz,confidence,voiced (confidence 0: not scored)
 //   notes.csv              one row per note: timing, pitch, fingering, expression
+//   contact_2.csv          only when the piece has double stops: the upper note of each
+//                          (contact.csv's format and rows; state rest on frames without
+//                          one, note = the double stop's row in notes.csv)
+//   notes_2.csv            only with double stops: one row per double stop, its upper
+//                          note (notes.csv's format; numbered 0.. in the order of the
+//                          double stops)
+//   (pitch.csv then also has the column f0_2_hz: the upper note's f0, 0 without one)
 //   bowing.csv             the bow arm per frame (refine/bowing.h's format: string,
 //                          direction, sounding_point_mm, bow_position); absent for a
 //                          re-captured recording
@@ -70,6 +77,8 @@ struct TruthManifest {
   // (synth/error_model.h; null when not recorded).
   std::string motion_source, audio_source;
   Json error_model;
+  // Double stops in the score (written only when > 0: contact_2.csv, notes_2.csv).
+  int64_t double_stops = 0;
 };
 
 // One row of notes.csv.
@@ -95,6 +104,12 @@ struct TruthFolder {
   std::vector<audio::PitchFrame> pitch;  // one per frame
   std::vector<TruthNote> notes;
   std::vector<refine::BowingFrame> bowing;  // one per frame, or empty: no bow truth
+  // Double stops (all empty for a single-note piece): contact_2.csv's rows (one per frame),
+  // notes_2.csv's, and pitch.csv's f0_2_hz (one per pitch row).
+  std::vector<refine::ContactRow> second_contacts;
+  std::vector<TruthNote> second_notes;
+  std::vector<double> second_f0_hz;
+  bool HasDoubleStops() const { return !second_contacts.empty(); }
 };
 
 // Paths of files inside a truth folder `dir`, for messages about their contents.

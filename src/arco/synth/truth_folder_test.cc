@@ -182,6 +182,66 @@ TEST(TruthFolder, WrittenFolderReadsBackEqual) {
   }
 }
 
+// A truth with double stops: contact_2.csv, notes_2.csv and pitch.csv's f0_2_hz read back;
+// a single-note truth has none of them (its files are as before double stops existed).
+TEST(TruthFolder, DoubleStopFilesReadBackAndOnlyExistWithDoubleStops) {
+  arco::testing::TempDir dir;
+  ASSERT_TRUE(WriteTruthFolder(dir / "single", SmallTruth()).ok());
+  EXPECT_FALSE(FileExists(dir / "single/contact_2.csv"));
+  EXPECT_FALSE(FileExists(dir / "single/notes_2.csv"));
+  EXPECT_EQ(ReadFileToString(dir / "single/pitch.csv")->find("f0_2_hz"), std::string::npos);
+  EXPECT_EQ(ReadFileToString(dir / "single/truth.json")->find("double_stops"), std::string::npos);
+  const auto single = ReadTruthFolder(dir / "single");
+  ASSERT_TRUE(single.ok());
+  EXPECT_FALSE(single->HasDoubleStops());
+  EXPECT_TRUE(single->second_f0_hz.empty());
+
+  TruthFolder t = SmallTruth();
+  t.manifest.double_stops = 1;
+  refine::ContactRow rest;
+  rest.frame = 0;
+  rest.state = "rest";
+  refine::ContactRow upper = t.contacts[1];
+  upper.string = 1;
+  upper.finger = 1;
+  upper.f0_hz = 659.25;
+  upper.point_mm = Eigen::Vector3d(2.5, -4.25, 3.0);
+  t.second_contacts = {rest, upper};
+  TruthNote n = t.notes[0];
+  n.midi_note = 76;
+  n.string = 1;
+  n.finger = 1;
+  t.second_notes = {n};
+  t.second_f0_hz = {0.0, 659.25};
+  ASSERT_TRUE(WriteTruthFolder(dir / "double", t).ok());
+  const auto in = ReadTruthFolder(dir / "double");
+  ASSERT_TRUE(in.ok()) << in.status().message();
+  EXPECT_EQ(in->manifest.double_stops, 1);
+  ASSERT_TRUE(in->HasDoubleStops());
+  EXPECT_EQ(in->second_contacts[0].state, "rest");
+  EXPECT_EQ(in->second_contacts[1].state, "pressed");
+  EXPECT_EQ(in->second_contacts[1].string, 1);
+  EXPECT_EQ(in->second_contacts[1].finger, 1);
+  EXPECT_EQ(in->second_contacts[1].note, 0);
+  EXPECT_EQ(in->second_contacts[1].point_mm, upper.point_mm);
+  ASSERT_EQ(in->second_notes.size(), 1u);
+  EXPECT_EQ(in->second_notes[0].midi_note, 76);
+  EXPECT_EQ(in->second_f0_hz, t.second_f0_hz);
+  // The first voice is what it was.
+  EXPECT_EQ(*ReadFileToString(dir / "double/contact.csv"),
+            *ReadFileToString(dir / "single/contact.csv"));
+
+  // contact_2.csv of another length than contact.csv: one error naming it.
+  ASSERT_TRUE(AtomicWriteFile(dir / "double/contact_2.csv",
+                              "frame,time_s,state,string,finger,note,f0_hz,contact_x_mm,"
+                              "contact_y_mm,contact_z_mm\n0,0.0,rest,0,0,-1,0,nan,nan,nan\n")
+                  .ok());
+  const auto bad = ReadTruthFolder(dir / "double");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("contact_2.csv"), std::string::npos)
+      << bad.status().message();
+}
+
 // One malformed file at a time: each read fails with one error naming that file.
 TEST(TruthFolder, MalformedFilesAreOneErrorNamingTheFile) {
   struct Case {

@@ -1,0 +1,80 @@
+// The second note of double stops (issue 27): after the refinement has decoded and placed
+// the first voice (refine.h), the upper note of each double-stop frame gets its string, its
+// finger and its contact, and the hand its second finger.
+//
+// Input per frame: the two notes a polyphonic tracker heard (audio/double_stops.h,
+// TrackDoubleStops: lower f0 first, 0 = none). The caller hands the refinement the lower
+// note as the frame's pitch (so the first voice is the lower note, as a synthetic truth's
+// contact.csv has it) and the upper note here. Per frame with a first voice (pressed or on
+// an open string) and an upper note:
+//   1. String: the next higher string (string - 1; 1 = highest): double stops are played
+//      on adjacent strings. None (the first voice is on the highest string, or the note
+//      lies below that string's open pitch by more than open_tolerance_cents): no second
+//      note.
+//   2. Open: within open_tolerance_cents of that string's open pitch the string sounds
+//      open (finger 0).
+//   3. Otherwise the contact (instrument/contact.h, ContactPoint) on that string of the
+//      frame's strings; a playable hand: the two stops at most max_span_semitones apart
+//      along the fingerboard, else uncertain. The finger: the fingertip of the refined hand
+//      nearest the contact (index .. little), but not the first voice's finger unless the
+//      two stops lie within fifth_semitones of each other, where the same finger stops both
+//      strings (a fifth), and not one farther than max_tip_distance_mm (uncertain).
+//   0. A first-voice note (FrameContact::note) with an upper note on at least half its
+//      frames gets their median on its frames without one, where it lies above the frame's
+//      pitch (fill_notes).
+//   4. IK: that finger's tip to the contact by the hand layer's bounded IK (MCP, PIP, DIP
+//      within the joint limits, regularised toward the refined pose); a fifth's finger is
+//      left where the first voice put it (its pad covers both strings).
+// Frames are independent; the result does not depend on the thread count.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "arco/refine/contact_annotation.h"
+#include "arco/refine/refine.h"
+#include "arco/util/number_range.h"
+#include "arco/util/status.h"
+
+namespace arco::refine {
+
+// Declared ranges of DoubleStopRefineOptions (Validate()).
+inline constexpr NumberRange kOpenToleranceRangeCents = Closed(0, 100);
+inline constexpr NumberRange kSpanRangeSemitones = Closed(0, 24);
+inline constexpr NumberRange kTipDistanceRangeMm = Closed(0, 500);
+
+struct DoubleStopRefineOptions {
+  double open_tolerance_cents = 40.0;  // an upper note this near its open string is open
+  double max_span_semitones = 7.5;     // the two stops along the fingerboard (an octave: 5-7)
+  double fifth_semitones = 0.5;        // stops this close: one finger may stop both strings
+  double max_tip_distance_mm = 60.0;   // the chosen fingertip's distance to its contact
+  int max_iterations = 15;             // of the second finger's IK
+  // A first-voice note with an upper note on at least half its frames keeps the median of
+  // them on its other frames (the tracker's window misses the second note near the ends).
+  bool fill_notes = true;
+  Status Validate() const;
+};
+
+struct DoubleStopRefineSummary {
+  int frames = 0;                    // frames with an upper note and a first voice
+  int pressed = 0, open_string = 0;  // second voices assigned
+  int one_finger_fifths = 0;         // pressed by the first voice's finger
+  int uncertain = 0;                 // no playable string / hand
+  int joint_limit_violations = 0;    // refined poses outside the limits (must stay 0)
+};
+
+struct DoubleStopRefineResult {
+  std::vector<FrameContact> second;                 // one per frame (kRest: none)
+  std::vector<std::optional<hand::HandPose>> hand;  // the hand with the second finger
+  DoubleStopRefineSummary summary;
+};
+
+// `first` is Refine(input, ...)'s result; upper_f0_hz one per frame (0 = none). Throws
+// std::invalid_argument on sizes that differ or invalid options.
+DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
+                                         const RefineResult& first,
+                                         const std::vector<double>& upper_f0_hz,
+                                         const DoubleStopRefineOptions& options);
+
+}  // namespace arco::refine

@@ -1,0 +1,109 @@
+// The second voice of double stops: string, finger, contact and the second finger's IK on a
+// synthetic violin scene (refine/test_scene.h).
+#include "arco/refine/double_stop_refine.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "arco/refine/test_scene.h"
+
+namespace arco::refine {
+namespace {
+
+// The A string (2) stopped by finger 1 two semitones up (B4), 20 frames, with the other
+// fingers hovering over their places; the refinement's first voice on it.
+struct Fixture {
+  testing::Scene scene;
+  RefineResult first;
+  Fixture() {
+    testing::SceneOptions o;
+    o.sway = false;
+    scene = testing::MakeScene(InstrumentKind::kViolin, {{2, 1, 2.0, 20}}, o);
+    RefineOptions options;
+    options.num_threads = 1;
+    first = Refine(scene.input, options);
+  }
+  double UpperHz(double semitones_on_e) const {
+    return scene.model->open_hz(1) * std::exp2(semitones_on_e / 12.0);
+  }
+};
+
+TEST(RefineSecondVoice, SixthFifthAndOpenStringOnTheNextHigherString) {
+  const Fixture fx;
+  const size_t n = fx.scene.input.pitch.size();
+  ASSERT_TRUE(fx.first.contacts[10].pressed());
+  ASSERT_EQ(fx.first.contacts[10].string, 2);
+  // Frames 5-9: a sixth (E string, 4 semitones: finger 2's place); 10-14: a fifth (E string,
+  // 2 semitones: finger 1 across both strings); 15-17: the open E; others none.
+  std::vector<double> upper(n, 0.0);
+  for (size_t f = 5; f < 10; ++f) upper[f] = fx.UpperHz(4);
+  for (size_t f = 10; f < 15; ++f) upper[f] = fx.UpperHz(2);
+  for (size_t f = 15; f < 18; ++f) upper[f] = fx.UpperHz(0.1);
+  DoubleStopRefineOptions per_frame;
+  per_frame.fill_notes = false;
+  const DoubleStopRefineResult r = RefineSecondVoice(fx.scene.input, fx.first, upper, per_frame);
+  ASSERT_EQ(r.second.size(), n);
+  EXPECT_EQ(r.second[2].state, ContactState::kRest);
+  for (size_t f = 5; f < 10; ++f) {
+    const FrameContact& c = r.second[f];
+    ASSERT_TRUE(c.pressed()) << f;
+    EXPECT_EQ(c.string, 1);
+    EXPECT_EQ(c.finger, 2);
+    EXPECT_LT(c.tip_distance_refined_mm, c.tip_distance_vision_mm);
+    EXPECT_LT(c.tip_distance_refined_mm, 5.0);  // the regularised IK leaves a few mm
+    // The first voice's finger is where the first refinement put it.
+    const auto first_tip = [&](const hand::HandPose& p) {
+      return hand::FingertipInWorld(fx.scene.input.hand_model, p, hand::Finger::kIndex);
+    };
+    EXPECT_LT((first_tip(*r.hand[f]) - first_tip(*fx.first.hand[f])).norm(), 1e-9);
+  }
+  for (size_t f = 10; f < 15; ++f) {
+    EXPECT_TRUE(r.second[f].pressed());
+    EXPECT_EQ(r.second[f].string, 1);
+    EXPECT_EQ(r.second[f].finger, 1);  // one finger stops the fifth
+  }
+  for (size_t f = 15; f < 18; ++f) {
+    EXPECT_EQ(r.second[f].state, ContactState::kOpenString);
+    EXPECT_EQ(r.second[f].string, 1);
+    EXPECT_EQ(r.second[f].finger, 0);
+  }
+  EXPECT_EQ(r.summary.frames, 13);
+  EXPECT_EQ(r.summary.pressed, 10);
+  EXPECT_EQ(r.summary.one_finger_fifths, 5);
+  EXPECT_EQ(r.summary.open_string, 3);
+  EXPECT_EQ(r.summary.joint_limit_violations, 0);
+  // fill_notes: 13 of the note's 20 frames have an upper note, so the others get their
+  // median (2 semitones on the E string: the fifth).
+  const DoubleStopRefineResult filled = RefineSecondVoice(fx.scene.input, fx.first, upper, {});
+  EXPECT_EQ(filled.summary.frames, 20);
+  EXPECT_TRUE(filled.second[2].pressed());
+  EXPECT_EQ(filled.second[2].string, 1);
+  EXPECT_NEAR(filled.second[2].f0_hz, fx.UpperHz(2), 1e-9);
+}
+
+TEST(RefineSecondVoice, NoHigherStringOrAnUnplayableSpanIsUncertain) {
+  const Fixture fx;
+  const size_t n = fx.scene.input.pitch.size();
+  std::vector<double> upper(n, 0.0);
+  upper[6] = fx.UpperHz(12);  // 10 semitones from the first stop: no hand spans it
+  upper[7] = fx.scene.model->open_hz(1) * 0.9;  // below the E string's open pitch
+  const DoubleStopRefineResult r = RefineSecondVoice(fx.scene.input, fx.first, upper, {});
+  EXPECT_EQ(r.second[6].state, ContactState::kUncertain);
+  EXPECT_EQ(r.second[7].state, ContactState::kUncertain);
+  EXPECT_EQ(r.summary.uncertain, 2);
+  // Wrong sizes and invalid options are a caller's bug.
+  EXPECT_THROW(RefineSecondVoice(fx.scene.input, fx.first, {1.0}, {}), std::invalid_argument);
+  DoubleStopRefineOptions bad;
+  bad.max_span_semitones = -1;
+  EXPECT_FALSE(bad.Validate().ok());
+  bad = {};
+  bad.open_tolerance_cents = 500;
+  EXPECT_FALSE(bad.Validate().ok());
+  bad = {};
+  bad.max_iterations = 0;
+  EXPECT_FALSE(bad.Validate().ok());
+}
+
+}  // namespace
+}  // namespace arco::refine
