@@ -11,14 +11,14 @@
 
 #include "arco/calibration/board_detection.h"
 #include "arco/calibration/rig_calibration.h"
-#include "arco/calibration/synthetic_board_rig.h"
+#include "arco/testing/synthetic_board_rig.h"
 
 namespace arco::calibration {
 namespace {
 
 struct Scene {
   BoardSpec board;
-  SyntheticBoardRig rig;
+  testing::SyntheticBoardRig rig;
   std::vector<media::Image> board_frames;  // a sample of camera 0's views, rendered
   media::Image empty;
 };
@@ -29,10 +29,10 @@ const Scene& GetScene() {
     s->board.inner_cols = 9;
     s->board.inner_rows = 6;
     s->board.square_mm = 80;
-    SyntheticBoardRigOptions options;
+    testing::SyntheticBoardRigOptions options;
     options.num_frames = 300;
-    s->rig = MakeSyntheticBoardRig(s->board, options);
-    const BoardRenderer renderer(s->board, s->rig.truth.cameras[0], 2);
+    s->rig = testing::MakeSyntheticBoardRig(s->board, options);
+    const testing::BoardRenderer renderer(s->board, s->rig.truth.cameras[0], 2);
     for (size_t i = 0; i < s->rig.views[0].views.size() && i < 24; ++i)
       s->board_frames.push_back(
           renderer.Render(s->rig.world_from_board[s->rig.views[0].views[i].frame]));

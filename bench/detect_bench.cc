@@ -30,7 +30,7 @@
 #include "arco/media/video_reader.h"
 #include "arco/pipeline/capture_new.h"
 #include "arco/pipeline/detect_stage.h"
-#include "arco/synth/plane_scene.h"
+#include "arco/testing/plane_scene.h"
 
 namespace arco::detect {
 namespace {
@@ -183,11 +183,11 @@ const PlaneCapture& GetPlaneCapture() {
       c.error = image.status().message();
       return c;
     }
-    const synth::PlaneScene scene = synth::DetectPlaneScene(*image);
-    synth::PlaneSceneWriteOptions write;
+    const testing::PlaneScene scene = testing::DetectPlaneScene(*image);
+    testing::PlaneSceneWriteOptions write;
     write.render.supersampling = 1;
     const std::string scene_dir = c.dir + "/scene";
-    const Status written = synth::WritePlaneScene(scene, scene_dir, write);
+    const Status written = testing::WritePlaneScene(scene, scene_dir, write);
     if (!written.ok()) {
       c.error = written.message();
       return c;

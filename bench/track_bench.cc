@@ -20,8 +20,8 @@
 #include "arco/media/video_reader.h"
 #include "arco/mocap/labelme.h"
 #include "arco/registry/keypoint_layout.h"
-#include "arco/synth/plane_bow.h"
-#include "arco/synth/plane_scene.h"
+#include "arco/testing/plane_bow.h"
+#include "arco/testing/plane_scene.h"
 #include "arco/track/bow_tracker.h"
 #include "arco/track/instrument_tracker.h"
 
@@ -47,30 +47,30 @@ const Scene& GetScene() {
       s.error = "../shared/data/spd/example.jpg and example.json are needed";
       return s;
     }
-    synth::PlaneTexture texture;
+    testing::PlaneTexture texture;
     texture.image = *reader->ReadFrame(0);
     texture.width_mm = texture.image.width * 0.778;
     texture.height_mm = texture.image.height * 0.778;
-    synth::BuildMipmaps(&texture);
-    synth::PlaneRigOptions rig;
+    testing::BuildMipmaps(&texture);
+    testing::PlaneRigOptions rig;
     rig.cameras = 6;
     rig.width = 768;
     rig.height = 886;
     rig.focal_px = 760;
-    const Rig r = synth::MakePlaneRig(rig);
+    const Rig r = testing::MakePlaneRig(rig);
     s.cameras = r.cameras;
-    synth::PlaneMotionOptions motion;
+    testing::PlaneMotionOptions motion;
     motion.frames = kFrames;
     motion.max_rotation_deg = 10;
-    const std::vector<Rigid3d> poses = synth::MakePlaneMotion(motion);
-    synth::PlaneRenderOptions render;
+    const std::vector<Rigid3d> poses = testing::MakePlaneMotion(motion);
+    testing::PlaneRenderOptions render;
     render.supersampling = 1;
     render.threads = 2;
     s.frames.resize(kFrames);
     for (const Camera& cam : s.cameras) {
-      const synth::PlaneRenderer renderer(cam, render);
+      const testing::PlaneRenderer renderer(cam, render);
       const media::Image background =
-          synth::MakeSolidImage(cam.width, cam.height, media::PixelFormat::kGray8, {90, 90, 90});
+          testing::MakeSolidImage(cam.width, cam.height, media::PixelFormat::kGray8, {90, 90, 90});
       for (int f = 0; f < kFrames; ++f) {
         media::Image out;
         renderer.Render(poses[f], texture, background, &out);
@@ -87,7 +87,7 @@ const Scene& GetScene() {
       for (size_t v = 0; v < s.cameras.size(); ++v) {
         const bool labelled = v == 1 || v == 4;
         frame_labels.pixels[v].push_back(
-            labelled ? *synth::ProjectPlanePoint(s.cameras[v], poses[0], texture, t)
+            labelled ? *testing::ProjectPlanePoint(s.cameras[v], poses[0], texture, t)
                      : Eigen::Vector2d::Constant(NAN));
       }
     }
@@ -148,31 +148,32 @@ const BowScene& GetBowScene() {
       s.error = "../shared/data/spd/example.jpg is needed";
       return s;
     }
-    synth::PlaneTexture cello;
+    testing::PlaneTexture cello;
     cello.image = *reader->ReadFrame(0);
     cello.width_mm = cello.image.width * 0.778;
     cello.height_mm = cello.image.height * 0.778;
-    synth::BuildMipmaps(&cello);
-    const synth::PlaneTexture bow = synth::MakeBowTexture();
-    const std::vector<Rigid3d> poses = synth::MakeBowingMotion(kFrames);
-    s.frog = synth::PlaneToWorld(poses[0], synth::TexturePixelToPlane(bow, synth::kBowFrogPx));
-    s.tip = synth::PlaneToWorld(poses[0], synth::TexturePixelToPlane(bow, synth::kBowTipPx));
-    synth::PlaneRigOptions rig;
+    testing::BuildMipmaps(&cello);
+    const testing::PlaneTexture bow = testing::MakeBowTexture();
+    const std::vector<Rigid3d> poses = testing::MakeBowingMotion(kFrames);
+    s.frog =
+        testing::PlaneToWorld(poses[0], testing::TexturePixelToPlane(bow, testing::kBowFrogPx));
+    s.tip = testing::PlaneToWorld(poses[0], testing::TexturePixelToPlane(bow, testing::kBowTipPx));
+    testing::PlaneRigOptions rig;
     rig.cameras = 6;
     rig.width = 768;
     rig.height = 886;
     rig.focal_px = 760;
-    s.cameras = synth::MakePlaneRig(rig).cameras;
-    synth::PlaneRenderOptions render;
+    s.cameras = testing::MakePlaneRig(rig).cameras;
+    testing::PlaneRenderOptions render;
     render.supersampling = 1;
     render.threads = 2;
     s.frames.resize(kFrames);
     for (const Camera& cam : s.cameras) {
-      const synth::PlaneRenderer renderer(cam, render);
+      const testing::PlaneRenderer renderer(cam, render);
       const media::Image background =
-          synth::MakeSolidImage(cam.width, cam.height, media::PixelFormat::kGray8, {90, 90, 90});
+          testing::MakeSolidImage(cam.width, cam.height, media::PixelFormat::kGray8, {90, 90, 90});
       media::Image picture;
-      renderer.Render(synth::PlaneRestPose(), cello, background, &picture);
+      renderer.Render(testing::PlaneRestPose(), cello, background, &picture);
       for (int f = 0; f < kFrames; ++f) {
         media::Image out;
         renderer.Render(poses[f], bow, picture, &out);

@@ -11,8 +11,8 @@
 #include <chrono>
 #include <cmath>
 
-#include "arco/mocap/synthetic_views.h"
 #include "arco/mocap/triangulate_sequence.h"
+#include "arco/testing/synthetic_views.h"
 #include "arco/util/parallel.h"
 #include "exhaustive_pairs.h"
 
@@ -33,15 +33,15 @@ struct Scene {
 const Scene& GetScene() {
   static const Scene* scene = [] {
     auto* s = new Scene;
-    SyntheticRigOptions r;
+    testing::SyntheticRigOptions r;
     r.num_cameras = kCameras;
-    s->rig = MakeSyntheticRig(r);
-    s->truth = MakeSyntheticPoints(kFrames, kPoints, 3);
-    SyntheticDetectionOptions d;
+    s->rig = testing::MakeSyntheticRig(r);
+    s->truth = testing::MakeSyntheticPoints(kFrames, kPoints, 3);
+    testing::SyntheticDetectionOptions d;
     d.noise_px = 1.0;
     d.outlier_fraction = 0.05;
     d.missing_fraction = 0.1;
-    s->detections = MakeSyntheticDetections(s->rig, s->truth, d);
+    s->detections = testing::MakeSyntheticDetections(s->rig, s->truth, d);
     for (int c = 0; c < kCameras; ++c) {
       s->view_to_camera.push_back(c);
       s->projections.push_back(s->rig.cameras[c].ProjectionMatrix());

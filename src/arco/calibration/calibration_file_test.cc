@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco {
 namespace {

@@ -15,10 +15,10 @@
 #include "arco/calibration/board_detection.h"
 #include "arco/calibration/calibrate.h"
 #include "arco/calibration/calibration_file.h"
-#include "arco/calibration/synthetic_board_rig.h"
 #include "arco/geometry/rotation.h"
 #include "arco/media/test_video.h"
-#include "arco/util/test_dir.h"
+#include "arco/testing/synthetic_board_rig.h"
+#include "arco/testing/temp_dir.h"
 
 namespace arco::calibration {
 namespace {
@@ -97,9 +97,9 @@ std::vector<Eigen::Vector2d> ImageGrid(const Camera& camera) {
 
 TEST(CalibrateRig, RecoversASyntheticRingOfEightDistortedCameras) {
   const BoardSpec board = Chessboard(80);
-  SyntheticBoardRigOptions options;
+  testing::SyntheticBoardRigOptions options;
   options.num_frames = 160;
-  const SyntheticBoardRig synthetic = MakeSyntheticBoardRig(board, options);
+  const testing::SyntheticBoardRig synthetic = testing::MakeSyntheticBoardRig(board, options);
   // Not every camera sees every frame; each sees enough.
   for (const auto& views : synthetic.views) {
     EXPECT_GE(views.views.size(), 20u) << views.camera;
@@ -178,10 +178,10 @@ TEST(CalibrateRig, RecoversASyntheticRingOfEightDistortedCameras) {
 
 TEST(CalibrateRig, SurvivesBackwardChessboardViewsAndABadDetection) {
   const BoardSpec board = Chessboard(80);
-  SyntheticBoardRigOptions options;
+  testing::SyntheticBoardRigOptions options;
   options.num_cameras = 5;
   options.num_frames = 100;
-  SyntheticBoardRig synthetic = MakeSyntheticBoardRig(board, options);
+  testing::SyntheticBoardRig synthetic = testing::MakeSyntheticBoardRig(board, options);
   // A third of cam1's views report the corners from the opposite end (what
   // findChessboardCorners may do); one view of cam2 is off by 75 px.
   int reversed = 0;
@@ -248,10 +248,10 @@ TEST(CalibrateRig, SurvivesBackwardChessboardViewsAndABadDetection) {
 TEST(CalibrateRig, UsesPartialChArUcoViews) {
   auto board = ParseBoardSpec("charuco:10x7:80:60");
   ASSERT_TRUE(board.ok());
-  SyntheticBoardRigOptions options;
+  testing::SyntheticBoardRigOptions options;
   options.num_cameras = 6;
   options.num_frames = 120;
-  SyntheticBoardRig synthetic = MakeSyntheticBoardRig(*board, options);
+  testing::SyntheticBoardRig synthetic = testing::MakeSyntheticBoardRig(*board, options);
   // A ChArUco detection misses corners (occluded or unreadable markers): drop a third.
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0, 1);
@@ -285,10 +285,10 @@ TEST(CalibrateRig, UsesPartialChArUcoViews) {
 
 TEST(CalibrateRig, OriginAtTheBoardOfTheFirstSharedFrame) {
   const BoardSpec board = Chessboard(80);
-  SyntheticBoardRigOptions options;
+  testing::SyntheticBoardRigOptions options;
   options.num_cameras = 6;
   options.num_frames = 80;
-  const SyntheticBoardRig synthetic = MakeSyntheticBoardRig(board, options);
+  const testing::SyntheticBoardRig synthetic = testing::MakeSyntheticBoardRig(board, options);
   RigCalibrationOptions calibrate;
   calibrate.origin = "board";
   auto result = CalibrateRig(calibrate, board, synthetic.views);
@@ -305,10 +305,10 @@ TEST(CalibrateRig, OriginAtTheBoardOfTheFirstSharedFrame) {
 
 TEST(CalibrateRig, FixedGivenIntrinsicsStayAsGiven) {
   const BoardSpec board = Chessboard(80);
-  SyntheticBoardRigOptions options;
+  testing::SyntheticBoardRigOptions options;
   options.num_cameras = 4;
   options.num_frames = 60;
-  const SyntheticBoardRig synthetic = MakeSyntheticBoardRig(board, options);
+  const testing::SyntheticBoardRig synthetic = testing::MakeSyntheticBoardRig(board, options);
   RigCalibrationOptions calibrate;
   calibrate.refine_intrinsics = false;
   auto result = CalibrateRig(calibrate, board, synthetic.views, &synthetic.truth);
@@ -324,10 +324,10 @@ TEST(CalibrateRig, FixedGivenIntrinsicsStayAsGiven) {
 
 TEST(CalibrateRig, NamesAHighResidualCameraAndFewViews) {
   const BoardSpec board = Chessboard(80);
-  SyntheticBoardRigOptions options;
+  testing::SyntheticBoardRigOptions options;
   options.num_cameras = 4;
   options.num_frames = 60;
-  SyntheticBoardRig synthetic = MakeSyntheticBoardRig(board, options);
+  testing::SyntheticBoardRig synthetic = testing::MakeSyntheticBoardRig(board, options);
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0, 2.0);
   for (BoardView& v : synthetic.views[2].views)
@@ -353,10 +353,10 @@ TEST(CalibrateRig, NamesAHighResidualCameraAndFewViews) {
 
 TEST(CalibrateRig, ExpectedFailuresAreOneLine) {
   const BoardSpec board = Chessboard(80);
-  SyntheticBoardRigOptions options;
+  testing::SyntheticBoardRigOptions options;
   options.num_cameras = 4;
   options.num_frames = 40;
-  const SyntheticBoardRig synthetic = MakeSyntheticBoardRig(board, options);
+  const testing::SyntheticBoardRig synthetic = testing::MakeSyntheticBoardRig(board, options);
 
   auto one = CalibrateRig(RigCalibrationOptions(), board, {synthetic.views[0]});
   ASSERT_FALSE(one.ok());
@@ -422,10 +422,10 @@ TEST(CalibrateRig, ExpectedFailuresAreOneLine) {
 
 TEST(CalibrateRig, InvalidOptionsAndInputsThrow) {
   const BoardSpec board = Chessboard(80);
-  SyntheticBoardRigOptions options;
+  testing::SyntheticBoardRigOptions options;
   options.num_cameras = 2;
   options.num_frames = 10;
-  auto synthetic = MakeSyntheticBoardRig(board, options);
+  auto synthetic = testing::MakeSyntheticBoardRig(board, options);
   RigCalibrationOptions bad;
   bad.loss_scale_px = 0;
   EXPECT_THROW((void)CalibrateRig(bad, board, synthetic.views), std::invalid_argument);
@@ -442,15 +442,15 @@ TEST(CalibrateRig, InvalidOptionsAndInputsThrow) {
 
 TEST(DetectBoard, FindsRenderedChessboardCornersToASmallFractionOfAPixel) {
   const BoardSpec board = Chessboard(80);
-  SyntheticBoardRigOptions options;
+  testing::SyntheticBoardRigOptions options;
   options.num_cameras = 3;
   options.num_frames = 30;
   options.width = 1280;
   options.height = 720;
   options.noise_px = 0;
-  const SyntheticBoardRig exact = MakeSyntheticBoardRig(board, options);
+  const testing::SyntheticBoardRig exact = testing::MakeSyntheticBoardRig(board, options);
   const Camera& camera = exact.truth.cameras[0];
-  const BoardRenderer renderer(board, camera, 4);
+  const testing::BoardRenderer renderer(board, camera, 4);
   double worst = 0;
   int found = 0;
   ASSERT_GE(exact.views[0].views.size(), 5u);
@@ -696,13 +696,13 @@ TEST(RunCalibrate, WritesTheCalibrationAndReportFromImageFolders) {
 TEST(RunCalibrate, RecoversARingFromRenderedVideos) {
   arco::testing::TempDir dir;
   const BoardSpec board = Chessboard(80);
-  SyntheticBoardRigOptions rig_options;
+  testing::SyntheticBoardRigOptions rig_options;
   rig_options.num_cameras = 4;
   rig_options.num_frames = 160;
   rig_options.width = 1280;
   rig_options.height = 720;
   rig_options.ring_radius_mm = 2500;
-  const SyntheticBoardRig synthetic = MakeSyntheticBoardRig(board, rig_options);
+  const testing::SyntheticBoardRig synthetic = testing::MakeSyntheticBoardRig(board, rig_options);
   CalibrateOptions options;
   options.board = board.ToString();
   options.output = dir / "rig.json";
@@ -713,7 +713,7 @@ TEST(RunCalibrate, RecoversARingFromRenderedVideos) {
   video.frames = rig_options.num_frames;
   for (int c = 0; c < rig_options.num_cameras; ++c) {
     const Camera& camera = synthetic.truth.cameras[c];
-    const BoardRenderer renderer(board, camera, 2);
+    const testing::BoardRenderer renderer(board, camera, 2);
     std::set<int64_t> seen;
     for (const BoardView& v : synthetic.views[c].views) seen.insert(v.frame);
     const media::Image empty = renderer.Render(Eigen::Isometry3d(Eigen::Translation3d(0, 0, -1e5)));
@@ -811,7 +811,8 @@ TEST(RunCalibrate, BadInputIsOneErrorAndNothingIsWritten) {
   cam.cx = 320;
   cam.cy = 240;
   other.cameras = {cam};
-  const std::string intrinsics = ::testing::TempDir() + "/other_intrinsics.json";
+  const arco::testing::TempDir temp("RunCalibrate_intrinsics");  // not inside `dir`
+  const std::string intrinsics = temp / "other_intrinsics.json";
   ASSERT_TRUE(SaveCalibration(intrinsics, other, CalibrationFormat::kArcoJson).ok());
   options.inputs = {{"left", PairImage("left", 1)}, {"right", PairImage("right", 1)}};
   options.intrinsics = intrinsics;

@@ -8,6 +8,8 @@
 #include <random>
 #include <sstream>
 
+#include "arco/testing/look_at.h"
+
 namespace arco {
 namespace {
 
@@ -55,13 +57,9 @@ std::string SensorXml(int id, const MetashapeSensor& s, bool with_offsets = true
 // A camera-to-chunk 4x4 transform looking roughly at the origin from `center`.
 Eigen::Matrix4d LookAt(const Eigen::Vector3d& center, std::mt19937* rng) {
   std::uniform_real_distribution<double> u(-0.1, 0.1);
-  const Eigen::Vector3d z = (-center + Eigen::Vector3d(u(*rng), u(*rng), u(*rng))).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d(0, 0, 1)).normalized();
-  const Eigen::Vector3d y = z.cross(x);
+  const Eigen::Vector3d target(u(*rng), u(*rng), u(*rng));
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  m.block<3, 1>(0, 0) = x;
-  m.block<3, 1>(0, 1) = y;
-  m.block<3, 1>(0, 2) = z;
+  m.topLeftCorner<3, 3>() = testing::CamFromWorldLookingAt(center, target).transpose();
   m.block<3, 1>(0, 3) = center;
   return m;
 }

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "arco/cli/number_option.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/number_range.h"
 
 namespace arco::cli {
@@ -106,17 +107,10 @@ Outcome TryValue(const CommandPath& command_template,
 
 class AppOptions : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("arco_app_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  arco::testing::TempDir temp_;
+  const fs::path dir_{temp_.path()};
   // Nothing was written: the parse only checks.
   void ExpectNothingWritten() const { EXPECT_TRUE(fs::is_empty(dir_)) << dir_; }
-  fs::path dir_;
 };
 
 TEST_F(AppOptions, EveryNumericOptionHasARange) {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "arco/detect/models_for_test.h"
+#include "arco/testing/temp_dir.h"
 
 namespace arco::detect {
 namespace {
@@ -28,8 +29,8 @@ TEST(NetworkLoad, MissingFileNamesItAndScriptsSetup) {
 }
 
 TEST(NetworkLoad, CorruptFileNamesIt) {
-  const std::string dir = ::testing::TempDir() + "/arco_detect_corrupt";
-  std::filesystem::create_directories(dir);
+  const arco::testing::TempDir temp;
+  const std::string& dir = temp.path();
   const std::string path = dir + "/hand_recrop.onnx";
   std::ofstream(path) << "not an onnx model";
   StatusOr<Network> network = Network::Load(ModelId::kHandRecrop, dir);
@@ -37,7 +38,6 @@ TEST(NetworkLoad, CorruptFileNamesIt) {
   EXPECT_EQ(network.status().message().rfind(path + ": cannot read the ONNX model", 0), 0u)
       << network.status().message();
   EXPECT_NE(network.status().message().find("scripts/setup"), std::string::npos);
-  std::filesystem::remove_all(dir);
 }
 
 TEST(NetworkOptions, RejectsZeroThreads) {

@@ -20,6 +20,7 @@
 #include "arco/detect/models_for_test.h"
 #include "arco/detect/roi.h"
 #include "arco/media/video_reader.h"
+#include "arco/testing/temp_dir.h"
 
 namespace arco::detect {
 namespace {
@@ -213,9 +214,8 @@ TEST(WholeBodyTracker, CellistLeftHandOnTheFingerboard) {
 // (here the hand model, the last one loaded).
 TEST(WholeBodyTracker, MissingHandModelNamesIt) {
   ARCO_REQUIRE_MODELS();
-  const std::string dir = ::testing::TempDir() + "/arco_wholebody_models";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const arco::testing::TempDir temp;
+  const std::string& dir = temp.path();
   for (ModelId id : {ModelId::kPoseDetection, ModelId::kPoseLandmarkFull, ModelId::kHandRecrop}) {
     std::filesystem::create_symlink(ModelPath(id), ModelPath(id, dir));
   }
@@ -227,7 +227,6 @@ TEST(WholeBodyTracker, MissingHandModelNamesIt) {
             dir +
                 "/hand_landmark_full.onnx: model file not found; run scripts/setup to fetch "
                 "and convert the models (docs/detect.md)");
-  std::filesystem::remove_all(dir);
 }
 
 TEST(WholeBodyTracker, RejectsAGrayFrame) {

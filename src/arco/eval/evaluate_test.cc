@@ -12,9 +12,9 @@
 #include "arco/camera/calibration_io.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/synth/capture_writer.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::eval {
 namespace {

@@ -6,6 +6,8 @@
 #include <Eigen/Geometry>
 #include <random>
 
+#include "arco/testing/look_at.h"
+
 namespace arco {
 namespace {
 
@@ -15,13 +17,7 @@ std::vector<Matrix34d> RingCameras(int n, double radius) {
   for (int i = 0; i < n; ++i) {
     const double a = 2 * M_PI * i / n;
     const Eigen::Vector3d center(radius * std::cos(a), radius * std::sin(a), 0.3 * radius);
-    const Eigen::Vector3d z = (-center).normalized();
-    const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-    const Eigen::Vector3d y = z.cross(x);
-    Eigen::Matrix3d r;
-    r.row(0) = x;
-    r.row(1) = y;
-    r.row(2) = z;
+    const Eigen::Matrix3d r = testing::CamFromWorldLookingAt(center, Eigen::Vector3d::Zero());
     Matrix34d p;
     p.leftCols<3>() = r;
     p.col(3) = -r * center;

@@ -10,6 +10,7 @@
 
 #include "arco/hand/hand_test_util.h"
 #include "arco/hand/synthetic_rig.h"
+#include "arco/testing/look_at.h"
 
 namespace arco::hand {
 namespace {
@@ -113,9 +114,8 @@ TEST(FuseViewHands, FaceOnViewsOutweighEdgeOnViews) {
   std::vector<Camera> cameras = testing::MakeRingRig(2, 2500, Eigen::Vector3d::Zero());
   // Camera 0 looks down the palm normal, camera 1 along the palm plane.
   auto look = [](Camera* c, const Eigen::Vector3d& center, const Eigen::Vector3d& up) {
-    const Eigen::Vector3d z = (-center).normalized();
-    const Eigen::Vector3d x = z.cross(up).normalized();
-    c->cam_from_world_rotation << x.transpose(), z.cross(x).transpose(), z.transpose();
+    c->cam_from_world_rotation =
+        arco::testing::CamFromWorldLookingAt(center, Eigen::Vector3d::Zero(), up);
     c->cam_from_world_translation = -c->cam_from_world_rotation * center;
   };
   look(&cameras[0], Eigen::Vector3d(0, 0, 2000), Eigen::Vector3d::UnitY());

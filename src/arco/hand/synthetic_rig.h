@@ -8,6 +8,7 @@
 
 #include "arco/camera/camera.h"
 #include "arco/hand/fit.h"
+#include "arco/testing/look_at.h"
 
 namespace arco::hand::testing {
 
@@ -19,9 +20,6 @@ inline std::vector<Camera> MakeRingRig(int n, double radius_mm, const Eigen::Vec
     const double h = (i % 2 == 0 ? 0.3 : -0.3) * radius_mm;
     const Eigen::Vector3d center =
         target + Eigen::Vector3d(radius_mm * std::cos(a), h, radius_mm * std::sin(a));
-    const Eigen::Vector3d z = (target - center).normalized();
-    const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitY()).normalized();
-    const Eigen::Vector3d y = z.cross(x);
     Camera& c = cameras[i];
     c.name = "cam" + std::to_string(i);
     c.width = 2300;
@@ -30,9 +28,8 @@ inline std::vector<Camera> MakeRingRig(int n, double radius_mm, const Eigen::Vec
     c.cx = 1149.5;
     c.cy = 1327.5;
     c.distortion.k1 = -0.08;
-    c.cam_from_world_rotation.row(0) = x;
-    c.cam_from_world_rotation.row(1) = y;
-    c.cam_from_world_rotation.row(2) = z;
+    c.cam_from_world_rotation =
+        arco::testing::CamFromWorldLookingAt(center, target, Eigen::Vector3d::UnitY());
     c.cam_from_world_translation = -c.cam_from_world_rotation * center;
   }
   return cameras;

@@ -1,12 +1,12 @@
 #include "arco/media/video_reader.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <random>
 
 #include "arco/media/test_video.h"
+#include "arco/testing/temp_dir.h"
 
 namespace arco::media {
 namespace {
@@ -16,13 +16,9 @@ using testing::IndexVideo;
 
 class VideoReaderTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("arco_media_test_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
+  arco::testing::TempDir temp_;
+  const fs::path dir_{temp_.path()};
 };
 
 // Seeks to random frames (and back) and checks each frame shows its index.

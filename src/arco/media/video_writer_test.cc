@@ -1,7 +1,6 @@
 #include "arco/media/video_writer.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -10,6 +9,7 @@
 #include <vector>
 
 #include "arco/media/video_reader.h"
+#include "arco/testing/temp_dir.h"
 
 namespace arco::media {
 namespace {
@@ -18,13 +18,9 @@ namespace fs = std::filesystem;
 
 class VideoWriterTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("arco_video_writer_test_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
+  arco::testing::TempDir temp_;
+  const fs::path dir_{temp_.path()};
 };
 
 // Frame k: noise (every value 0..255 occurs) over smooth gradients that move with k.

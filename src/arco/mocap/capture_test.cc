@@ -7,8 +7,8 @@
 #include <filesystem>
 
 #include "arco/mocap/sample_manifest.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco {
 namespace {

@@ -9,8 +9,8 @@
 #include "arco/mocap/mmpose_json.h"
 #include "arco/mocap/openpose_json.h"
 #include "arco/registry/keypoint_layout.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco {
 namespace {

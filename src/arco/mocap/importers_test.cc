@@ -5,7 +5,7 @@
 
 #include "arco/mocap/labelme.h"
 #include "arco/mocap/spd_import.h"
-#include "arco/util/test_dir.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 
 namespace arco {

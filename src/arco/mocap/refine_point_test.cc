@@ -5,7 +5,7 @@
 #include <random>
 #include <vector>
 
-#include "arco/mocap/synthetic_views.h"
+#include "arco/testing/synthetic_views.h"
 
 namespace arco {
 namespace {
@@ -35,9 +35,9 @@ double RobustCost(const std::vector<RefinementView>& views, double b, const Eige
 }
 
 TEST(RefinePointRobust, ConvergesToTheTruthWithoutNoise) {
-  SyntheticRigOptions o;
+  testing::SyntheticRigOptions o;
   o.num_cameras = 8;
-  const Rig rig = MakeSyntheticRig(o);
+  const Rig rig = testing::MakeSyntheticRig(o);
   std::mt19937 rng(1);
   const Eigen::Vector3d truth(0.2, -0.1, 1.3);
   const auto views = Observe(rig, truth, 0.0, &rng);
@@ -55,9 +55,9 @@ TEST(RefinePointRobust, ConvergesToTheTruthWithoutNoise) {
 }
 
 TEST(RefinePointRobust, EndsAtAMinimumOfTheRobustCost) {
-  SyntheticRigOptions o;
+  testing::SyntheticRigOptions o;
   o.num_cameras = 12;
-  const Rig rig = MakeSyntheticRig(o);
+  const Rig rig = testing::MakeSyntheticRig(o);
   std::mt19937 rng(2);
   const double b = 3.0;
   for (int i = 0; i < 10; ++i) {
@@ -87,7 +87,7 @@ TEST(RefinePointRobust, EndsAtAMinimumOfTheRobustCost) {
 }
 
 TEST(RefinePointRobust, StartBehindACameraIsLeftAlone) {
-  const Rig rig = MakeSyntheticRig(SyntheticRigOptions());
+  const Rig rig = testing::MakeSyntheticRig(testing::SyntheticRigOptions());
   std::mt19937 rng(3);
   const auto views = Observe(rig, Eigen::Vector3d(0, 0, 1), 0.5, &rng);
   // 10 m from the origin the point is behind the cameras on the other side of the ring.

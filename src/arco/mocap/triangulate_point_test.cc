@@ -6,7 +6,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "arco/mocap/synthetic_views.h"
+#include "arco/testing/synthetic_views.h"
 
 namespace arco {
 namespace {
@@ -26,10 +26,10 @@ std::vector<PointObservation> Observe(const Rig& rig,
 }
 
 Rig SmallRig(int n, bool distortion = true) {
-  SyntheticRigOptions o;
+  testing::SyntheticRigOptions o;
   o.num_cameras = n;
   o.distortion = distortion;
-  return MakeSyntheticRig(o);
+  return testing::MakeSyntheticRig(o);
 }
 
 TEST(TriangulateRobust, ExactWithoutNoiseThroughDistortion) {

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "arco/mocap/synthetic_views.h"
+#include "arco/testing/synthetic_views.h"
 
 namespace arco {
 namespace {
@@ -20,15 +20,15 @@ struct Scene {
 
 Scene MakeScene(int cameras, int frames, int points, double outliers, double missing) {
   Scene s;
-  SyntheticRigOptions rig_options;
+  testing::SyntheticRigOptions rig_options;
   rig_options.num_cameras = cameras;
-  s.rig = MakeSyntheticRig(rig_options);
-  s.truth = MakeSyntheticPoints(frames, points, 11);
-  SyntheticDetectionOptions d;
+  s.rig = testing::MakeSyntheticRig(rig_options);
+  s.truth = testing::MakeSyntheticPoints(frames, points, 11);
+  testing::SyntheticDetectionOptions d;
   d.noise_px = 1.0;
   d.outlier_fraction = outliers;
   d.missing_fraction = missing;
-  s.detections = MakeSyntheticDetections(s.rig, s.truth, d);
+  s.detections = testing::MakeSyntheticDetections(s.rig, s.truth, d);
   for (int c = 0; c < cameras; ++c) s.view_to_camera.push_back(c);
   return s;
 }

@@ -5,11 +5,11 @@
 #include "arco/calibration/calibration_file.h"
 #include "arco/geometry/rotation.h"
 #include "arco/mocap/capture.h"
-#include "arco/mocap/synthetic_views.h"
 #include "arco/pipeline/triangulate_stage.h"
+#include "arco/testing/synthetic_views.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {
@@ -18,14 +18,14 @@ using arco::testing::TempDir;
 
 // 8 cameras, 21 points in 40 frames, 1 px noise and 5 % outliers.
 void WriteCapture(const std::string& dir, Rig* rig) {
-  SyntheticRigOptions ro;
+  testing::SyntheticRigOptions ro;
   ro.num_cameras = 8;
-  *rig = MakeSyntheticRig(ro);
-  const NpyArray<double> truth = MakeSyntheticPoints(40, 21, 5);
-  SyntheticDetectionOptions d;
+  *rig = testing::MakeSyntheticRig(ro);
+  const NpyArray<double> truth = testing::MakeSyntheticPoints(40, 21, 5);
+  testing::SyntheticDetectionOptions d;
   d.outlier_fraction = 0.05;
   d.missing_fraction = 0.1;
-  const NpyArray<double> k = MakeSyntheticDetections(*rig, truth, d);
+  const NpyArray<double> k = testing::MakeSyntheticDetections(*rig, truth, d);
   ASSERT_TRUE(MakeDirectories(dir).ok());
   ASSERT_TRUE(SaveCalibration(dir + "/rig.json", *rig).ok());
   NpyArray<float> kf;

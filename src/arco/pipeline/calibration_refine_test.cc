@@ -19,9 +19,9 @@
 #include "arco/pipeline/run_with_rig_test_support.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {

@@ -11,8 +11,8 @@
 #include "arco/calibration/calibration_file.h"
 #include "arco/media/test_video.h"
 #include "arco/mocap/capture.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {

@@ -23,10 +23,10 @@
 #include "arco/pipeline/detect_stage.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/registry/keypoint_layout.h"
-#include "arco/synth/plane_scene.h"
+#include "arco/testing/plane_scene.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/npy.h"
 #include "arco/util/stats.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {
@@ -44,16 +44,16 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
   ASSERT_TRUE(reader.ok()) << reader.status().message();
   auto image = reader->ReadFrame(0);
   ASSERT_TRUE(image.ok());
-  const synth::PlaneScene scene = synth::DetectPlaneScene(*image);
+  const testing::PlaneScene scene = testing::DetectPlaneScene(*image);
   const int frames = static_cast<int>(scene.world_from_plane.size());
   const std::string scene_dir = dir / "scene";
   const auto start = std::chrono::steady_clock::now();
   const auto seconds = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  synth::PlaneSceneWriteOptions write;
+  testing::PlaneSceneWriteOptions write;
   write.render.supersampling = 1;  // the texture pyramid still filters the shrunk photo
-  ASSERT_TRUE(synth::WritePlaneScene(scene, scene_dir, write).ok());
+  ASSERT_TRUE(testing::WritePlaneScene(scene, scene_dir, write).ok());
   const double render_s = seconds();
 
   // capture new -> detect -> triangulate.

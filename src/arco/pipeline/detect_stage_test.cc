@@ -22,9 +22,9 @@
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/capture_new.h"
 #include "arco/registry/keypoint_layout.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/json_io.h"
 #include "arco/util/npy.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {

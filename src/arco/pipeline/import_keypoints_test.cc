@@ -10,14 +10,14 @@
 #include "arco/calibration/calibration_file.h"
 #include "arco/media/test_video.h"
 #include "arco/mocap/capture.h"
-#include "arco/mocap/synthetic_views.h"
 #include "arco/pipeline/capture_new.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/registry/keypoint_layout.h"
+#include "arco/testing/synthetic_views.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {
@@ -229,10 +229,10 @@ TEST(ImportKeypoints, RotatedCameraNeedsPixelsAndTurnsDecodedOnes) {
 // the decoded frames -> import -> triangulate: every point back where it was.
 TEST(ImportKeypoints, VideosToCaptureToTriangulation) {
   TempDir dir;
-  SyntheticRigOptions ro;
+  testing::SyntheticRigOptions ro;
   ro.num_cameras = 4;
   ro.distortion = false;
-  Rig rig = MakeSyntheticRig(ro);
+  Rig rig = testing::MakeSyntheticRig(ro);
   for (Camera& c : rig.cameras) {  // 2300 x 2656 scaled to 128 x 160 (about 1/18)
     const double s = 128.0 / 2300.0;
     c.width = 128;
@@ -244,10 +244,10 @@ TEST(ImportKeypoints, VideosToCaptureToTriangulation) {
   }
   ASSERT_TRUE(SaveCalibration(dir / "rig.json", rig).ok());
   constexpr int kFrames = 5;
-  const NpyArray<double> truth = MakeSyntheticPoints(kFrames, 133, 3);
-  SyntheticDetectionOptions d;
+  const NpyArray<double> truth = testing::MakeSyntheticPoints(kFrames, 133, 3);
+  testing::SyntheticDetectionOptions d;
   d.noise_px = 0;
-  const NpyArray<double> k = MakeSyntheticDetections(rig, truth, d);
+  const NpyArray<double> k = testing::MakeSyntheticDetections(rig, truth, d);
 
   CaptureNewOptions c;
   c.calibration = dir / "rig.json";

@@ -6,12 +6,12 @@
 #include <filesystem>
 
 #include "arco/calibration/calibration_file.h"
-#include "arco/mocap/synthetic_views.h"
 #include "arco/pipeline/label_views.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/triangulate_stage.h"
+#include "arco/testing/synthetic_views.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {
@@ -30,15 +30,15 @@ TEST(ImportSpdCapture, SpdFoldersToCaptureToTriangulation) {
   Rig rig = calibration->rig;
   rig.cameras.resize(6);
   // Points near the cello of frame 128 (metashape units, about 2 m per unit).
-  NpyArray<double> truth = MakeSyntheticPoints(3, 142, 9);
+  NpyArray<double> truth = testing::MakeSyntheticPoints(3, 142, 9);
   for (int64_t i = 0; i < 3 * 142; ++i) {
     truth.data[3 * i + 0] = 0.1 + 0.25 * (truth.data[3 * i + 0]);
     truth.data[3 * i + 1] = 0.0 + 0.25 * (truth.data[3 * i + 1]);
     truth.data[3 * i + 2] = -1.1 + 0.2 * (truth.data[3 * i + 2] - 1.0);
   }
-  SyntheticDetectionOptions d;
+  testing::SyntheticDetectionOptions d;
   d.noise_px = 0.5;
-  NpyArray<double> k = MakeSyntheticDetections(rig, truth, d);
+  NpyArray<double> k = testing::MakeSyntheticDetections(rig, truth, d);
   SpdImportOptions spd;
   spd.human_dir = dir / "human";
   spd.instrument_dir = dir / "cello";

@@ -9,8 +9,8 @@
 #include "arco/audio/test_signals.h"
 #include "arco/pipeline/capture_checks.h"
 #include "arco/pipeline/run_capture.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {

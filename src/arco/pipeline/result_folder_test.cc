@@ -14,8 +14,8 @@
 #include "arco/refine/refine.h"
 #include "arco/refine/test_scene.h"
 #include "arco/registry/keypoint_layout.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {

@@ -12,9 +12,9 @@
 #include "arco/mocap/sample_manifest.h"
 #include "arco/pipeline/capture_inputs.h"
 #include "arco/pipeline/result_folder.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {

@@ -28,30 +28,20 @@
 #include "arco/registry/keypoint_layout.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {
 
 namespace fs = std::filesystem;
 
-// Removes the shared capture when the test binary ends.
-struct RemoveAtExit {
-  std::string path;
-  ~RemoveAtExit() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
-
-// A 4-second cello scale with audio (soundfont tuning off: faster), once per test binary.
+// A 4-second cello scale with audio (soundfont tuning off: faster), once per test binary
+// (removed when it ends).
 const std::string& SyntheticCapture() {
-  static const RemoveAtExit dir{[] {
-    const std::string path =
-        (fs::temp_directory_path() / ("arco_run_test_capture_" + std::to_string(::getpid())))
-            .string();
-    fs::remove_all(path);
+  static const arco::testing::TempDir dir("RunCaptureShared");
+  static const std::string capture = [] {
+    const std::string path = dir / "capture";
     auto calibration =
         LoadCalibration(std::string(ARCO_SHARED_DATA_DIR) + "/spd/cello_1113_scale_camera.xml");
     EXPECT_TRUE(calibration.ok()) << calibration.status().message();
@@ -65,8 +55,8 @@ const std::string& SyntheticCapture() {
     const Status written = synth::WriteCapture(*capture, path, w);
     EXPECT_TRUE(written.ok()) << written.message();
     return path;
-  }()};
-  return dir.path;
+  }();
+  return capture;
 }
 
 TEST(RunCapture, EveryStageAndThreeMethodsThatEvalScores) {

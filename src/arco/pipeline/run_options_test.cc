@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "arco/pipeline/run_capture.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {

@@ -1,6 +1,6 @@
 // `arco track` with a bow that moves on its own (issue 13's second test): the real photo
 // of a cellist (the instrument, moving a little) and a textured bow (a random-block strip
-// 720 x 24 mm) on their own rigid planes, rendered exactly (synth::PlaneRenderer, the bow
+// 720 x 24 mm) on their own rigid planes, rendered exactly (testing::PlaneRenderer, the bow
 // over the picture) into 6 distorted cameras: bowing strokes of +-200 mm at 0.7 Hz (about
 // 9 px per frame), string crossings (the bow turns +-10 degrees in its plane), and a
 // hand-shaped blob that holds the frog and hides part of the stick. Labels on frame 1 in
@@ -29,13 +29,13 @@
 #include "arco/pipeline/track_stage.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/registry/keypoint_layout.h"
-#include "arco/synth/plane_bow.h"
-#include "arco/synth/plane_scene.h"
+#include "arco/testing/plane_bow.h"
+#include "arco/testing/plane_scene.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/stats.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {
@@ -80,51 +80,51 @@ void MovingBow(bool plain_stick, bool with_hand_too) {
   const std::string data = ARCO_SHARED_DATA_DIR;
   auto reader = media::VideoReader::Open(data + "/spd/example.jpg");
   ASSERT_TRUE(reader.ok()) << reader.status().message();
-  synth::PlaneTexture cello;
+  testing::PlaneTexture cello;
   cello.image = *reader->ReadFrame(0);
   cello.width_mm = cello.image.width * 0.778;
   cello.height_mm = cello.image.height * 0.778;
-  synth::BuildMipmaps(&cello);
-  synth::PlaneMotionOptions motion;
+  testing::BuildMipmaps(&cello);
+  testing::PlaneMotionOptions motion;
   motion.frames = kFrames;
   motion.max_translation_mm = 40;
   motion.max_rotation_deg = 4;
-  const std::vector<Rigid3d> world_from_cello = synth::MakePlaneMotion(motion);
+  const std::vector<Rigid3d> world_from_cello = testing::MakePlaneMotion(motion);
   // The bow (synth/plane_bow.h): random 6 mm blocks on a 720 x 24 mm strip, or a plain
   // stick; frog and tip on its axis; bowing strokes and string crossings.
-  const synth::PlaneTexture bow = synth::MakeBowTexture(plain_stick);
-  const Eigen::Vector2d frog_px = synth::kBowFrogPx, tip_px = synth::kBowTipPx;
-  const std::vector<Rigid3d> world_from_bow = synth::MakeBowingMotion(kFrames);
+  const testing::PlaneTexture bow = testing::MakeBowTexture(plain_stick);
+  const Eigen::Vector2d frog_px = testing::kBowFrogPx, tip_px = testing::kBowTipPx;
+  const std::vector<Rigid3d> world_from_bow = testing::MakeBowingMotion(kFrames);
 
   // The right hand: a dark blob around the frog end, moving with the bow (its centre per
   // view and frame).
   const auto hand_centre = [&](const Camera& cam, int f) -> std::optional<Eigen::Vector2d> {
-    const auto frog = synth::ProjectPlanePoint(cam, world_from_bow[f], bow, frog_px);
-    const auto tip = synth::ProjectPlanePoint(cam, world_from_bow[f], bow, tip_px);
+    const auto frog = testing::ProjectPlanePoint(cam, world_from_bow[f], bow, frog_px);
+    const auto tip = testing::ProjectPlanePoint(cam, world_from_bow[f], bow, tip_px);
     if (!frog || !tip) return std::nullopt;
     return *frog + 30 * (*tip - *frog).normalized() + Eigen::Vector2d(0, 8);
   };
 
   // The rig and the videos.
-  synth::PlaneRigOptions rig_options;
+  testing::PlaneRigOptions rig_options;
   rig_options.cameras = kCameras;
   rig_options.width = 768;
   rig_options.height = 886;
   rig_options.focal_px = 760;
-  const Rig rig = synth::MakePlaneRig(rig_options);
+  const Rig rig = testing::MakePlaneRig(rig_options);
   const std::string scene = dir / "scene";
   ASSERT_TRUE(MakeDirectories(scene).ok());
   ASSERT_TRUE(SaveCalibration(scene + "/calibration.json", rig).ok());
-  synth::PlaneRenderOptions render;
+  testing::PlaneRenderOptions render;
   render.supersampling = 1;
   render.threads = 2;
   CaptureNewOptions c;
   c.calibration = scene + "/calibration.json";
   c.instrument = "cello";
   for (const Camera& cam : rig.cameras) {
-    const synth::PlaneRenderer renderer(cam, render);
+    const testing::PlaneRenderer renderer(cam, render);
     const media::Image background =
-        synth::MakeSolidImage(cam.width, cam.height, media::PixelFormat::kGray8, {90, 90, 90});
+        testing::MakeSolidImage(cam.width, cam.height, media::PixelFormat::kGray8, {90, 90, 90});
     media::VideoWriterOptions w;
     w.width = cam.width;
     w.height = cam.height;
@@ -203,12 +203,12 @@ void MovingBow(bool plain_stick, bool with_hand_too) {
       std::vector<Eigen::Vector2d> px;
       for (size_t p = 0; p < slots.size(); ++p) {
         names.push_back(layout->names[slots[p]]);
-        px.push_back(*synth::ProjectPlanePoint(cam, world_from_cello[0], cello, cello_px[p]));
+        px.push_back(*testing::ProjectPlanePoint(cam, world_from_cello[0], cello, cello_px[p]));
       }
       names.push_back("frog");
-      px.push_back(*synth::ProjectPlanePoint(cam, world_from_bow[0], bow, frog_px));
+      px.push_back(*testing::ProjectPlanePoint(cam, world_from_bow[0], bow, frog_px));
       names.push_back("tip_plate");
-      px.push_back(*synth::ProjectPlanePoint(cam, world_from_bow[0], bow, tip_px));
+      px.push_back(*testing::ProjectPlanePoint(cam, world_from_bow[0], bow, tip_px));
       const std::string file = dir / (cam.name + ".json");
       ASSERT_TRUE(AtomicWriteFile(file, LabelmeText(cam, names, px)).ok());
       o.labels.push_back({cam.name, -1, file});
@@ -233,7 +233,7 @@ void MovingBow(bool plain_stick, bool with_hand_too) {
     // Errors: 2D in every view where the truth is in the image, 3D per frame.
     const auto measure = [&](const std::vector<int>& which,
                              const std::vector<Rigid3d>& poses,
-                             const synth::PlaneTexture& texture,
+                             const testing::PlaneTexture& texture,
                              const std::vector<Eigen::Vector2d>& texture_px,
                              std::vector<double>* px_err,
                              std::vector<double>* mm_err,
@@ -244,8 +244,8 @@ void MovingBow(bool plain_stick, bool with_hand_too) {
             const float* x =
                 &kp->data[static_cast<size_t>(((f * kCameras + v) * kp->shape[2] + which[p]) * 3)];
             const auto truth =
-                synth::ProjectPlanePoint(rig.cameras[v], poses[f], texture, texture_px[p]);
-            if (!truth || !synth::InImage(rig.cameras[v], *truth)) continue;
+                testing::ProjectPlanePoint(rig.cameras[v], poses[f], texture, texture_px[p]);
+            if (!truth || !testing::InImage(rig.cameras[v], *truth)) continue;
             if (std::isfinite(x[0]))
               px_err->push_back((Eigen::Vector2d(x[0], x[1]) - *truth).norm());
           }
@@ -255,7 +255,7 @@ void MovingBow(bool plain_stick, bool with_hand_too) {
             continue;
           }
           const Eigen::Vector3d truth =
-              synth::PlaneToWorld(poses[f], synth::TexturePixelToPlane(texture, texture_px[p]));
+              testing::PlaneToWorld(poses[f], testing::TexturePixelToPlane(texture, texture_px[p]));
           mm_err->push_back((Eigen::Vector3d(x[0], x[1], x[2]) - truth).norm());
         }
     };

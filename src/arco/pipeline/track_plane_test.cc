@@ -10,7 +10,6 @@
 // Lucas-Kanade with no rigid model (labels given in every view). Figures are printed for
 // docs/track.md; the bounds are the issue's.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -28,7 +27,8 @@
 #include "arco/pipeline/track_stage.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/registry/keypoint_layout.h"
-#include "arco/synth/plane_scene.h"
+#include "arco/testing/plane_scene.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/track/instrument_tracker.h"
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
@@ -45,25 +45,9 @@ constexpr int kCameras = 6;
 constexpr int kFrames = 45;
 constexpr int kLabelViews[2] = {1, 4};
 
-// A folder for the whole suite (testing::TempDir needs a running test).
-struct SuiteDir {
-  std::string path =
-      (fs::temp_directory_path() / ("arco_test_" + std::to_string(::getpid()) + "_TrackPlane"))
-          .string();
-  SuiteDir() {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~SuiteDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string operator/(const std::string& name) const { return path + "/" + name; }
-};
-
 struct Scene {
-  SuiteDir dir;
-  synth::PlaneScene scene;
+  arco::testing::TempDir dir{"TrackPlane"};  // the whole suite's folder (made before any test runs)
+  testing::PlaneScene scene;
   std::vector<std::string> names;               // the cello's points, layout order
   std::vector<Eigen::Vector2d> bow_texture_px;  // frog, tip
   std::vector<Eigen::Vector2d> texture_px;      // their labelled texture pixels
@@ -111,26 +95,26 @@ class TrackPlane : public ::testing::Test {
     s.scene.texture.image = *image;
     s.scene.texture.width_mm = image->width * kPhotoMmPerPx;
     s.scene.texture.height_mm = image->height * kPhotoMmPerPx;
-    synth::BuildMipmaps(&s.scene.texture);
-    synth::PlaneRigOptions rig;
+    testing::BuildMipmaps(&s.scene.texture);
+    testing::PlaneRigOptions rig;
     rig.cameras = kCameras;
     rig.width = 768;
     rig.height = 886;
     rig.focal_px = 760;
     rig.distance_mm = 2500;
     rig.arc_deg = 100;
-    s.scene.rig = synth::MakePlaneRig(rig);
-    synth::PlaneMotionOptions motion;
+    s.scene.rig = testing::MakePlaneRig(rig);
+    testing::PlaneMotionOptions motion;
     motion.frames = kFrames;
     motion.max_translation_mm = 150;
     motion.max_rotation_deg = 10;
-    s.scene.world_from_plane = synth::MakePlaneMotion(motion);
+    s.scene.world_from_plane = testing::MakePlaneMotion(motion);
     const auto start = std::chrono::steady_clock::now();
-    synth::PlaneSceneWriteOptions write;
+    testing::PlaneSceneWriteOptions write;
     write.render.supersampling = 1;
     const std::string scene_dir = s.dir / "scene";
     s.scene_dir = scene_dir;
-    ASSERT_TRUE(synth::WritePlaneScene(s.scene, scene_dir, write).ok());
+    ASSERT_TRUE(testing::WritePlaneScene(s.scene, scene_dir, write).ok());
     s.render_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     // The labelled cello points of the photo.
@@ -156,8 +140,8 @@ class TrackPlane : public ::testing::Test {
       std::vector<Eigen::Vector2d> px;
       for (const auto& t : s.texture_px) {
         const auto p =
-            synth::ProjectPlanePoint(cam, s.scene.world_from_plane[f], s.scene.texture, t);
-        ASSERT_TRUE(p && synth::InImage(cam, *p)) << cam.name << " frame " << f;
+            testing::ProjectPlanePoint(cam, s.scene.world_from_plane[f], s.scene.texture, t);
+        ASSERT_TRUE(p && testing::InImage(cam, *p)) << cam.name << " frame " << f;
         px.push_back(*p);
       }
       for (const char* bow : {"frog", "tip_plate"}) {
@@ -165,7 +149,7 @@ class TrackPlane : public ::testing::Test {
         ASSERT_GE(i, 0);
         names.push_back(bow);
         if (v == kLabelViews[0] && f == 0) s.bow_texture_px.push_back(labels->points[i].pixel);
-        px.push_back(*synth::ProjectPlanePoint(
+        px.push_back(*testing::ProjectPlanePoint(
             cam, s.scene.world_from_plane[f], s.scene.texture, labels->points[i].pixel));
       }
       ASSERT_TRUE(
@@ -220,9 +204,9 @@ void Compare2d(std::vector<double>* errors_px, std::vector<int>* missing) {
       for (size_t p = 0; p < slots.size(); ++p) {
         const float* x =
             &kp->data[static_cast<size_t>(((f * kCameras + v) * points + slots[p]) * 3)];
-        const auto truth = synth::ProjectPlanePoint(
+        const auto truth = testing::ProjectPlanePoint(
             s.scene.rig.cameras[v], s.scene.world_from_plane[f], s.scene.texture, s.texture_px[p]);
-        if (!truth || !synth::InImage(s.scene.rig.cameras[v], *truth)) continue;
+        if (!truth || !testing::InImage(s.scene.rig.cameras[v], *truth)) continue;
         if (!std::isfinite(x[0])) {
           ++(*missing)[p];
           continue;
@@ -291,8 +275,8 @@ TEST_F(TrackPlane, EveryInstrumentPointInEveryViewAndFrame) {
     for (size_t p = 0; p < slots.size(); ++p) {
       const double* x = &p3->data[static_cast<size_t>((f * p3->shape[1] + slots[p]) * 3)];
       const Eigen::Vector3d truth =
-          synth::PlaneToWorld(s.scene.world_from_plane[f],
-                              synth::TexturePixelToPlane(s.scene.texture, s.texture_px[p]));
+          testing::PlaneToWorld(s.scene.world_from_plane[f],
+                                testing::TexturePixelToPlane(s.scene.texture, s.texture_px[p]));
       if (!std::isfinite(x[0])) {
         ++missing_3d;
         continue;
@@ -315,7 +299,7 @@ TEST_F(TrackPlane, EveryInstrumentPointInEveryViewAndFrame) {
       std::vector<Eigen::Vector2d> start;
       for (const auto& tp : s.texture_px) {
         start.push_back(
-            *synth::ProjectPlanePoint(cam, s.scene.world_from_plane[0], s.scene.texture, tp));
+            *testing::ProjectPlanePoint(cam, s.scene.world_from_plane[0], s.scene.texture, tp));
       }
       track::PointTracker2d baseline(track::InstrumentTrackerOptions(), start);
       media::Image previous, current;
@@ -334,9 +318,9 @@ TEST_F(TrackPlane, EveryInstrumentPointInEveryViewAndFrame) {
         std::vector<PointObservation> obs;
         for (int v = 0; v < kCameras; ++v) {
           const Camera& cam = s.scene.rig.cameras[v];
-          const auto truth = synth::ProjectPlanePoint(
+          const auto truth = testing::ProjectPlanePoint(
               cam, s.scene.world_from_plane[f], s.scene.texture, s.texture_px[p]);
-          if (!truth || !synth::InImage(cam, *truth)) continue;
+          if (!truth || !testing::InImage(cam, *truth)) continue;
           ++base_total;
           const Eigen::Vector2d& q = pixels[f][v][p];
           if (!std::isfinite(q.x())) {
@@ -349,8 +333,8 @@ TEST_F(TrackPlane, EveryInstrumentPointInEveryViewAndFrame) {
         const auto x = triangulator.Triangulate(obs);
         if (!x) continue;
         const Eigen::Vector3d truth =
-            synth::PlaneToWorld(s.scene.world_from_plane[f],
-                                synth::TexturePixelToPlane(s.scene.texture, s.texture_px[p]));
+            testing::PlaneToWorld(s.scene.world_from_plane[f],
+                                  testing::TexturePixelToPlane(s.scene.texture, s.texture_px[p]));
         base_mm.push_back((x->point_in_world - truth).norm());
       }
   }
@@ -401,19 +385,19 @@ TEST_F(TrackPlane, EveryInstrumentPointInEveryViewAndFrame) {
       for (int v = 0; v < kCameras; ++v) {
         const float* x =
             &kp->data[static_cast<size_t>(((f * kCameras + v) * kp->shape[2] + bow_slots[p]) * 3)];
-        const auto truth = synth::ProjectPlanePoint(s.scene.rig.cameras[v],
-                                                    s.scene.world_from_plane[f],
-                                                    s.scene.texture,
-                                                    s.bow_texture_px[p]);
-        if (!truth || !synth::InImage(s.scene.rig.cameras[v], *truth) || !std::isfinite(x[0]))
+        const auto truth = testing::ProjectPlanePoint(s.scene.rig.cameras[v],
+                                                      s.scene.world_from_plane[f],
+                                                      s.scene.texture,
+                                                      s.bow_texture_px[p]);
+        if (!truth || !testing::InImage(s.scene.rig.cameras[v], *truth) || !std::isfinite(x[0]))
           continue;
         bow_px.push_back((Eigen::Vector2d(x[0], x[1]) - *truth).norm());
       }
       const double* x = &p3->data[static_cast<size_t>((f * p3->shape[1] + bow_slots[p]) * 3)];
       if (!std::isfinite(x[0])) continue;
       const Eigen::Vector3d truth =
-          synth::PlaneToWorld(s.scene.world_from_plane[f],
-                              synth::TexturePixelToPlane(s.scene.texture, s.bow_texture_px[p]));
+          testing::PlaneToWorld(s.scene.world_from_plane[f],
+                                testing::TexturePixelToPlane(s.scene.texture, s.bow_texture_px[p]));
       bow_mm.push_back((Eigen::Vector3d(x[0], x[1], x[2]) - truth).norm());
     }
   ASSERT_FALSE(bow_px.empty());

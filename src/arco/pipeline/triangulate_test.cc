@@ -6,12 +6,12 @@
 #include <filesystem>
 
 #include "arco/calibration/calibration_file.h"
-#include "arco/mocap/synthetic_views.h"
 #include "arco/pipeline/label_views.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/triangulate_stage.h"
+#include "arco/testing/synthetic_views.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::pipeline {
 namespace {
@@ -179,15 +179,15 @@ struct SyntheticCapture {
 };
 
 SyntheticCapture WriteSyntheticCapture(const std::string& dir, int frames) {
-  SyntheticRigOptions ro;
+  testing::SyntheticRigOptions ro;
   ro.num_cameras = 8;
   SyntheticCapture c;
-  c.rig = MakeSyntheticRig(ro);
-  c.truth = MakeSyntheticPoints(frames, 21, 5);
-  SyntheticDetectionOptions d;
+  c.rig = testing::MakeSyntheticRig(ro);
+  c.truth = testing::MakeSyntheticPoints(frames, 21, 5);
+  testing::SyntheticDetectionOptions d;
   d.outlier_fraction = 0.05;
   d.missing_fraction = 0.1;
-  NpyArray<double> k = MakeSyntheticDetections(c.rig, c.truth, d);
+  NpyArray<double> k = testing::MakeSyntheticDetections(c.rig, c.truth, d);
   EXPECT_TRUE(MakeDirectories(dir).ok());
   EXPECT_TRUE(SaveCalibration(dir + "/rig.json", c.rig).ok());
   NpyArray<float> kf;
@@ -307,9 +307,9 @@ namespace {
 TEST(TriangulateCapture, CamerasSyncedBySoundAreTriangulatedAtOneInstant) {
   constexpr int kFrames = 30;
   constexpr double kFps = 30, kOffsetS = 0.016, kDriftPpm = 50;
-  SyntheticRigOptions ro;
+  testing::SyntheticRigOptions ro;
   ro.num_cameras = 8;
-  const Rig rig = MakeSyntheticRig(ro);
+  const Rig rig = testing::MakeSyntheticRig(ro);
   // 21 points of a rigid stick moving along x at 1 m/s.
   const auto points_at = [](const std::vector<double>& times_s) {
     NpyArray<double> p;
@@ -330,10 +330,10 @@ TEST(TriangulateCapture, CamerasSyncedBySoundAreTriangulatedAtOneInstant) {
     camera_s.push_back(kOffsetS + (1 + kDriftPpm * 1e-6) * f / kFps);
   }
   const NpyArray<double> truth = points_at(capture_s);
-  SyntheticDetectionOptions d;
+  testing::SyntheticDetectionOptions d;
   d.noise_px = 0.1;
-  const NpyArray<double> on_clock = MakeSyntheticDetections(rig, truth, d);
-  const NpyArray<double> late = MakeSyntheticDetections(rig, points_at(camera_s), d);
+  const NpyArray<double> on_clock = testing::MakeSyntheticDetections(rig, truth, d);
+  const NpyArray<double> late = testing::MakeSyntheticDetections(rig, points_at(camera_s), d);
   NpyArray<float> k;
   k.shape = on_clock.shape;
   k.data.assign(on_clock.data.begin(), on_clock.data.end());

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "arco/testing/temp_dir.h"
 #include "arco/util/npy.h"
 
 namespace arco::refine {
@@ -234,9 +235,8 @@ TEST(AnalyzeBowing, OffTheStringsUnseenAndBadInput) {
 }
 
 TEST(BowingCsv, RoundTripsAndRejectsBadRows) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("arco_bowing_csv_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  const arco::testing::TempDir temp;
+  const std::filesystem::path dir = temp.path();
   std::vector<BowingFrame> frames(3);
   frames[0].string = 1, frames[0].direction = BowDirection::kDown, frames[0].sounding_point_mm = 52.5;
   frames[1].string = 2, frames[1].second_string = 3, frames[1].direction = BowDirection::kUp;
@@ -267,7 +267,6 @@ TEST(BowingCsv, RoundTripsAndRejectsBadRows) {
     EXPECT_NE(r.status().message().find(path), std::string::npos) << r.status().message();
     EXPECT_NE(r.status().message().find(what), std::string::npos) << r.status().message();
   }
-  std::filesystem::remove_all(dir);
 }
 
 // SPD's real cello take (their 3D: the bow's frog and tip on the stick, the strings lowest

@@ -6,8 +6,8 @@
 
 #include <cmath>
 
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::refine {
 namespace {

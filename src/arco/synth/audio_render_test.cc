@@ -15,7 +15,7 @@
 #include "arco/audio/harmonic_fit.h"
 #include "arco/audio/pitch_tracker.h"
 #include "arco/synth/test_instruments.h"
-#include "arco/util/test_dir.h"
+#include "arco/testing/temp_dir.h"
 
 namespace arco::synth {
 namespace {

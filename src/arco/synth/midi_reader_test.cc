@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "arco/synth/test_instruments.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::synth {
 namespace {

@@ -15,9 +15,9 @@
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/error_model.h"
 #include "arco/synth/truth_folder.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
-#include "arco/util/test_dir.h"
 
 namespace arco::synth {
 namespace {

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <random>
 
+#include "arco/testing/look_at.h"
+
 namespace arco::track {
 namespace {
 
@@ -24,13 +26,7 @@ std::vector<Camera> Rig3() {
     // Cameras on an arc at 2.5 m looking at the origin, at three heights.
     const double a = (i - 1) * 0.6;
     const Eigen::Vector3d centre(2500 * std::sin(a), -2500 * std::cos(a), 300.0 * (i - 1));
-    const Eigen::Vector3d z = (-centre).normalized();
-    const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-    const Eigen::Vector3d y = z.cross(x);
-    Eigen::Matrix3d r;
-    r.row(0) = x;
-    r.row(1) = y;
-    r.row(2) = z;
+    const Eigen::Matrix3d r = testing::CamFromWorldLookingAt(centre, Eigen::Vector3d::Zero());
     c.cam_from_world_rotation = r;
     c.cam_from_world_translation = -r * centre;
     cams.push_back(c);

@@ -7,6 +7,8 @@
 
 #include <random>
 
+#include "arco/testing/look_at.h"
+
 namespace arco::track {
 namespace {
 
@@ -25,13 +27,7 @@ std::vector<Camera> Rig3() {
     // Cameras on an arc at 2.5 m looking at the origin.
     const double a = (i - 1) * 0.6;
     const Eigen::Vector3d centre(2500 * std::sin(a), -2500 * std::cos(a), 100.0 * i);
-    const Eigen::Vector3d z = (-centre).normalized();
-    const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-    const Eigen::Vector3d y = z.cross(x);
-    Eigen::Matrix3d R;
-    R.row(0) = x;
-    R.row(1) = y;
-    R.row(2) = z;
+    const Eigen::Matrix3d R = testing::CamFromWorldLookingAt(centre, Eigen::Vector3d::Zero());
     c.cam_from_world_rotation = R;
     c.cam_from_world_translation = -R * centre;
     cams.push_back(c);

@@ -5,9 +5,9 @@
 #include <filesystem>
 #include <string>
 
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 #include "arco/util/stats.h"
-#include "arco/util/test_dir.h"
 
 namespace arco {
 namespace {

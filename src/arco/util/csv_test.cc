@@ -5,7 +5,7 @@
 #include <cmath>
 #include <fstream>
 
-#include "arco/util/test_dir.h"
+#include "arco/testing/temp_dir.h"
 
 namespace arco {
 namespace {

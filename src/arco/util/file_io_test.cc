@@ -8,7 +8,7 @@
 #include <thread>
 #include <utility>
 
-#include "arco/util/test_dir.h"
+#include "arco/testing/temp_dir.h"
 
 namespace arco {
 namespace {

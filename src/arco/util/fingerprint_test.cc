@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <string>
 
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco {
 namespace {

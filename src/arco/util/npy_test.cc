@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <string>
 
-#include "arco/util/test_dir.h"
+#include "arco/testing/temp_dir.h"
 
 namespace arco {
 namespace {

@@ -9,9 +9,9 @@
 #include <set>
 #include <string>
 
+#include "arco/testing/temp_dir.h"
 #include "arco/util/atomic_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco {
 namespace {

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <string>
 
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
-#include "arco/util/test_dir.h"
 
 namespace arco {
 namespace {

@@ -11,7 +11,7 @@ work=$3
 rm -rf "$work"
 # Bad input, without a browser: one line "arco: error: ...", exit 1, nothing written.
 mkdir -p "$work"
-source "$src/src/arco/cli/cli_test_lib.sh"
+source "$src/tests/cli/cli_test_lib.sh"
 SNAPSHOT_DIR=$work
 mkdir -p "$work/not_a_result"
 expect_error "no result.json" "*not_a_result/result.json: not found (not an arco result folder)" \

@@ -21,7 +21,7 @@ if ! command -v ffmpeg >/dev/null; then
 fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-source "$src/src/arco/cli/cli_test_lib.sh"
+source "$src/tests/cli/cli_test_lib.sh"
 mkdir -p "$tmp/w"
 SNAPSHOT_DIR=$tmp/w
 

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 #include "arco/view/server.h"
 #include "arco/view/video_cache.h"
@@ -26,9 +27,8 @@ TEST(Base64, Rfc4648Vectors) {
 }
 
 TEST(WriteViewFolder, RejectsAFolderWithoutResultJson) {
-  const std::string dir =
-      (std::filesystem::temp_directory_path() / "arco_view_test_empty").string();
-  std::filesystem::remove_all(dir);
+  const arco::testing::TempDir temp;
+  const std::string& dir = temp.path();
   std::filesystem::create_directories(dir + "/out");
   ViewOptions options;
   options.result_dir = dir;
@@ -37,7 +37,6 @@ TEST(WriteViewFolder, RejectsAFolderWithoutResultJson) {
   EXPECT_NE(summary.status().message().find("result.json: not found"), std::string::npos)
       << summary.status().message();
   EXPECT_TRUE(std::filesystem::is_empty(dir + "/out"));
-  std::filesystem::remove_all(dir);
 }
 
 TEST(ViewOptions, RejectsAnEmptyResultDir) { EXPECT_FALSE(ViewOptions{}.Validate().ok()); }
@@ -103,14 +102,6 @@ TEST(Sha256, FieldsAreUnambiguous) {
   EXPECT_NE(a.HexDigest(), b.HexDigest());
 }
 
-// A scratch folder, emptied.
-std::string Scratch(const std::string& name) {
-  const std::string dir = (std::filesystem::temp_directory_path() / name).string();
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
 std::string VideoDigest(const std::string& path, int64_t sample) {
   Sha256 h;
   EXPECT_TRUE(HashVideoSource(h, "v", path, sample).ok());
@@ -118,7 +109,8 @@ std::string VideoDigest(const std::string& path, int64_t sample) {
 }
 
 TEST(HashVideoSource, SeesTheSizeAndBothEnds) {
-  const std::string dir = Scratch("arco_view_test_hash");
+  const arco::testing::TempDir temp;
+  const std::string& dir = temp.path();
   const std::string path = dir + "/v.bin";
   std::string bytes(100, 'a');
   ASSERT_TRUE(AtomicWriteFile(path, bytes).ok());
@@ -140,12 +132,12 @@ TEST(HashVideoSource, SeesTheSizeAndBothEnds) {
   EXPECT_NE(VideoDigest(path, 10), hundred);
   Sha256 missing;
   EXPECT_FALSE(HashVideoSource(missing, "v", dir + "/none.mp4").ok());
-  std::filesystem::remove_all(dir);
 }
 
 TEST(EvictVideoCache, RemovesTheLeastRecentlyUsedBeyondTheBound) {
   namespace fs = std::filesystem;
-  const std::string dir = Scratch("arco_view_test_evict");
+  const arco::testing::TempDir temp;
+  const std::string& dir = temp.path();
   const auto now = fs::file_time_type::clock::now();
   // Entries a (oldest) .. d (newest), 100 bytes of video + 10 of sidecar each.
   const char* keys[] = {"a", "b", "c", "d"};

@@ -74,7 +74,7 @@ grep -q "video of $cam (576x664, $frames frames, arco overlay" "$work/out.txt" |
 video=$(/usr/bin/python3 -c "import json,sys; v=json.load(open(sys.argv[1]))['videos']; assert len(v)==1; print(v[0]['file'])" \
   "$work/page/manifest.json") || { echo "FAILED: manifest.json's videos"; exit 1; }
 if /usr/bin/python3 -c "import numpy" 2>/dev/null; then
-  /usr/bin/python3 "$src/src/arco/cli/overlay_check.py" "$work/page/$video" "$work/res" $cam 0.25 1 "$frames" \
+  /usr/bin/python3 "$src/tests/cli/overlay_check.py" "$work/page/$video" "$work/res" $cam 0.25 1 "$frames" \
     "$work/cap/$cam.mp4" 90 || { echo "FAILED: overlay_check.py on $video"; fail=1; }
 else
   echo "FAILED: python3-numpy missing (scripts/setup)"; fail=1

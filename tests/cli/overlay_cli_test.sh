@@ -14,7 +14,7 @@ set -uo pipefail
 arco=$1
 src=$2
 py=/usr/bin/python3
-check_py=$src/src/arco/cli/overlay_check.py
+check_py=$src/tests/cli/overlay_check.py
 if ! command -v ffmpeg >/dev/null || ! command -v ffprobe >/dev/null; then
   echo "ffmpeg/ffprobe not installed (scripts/setup installs them)"
   [ -n "${CI:-}" ] && exit 1

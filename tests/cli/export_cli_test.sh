@@ -13,7 +13,7 @@ set -uo pipefail
 arco=$1
 src=$2
 py=/usr/bin/python3
-check_py=$src/src/arco/cli/export_check.py
+check_py=$src/tests/cli/export_check.py
 validator=$src/tools/gltf_validate
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

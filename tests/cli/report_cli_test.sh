@@ -9,7 +9,7 @@ arco=$(realpath "$1")
 src=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-source "$src/src/arco/cli/cli_test_lib.sh"
+source "$src/tests/cli/cli_test_lib.sh"
 
 "$arco" synth --duration-s 12 --piece slow-melody --seed 2 -o "$tmp/cap" >/dev/null 2>&1 &&
   "$arco" run "$tmp/cap" -o "$tmp/res" >/dev/null 2>&1 ||
@@ -85,7 +85,7 @@ if ! command -v node >/dev/null || [ ! -f "$playwright/package.json" ]; then
   echo "FAILED: node or $playwright missing (run scripts/fetch_view_tools)"
   exit 1
 fi
-node "$src/src/arco/cli/report_browser_check.js" "$playwright" "$tmp/report.html" \
+node "$src/tests/cli/report_browser_check.js" "$playwright" "$tmp/report.html" \
   "$tmp/res/arco/fingering.csv" "$tmp" || fail=1
 [ $fail -eq 0 ] && echo "report_cli_test: passed"
 exit $fail

@@ -1,11 +1,11 @@
-#include "arco/synth/plane_bow.h"
+#include "arco/testing/plane_bow.h"
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdlib>
 #include <random>
 
-namespace arco::synth {
+namespace arco::testing {
 
 PlaneTexture MakeBowTexture(bool plain, uint32_t seed) {
   PlaneTexture bow;
@@ -47,4 +47,4 @@ std::vector<Rigid3d> MakeBowingMotion(int frames, double fps_hz) {
   return world_from_bow;
 }
 
-}  // namespace arco::synth
+}  // namespace arco::testing

@@ -13,7 +13,7 @@ set -uo pipefail
 arco=$1
 src=$2
 py=/usr/bin/python3
-check_py=$src/src/arco/cli/plot_check.py
+check_py=$src/tests/cli/plot_check.py
 if ! command -v ffmpeg >/dev/null; then
   echo "ffmpeg not installed (scripts/setup installs it)"
   [ -n "${CI:-}" ] && exit 1

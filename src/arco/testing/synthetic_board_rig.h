@@ -13,7 +13,7 @@
 #include "arco/camera/rig.h"
 #include "arco/media/image.h"
 
-namespace arco::calibration {
+namespace arco::testing {
 
 struct SyntheticBoardRigOptions {
   int num_cameras = 8;
@@ -27,12 +27,12 @@ struct SyntheticBoardRigOptions {
 };
 
 struct SyntheticBoardRig {
-  Rig truth;                                        // units mm, world z up
-  std::vector<Eigen::Isometry3d> world_from_board;  // per frame
-  std::vector<CameraBoardViews> views;              // per camera (names cam0, cam1, ...)
+  Rig truth;                                         // units mm, world z up
+  std::vector<Eigen::Isometry3d> world_from_board;   // per frame
+  std::vector<calibration::CameraBoardViews> views;  // per camera (names cam0, cam1, ...)
 };
 
-SyntheticBoardRig MakeSyntheticBoardRig(const BoardSpec& board,
+SyntheticBoardRig MakeSyntheticBoardRig(const calibration::BoardSpec& board,
                                         const SyntheticBoardRigOptions& options);
 
 // Draws the board (white margin of one square around the squares) as `camera` sees it, with
@@ -40,14 +40,14 @@ SyntheticBoardRig MakeSyntheticBoardRig(const BoardSpec& board,
 // sample are computed once, at construction.
 class BoardRenderer {
  public:
-  BoardRenderer(const BoardSpec& board, const Camera& camera, int supersample = 2);
+  BoardRenderer(const calibration::BoardSpec& board, const Camera& camera, int supersample = 2);
   media::Image Render(const Eigen::Isometry3d& world_from_board) const;
 
  private:
-  BoardSpec board_;
+  calibration::BoardSpec board_;
   Camera camera_;
   int supersample_;
   std::vector<Eigen::Vector2f> rays_;  // normalised coordinates per sample, row-major
 };
 
-}  // namespace arco::calibration
+}  // namespace arco::testing

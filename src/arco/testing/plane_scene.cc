@@ -1,4 +1,4 @@
-#include "arco/synth/plane_scene.h"
+#include "arco/testing/plane_scene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,12 +8,13 @@
 #include "arco/camera/calibration_io.h"
 #include "arco/media/video_writer.h"
 #include "arco/synth/random.h"
+#include "arco/testing/look_at.h"
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
 #include "arco/util/output_set.h"
 #include "arco/util/parallel.h"
 
-namespace arco::synth {
+namespace arco::testing {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -407,7 +408,7 @@ Rig MakePlaneRig(const PlaneRigOptions& o) {
   rig.units = "mm";
   const double focal = o.focal_px > 0 ? o.focal_px : o.width;
   for (int i = 0; i < o.cameras; ++i) {
-    Rng rng = Rng::Stream(o.seed, i);
+    synth::Rng rng = synth::Rng::Stream(o.seed, i);
     Camera cam;
     cam.name = "cam" + std::to_string(i);
     cam.width = o.width;
@@ -429,9 +430,10 @@ Rig MakePlaneRig(const PlaneRigOptions& o) {
     const Eigen::Vector3d center(
         o.distance_mm * std::sin(angle), -o.distance_mm * std::cos(angle), height);
     const Eigen::Vector3d target(rng.Uniform(-50, 50), 0.0, rng.Uniform(-50, 50));
-    const Eigen::Vector3d z = (target - center).normalized();
-    const Eigen::Vector3d x0 = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-    const Eigen::Vector3d y0 = z.cross(x0);
+    const Eigen::Matrix3d upright = CamFromWorldLookingAt(center, target);
+    const Eigen::Vector3d x0 = upright.row(0).transpose();
+    const Eigen::Vector3d y0 = upright.row(1).transpose();
+    const Eigen::Vector3d z = upright.row(2).transpose();
     const double roll = rng.Uniform(-3, 3) * kPi / 180;
     const Eigen::Vector3d x = std::cos(roll) * x0 + std::sin(roll) * y0;
     const Eigen::Vector3d y = z.cross(x);
@@ -474,7 +476,7 @@ std::vector<Rigid3d> MakePlaneMotion(const PlaneMotionOptions& o) {
   };
   Wave waves[6];
   for (int k = 0; k < 6; ++k) {
-    Rng rng = Rng::Stream(o.seed, 1000 + k);
+    synth::Rng rng = synth::Rng::Stream(o.seed, 1000 + k);
     double sum = 0;
     for (int j = 0; j < 3; ++j) {
       waves[k].amplitude[j] = rng.Uniform(0.2, 1.0);
@@ -669,4 +671,4 @@ StatusOr<PlaneSceneTruth> ReadPlaneSceneTruth(const std::string& path) {
   return truth;
 }
 
-}  // namespace arco::synth
+}  // namespace arco::testing

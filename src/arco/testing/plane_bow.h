@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "arco/geometry/transform.h"
-#include "arco/synth/plane_scene.h"
+#include "arco/testing/plane_scene.h"
 
-namespace arco::synth {
+namespace arco::testing {
 
 // Frog and tip on the bow texture's axis (texture pixels; 1 px = 1 mm).
 inline const Eigen::Vector2d kBowFrogPx(20, 11.5), kBowTipPx(700, 11.5);
@@ -25,4 +25,4 @@ PlaneTexture MakeBowTexture(bool plain = false, uint32_t seed = 7);
 // plane's rest pose moved to (0, -200, -150) mm.
 std::vector<Rigid3d> MakeBowingMotion(int frames, double fps_hz = 30);
 
-}  // namespace arco::synth
+}  // namespace arco::testing

@@ -1,7 +1,6 @@
-#include "arco/synth/plane_scene.h"
+#include "arco/testing/plane_scene.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -12,9 +11,10 @@
 #include "arco/geometry/triangulation.h"
 #include "arco/media/video_reader.h"
 #include "arco/media/video_writer.h"
+#include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 
-namespace arco::synth {
+namespace arco::testing {
 namespace {
 
 namespace fs = std::filesystem;
@@ -339,12 +339,8 @@ TEST(MakePlaneRig, CamerasSeeThePlaneAndCarryDistortion) {
 
 class PlaneSceneFolder : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("arco_plane_scene_test_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  TempDir temp_;
+  const fs::path dir_{temp_.path()};
 };
 
 TEST_F(PlaneSceneFolder, WritesVideosCalibrationAndTruthThatReadBack) {
@@ -518,4 +514,4 @@ TEST(RenderView, RealPhotoSmokeRender) {
 }
 
 }  // namespace
-}  // namespace arco::synth
+}  // namespace arco::testing

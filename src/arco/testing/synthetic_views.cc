@@ -1,12 +1,13 @@
-#include "arco/mocap/synthetic_views.h"
+#include "arco/testing/synthetic_views.h"
 
 #include <cmath>
 #include <limits>
 #include <string>
 
 #include "arco/geometry/robust.h"
+#include "arco/testing/look_at.h"
 
-namespace arco {
+namespace arco::testing {
 namespace {
 
 double Uniform01(SplitMix64* rng) { return (rng->Next() >> 11) * (1.0 / 9007199254740992.0); }
@@ -29,13 +30,8 @@ Rig MakeSyntheticRig(const SyntheticRigOptions& options) {
     const double a = 2 * M_PI * i / options.num_cameras + 0.05 * (Uniform01(&rng) - 0.5);
     const double h = 1.2 + ((i % 2) ? 0.5 : -0.5) * options.height_spread_m;
     const Eigen::Vector3d center(options.radius_m * std::cos(a), options.radius_m * std::sin(a), h);
-    const Eigen::Vector3d look =
-        (target + Eigen::Vector3d(0.1 * (Uniform01(&rng) - 0.5), 0.1 * (Uniform01(&rng) - 0.5), 0) -
-         center)
-            .normalized();
-    // Portrait cameras (like SPD's rotated images): image y points down the world z axis.
-    const Eigen::Vector3d x_axis = look.cross(Eigen::Vector3d::UnitZ()).normalized();
-    const Eigen::Vector3d y_axis = look.cross(x_axis);
+    const Eigen::Vector3d aim =
+        target + Eigen::Vector3d(0.1 * (Uniform01(&rng) - 0.5), 0.1 * (Uniform01(&rng) - 0.5), 0);
     Camera cam;
     cam.name = "cam" + std::to_string(i);
     cam.serial = std::to_string(30000000 + i);
@@ -45,9 +41,8 @@ Rig MakeSyntheticRig(const SyntheticRigOptions& options) {
     cam.cx = 1149.5 - 5.4;
     cam.cy = 1327.5 - 8.5;
     if (options.distortion) cam.distortion = {-0.081, 0.066, 0.0195, -0.00035, 0.00062};
-    cam.cam_from_world_rotation.row(0) = x_axis;
-    cam.cam_from_world_rotation.row(1) = y_axis;
-    cam.cam_from_world_rotation.row(2) = look;
+    // Portrait cameras (like SPD's rotated images): image y points down the world z axis.
+    cam.cam_from_world_rotation = CamFromWorldLookingAt(center, aim);
     cam.cam_from_world_translation = -cam.cam_from_world_rotation * center;
     rig.cameras.push_back(cam);
   }
@@ -111,4 +106,4 @@ NpyArray<double> MakeSyntheticDetections(const Rig& rig,
   return out;
 }
 
-}  // namespace arco
+}  // namespace arco::testing

@@ -1,24 +1,16 @@
-#include "arco/calibration/synthetic_board_rig.h"
+#include "arco/testing/synthetic_board_rig.h"
 
 #include <algorithm>
 #include <cmath>
 #include <random>
 
-namespace arco::calibration {
-namespace {
+#include "arco/testing/look_at.h"
 
-Eigen::Matrix3d LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target) {
-  const Eigen::Vector3d z = (target - centre).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  Eigen::Matrix3d cam_from_world;
-  cam_from_world.row(0) = x;
-  cam_from_world.row(1) = y;
-  cam_from_world.row(2) = z;
-  return cam_from_world;
-}
+namespace arco::testing {
 
-}  // namespace
+using calibration::BoardSpec;
+using calibration::BoardView;
+using calibration::CameraBoardViews;
 
 SyntheticBoardRig MakeSyntheticBoardRig(const BoardSpec& board,
                                         const SyntheticBoardRigOptions& options) {
@@ -48,7 +40,7 @@ SyntheticBoardRig MakeSyntheticBoardRig(const BoardSpec& board,
                                    options.camera_height_mm + 100 * uniform(rng));
     const Eigen::Vector3d target =
         centre + Eigen::Vector3d(100 * uniform(rng), 100 * uniform(rng), 0);
-    cam.cam_from_world_rotation = LookAt(position, target);
+    cam.cam_from_world_rotation = CamFromWorldLookingAt(position, target);
     cam.cam_from_world_translation = -cam.cam_from_world_rotation * position;
     rig.truth.cameras.push_back(cam);
     CameraBoardViews views;
@@ -177,4 +169,4 @@ media::Image BoardRenderer::Render(const Eigen::Isometry3d& world_from_board) co
   return image;
 }
 
-}  // namespace arco::calibration
+}  // namespace arco::testing

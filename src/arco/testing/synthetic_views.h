@@ -7,7 +7,7 @@
 #include "arco/camera/rig.h"
 #include "arco/util/npy.h"
 
-namespace arco {
+namespace arco::testing {
 
 struct SyntheticRigOptions {
   int num_cameras = 20;
@@ -37,4 +37,4 @@ NpyArray<double> MakeSyntheticDetections(const Rig& rig,
                                          const NpyArray<double>& points3d,
                                          const SyntheticDetectionOptions& options);
 
-}  // namespace arco
+}  // namespace arco::testing

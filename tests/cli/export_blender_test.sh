@@ -22,7 +22,7 @@ trap 'rm -rf "$tmp"' EXIT
   "$arco" export "$tmp/res" --format gltf -o "$tmp/take.glb" >/dev/null ||
   { echo "FAILED: synth, run or export"; exit 1; }
 blender -b --factory-startup --python-exit-code 1 \
-  --python "$src/src/arco/cli/export_blender.py" -- "$tmp/take.bvh" "$tmp/take.glb" "$tmp/res" arco \
+  --python "$src/tests/cli/export_blender.py" -- "$tmp/take.bvh" "$tmp/take.glb" "$tmp/res" arco \
   >"$tmp/blender.log" 2>&1
 rc=$?
 grep -E "^(FAIL|blender (bvh|glb))" "$tmp/blender.log"

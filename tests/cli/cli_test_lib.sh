@@ -1,4 +1,4 @@
-# Shared helpers of the command-line tests (src/arco/cli/*_cli_test.sh), sourced after the
+# Shared helpers of the command-line tests (tests/cli/*_cli_test.sh), sourced after the
 # test has set `arco` (the binary) and made `tmp` (its scratch folder):
 #   source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 # A bad input must give exactly one stderr line "arco: error: ...", exit status 1 and

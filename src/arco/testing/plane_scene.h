@@ -45,7 +45,7 @@
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
 
-namespace arco::synth {
+namespace arco::testing {
 
 // A picture on a flat rectangle of a physical size.
 struct PlaneTexture {
@@ -229,4 +229,4 @@ struct PlaneSceneTruth {
 };
 StatusOr<PlaneSceneTruth> ReadPlaneSceneTruth(const std::string& path);
 
-}  // namespace arco::synth
+}  // namespace arco::testing
