@@ -1,7 +1,7 @@
 // From videos to 3D on real image content with exact geometry (issue 12's multi-view
 // test): the real photo of a cellist (../shared/data/spd/example.jpg) on a flat
 // rectangle of its physical size moves rigidly in front of 8 calibrated cameras with
-// lens distortion (synth/plane_scene.h renders each view by exact inverse warping into
+// lens distortion (testing/plane_scene.h renders each view by exact inverse warping into
 // FFV1 videos). `capture new` -> `detect` -> `triangulate`: because the picture is flat,
 // every keypoint the detector finds must triangulate onto the plane and stay still on
 // it (in plane coordinates) while the plane moves. Figures are printed for

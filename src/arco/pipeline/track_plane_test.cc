@@ -1,7 +1,7 @@
 // `arco track` on real image content with exact truth (issue 13's moving-plane test): the
 // real photo of a cellist (../shared/data/spd/example.jpg) with its labelled cello points
 // (example.json) on a flat rectangle of its physical size moves rigidly in front of 6
-// calibrated cameras with lens distortion (synth/plane_scene.h renders every view exactly
+// calibrated cameras with lens distortion (testing/plane_scene.h renders every view exactly
 // into FFV1 videos). Labels are given on the first frame in two views (the labelled
 // texture points projected exactly, written as labelme files); `capture new` -> `track`
 // -> `triangulate`; every instrument point in every view and frame is compared with its
