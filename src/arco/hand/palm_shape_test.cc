@@ -60,7 +60,7 @@ TEST(PalmShape, FindsThePerformersBasesUnderNoiseAndOutliers) {
                                                           Eigen::Vector3d(-3, 1, -1),
                                                           Eigen::Vector3d(-1, 2, 1),
                                                           Eigen::Vector3d(2, 1, 3)};
-  const Take take = MakeTake(model, moves, 400, 2.0, 0.02, 7);
+  const Take take = MakeTake(model, moves, 1600, 2.0, 0.02, 7);
   StatusOr<PalmShapeEstimate> est = EstimatePalmShape(take.frames, model, PalmShapeOptions());
   ASSERT_TRUE(est.ok()) << est.status().message();
   // The frame convention: the estimate is turned onto the model's bases, so compare after
@@ -79,8 +79,8 @@ TEST(PalmShape, FindsThePerformersBasesUnderNoiseAndOutliers) {
     EXPECT_LT(error, 0.3 * model_error) << "finger " << f;
     EXPECT_EQ(est->kept_model[f], 0);
   }
-  EXPECT_GT(est->frames_used, 350);  // the outlier frames are gated away, not all
-  EXPECT_LT(est->frames_used, 400);
+  EXPECT_GT(est->frames_used, 1300);  // the outlier frames are gated away, not all
+  EXPECT_LT(est->frames_used, 1600);
 }
 
 TEST(PalmShape, TheModelsOwnPalmStaysPut) {
