@@ -21,6 +21,12 @@ constexpr double kPartialCents = 25.0;
 // Notes closer than this are one note (the residual of a vibrato's smeared peak).
 constexpr double kMinIntervalSemitones = 0.8;
 
+// A note's octave below is the note when its odd partials (none of them the heard note's)
+// carry at least this share of its even partials' weighted amplitude (check (4)): 0.2-0.6
+// for fluidsynth's violin B3 and double bass G#1 (whose fundamentals are 5-30% of their
+// 2nd partials), leakage only (< 0.05) for a note with nothing an octave below.
+constexpr double kLostFundamentalOddRatio = 0.15;
+
 // Auto window: periods of the lowest f0, so that the partials of a third on the lowest
 // strings (4 Hz apart at the double bass's 40 Hz) are at least a Hann main lobe apart.
 constexpr double kAutoWindowPeriods = 8.0;
@@ -249,6 +255,38 @@ double DoubleStopAnalyzer::Cancel(int c) {
   return own_salience;
 }
 
+// The candidate an octave below `note` when it is the pair's true note (checks (1) and (2)
+// with `partner`, and its odd partials, on the spectrum without the partner, carry at least
+// kLostFundamentalOddRatio of its even ones' salience: a single note's octave below has
+// nothing at its odd partials but leakage); else -1. On success residual_ is the spectrum
+// without the partner.
+int DoubleStopAnalyzer::LostFundamental(int note, int partner) {
+  const int below = note - static_cast<int>(std::lround(1200.0 / options_.grid_cents));
+  if (below < 0) return -1;
+  const double a = candidates_midi_[partner], b = candidates_midi_[below];
+  if (std::abs(a - b) < kMinIntervalSemitones) return -1;
+  if (has_strings_ &&
+      !PlayableDoubleStop(
+          open_midi_, std::min(a, b), std::max(a, b), options_.max_span_semitones)) {
+    return -1;
+  }
+  residual_ = magnitude_;
+  Cancel(partner);
+  const double peak = *std::max_element(magnitude_.begin(), magnitude_.end());
+  // Half the usual bar: the low strings' fundamentals (a double bass's E1 at 41 Hz) are
+  // 2-5% of the strongest partial; the odd partials below are the stronger evidence.
+  if (BandMax(below, 1, residual_, nullptr) < 0.5 * options_.min_fundamental_ratio * peak) {
+    return -1;
+  }
+  double odd = 0, even = 0;
+  for (int m = 1; m <= options_.harmonics; ++m) {
+    const double amplitude = BandMax(below, m, residual_, nullptr);
+    if (amplitude < 0) break;
+    (m % 2 == 1 ? odd : even) += Weight(candidates_hz_[below], m) * amplitude;
+  }
+  return even > 0 && odd >= kLostFundamentalOddRatio * even ? below : -1;
+}
+
 int DoubleStopAnalyzer::Analyze(const float* x, std::array<PolyNote, 2>* notes) {
   *notes = {};
   double mean = 0;
@@ -277,6 +315,19 @@ int DoubleStopAnalyzer::Analyze(const float* x, std::array<PolyNote, 2>* notes) 
     return 1;
   }
   PolyNote two{Refine(second.index, residual_), second.salience};
+  // (4) A lost fundamental: a note whose own fundamental is weak is heard as its 2nd
+  // partial, an octave too high, when the partner's cancellation leaves that partial the
+  // strongest (a sixth B3 + G#4 read as G#4 + B4). Look at each note's octave below on the
+  // spectrum without the partner: its odd partials belong to no note of the pair.
+  for (int which = 0; which < 2; ++which) {
+    const int note = which == 0 ? first.index : second.index;
+    const int partner = which == 0 ? second.index : first.index;
+    const int below = LostFundamental(note, partner);
+    if (below < 0) continue;
+    const PolyNote lower{Refine(below, residual_), Salience(below, residual_)};
+    (which == 0 ? one : two) = lower;
+    break;
+  }
   if (two.f0_hz < one.f0_hz) std::swap(one, two);
   (*notes)[0] = one;
   (*notes)[1] = two;

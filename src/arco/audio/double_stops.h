@@ -17,7 +17,11 @@
 //       max_span_semitones of each other along the fingerboard (PlayableDoubleStop);
 //   (2) its fundamental is present in the residual (kills the sub-octave, sub-fifth and
 //       fifth-above ghosts of a single note, whose fundamentals are no partial);
-//   (3) its residual salience is at least second_min_ratio of the first note's.
+//   (3) its residual salience is at least second_min_ratio of the first note's;
+//   (4) then, for each note of the pair, its octave below replaces it when that forms a
+//       playable pair with the partner, its fundamental is present and its odd partials
+//       (which the heard note does not have) are strong on the spectrum without the
+//       partner: a note with a weak fundamental heard as its own 2nd partial.
 #pragma once
 
 #include <array>
@@ -117,6 +121,7 @@ class DoubleStopAnalyzer {
   Best Search(const std::vector<double>& spectrum, int first) const;
   double Refine(int candidate, const std::vector<double>& spectrum);
   double Cancel(int candidate);
+  int LostFundamental(int note, int partner);
 
   DoubleStopOptions options_;
   int window_ = 0, fft_size_ = 0, lobe_bins_ = 0;

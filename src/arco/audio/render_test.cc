@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "arco/audio/double_stops.h"
+#include "arco/audio/midi_file.h"
 #include "arco/audio/notes.h"
 #include "arco/audio/pitch_tracker.h"
 #include "arco/audio/test_music.h"
@@ -120,6 +122,49 @@ TEST_P(RenderedInstrument, KeyContoursAreMeasured) {
 INSTANTIATE_TEST_SUITE_P(FluidR3,
                          RenderedInstrument,
                          ::testing::Values("cello", "violin", "viola", "bass"));
+
+// Double stops of FluidR3's sampled strings whose lower note's fundamental is weak (5-30%
+// of its 2nd partial): a violin sixth B3 + G#4 and a double bass third G#1 + C2, which the
+// analyzer heard as the upper note and the lower note's 2nd partial (G#4 + B4, C2 + G#2)
+// before its lost-fundamental check (double_stops.h, check (4)).
+TEST(RenderedDoubleStops, FindsLowerNotesWithWeakFundamentals) {
+  struct Case {
+    const char* instrument;
+    int program, low, high;
+  };
+  for (const Case c : {Case{"violin", 40, 59, 68}, Case{"double_bass", 43, 32, 36}}) {
+    MidiFile midi;
+    for (int voice = 0; voice < 2; ++voice) {
+      MidiTrack track;
+      track.channel = voice;
+      track.program = c.program;
+      track.notes.push_back({0.2, 1.4, voice == 0 ? c.low : c.high, 80});
+      midi.tracks.push_back(track);
+    }
+    const std::string stem = std::string("double_stop_") + c.instrument;
+    const std::string mid = testing::TempPath(stem + ".mid");
+    const std::string wav = testing::TempPath(stem + ".wav");
+    ASSERT_TRUE(WriteMidiFile(mid, midi).ok());
+    ASSERT_TRUE(testing::RenderWithFluidsynth(mid, wav).ok());
+    DoubleStopOptions options;
+    options.range = *InstrumentRangeByName(c.instrument);
+    auto frames = TrackDoubleStopsFile(wav, options, nullptr);
+    ASSERT_TRUE(frames.ok()) << frames.status().message();
+    int scored = 0, both = 0;
+    for (const auto& f : *frames) {
+      if (f.time_s < 0.45 || f.time_s > 1.2) continue;  // well inside the notes
+      ++scored;
+      const auto near = [](double hz, int midi_note) {
+        return hz > 0 && std::abs(69 + 12 * std::log2(hz / 440.0) - midi_note) < 0.5;
+      };
+      both += f.count == 2 && near(f.notes[0].f0_hz, c.low) && near(f.notes[1].f0_hz, c.high);
+    }
+    std::printf("%s: both notes on %d of %d frames\n", c.instrument, both, scored);
+    ASSERT_GT(scored, 15);
+    EXPECT_GE(both, 0.8 * scored) << c.instrument << ": both notes on " << both << " of " << scored
+                                  << " frames";
+  }
+}
 
 }  // namespace
 }  // namespace arco::audio

@@ -196,13 +196,17 @@ StatusOr<VideoWriter> VideoWriter::Open(const std::string& path,
     // libvpx's constrained quality: crf 16 (0-63, lower is better) under a cap of 0.12
     // bit per pixel (5.5 Mbit/s at 1150x1328, 30 fps), which libvpx needs (VP8 has no
     // unconstrained quality mode); "realtime" with the fastest speed, as a web page's
-    // preview is written per take.
+    // preview is written per take. The speed is negative: libvpx's VP8 treats a positive
+    // cpu-used in realtime mode as a starting point and re-selects the speed from how
+    // long each frame took to encode (vp8_auto_select_speed), so a loaded machine wrote
+    // different bytes; a negative value fixes the speed at its magnitude (VP9 takes the
+    // magnitude too).
     c->bit_rate = std::max<int64_t>(
         500000,
         static_cast<int64_t>(0.12 * options.width * options.height * options.fps.ToDouble()));
     av_opt_set(c->priv_data, "crf", "16", 0);
     av_opt_set(c->priv_data, "deadline", "realtime", 0);
-    av_opt_set(c->priv_data, "cpu-used", "8", 0);
+    av_opt_set(c->priv_data, "cpu-used", "-8", 0);
   }
   if (s->format->oformat->flags & AVFMT_GLOBALHEADER) c->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
   if (options.bitexact) {

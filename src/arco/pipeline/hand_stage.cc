@@ -117,7 +117,10 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
       summary.palm_from_data = true;
       summary.palm_frames = palm->frames_used;
       for (int f = 0; f < hand::kNumFingers; ++f) {
-        summary.palm_max_shift_mm = std::max(summary.palm_max_shift_mm, palm->shift_mm[f]);
+        // The largest move applied: a base that keeps the model's did not move.
+        if (!palm->kept_model[f]) {
+          summary.palm_max_shift_mm = std::max(summary.palm_max_shift_mm, palm->shift_mm[f]);
+        }
         summary.palm_bases_kept += palm->kept_model[f];
       }
     } else {

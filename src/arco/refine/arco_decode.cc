@@ -79,16 +79,6 @@ std::vector<State> NoteStates(const DecodeContext& context,
         if (d > lift_max_mm[static_cast<size_t>(k)]) st.cost += options.infeasible_cost;
       }
       states.push_back(st);
-      if (std::getenv("ARCO_DEBUG_DECODE")) {
-        std::fprintf(stderr,
-                     "note %lld-%lld s%d f%d cost %.1f pos %.1f\n",
-                     (long long)note.first_frame,
-                     (long long)note.last_frame,
-                     s,
-                     k,
-                     st.cost,
-                     st.position_semitones);
-      }
     }
   }
   return states;
