@@ -16,6 +16,8 @@
 #include <set>
 #include <stdexcept>
 
+#include "arco/calibration/bundle_solver.h"
+#include "arco/calibration/pose_parameters.h"
 #include "arco/calibration/reprojection_cost.h"
 #include "arco/geometry/alignment.h"
 #include "arco/geometry/rotation.h"
@@ -35,14 +37,17 @@ struct Pose {
   Pose Inverse() const { return {R.transpose(), -R.transpose() * t}; }
 };
 
-std::array<double, 6> PoseToParams(const Pose& pose) {
-  const Eigen::Vector3d aa = AxisAngleFromRotation(pose.R);
-  return {aa[0], aa[1], aa[2], pose.t[0], pose.t[1], pose.t[2]};
+// pose_parameters.h's converters for this file's Pose.
+std::array<double, kPoseParams> PoseToParams(const Pose& pose) {
+  std::array<double, kPoseParams> params;
+  calibration::PoseToParams(pose.R, pose.t, params.data());
+  return params;
 }
 
 Pose PoseFromParams(const double* p) {
-  return {RotationFromAxisAngle(Eigen::Vector3d(p[0], p[1], p[2])),
-          Eigen::Vector3d(p[3], p[4], p[5])};
+  Pose pose;
+  ParamsToPose(p, &pose.R, &pose.t);
+  return pose;
 }
 
 Camera CameraWithIntrinsics(const std::array<double, kNumIntrinsics>& intrinsics,
@@ -71,13 +76,6 @@ std::vector<double> ViewErrors(const std::array<double, kNumIntrinsics>& intrins
     errors.push_back(pixel ? (*pixel - view.corners_px[i]).norm() : 1e9);
   }
   return errors;
-}
-
-double Rms(const std::vector<double>& errors) {
-  if (errors.empty()) return 0;
-  double sum = 0;
-  for (double e : errors) sum += e * e;
-  return std::sqrt(sum / errors.size());
 }
 
 // Views spread over the image: greedy, each step the view whose corners fall in the least
@@ -587,8 +585,6 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
     else
       problem.SetManifold(intrinsics_block(c), new ceres::SubsetManifold(kNumIntrinsics, {kSkew}));
   }
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_SCHUR;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (auto& b : board_params) ordering->AddElementToGroup(b.data(), 0);
   for (int c = 0; c < num_cameras; ++c) {
@@ -596,18 +592,9 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
     ordering->AddElementToGroup(pose_block(c), 1);
     ordering->AddElementToGroup(intrinsics_block(c), 1);
   }
-  solver_options.linear_solver_ordering = ordering;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.function_tolerance = 1e-10;
-  solver_options.gradient_tolerance = 1e-12;
-  solver_options.parameter_tolerance = 1e-10;
-  // One thread: Ceres's multi-threaded Schur elimination sums in a varying order, and the
-  // result must not depend on the thread count (the adjustment takes about a second).
-  solver_options.num_threads = 1;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
-  if (summary.termination_type == ceres::FAILURE)
-    return Status::Error("bundle adjustment failed: " + summary.message);
+  // One thread inside (bundle_solver.h): the adjustment takes about a second.
+  ARCO_ASSIGN_OR_RETURN(const BundleAdjustmentSummary solved,
+                        SolveBundle(&problem, ordering, options.max_iterations, start));
   for (int c = 0; c < num_cameras; ++c) {
     std::copy(pose_block(c), pose_block(c) + 6, camera_params[c].begin());
     std::copy(intrinsics_block(c), intrinsics_block(c) + kNumIntrinsics, intrinsics[c].begin());
@@ -616,14 +603,8 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   RigCalibration result;
   RigCalibrationReport& report = result.report;
   report.board = board.ToString();
-  report.bundle_adjustment.termination = ceres::TerminationTypeToString(summary.termination_type);
-  report.bundle_adjustment.iterations = static_cast<int>(summary.iterations.size()) - 1;
-  report.bundle_adjustment.initial_cost = summary.initial_cost;
-  report.bundle_adjustment.final_cost = summary.final_cost;
-  report.bundle_adjustment.residual_blocks = summary.num_residual_blocks;
+  report.bundle_adjustment = solved;
   report.bundle_adjustment.board_poses = static_cast<int>(ba_frames.size());
-  report.bundle_adjustment.time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   // 7. World frame, the rig and the report.
   progress.StartStage(3, 3, "report");

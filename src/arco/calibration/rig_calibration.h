@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "arco/calibration/board.h"
+#include "arco/calibration/bundle_adjustment.h"
 #include "arco/camera/rig.h"
 #include "arco/util/number_range.h"
 #include "arco/util/progress.h"
@@ -82,15 +83,6 @@ struct CalibrationWarning {
   std::string code;
   std::string camera;
   std::string message;
-};
-
-struct BundleAdjustmentSummary {
-  std::string termination;  // Ceres's termination type ("CONVERGENCE", "NO_CONVERGENCE", ...)
-  int iterations = 0;
-  double initial_cost = 0, final_cost = 0;
-  int residual_blocks = 0;
-  int board_poses = 0;
-  double time_s = 0;
 };
 
 struct RigCalibrationReport {

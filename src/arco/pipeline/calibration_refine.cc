@@ -1,18 +1,14 @@
 #include "arco/pipeline/calibration_refine.h"
 
-#include <ceres/ceres.h>
-#include <ceres/rotation.h>
-
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <memory>
 
+#include "arco/calibration/bundle_adjustment.h"
 #include "arco/calibration/calibration_file.h"
-#include "arco/calibration/reprojection_cost.h"
+#include "arco/calibration/pose_parameters.h"
 #include "arco/geometry/rotation.h"
 #include "arco/instrument/instrument_model.h"
 #include "arco/instrument/template_fit.h"
@@ -26,99 +22,13 @@ namespace arco::pipeline {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// Per camera in the parameter buffer: cam_from_world (angle-axis, translation), then the
-// intrinsics (camera.h IntrinsicIndex order).
-constexpr int kPoseSize = 6;
-constexpr int kCameraStride = kPoseSize + kNumIntrinsics;
 // Every camera must keep this many detections, or its pose is left to a handful of points.
 constexpr int64_t kMinCameraObservations = 30;
 constexpr int64_t kMinPoints = 30;
 
-struct Observation {
-  int camera = 0;  // rig index
-  Eigen::Vector2d pixel;
-};
-
-// One keypoint in one frame with the views that agree on it.
-struct Track {
-  int frame = 0;   // index into the selected frames
-  int point = 0;   // layout index
-  int rigid = -1;  // instrument template index (model keypoint order), -1 = free point
-  Eigen::Vector3d point_in_world = Eigen::Vector3d::Zero();
-  std::vector<Observation> observations;
-};
-
-// Reprojection of a free point: x_cam = cam_from_world * X.
-struct PointReprojection {
-  explicit PointReprojection(const Eigen::Vector2d& px) : observed_px(px) {}
-  template <typename T>
-  bool operator()(const T* cam, const T* intrinsics, const T* point, T* residual) const {
-    return ReprojectionResidual(cam, intrinsics, point, observed_px, residual);
-  }
-  Eigen::Vector2d observed_px;
-};
-
-// Reprojection of a point of the rigid instrument: X = world_from_instrument * X_template
-// (the template in world units, oriented in the instrument frame).
-struct RigidReprojection {
-  explicit RigidReprojection(const Eigen::Vector2d& px) : observed_px(px) {}
-  template <typename T>
-  bool operator()(const T* cam,
-                  const T* intrinsics,
-                  const T* world_from_instrument,
-                  const T* point_in_instrument,
-                  T* residual) const {
-    T world_point[3];
-    TransformByPose(world_from_instrument, point_in_instrument, world_point);
-    return ReprojectionResidual(cam, intrinsics, world_point, observed_px, residual);
-  }
-  Eigen::Vector2d observed_px;
-};
-
-// The template's nut-centre to bridge-centre distance held at the string length (world
-// units): the only residual that sees the scale, so it is met exactly at the optimum
-// whatever its weight (the weight only conditions the problem).
-struct NutBridgeLength {
-  NutBridgeLength(double target, double weight) : target(target), weight(weight) {}
-  template <typename T>
-  bool operator()(
-      const T* nut_l, const T* nut_r, const T* bridge_l, const T* bridge_r, T* residual) const {
-    T sq = T(0);
-    for (int i = 0; i < 3; ++i) {
-      const T d = T(0.5) * (nut_l[i] + nut_r[i]) - T(0.5) * (bridge_l[i] + bridge_r[i]);
-      sq += d * d;
-    }
-    residual[0] = T(weight) * (ceres::sqrt(sq) - T(target));
-    return true;
-  }
-  double target, weight;
-};
-
-void PoseToParams(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, double* p) {
-  const Eigen::Vector3d aa = AxisAngleFromRotation(R);
-  for (int i = 0; i < 3; ++i) p[i] = aa[i], p[3 + i] = t[i];
-}
-
-void ParamsToPose(const double* p, Eigen::Matrix3d* R, Eigen::Vector3d* t) {
-  *R = RotationFromAxisAngle(Eigen::Vector3d(p[0], p[1], p[2]));
-  *t = Eigen::Vector3d(p[3], p[4], p[5]);
-}
-
-// The instrument as a rigid body: template points (world units, instrument frame; NaN =
-// not in the template) and a pose per selected frame (valid[f] false = none).
-struct RigidBody {
-  std::vector<Eigen::Vector3d> points;
-  std::vector<Eigen::Matrix3d> rotation;
-  std::vector<Eigen::Vector3d> translation;
-  std::vector<char> valid;
-};
-
-double Rms(const std::vector<double>& v) {
-  if (v.empty()) return 0;
-  double s = 0;
-  for (double e : v) s += e * e;
-  return std::sqrt(s / v.size());
-}
+using calibration::BundleObservation;
+using calibration::BundleTrack;
+using calibration::Rms;
 
 }  // namespace
 
@@ -287,16 +197,13 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
   const int num_frames = static_cast<int>(selected.size());
   summary.frames = num_frames;
 
-  // Parameters in one buffer, in a fixed order: Ceres orders the blocks of an elimination
-  // group by address, so separate allocations would make the solution depend on where the
-  // heap put them (the last bits differ from run to run).
   Rig rig = input;
-  RigidBody body;
+  calibration::RigidBody body;
   body.points.assign(num_k, Eigen::Vector3d::Constant(kNaN));
   body.rotation.assign(num_frames, Eigen::Matrix3d::Identity());
   body.translation.assign(num_frames, Eigen::Vector3d::Zero());
   body.valid.assign(num_frames, 0);
-  std::vector<Track> tracks;
+  std::vector<BundleTrack> tracks;
   // Progress counts passes (no stage line: an error is then the command's only line).
   progress.SetTotal(3);
 
@@ -310,8 +217,8 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
   // Enough to go on: the rig enough points, every camera enough detections of them.
   auto enough = [&]() -> Status {
     std::vector<int64_t> per_camera(num_cameras, 0);
-    for (const Track& t : tracks)
-      for (const Observation& o : t.observations) ++per_camera[o.camera];
+    for (const BundleTrack& t : tracks)
+      for (const BundleObservation& o : t.observations) ++per_camera[o.camera];
     if (static_cast<int64_t>(tracks.size()) < kMinPoints)
       return Status::Error(ResolveCapturePath(options.capture_dir, manifest.keypoints2d) +
                            ": only " + std::to_string(tracks.size()) + " keypoints are seen by " +
@@ -351,7 +258,7 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
         if (static_cast<int>(observations.size()) < options.min_views) continue;
         const auto point = triangulator.Triangulate(observations, &scratch);
         if (!point || static_cast<int>(point->inlier_cameras.size()) < options.min_views) continue;
-        Track track;
+        BundleTrack track;
         track.frame = f;
         track.point = static_cast<int>(p);
         track.rigid = rigid_of_point[p];
@@ -371,7 +278,7 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
                                                       Eigen::Matrix3Xd::Constant(3, num_k, kNaN));
       std::vector<FrontHint> hints(num_frames);
       std::vector<Eigen::Vector3d> shoulders(2 * num_frames, Eigen::Vector3d::Constant(kNaN));
-      for (const Track& t : tracks) {
+      for (const BundleTrack& t : tracks) {
         if (t.rigid >= 0) instrument_points[t.frame].col(t.rigid) = t.point_in_world;
         if (t.point == wholebody::kLeftShoulder) shoulders[2 * t.frame] = t.point_in_world;
         if (t.point == wholebody::kRightShoulder) shoulders[2 * t.frame + 1] = t.point_in_world;
@@ -409,154 +316,53 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
     // Rigid points only where the body has a pose and the template the point.
     tracks.erase(std::remove_if(tracks.begin(),
                                 tracks.end(),
-                                [&](const Track& t) {
+                                [&](const BundleTrack& t) {
                                   return t.rigid >= 0 && (!body.valid[t.frame] ||
                                                           !body.points[t.rigid].allFinite());
                                 }),
                  tracks.end());
     // A frame's pose needs three of its points (two leave a rotation free).
     std::vector<int> rigid_in_frame(num_frames, 0);
-    for (const Track& t : tracks) rigid_in_frame[t.frame] += t.rigid >= 0;
-    tracks.erase(
-        std::remove_if(tracks.begin(),
-                       tracks.end(),
-                       [&](const Track& t) { return t.rigid >= 0 && rigid_in_frame[t.frame] < 3; }),
-        tracks.end());
+    for (const BundleTrack& t : tracks) rigid_in_frame[t.frame] += t.rigid >= 0;
+    tracks.erase(std::remove_if(tracks.begin(),
+                                tracks.end(),
+                                [&](const BundleTrack& t) {
+                                  return t.rigid >= 0 && rigid_in_frame[t.frame] < 3;
+                                }),
+                 tracks.end());
     for (int f = 0; f < num_frames; ++f)
       if (rigid_in_frame[f] < 3) body.valid[f] = 0;
     ARCO_RETURN_IF_ERROR(enough());
 
-    // 3. The parameters, in one buffer: cameras, template, instrument poses, free points.
-    int64_t num_free = 0;
-    std::vector<int64_t> free_index(tracks.size(), -1);
-    for (size_t i = 0; i < tracks.size(); ++i)
-      if (tracks[i].rigid < 0) free_index[i] = num_free++;
-    const int64_t template_offset = int64_t{num_cameras} * kCameraStride;
-    const int64_t pose_offset = template_offset + 3 * num_k;
-    const int64_t point_offset = pose_offset + int64_t{kPoseSize} * num_frames;
-    std::vector<double> x(point_offset + 3 * num_free, 0.0);
-    for (int c = 0; c < num_cameras; ++c) {
-      const Camera& cam = rig.cameras[c];
-      PoseToParams(
-          cam.cam_from_world_rotation, cam.cam_from_world_translation, &x[c * kCameraStride]);
-      const auto intrinsics = cam.Intrinsics();
-      std::copy(intrinsics.begin(), intrinsics.end(), &x[c * kCameraStride + kPoseSize]);
-    }
-    for (int k = 0; k < num_k; ++k)
-      for (int i = 0; i < 3; ++i)
-        x[template_offset + 3 * k + i] = body.points[k].allFinite() ? body.points[k][i] : 0.0;
-    for (int f = 0; f < num_frames; ++f)
-      PoseToParams(body.rotation[f], body.translation[f], &x[pose_offset + kPoseSize * f]);
-    for (size_t i = 0; i < tracks.size(); ++i)
-      if (free_index[i] >= 0)
-        for (int d = 0; d < 3; ++d)
-          x[point_offset + 3 * free_index[i] + d] = tracks[i].point_in_world[d];
-
-    ceres::Problem::Options problem_options;
-    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    ceres::Problem problem(problem_options);
+    // 3. The bundle adjustment: the rig, the instrument and the free points.
+    calibration::RigAdjustmentOptions adjustment;
+    adjustment.reference_camera = reference;
+    adjustment.cameras = view_to_camera;
+    adjustment.refine_focal = options.refine_focal;
     // Cauchy while gross errors may remain (pass 1); Huber once the gate has removed them:
     // Cauchy's down-weighting near the noise level made the last pass's reduced system
     // indefinite (failed Cholesky steps, 70 iterations instead of a few).
-    std::unique_ptr<ceres::LossFunction> loss;
-    if (pass == 0)
-      loss = std::make_unique<ceres::CauchyLoss>(plan[pass].loss_px);
-    else
-      loss = std::make_unique<ceres::HuberLoss>(plan[pass].loss_px);
-    for (size_t i = 0; i < tracks.size(); ++i) {
-      const Track& t = tracks[i];
-      for (const Observation& o : t.observations) {
-        double* cam = &x[o.camera * kCameraStride];
-        double* intrinsics = cam + kPoseSize;
-        if (t.rigid < 0) {
-          problem.AddResidualBlock(
-              new ceres::AutoDiffCostFunction<PointReprojection, 2, 6, kNumIntrinsics, 3>(
-                  new PointReprojection(o.pixel)),
-              loss.get(),
-              cam,
-              intrinsics,
-              &x[point_offset + 3 * free_index[i]]);
-        } else {
-          problem.AddResidualBlock(
-              new ceres::AutoDiffCostFunction<RigidReprojection, 2, 6, kNumIntrinsics, 6, 3>(
-                  new RigidReprojection(o.pixel)),
-              loss.get(),
-              cam,
-              intrinsics,
-              &x[pose_offset + kPoseSize * t.frame],
-              &x[template_offset + 3 * t.rigid]);
-        }
-      }
-    }
-    const double target = model.string_length_mm() * units_per_mm;
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<NutBridgeLength, 1, 3, 3, 3, 3>(
-                                 new NutBridgeLength(target, 10.0 / units_per_mm)),
-                             nullptr,
-                             &x[template_offset + 3 * nut_l],
-                             &x[template_offset + 3 * nut_r],
-                             &x[template_offset + 3 * bridge_l],
-                             &x[template_offset + 3 * bridge_r]);
-    std::vector<int> free_intrinsics = {kFx, kFy};
-    std::vector<int> held;
-    for (int i = 0; i < kNumIntrinsics; ++i)
-      if (i != kFx && i != kFy) held.push_back(i);
-    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-    for (int c = 0; c < num_cameras; ++c) {
-      double* cam = &x[c * kCameraStride];
-      if (!problem.HasParameterBlock(cam)) continue;
-      if (c == reference) problem.SetParameterBlockConstant(cam);
-      if (options.refine_focal)
-        problem.SetManifold(cam + kPoseSize, new ceres::SubsetManifold(kNumIntrinsics, held));
-      else
-        problem.SetParameterBlockConstant(cam + kPoseSize);
-      ordering->AddElementToGroup(cam, 1);
-      ordering->AddElementToGroup(cam + kPoseSize, 1);
-    }
-    for (int k = 0; k < num_k; ++k)
-      if (problem.HasParameterBlock(&x[template_offset + 3 * k]))
-        ordering->AddElementToGroup(&x[template_offset + 3 * k], 1);
-    for (int f = 0; f < num_frames; ++f)
-      if (problem.HasParameterBlock(&x[pose_offset + kPoseSize * f]))
-        ordering->AddElementToGroup(&x[pose_offset + kPoseSize * f], 0);
-    for (int64_t i = 0; i < num_free; ++i) ordering->AddElementToGroup(&x[point_offset + 3 * i], 0);
-    ceres::Solver::Options solver_options;
-    solver_options.linear_solver_type = ceres::DENSE_SCHUR;
-    solver_options.linear_solver_ordering = ordering;
-    solver_options.max_num_iterations = options.max_iterations;
-    solver_options.function_tolerance = 1e-10;
-    solver_options.gradient_tolerance = 1e-12;
-    solver_options.parameter_tolerance = 1e-10;
-    // One thread: the multi-threaded Schur elimination sums in a varying order.
-    solver_options.num_threads = 1;
-    const auto start = std::chrono::steady_clock::now();
-    ceres::Solver::Summary solved;
-    ceres::Solve(solver_options, &problem, &solved);
-    if (solved.termination_type == ceres::FAILURE)
-      return Status::Error("bundle adjustment failed: " + solved.message);
+    adjustment.loss =
+        pass == 0 ? calibration::BundleLoss::kCauchy : calibration::BundleLoss::kHuber;
+    adjustment.loss_scale_px = plan[pass].loss_px;
+    adjustment.max_iterations = options.max_iterations;
+    // The string length holds the scale; the weight only conditions the problem.
+    adjustment.scale = {nut_l,
+                        nut_r,
+                        bridge_l,
+                        bridge_r,
+                        model.string_length_mm() * units_per_mm,
+                        10.0 / units_per_mm};
+    ARCO_ASSIGN_OR_RETURN(const calibration::BundleAdjustmentSummary solved,
+                          calibration::AdjustRig(adjustment, tracks, &rig, &body));
     CalibrationRefineSummary::Pass report;
-    report.termination = ceres::TerminationTypeToString(solved.termination_type);
-    report.iterations = static_cast<int>(solved.iterations.size()) - 1;
+    report.termination = solved.termination;
+    report.iterations = solved.iterations;
     report.initial_cost = solved.initial_cost;
     report.final_cost = solved.final_cost;
-    report.residual_blocks = solved.num_residual_blocks;
-    report.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    report.residual_blocks = solved.residual_blocks;
+    report.time_s = solved.time_s;
     summary.passes.push_back(report);
-
-    // 4. Back into the rig, the body and the tracks.
-    // Only the capture's cameras (a rig camera the capture lacks stays exactly as given).
-    for (int c : view_to_camera) {
-      Camera& cam = rig.cameras[c];
-      const double* p = &x[c * kCameraStride];
-      // The reference's pose exactly as given (not through angle-axis and back).
-      if (c != reference)
-        ParamsToPose(p, &cam.cam_from_world_rotation, &cam.cam_from_world_translation);
-      cam.fx = p[kPoseSize + kFx];
-      cam.fy = p[kPoseSize + kFy];
-    }
-    for (int k = 0; k < num_k; ++k)
-      if (body.points[k].allFinite()) body.points[k] = Eigen::Vector3d(&x[template_offset + 3 * k]);
-    for (int f = 0; f < num_frames; ++f)
-      ParamsToPose(&x[pose_offset + kPoseSize * f], &body.rotation[f], &body.translation[f]);
     progress.Advance(1);
   }
 
@@ -568,15 +374,16 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
   const Triangulator before(input, wide), after(rig, wide);
   std::vector<std::vector<double>> errors_before(num_cameras), errors_after(num_cameras);
   std::vector<PointObservation> observations;
-  for (const Track& t : tracks) {
+  for (const BundleTrack& t : tracks) {
     if (t.rigid < 0) ++summary.points;
     observations.clear();
-    for (const Observation& o : t.observations) observations.push_back({o.camera, o.pixel, 1.0});
+    for (const BundleObservation& o : t.observations)
+      observations.push_back({o.camera, o.pixel, 1.0});
     for (const auto& [triangulator, errors] :
          {std::make_pair(&before, &errors_before), std::make_pair(&after, &errors_after)}) {
       const auto point = triangulator->Triangulate(observations);
       if (!point) continue;
-      for (const Observation& o : t.observations) {
+      for (const BundleObservation& o : t.observations) {
         const double e = ReprojectionErrorPx(
             triangulator->rig().cameras[o.camera], point->point_in_world, o.pixel);
         if (std::isfinite(e)) (*errors)[o.camera].push_back(e);

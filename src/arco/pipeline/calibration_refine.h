@@ -18,6 +18,8 @@
 // degrees off) and solves with a Cauchy loss; passes 2 and 3 re-triangulate with the
 // refined rig, keep only views within a tighter gate and points still seen by min_views
 // cameras, and solve again (Cauchy, loss_scale_px in the last pass).
+// This file reads the capture, triangulates and fits the instrument; each pass's solve is
+// calibration/bundle_adjustment.h's AdjustRig.
 #pragma once
 
 #include <cstdint>
