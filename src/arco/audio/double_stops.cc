@@ -27,6 +27,11 @@ constexpr double kMinIntervalSemitones = 0.8;
 // 2nd partials), leakage only (< 0.05) for a note with nothing an octave below.
 constexpr double kLostFundamentalOddRatio = 0.15;
 
+// A fifth is one note's 2nd and 3rd partials when that note's partials prime to 6 carry at
+// least this share of its 2nd and 3rd's weighted amplitude (check (5)): 0.16-0.25 for
+// fluidsynth's cello C2 and D2 (fundamentals 5-9% of the strongest partial).
+constexpr double kPartialFifthRatio = 0.1;
+
 // Auto window: periods of the lowest f0, so that the partials of a third on the lowest
 // strings (4 Hz apart at the double bass's 40 Hz) are at least a Hann main lobe apart.
 constexpr double kAutoWindowPeriods = 8.0;
@@ -287,6 +292,31 @@ int DoubleStopAnalyzer::LostFundamental(int note, int partner) {
   return even > 0 && odd >= kLostFundamentalOddRatio * even ? below : -1;
 }
 
+// The candidate an octave below `low` when `low` and `high` are a fifth (3:2) that is its
+// 2nd and 3rd partials: its fundamental is present (2.5% of the strongest peak) and its
+// partials that neither heard note has (m = 1, 5, 7, 11: prime to 6) carry at least
+// kPartialFifthRatio of the weighted amplitude of its 2nd and 3rd; else -1. A true fifth
+// (C3 + G3) has nothing at 65, 327 or 458 Hz but leakage.
+int DoubleStopAnalyzer::PartialFifth(int low, int high) const {
+  const double fifth = candidates_midi_[high] - candidates_midi_[low];
+  if (std::abs(fifth - 12.0 * std::log2(1.5)) > kPartialCents / 100.0) return -1;
+  const int below = low - static_cast<int>(std::lround(1200.0 / options_.grid_cents));
+  if (below < 0) return -1;
+  const double peak = *std::max_element(magnitude_.begin(), magnitude_.end());
+  if (BandMax(below, 1, magnitude_, nullptr) < 0.5 * options_.min_fundamental_ratio * peak) {
+    return -1;
+  }
+  double unique = 0, heard = 0;
+  for (int m = 1; m <= options_.harmonics; ++m) {
+    const double amplitude = BandMax(below, m, magnitude_, nullptr);
+    if (amplitude < 0) break;
+    const double weighted = Weight(candidates_hz_[below], m) * amplitude;
+    if (m == 2 || m == 3) heard += weighted;
+    if (m % 2 != 0 && m % 3 != 0) unique += weighted;
+  }
+  return heard > 0 && unique >= kPartialFifthRatio * heard ? below : -1;
+}
+
 int DoubleStopAnalyzer::Analyze(const float* x, std::array<PolyNote, 2>* notes) {
   *notes = {};
   double mean = 0;
@@ -315,6 +345,15 @@ int DoubleStopAnalyzer::Analyze(const float* x, std::array<PolyNote, 2>* notes) 
     return 1;
   }
   PolyNote two{Refine(second.index, residual_), second.salience};
+  // (5) One low note heard as its 2nd and 3rd partials (a fifth): D2 with a fundamental at
+  // 9% of its 3rd partial read as D3 + A3.
+  const int low =
+      candidates_hz_[first.index] < candidates_hz_[second.index] ? first.index : second.index;
+  const int single = PartialFifth(low, first.index == low ? second.index : first.index);
+  if (single >= 0) {
+    (*notes)[0] = PolyNote{Refine(single, magnitude_), Salience(single, magnitude_)};
+    return 1;
+  }
   // (4) A lost fundamental: a note whose own fundamental is weak is heard as its 2nd
   // partial, an octave too high, when the partner's cancellation leaves that partial the
   // strongest (a sixth B3 + G#4 read as G#4 + B4). Look at each note's octave below on the

@@ -21,7 +21,10 @@
 //   (4) then, for each note of the pair, its octave below replaces it when that forms a
 //       playable pair with the partner, its fundamental is present and its odd partials
 //       (which the heard note does not have) are strong on the spectrum without the
-//       partner: a note with a weak fundamental heard as its own 2nd partial.
+//       partner: a note with a weak fundamental heard as its own 2nd partial;
+//   (5) before (4), a pair a fifth apart whose octave below has a present fundamental and
+//       strong partials prime to 6 (neither heard note's) is that one note, heard as its
+//       2nd and 3rd partials.
 #pragma once
 
 #include <array>
@@ -122,6 +125,7 @@ class DoubleStopAnalyzer {
   double Refine(int candidate, const std::vector<double>& spectrum);
   double Cancel(int candidate);
   int LostFundamental(int note, int partner);
+  int PartialFifth(int low, int high) const;
 
   DoubleStopOptions options_;
   int window_ = 0, fft_size_ = 0, lobe_bins_ = 0;
