@@ -1,4 +1,4 @@
-#include "arco/pipeline/track_stage.h"
+#include "arco/capture/track_stage.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,18 +11,18 @@
 #include <utility>
 
 #include "arco/calibration/calibration_file.h"
+#include "arco/capture/capture_videos.h"
 #include "arco/instrument/instrument_model.h"
 #include "arco/media/video_reader.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/labelme.h"
-#include "arco/pipeline/capture_videos.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/output_set.h"
 #include "arco/util/parallel.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 constexpr float kNaNf = std::numeric_limits<float>::quiet_NaN();
@@ -110,8 +110,8 @@ StatusOr<double> MmPerWorldUnit(const std::string& units,
   const Eigen::Vector3d nut = 0.5 * (point("nut_l") + point("nut_r"));
   const Eigen::Vector3d bridge = 0.5 * (point("bridge_l") + point("bridge_r"));
   if (!nut.allFinite() || !bridge.allFinite() || !((nut - bridge).norm() > 0)) {
-    return Status::Error(label_files + ": the calibration " + calibration_path +
-                         " is in units '" + units +
+    return Status::Error(label_files + ": the calibration " + calibration_path + " is in units '" +
+                         units +
                          "' (no metric scale): label nut_l, nut_r, bridge_l and bridge_r in two "
                          "views, whose distance gives the scale");
   }
@@ -619,4 +619,4 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   return summary;
 }
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture
