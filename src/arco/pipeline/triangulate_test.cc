@@ -31,7 +31,7 @@ capture::LabelViewsOptions RealLabels() {
 }
 
 // The acceptance test of issue 2 on the real frame-128 labels.
-TEST(capture::TriangulateLabelViews, RealSpdLabelsMeetTheReprojectionAndStringSideBars) {
+TEST(TriangulateLabelViews, RealSpdLabelsMeetTheReprojectionAndStringSideBars) {
   auto r = capture::TriangulateLabelViews(RealLabels());
   ASSERT_TRUE(r.ok()) << r.status().message();
   const double rms = (*r)["rms_reprojection_px"];
@@ -54,7 +54,7 @@ TEST(capture::TriangulateLabelViews, RealSpdLabelsMeetTheReprojectionAndStringSi
               lengths["difference_percent"].get<double>());
 }
 
-TEST(capture::TriangulateLabelViews, IgnoringDistortionRaisesTheError) {
+TEST(TriangulateLabelViews, IgnoringDistortionRaisesTheError) {
   capture::LabelViewsOptions o = RealLabels();
   auto with = capture::TriangulateLabelViews(o);
   o.ignore_distortion = true;
@@ -66,7 +66,7 @@ TEST(capture::TriangulateLabelViews, IgnoringDistortionRaisesTheError) {
   EXPECT_FALSE((*without)["distortion_modelled"].get<bool>());
 }
 
-TEST(capture::TriangulateLabelViews, SameResultWithCameraNamesAndSpdJsonCalibration) {
+TEST(TriangulateLabelViews, SameResultWithCameraNamesAndSpdJsonCalibration) {
   // SPD JSON names cameras camK: 21334181 = cam0, 21334190 = cam18, 21334211 = cam19,
   // 21334237 = cam1 (spd/README.md). Its converter dropped the distortion, which arco
   // reads back, so the results must agree with the XML.
@@ -83,7 +83,7 @@ TEST(capture::TriangulateLabelViews, SameResultWithCameraNamesAndSpdJsonCalibrat
               0.05);
 }
 
-TEST(capture::TriangulateLabelViews, ViewOrderDoesNotChangeThePoints) {
+TEST(TriangulateLabelViews, ViewOrderDoesNotChangeThePoints) {
   capture::LabelViewsOptions o = RealLabels();
   auto a = capture::TriangulateLabelViews(o);
   std::reverse(o.views.begin(), o.views.end());
@@ -100,7 +100,7 @@ TEST(capture::TriangulateLabelViews, ViewOrderDoesNotChangeThePoints) {
   }
 }
 
-TEST(capture::TriangulateLabelViews, ScaleToInstrumentReportsMillimetres) {
+TEST(TriangulateLabelViews, ScaleToInstrumentReportsMillimetres) {
   capture::LabelViewsOptions o = RealLabels();
   o.reference_string_length_mm = 695;
   auto r = capture::TriangulateLabelViews(o);
@@ -121,7 +121,7 @@ void ExpectError(const capture::LabelViewsOptions& o, const std::string& words) 
   EXPECT_EQ(r.status().message().find('\n'), std::string::npos);  // one line
 }
 
-TEST(capture::TriangulateLabelViews, BadInputsGiveOneLineErrors) {
+TEST(TriangulateLabelViews, BadInputsGiveOneLineErrors) {
   TempDir dir;
   capture::LabelViewsOptions o = RealLabels();
   o.views.resize(1);
