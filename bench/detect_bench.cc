@@ -12,8 +12,8 @@
 //   the tracker times separately;
 // - BM_DecodeFrame: reading frames with media::VideoReader (decoding is not part of
 //   the tracker's time): opencv-doc's vtest.avi (768 x 576 MPEG-4) and the cellist JPEG;
-// - BM_DetectStagePlane: `arco detect` (pipeline::RunDetectStage, default models) on
-//   pipeline_detect_plane_test's scene (8 views x 12 frames of 1152 x 1328 FFV1, rendered
+// - BM_DetectStagePlane: `arco detect` (capture::RunDetectStage, default models) on
+//   capture_detect_plane_test's scene (8 views x 12 frames of 1152 x 1328 FFV1, rendered
 //   once, untimed), wall time per view-frame with decoding, for --threads 1 and 2 and
 //   with frames decoded ahead on a thread beside each worker or in turn (issue 28).
 #include <benchmark/benchmark.h>
@@ -25,11 +25,11 @@
 #include <string>
 #include <vector>
 
+#include "arco/capture/capture_new.h"
+#include "arco/capture/detect_stage.h"
 #include "arco/detect/network.h"
 #include "arco/detect/wholebody.h"
 #include "arco/media/video_reader.h"
-#include "arco/pipeline/capture_new.h"
-#include "arco/pipeline/detect_stage.h"
 #include "arco/testing/plane_scene.h"
 
 namespace arco::detect {
@@ -155,7 +155,7 @@ void BM_DecodeFrame(benchmark::State& state) {
 }
 BENCHMARK(BM_DecodeFrame)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 
-// pipeline_detect_plane_test's capture (same photo, rig and motion), made once per
+// capture_detect_plane_test's capture (same photo, rig and motion), made once per
 // process in a temporary folder removed at exit; empty with the reason on failure.
 struct PlaneCapture {
   std::string dir, error;
@@ -192,13 +192,13 @@ const PlaneCapture& GetPlaneCapture() {
       c.error = written.message();
       return c;
     }
-    pipeline::CaptureNewOptions o;
+    capture::CaptureNewOptions o;
     o.calibration = scene_dir + "/calibration.json";
     for (const Camera& cam : scene.rig.cameras) {
       o.inputs.push_back({cam.name, scene_dir + "/videos/" + cam.name + ".mkv", false});
     }
     o.output_dir = c.dir + "/capture";
-    auto made = pipeline::CreateCapture(o);
+    auto made = capture::CreateCapture(o);
     if (!made.ok()) {
       c.error = made.status().message();
       return c;
@@ -217,7 +217,7 @@ void BM_DetectStagePlane(benchmark::State& state) {
     state.SkipWithError(capture.error.c_str());
     return;
   }
-  pipeline::DetectStageOptions o;
+  capture::DetectStageOptions o;
   o.capture_dir = capture.dir + "/capture";
   o.num_threads = static_cast<int>(state.range(0));
   o.decode_ahead = state.range(1) != 0;
@@ -226,7 +226,7 @@ void BM_DetectStagePlane(benchmark::State& state) {
   double decode_s = 0, wait_s = 0, inference_s = 0;
   int64_t runs = 0;
   for (auto _ : state) {
-    StatusOr<pipeline::DetectStageSummary> s = pipeline::RunDetectStage(o);
+    StatusOr<capture::DetectStageSummary> s = capture::RunDetectStage(o);
     if (!s.ok()) {
       state.SkipWithError(s.status().message().c_str());
       return;

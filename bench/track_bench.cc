@@ -1,10 +1,10 @@
 // The instrument tracker's cost (docs/performance.md, section "Track"), wall time:
-// BM_TrackInstrument/T tracks the moving-plane scene of pipeline_track_plane_test (the
+// BM_TrackInstrument/T tracks the moving-plane scene of capture_track_plane_test (the
 // real SPD cellist photo on a rigidly moving plane, 6 distorted 768 x 886 views, labels
 // on frame 1 in two views) for 20 frames with T threads, frames already decoded and in
 // memory (decoding is media::VideoReader's, timed by detect_bench's BM_DecodeFrame).
 // Counter ms_per_view_frame: track::InstrumentTracker::Next per view-frame.
-// BM_TrackBow/R tracks the moving bow of pipeline_track_bow_test (a 720 x 24 mm strip of
+// BM_TrackBow/R tracks the moving bow of capture_track_bow_test (a 720 x 24 mm strip of
 // random 6 mm blocks, +-200 mm strokes at 0.7 Hz and +-10 degree string crossings, over
 // the photo at rest; same rig) for 20 frames on one thread: R = 1 with the all-view pose
 // (BowTrackerOptions::refine), R = 0 without. Counter cpu_ms_per_view_frame:

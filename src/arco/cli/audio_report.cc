@@ -1,4 +1,4 @@
-// The terminal text of `arco pitch` and `arco sync` (the work is pipeline/pitch_sync.h).
+// The terminal text of `arco pitch` and `arco sync` (the work is capture/pitch_sync.h).
 #include "arco/cli/audio_report.h"
 
 #include <cmath>
@@ -24,8 +24,7 @@ std::string Format(const char* format, ...) {
 
 }  // namespace
 
-std::string FormatPitchReport(const pipeline::PitchRunOptions& o,
-                              const pipeline::PitchRunResult& r) {
+std::string FormatPitchReport(const capture::PitchRunOptions& o, const capture::PitchRunResult& r) {
   const auto& s = r.summary;
   std::string out;
   out += Format("%s: %s, %d Hz, %d ch, %.2f s (analysed at %d Hz, %s %.0f-%.0f Hz)\n",
@@ -60,8 +59,7 @@ std::string FormatPitchReport(const pipeline::PitchRunOptions& o,
   return out;
 }
 
-std::string FormatSyncReport(const pipeline::SyncRunOptions& o,
-                             const pipeline::SyncRunResult& run) {
+std::string FormatSyncReport(const capture::SyncRunOptions& o, const capture::SyncRunResult& run) {
   const audio::SyncResult& r = run.sync;
   std::string out;
   out += Format("audio %s: onset at %.4f s (%.1f dB over the preceding 50 ms; runner-up %.1f dB",
@@ -111,13 +109,13 @@ std::string FormatSyncReport(const pipeline::SyncRunOptions& o,
   return out;
 }
 
-std::vector<std::string> PitchWarnings(const pipeline::PitchRunResult& result) {
+std::vector<std::string> PitchWarnings(const capture::PitchRunResult& result) {
   std::vector<std::string> out;
   for (const auto& w : result.summary.warnings) out.push_back(WithFlagNames(w, kPitchFlags));
   return out;
 }
 
-std::vector<std::string> SyncWarnings(const pipeline::SyncRunResult& result) {
+std::vector<std::string> SyncWarnings(const capture::SyncRunResult& result) {
   std::vector<std::string> out;
   for (const auto& w : result.sync.warnings) out.push_back(WithFlagNames(w, kSyncFlags));
   return out;

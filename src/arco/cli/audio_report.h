@@ -5,16 +5,16 @@
 #include <string>
 #include <vector>
 
-#include "arco/pipeline/pitch_sync.h"
+#include "arco/capture/pitch_sync.h"
 
 namespace arco::cli {
 
-std::string FormatPitchReport(const pipeline::PitchRunOptions& options,
-                              const pipeline::PitchRunResult& result);
-std::string FormatSyncReport(const pipeline::SyncRunOptions& options,
-                             const pipeline::SyncRunResult& result);
+std::string FormatPitchReport(const capture::PitchRunOptions& options,
+                              const capture::PitchRunResult& result);
+std::string FormatSyncReport(const capture::SyncRunOptions& options,
+                             const capture::SyncRunResult& result);
 // Their warnings (for stderr: PrintWarning), the fields named by the command's flags.
-std::vector<std::string> PitchWarnings(const pipeline::PitchRunResult& result);
-std::vector<std::string> SyncWarnings(const pipeline::SyncRunResult& result);
+std::vector<std::string> PitchWarnings(const capture::PitchRunResult& result);
+std::vector<std::string> SyncWarnings(const capture::SyncRunResult& result);
 
 }  // namespace arco::cli

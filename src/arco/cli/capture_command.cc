@@ -1,6 +1,6 @@
-// `arco capture new`: a capture folder that references videos (pipeline/capture_new.h);
+// `arco capture new`: a capture folder that references videos (capture/capture_new.h);
 // `arco capture import-keypoints`: another detector's 2D keypoints into a capture
-// (pipeline/import_keypoints.h).
+// (capture/import_keypoints.h).
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
@@ -9,13 +9,13 @@
 #include <string>
 #include <vector>
 
+#include "arco/capture/capture_new.h"
+#include "arco/capture/import_keypoints.h"
 #include "arco/cli/command.h"
 #include "arco/cli/command_paths.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
 #include "arco/mocap/capture.h"
-#include "arco/pipeline/capture_new.h"
-#include "arco/pipeline/import_keypoints.h"
 
 namespace arco::cli {
 namespace {
@@ -62,11 +62,11 @@ int64_t ParseWhole(const std::string& flag, const std::string& text, int64_t min
 struct CaptureNewArgs {
   std::vector<std::string> videos, images, rotate, drops;
   std::string sync = "none";
-  pipeline::CaptureNewOptions options;
+  capture::CaptureNewOptions options;
   // The typed options from the CAMERA=VALUE lists (parse-complete).
   void Convert() {
     auto& o = options;
-    o.sync = sync == "audio" ? pipeline::CaptureSync::kAudio : pipeline::CaptureSync::kNone;
+    o.sync = sync == "audio" ? capture::CaptureSync::kAudio : capture::CaptureSync::kNone;
     o.inputs.clear();
     for (const std::string& v : videos) {
       const auto [camera, path] = SplitAssignment("--video", v, "CAMERA=FILE");
@@ -104,11 +104,11 @@ struct CaptureNewArgs {
   }
 };
 
-int RunCaptureNew(const pipeline::CaptureNewOptions& o) {
-  auto r = pipeline::CreateCapture(o);
+int RunCaptureNew(const capture::CaptureNewOptions& o) {
+  auto r = capture::CreateCapture(o);
   if (!r.ok()) return PrintError(WithFlagNames(r.status().message(), kCaptureFlags));
-  const bool synced = o.sync == pipeline::CaptureSync::kAudio;
-  for (const pipeline::CaptureNewCamera& c : r->cameras) {
+  const bool synced = o.sync == capture::CaptureSync::kAudio;
+  for (const capture::CaptureNewCamera& c : r->cameras) {
     if (synced) {
       std::printf("  %-12s starts at %+.6f s, clock %+.1f ppm, confidence %.2f\n",
                   c.name.c_str(),
@@ -144,7 +144,7 @@ int RunCaptureNew(const pipeline::CaptureNewOptions& o) {
 
 struct ImportArgs {
   std::vector<std::string> cameras;
-  pipeline::ImportKeypointsOptions options;
+  capture::ImportKeypointsOptions options;
   void Convert() {
     options.sources.clear();
     for (const std::string& c : cameras) {
@@ -154,8 +154,8 @@ struct ImportArgs {
   }
 };
 
-int RunImportKeypoints(const pipeline::ImportKeypointsOptions& o) {
-  auto r = pipeline::ImportKeypoints(o);
+int RunImportKeypoints(const capture::ImportKeypointsOptions& o) {
+  auto r = capture::ImportKeypoints(o);
   if (!r.ok()) return PrintError(WithFlagNames(r.status().message(), kCaptureFlags));
   std::printf(
       "imported %lld frames x %lld views x %lld points (%s, layout %s): %lld detections, %lld "

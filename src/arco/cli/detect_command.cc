@@ -1,15 +1,15 @@
 // `arco detect CAPTURE`: the body and both hands in every camera's video
-// (pipeline/detect_stage.h, docs/detect.md).
+// (capture/detect_stage.h, docs/detect.md).
 #include <cstdio>
 #include <memory>
 #include <string>
 
+#include "arco/capture/detect_stage.h"
 #include "arco/cli/command.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/frame_range.h"
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
-#include "arco/pipeline/detect_stage.h"
 #include "arco/util/output_set.h"
 
 namespace arco::cli {
@@ -23,7 +23,7 @@ inline constexpr FieldFlag kDetectFlags[] = {{"num_threads", "--threads"},
                                              {"min_hand_presence", "--min-hand-presence"}};
 
 struct DetectArgs {
-  pipeline::DetectStageOptions o;
+  capture::DetectStageOptions o;
   std::string model = "full";
   std::string hand_model = "full";
   std::string frames;  // FIRST:LAST
@@ -47,7 +47,7 @@ void ApplyAndValidate(DetectArgs& a) {
 
 int RunDetect(const DetectArgs& a) {
   ProgressBar bar("detect");
-  auto summary = pipeline::RunDetectStage(a.o, bar);
+  auto summary = capture::RunDetectStage(a.o, bar);
   bar.Finish();
   if (!summary.ok()) return PrintError(summary.status().message());
   const auto& s = *summary;
@@ -117,7 +117,7 @@ std::function<int()> SetupDetect(CLI::App& app) {
             "--chunk-frames",
             a->o.chunk_frames,
             "Frames per work item; tracking restarts with person detection at each chunk",
-            pipeline::kDetectChunkFramesRange)
+            capture::kDetectChunkFramesRange)
       ->capture_default_str();
   AddNumber(sub,
             "--min-detection-score",

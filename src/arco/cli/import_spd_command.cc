@@ -2,10 +2,10 @@
 #include <cstdio>
 #include <memory>
 
+#include "arco/capture/import_spd.h"
 #include "arco/cli/command.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
-#include "arco/pipeline/import_spd.h"
 
 namespace arco::cli {
 namespace {
@@ -15,7 +15,7 @@ inline constexpr FieldFlag kImportSpdFlags[] = {{"frame_first", "--first"},
                                                 {"frame_last", "--last"}};
 
 CommandRun Setup(CLI::App& app) {
-  auto o = std::make_shared<pipeline::ImportSpdOptions>();
+  auto o = std::make_shared<capture::ImportSpdOptions>();
   CLI::App* sub = app.add_subcommand(
       "import-spd",
       "Turn SPD per-frame 2D keypoint folders (HUMAN_DIR/<serial>/<n>.json, bare NaN, "
@@ -72,7 +72,7 @@ CommandRun Setup(CLI::App& app) {
   };
   return CommandRun(
       [o]() {
-        auto r = pipeline::ImportSpdCapture(*o);
+        auto r = capture::ImportSpdCapture(*o);
         if (!r.ok()) return PrintError(WithFlagNames(r.status().message(), kImportSpdFlags));
         std::printf(
             "imported %lld frames x %lld views x %lld points (%lld files read, %lld missing -> "

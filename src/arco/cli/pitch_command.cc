@@ -13,7 +13,7 @@ namespace arco::cli {
 namespace {
 
 CommandRun SetupPitch(CLI::App& app) {
-  auto o = std::make_shared<pipeline::PitchRunOptions>();
+  auto o = std::make_shared<capture::PitchRunOptions>();
   auto* cmd = app.add_subcommand(
       "pitch", "Pitch (f0) at video-frame times: pitch.csv with one row per frame");
   cmd->add_option("input", o->input, "Audio file (WAV/FLAC/OGG/...) or a video with audio");
@@ -95,7 +95,7 @@ CommandRun SetupPitch(CLI::App& app) {
   return CommandRun(
       [o] {
         ProgressBar bar("pitch");  // the bar starts at TrackPitch's SetTotal
-        auto result = pipeline::RunPitch(*o, bar);
+        auto result = capture::RunPitch(*o, bar);
         bar.Finish();
         if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kPitchFlags));
         std::fputs(FormatPitchReport(*o, *result).c_str(), stdout);

@@ -20,7 +20,7 @@ std::string FormatRefineSummary(const refine::RefineSummary& summary);
 std::string FormatStageLine(const pipeline::RunSummary& summary,
                             const pipeline::StageTiming& timing);
 
-// Human-readable report of pipeline::TriangulateLabelViews' JSON.
+// Human-readable report of capture::TriangulateLabelViews' JSON.
 std::string FormatLabelViewsReport(const Json& result);
 
 }  // namespace arco::cli

@@ -3,8 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "arco/capture/label_views.h"
 #include "arco/cli/audio_report.h"
-#include "arco/pipeline/label_views.h"
 
 namespace arco::cli {
 namespace {
@@ -12,14 +12,14 @@ namespace {
 const std::string kSpd = std::string(ARCO_SHARED_DATA_DIR) + "/spd/";
 
 TEST(FormatLabelViewsReport, RealLabelsScaledToTheCello) {
-  pipeline::LabelViewsOptions o;
+  capture::LabelViewsOptions o;
   o.calibration = kSpd + "cello_1113_scale_camera.xml";
   for (const char* s : {"21334181", "21334190", "21334211", "21334237"}) {
     o.views.emplace_back(s,
                          kSpd + "labels_frame128/cello_1113_scale_" + std::string(s) + "_128.json");
   }
   o.reference_string_length_mm = 695;
-  auto r = pipeline::TriangulateLabelViews(o);
+  auto r = capture::TriangulateLabelViews(o);
   ASSERT_TRUE(r.ok()) << r.status().message();
   const std::string report = FormatLabelViewsReport(*r);
   EXPECT_NE(report.find("overall reprojection RMS"), std::string::npos);
@@ -45,9 +45,9 @@ TEST(FormatStageLine, OneLinePerStage) {
 }
 
 TEST(FormatPitchReport, NotesAndWarningsWithTheCommandsFlags) {
-  pipeline::PitchRunOptions o;
+  capture::PitchRunOptions o;
   o.output = "p.csv";
-  pipeline::PitchRunResult r;
+  capture::PitchRunResult r;
   r.input = "take.wav";
   r.fine_fps = 120;
   r.notes = 2;

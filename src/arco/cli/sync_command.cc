@@ -11,7 +11,7 @@ namespace arco::cli {
 namespace {
 
 std::function<int()> SetupSync(CLI::App& app) {
-  auto o = std::make_shared<pipeline::SyncRunOptions>();
+  auto o = std::make_shared<capture::SyncRunOptions>();
   auto* cmd = app.add_subcommand(
       "sync", "Find a clap/flash in audio and video; print offset_s (audio = video + offset)");
   cmd->add_option("audio", o->audio, "Audio recording (or a video whose audio track to use)")
@@ -58,7 +58,7 @@ std::function<int()> SetupSync(CLI::App& app) {
                   "confidence as audio.offset_s / audio.sync_confidence in its capture.json");
   return [o, event] {
     o->sync.video_event = *event == "flash" ? audio::VideoEvent::kFlash : audio::VideoEvent::kClap;
-    auto result = pipeline::RunSync(*o);
+    auto result = capture::RunSync(*o);
     if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kSyncFlags));
     std::fputs(FormatSyncReport(*o, *result).c_str(), stdout);
     for (const std::string& w : SyncWarnings(*result)) PrintWarning(w);

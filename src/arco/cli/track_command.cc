@@ -1,16 +1,16 @@
 // `arco track CAPTURE --labels CAMERA=LABELME.json ...`: the instrument's points in every
-// camera and frame from labels of one frame in two views (pipeline/track_stage.h,
+// camera and frame from labels of one frame in two views (capture/track_stage.h,
 // docs/track.md).
 #include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "arco/capture/track_stage.h"
 #include "arco/cli/command.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
-#include "arco/pipeline/track_stage.h"
 #include "arco/util/output_set.h"
 
 namespace arco::cli {
@@ -24,7 +24,7 @@ inline constexpr FieldFlag kTrackFlags[] = {{"num_threads", "--threads"},
                                             {"inlier_px", "--inlier-px"}};
 
 struct TrackArgs {
-  pipeline::TrackStageOptions o;
+  capture::TrackStageOptions o;
   std::vector<std::string> labels;
   int64_t labels_frame = -1;
 };
@@ -32,7 +32,7 @@ struct TrackArgs {
 void ApplyAndValidate(TrackArgs& a) {
   a.o.labels.clear();
   for (const std::string& text : a.labels) {
-    auto spec = pipeline::ParseTrackLabelsSpec(text);
+    auto spec = capture::ParseTrackLabelsSpec(text);
     ThrowIfInvalid(spec.status());
     a.o.labels.push_back(*spec);
   }
@@ -43,7 +43,7 @@ void ApplyAndValidate(TrackArgs& a) {
 
 int RunTrack(const TrackArgs& a) {
   ProgressBar bar("track");
-  auto summary = pipeline::RunTrackStage(a.o, bar);
+  auto summary = capture::RunTrackStage(a.o, bar);
   bar.Finish();
   if (!summary.ok()) return PrintError(WithFlagNames(summary.status().message(), kTrackFlags));
   const auto& s = *summary;

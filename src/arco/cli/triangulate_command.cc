@@ -3,14 +3,14 @@
 #include <cstdio>
 #include <memory>
 
+#include "arco/capture/label_views.h"
 #include "arco/cli/command.h"
 #include "arco/cli/command_paths.h"
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
 #include "arco/cli/report.h"
-#include "arco/pipeline/label_views.h"
-#include "arco/pipeline/triangulate_stage.h"
 #include "arco/instrument/instrument_model.h"
+#include "arco/pipeline/triangulate_stage.h"
 #include "arco/util/output_set.h"
 
 namespace arco::cli {
@@ -36,7 +36,7 @@ StatusOr<std::pair<std::string, std::string>> SplitAssignment(const std::string&
 }
 
 int RunViews(const Args& a) {
-  pipeline::LabelViewsOptions o;
+  capture::LabelViewsOptions o;
   o.calibration = a.calibration;
   o.triangulation = a.t;
   o.ignore_distortion = a.ignore_distortion;
@@ -53,7 +53,7 @@ int RunViews(const Args& a) {
   }
   const Status writable = CheckOutputFile(a.output);  // before the work
   if (!writable.ok()) return PrintError(writable.message());
-  auto result = pipeline::TriangulateLabelViews(o);
+  auto result = capture::TriangulateLabelViews(o);
   if (!result.ok()) return PrintError(result.status().message());
   const Status written = WriteJsonFile(a.output, *result);
   if (!written.ok()) return PrintError(written.message());

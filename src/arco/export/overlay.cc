@@ -9,12 +9,12 @@
 #include <vector>
 
 #include "arco/calibration/calibration_file.h"
+#include "arco/capture/capture_videos.h"
 #include "arco/export/export.h"
 #include "arco/media/video_reader.h"
 #include "arco/media/video_writer.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/capture_checks.h"
-#include "arco/pipeline/capture_videos.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/refine/contact_annotation.h"
 #include "arco/registry/keypoint_layout.h"
@@ -318,7 +318,7 @@ StatusOr<OverlaySummary> WriteOverlay(const OverlayOptions& options,
                                             ": calibration");
   }
   ARCO_ASSIGN_OR_RETURN(const std::vector<int> rig_index,
-                        pipeline::MatchCaptureCameras(
+                        capture::MatchCaptureCameras(
                             header.capture_dir, manifest, calibration->rig, calibration_path));
   const Camera& camera = calibration->rig.cameras[rig_index[view]];
 
@@ -344,12 +344,12 @@ StatusOr<OverlaySummary> WriteOverlay(const OverlayOptions& options,
   // The background video, when the camera has one.
   OverlaySummary summary;
   summary.camera = manifest.cameras[view].name;
-  std::optional<pipeline::CaptureFrameReader> reader;
+  std::optional<capture::CaptureFrameReader> reader;
   int rotate_deg = 0;
   if (!manifest.cameras[view].video.empty()) {
     ARCO_ASSIGN_OR_RETURN(
-        pipeline::CaptureVideo video,
-        pipeline::OpenCaptureVideo(
+        capture::CaptureVideo video,
+        capture::OpenCaptureVideo(
             header.capture_dir, manifest, view, camera, calibration_path, first, last));
     rotate_deg = video.rotate_deg;
     summary.video = video.video;

@@ -6,10 +6,10 @@
 #include <optional>
 
 #include "arco/calibration/calibration_file.h"
+#include "arco/capture/label_views.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/triangulate_point.h"
 #include "arco/pipeline/capture_checks.h"
-#include "arco/pipeline/label_views.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/util/file_io.h"
 #include "arco/util/stats.h"
@@ -84,10 +84,10 @@ Status Flag(const CalibrationCheckOptions& options,
 }
 
 StatusOr<CalibrationCheckSummary> CheckLabelViews(const CalibrationCheckOptions& options) {
-  LabelViewsOptions labels;
+  capture::LabelViewsOptions labels;
   labels.calibration = options.calibration;
   labels.views = options.label_views;
-  ARCO_ASSIGN_OR_RETURN(const Json triangulated, TriangulateLabelViews(labels));
+  ARCO_ASSIGN_OR_RETURN(const Json triangulated, capture::TriangulateLabelViews(labels));
   CalibrationCheckSummary summary;
   summary.calibration = options.calibration;
   summary.frames = 1;
@@ -140,8 +140,9 @@ StatusOr<CalibrationCheckSummary> CheckCalibration(const CalibrationCheckOptions
   if (result_points && header.units != rig.units)
     return Status::Error(options.capture_dir + "/result.json: points in '" + header.units +
                          "', the calibration " + summary.calibration + " in '" + rig.units + "'");
-  ARCO_ASSIGN_OR_RETURN(const std::vector<int> view_to_camera,
-                        MatchCaptureCameras(capture_dir, manifest, rig, summary.calibration));
+  ARCO_ASSIGN_OR_RETURN(
+      const std::vector<int> view_to_camera,
+      capture::MatchCaptureCameras(capture_dir, manifest, rig, summary.calibration));
   ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(capture_dir, manifest));
   ARCO_ASSIGN_OR_RETURN(const NpyArray<double> keypoints,
                         ReadCaptureKeypoints2d(capture_dir, manifest));

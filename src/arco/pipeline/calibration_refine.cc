@@ -132,7 +132,7 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
   summary.units = input.units;
   ARCO_ASSIGN_OR_RETURN(
       const std::vector<int> view_to_camera,
-      MatchCaptureCameras(options.capture_dir, manifest, input, summary.calibration));
+      capture::MatchCaptureCameras(options.capture_dir, manifest, input, summary.calibration));
   const int num_cameras = static_cast<int>(input.cameras.size());
   if (view_to_camera.size() < 2)
     return Status::Error(options.capture_dir +

@@ -1,26 +1,21 @@
-// The checks of a capture's inputs, one function each, for every command that reads them
-// (arco run's PreflightRun in run_capture.h, arco triangulate, arco pitch --capture, arco
-// calibrate check/refine, arco overlay, importers). Errors are one line naming the file
-// and the field (docs/architecture.md, "Validation rules").
+// The checks of an opened capture's inputs (CaptureContext), one function each, for the
+// commands that read them (arco run's PreflightRun in run_capture.h, arco triangulate, arco
+// calibrate check/refine, arco overlay); the checks that need only the manifest
+// (MatchCaptureCameras, the audio check) are capture/capture_checks.h's. Errors are one line naming
+// the file and the field (docs/architecture.md, "Validation rules").
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "arco/camera/rig.h"
+#include "arco/capture/capture_checks.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/capture_context.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/util/status.h"
 
 namespace arco::pipeline {
-
-// The calibration camera of each capture camera (by name, else serial), in the manifest's
-// order. Error naming capture.json, the camera and the calibration file for one absent.
-StatusOr<std::vector<int>> MatchCaptureCameras(const std::string& capture_dir,
-                                               const CaptureManifest& manifest,
-                                               const Rig& rig,
-                                               const std::string& calibration_path);
 
 // The capture's calibration (`calibration` in capture.json) is readable and holds every
 // capture camera.
@@ -30,23 +25,9 @@ Status CheckCaptureCalibration(const std::string& capture_dir, const CaptureMani
 // once.
 Status LoadCaptureCalibration(CaptureContext* capture);
 
-// What the audio check learnt (for messages and tests).
-struct CaptureAudioCheck {
-  std::string path;       // resolved audio.file
-  double duration_s = 0;  // decoded length
-  std::string format;     // the decoder's name for it
-};
-
-// The capture's audio (`audio.file`) exists, opens and decodes (its first samples; the
-// length from the header, or by decoding it all when the container does not say), and
-// `audio.offset_s` puts at least one video frame inside it: an offset at or after the
-// audio's end, or one whose last frame comes before the audio starts, is an error naming
-// capture.json's audio.offset_s (frames partly outside are the pitch stage's warning).
-// A capture without audio passes.
-StatusOr<CaptureAudioCheck> CheckCaptureAudio(const std::string& capture_dir,
-                                              const CaptureManifest& manifest);
-// The same, decoding capture.audio_bytes when read (OpenCaptureAudio).
-StatusOr<CaptureAudioCheck> CheckCaptureAudio(const CaptureContext& capture);
+// The audio check (capture/capture_checks.h), decoding capture.audio_bytes when read
+// (OpenCaptureAudio).
+StatusOr<capture::CaptureAudioCheck> CheckCaptureAudio(const CaptureContext& capture);
 
 // The temporal filters of the triangulation options name groups of `layout` and suit the
 // capture's frame rate.

@@ -5,7 +5,7 @@
 
 #include "arco/audio/notes.h"
 #include "arco/audio/pitch_tracker.h"
-#include "arco/pipeline/pitch_sync.h"
+#include "arco/capture/pitch_sync.h"
 #include "arco/pipeline/result_folder.h"
 
 namespace arco::pipeline {
@@ -30,13 +30,13 @@ StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
     return record;
   }
   // The capture's values, as `arco pitch --capture` takes them from capture.json.
-  PitchRunOptions run;
+  capture::PitchRunOptions run;
   run.instrument = capture.instrument->name();
   run.fps = m.fps;
   run.start_s = m.audio_offset_s;
   run.frames = m.frame_count;
   run.a4_hz = m.tuning_a4_hz;
-  ARCO_ASSIGN_OR_RETURN(const audio::PitchTrackerOptions po, PitchTrackerOptionsFor(run));
+  ARCO_ASSIGN_OR_RETURN(const audio::PitchTrackerOptions po, capture::PitchTrackerOptionsFor(run));
   const std::string audio_path = ResolveCapturePath(capture.capture_dir, m.audio);
   audio::PitchSummary tracked;
   ARCO_RETURN_IF_ERROR(po.Validate());

@@ -66,7 +66,7 @@ struct TestCapture {
 TEST(PreflightRun, AcceptsAGoodCaptureAndCreatesNothing) {
   TestCapture c;
   EXPECT_EQ(c.Preflight(), "ok");
-  auto audio = CheckCaptureAudio(c.dir.path(), c.manifest);
+  auto audio = capture::CheckCaptureAudio(c.dir.path(), c.manifest);
   ASSERT_TRUE(audio.ok()) << audio.status().message();
   EXPECT_DOUBLE_EQ(audio->duration_s, 2.0);
   EXPECT_EQ(audio->path, c.dir / "audio.wav");

@@ -50,7 +50,7 @@ StatusOr<CaptureContext> OpenForTriangulation(const TriangulateStageOptions& o) 
   if (!calibration.ok()) return calibration.status().WithContext(manifest_path + ": calibration");
   ARCO_ASSIGN_OR_RETURN(
       capture.view_to_camera,
-      MatchCaptureCameras(o.capture_dir, manifest, calibration->rig, calibration_path));
+      capture::MatchCaptureCameras(o.capture_dir, manifest, calibration->rig, calibration_path));
   capture.calibration = std::move(calibration).value();
   ARCO_ASSIGN_OR_RETURN(capture.keypoints2d, ReadKeypoints2d(capture));
   ARCO_ASSIGN_OR_RETURN(

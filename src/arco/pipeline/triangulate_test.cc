@@ -6,7 +6,7 @@
 #include <filesystem>
 
 #include "arco/calibration/calibration_file.h"
-#include "arco/pipeline/label_views.h"
+#include "arco/capture/label_views.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/testing/synthetic_views.h"
@@ -21,8 +21,8 @@ using arco::testing::TempDir;
 const std::string kSpd = std::string(ARCO_SHARED_DATA_DIR) + "/spd/";
 const char* kSerials[] = {"21334181", "21334190", "21334211", "21334237"};
 
-LabelViewsOptions RealLabels() {
-  LabelViewsOptions o;
+capture::LabelViewsOptions RealLabels() {
+  capture::LabelViewsOptions o;
   o.calibration = kSpd + "cello_1113_scale_camera.xml";
   for (const char* s : kSerials) {
     o.views.emplace_back(s, kSpd + "labels_frame128/cello_1113_scale_" + s + "_128.json");
@@ -32,7 +32,7 @@ LabelViewsOptions RealLabels() {
 
 // The acceptance test of issue 2 on the real frame-128 labels.
 TEST(TriangulateLabelViews, RealSpdLabelsMeetTheReprojectionAndStringSideBars) {
-  auto r = TriangulateLabelViews(RealLabels());
+  auto r = capture::TriangulateLabelViews(RealLabels());
   ASSERT_TRUE(r.ok()) << r.status().message();
   const double rms = (*r)["rms_reprojection_px"];
   EXPECT_LE(rms, 2.6);
@@ -55,10 +55,10 @@ TEST(TriangulateLabelViews, RealSpdLabelsMeetTheReprojectionAndStringSideBars) {
 }
 
 TEST(TriangulateLabelViews, IgnoringDistortionRaisesTheError) {
-  LabelViewsOptions o = RealLabels();
-  auto with = TriangulateLabelViews(o);
+  capture::LabelViewsOptions o = RealLabels();
+  auto with = capture::TriangulateLabelViews(o);
   o.ignore_distortion = true;
-  auto without = TriangulateLabelViews(o);
+  auto without = capture::TriangulateLabelViews(o);
   ASSERT_TRUE(with.ok() && without.ok());
   const double a = (*with)["rms_reprojection_px"], b = (*without)["rms_reprojection_px"];
   EXPECT_GT(b, a + 0.5);  // DOMAIN.md: about 3.4 px without, 2.4-2.5 px with
@@ -70,12 +70,12 @@ TEST(TriangulateLabelViews, SameResultWithCameraNamesAndSpdJsonCalibration) {
   // SPD JSON names cameras camK: 21334181 = cam0, 21334190 = cam18, 21334211 = cam19,
   // 21334237 = cam1 (spd/README.md). Its converter dropped the distortion, which arco
   // reads back, so the results must agree with the XML.
-  LabelViewsOptions o = RealLabels();
+  capture::LabelViewsOptions o = RealLabels();
   o.calibration = kSpd + "cello_1113_scale_camera.json";
   const char* names[] = {"cam0", "cam18", "cam19", "cam1"};
   for (int i = 0; i < 4; ++i) o.views[i].first = names[i];
-  auto json = TriangulateLabelViews(o);
-  auto xml = TriangulateLabelViews(RealLabels());
+  auto json = capture::TriangulateLabelViews(o);
+  auto xml = capture::TriangulateLabelViews(RealLabels());
   ASSERT_TRUE(json.ok()) << json.status().message();
   ASSERT_TRUE(xml.ok());
   EXPECT_NEAR((*json)["rms_reprojection_px"].get<double>(),
@@ -84,10 +84,10 @@ TEST(TriangulateLabelViews, SameResultWithCameraNamesAndSpdJsonCalibration) {
 }
 
 TEST(TriangulateLabelViews, ViewOrderDoesNotChangeThePoints) {
-  LabelViewsOptions o = RealLabels();
-  auto a = TriangulateLabelViews(o);
+  capture::LabelViewsOptions o = RealLabels();
+  auto a = capture::TriangulateLabelViews(o);
   std::reverse(o.views.begin(), o.views.end());
-  auto b = TriangulateLabelViews(o);
+  auto b = capture::TriangulateLabelViews(o);
   ASSERT_TRUE(a.ok() && b.ok());
   for (const Json& pa : (*a)["points"]) {
     bool found = false;
@@ -101,9 +101,9 @@ TEST(TriangulateLabelViews, ViewOrderDoesNotChangeThePoints) {
 }
 
 TEST(TriangulateLabelViews, ScaleToInstrumentReportsMillimetres) {
-  LabelViewsOptions o = RealLabels();
+  capture::LabelViewsOptions o = RealLabels();
   o.reference_string_length_mm = 695;
-  auto r = TriangulateLabelViews(o);
+  auto r = capture::TriangulateLabelViews(o);
   ASSERT_TRUE(r.ok());
   const Json& l = (*r)["lengths"];
   EXPECT_NEAR(0.5 * (l["nut_l-bridge_l_mm"].get<double>() + l["nut_r-bridge_r_mm"].get<double>()),
@@ -114,8 +114,8 @@ TEST(TriangulateLabelViews, ScaleToInstrumentReportsMillimetres) {
   EXPECT_NEAR(l["bridge_l-bridge_r_mm"].get<double>(), 48.2, 4.0);
 }
 
-void ExpectError(const LabelViewsOptions& o, const std::string& words) {
-  auto r = TriangulateLabelViews(o);
+void ExpectError(const capture::LabelViewsOptions& o, const std::string& words) {
+  auto r = capture::TriangulateLabelViews(o);
   ASSERT_FALSE(r.ok()) << "expected an error about " << words;
   EXPECT_NE(r.status().message().find(words), std::string::npos) << r.status().message();
   EXPECT_EQ(r.status().message().find('\n'), std::string::npos);  // one line
@@ -123,7 +123,7 @@ void ExpectError(const LabelViewsOptions& o, const std::string& words) {
 
 TEST(TriangulateLabelViews, BadInputsGiveOneLineErrors) {
   TempDir dir;
-  LabelViewsOptions o = RealLabels();
+  capture::LabelViewsOptions o = RealLabels();
   o.views.resize(1);
   ExpectError(o, "at least two");
 

@@ -7,7 +7,7 @@
 
 #include "arco/audio/audio_reader.h"
 #include "arco/audio/pitch_tracker.h"
-#include "arco/pipeline/pitch_sync.h"
+#include "arco/capture/pitch_sync.h"
 #include "arco/python/bindings.h"
 
 namespace arco::python {
@@ -97,7 +97,7 @@ py::dict TrackPitch(const py::array_t<float, py::array::c_style | py::array::for
   CheckValid(CheckInRange("a4_hz", a4_hz, kA4RangeHz));
   CheckValid(
       audio::CheckSamples(samples.data(), samples.size(), channels, 0, sample_rate, "samples"));
-  pipeline::PitchRunOptions o;
+  capture::PitchRunOptions o;
   o.instrument = instrument;
   o.fps = fps;
   o.start_s = start_s;
@@ -106,7 +106,7 @@ py::dict TrackPitch(const py::array_t<float, py::array::c_style | py::array::for
   o.a4_hz = a4_hz;
   o.min_f0_hz = min_f0_hz;
   o.max_f0_hz = max_f0_hz;
-  const StatusOr<audio::PitchTrackerOptions> tracker = pipeline::PitchTrackerOptionsFor(o);
+  const StatusOr<audio::PitchTrackerOptions> tracker = capture::PitchTrackerOptionsFor(o);
   CheckValid(tracker.status());
   audio::PitchSummary summary;
   auto reader =

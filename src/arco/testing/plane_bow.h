@@ -1,4 +1,4 @@
-// A bow for the tracking tests and benchmarks (pipeline_track_bow_test, track_bench's
+// A bow for the tracking tests and benchmarks (capture_track_bow_test, track_bench's
 // BM_TrackBow): its texture as a plane of the plane scene (plane_scene.h) and a bowing
 // motion with known truth.
 #pragma once

@@ -47,7 +47,7 @@
 
 #include "arco/util/status.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 
 struct CaptureNewInput {
   std::string camera;   // a calibration camera's name or serial
@@ -103,4 +103,4 @@ struct CaptureNewSummary {
 
 StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& options);
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

@@ -1,4 +1,4 @@
-#include "arco/pipeline/pitch_sync.h"
+#include "arco/capture/pitch_sync.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,12 +7,12 @@
 #include <utility>
 
 #include "arco/audio/double_stops.h"
+#include "arco/capture/capture_checks.h"
 #include "arco/mocap/capture.h"
-#include "arco/pipeline/capture_checks.h"
 #include "arco/util/file_io.h"
 #include "arco/util/output_set.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 std::string InstrumentFromManifest(const std::string& name) {
@@ -221,4 +221,4 @@ StatusOr<SyncRunResult> RunSync(const SyncRunOptions& o) {
   return out;
 }
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

@@ -9,7 +9,7 @@
 #include "arco/mocap/spd_import.h"
 #include "arco/util/status.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 
 struct ImportSpdOptions {
   std::string calibration;           // copied into the capture; gives camera names and serials
@@ -38,4 +38,4 @@ struct ImportSpdSummary {
 // a temporary folder and renamed into place, so nothing is left on error.
 StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& options);
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

@@ -17,7 +17,7 @@
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 
 // One labelme file: the labels of `camera` (name or serial) on global frame `frame`
 // (-1: TrackStageOptions::labels_frame).
@@ -39,8 +39,8 @@ struct TrackStageOptions {
   // The bow as a thin rigid body of fixed length from its frog and tip labels
   // (track/bow_tracker.h: line segments, the profile along the stick, the pose from all
   // views at once, the right hand as the frog's prior), when both are labelled in two
-  // views. Measured on synthetic renders (pipeline_track_plane_test,
-  // pipeline_track_bow_test: 0.24 mm median against issue 13's 8 mm), not yet on real
+  // views. Measured on synthetic renders (capture_track_plane_test,
+  // capture_track_bow_test: 0.24 mm median against issue 13's 8 mm), not yet on real
   // footage (docs/track.md). false: the bow's slots keep what the file held.
   bool track_bow = true;
   track::BowTrackerOptions bow;  // its num_threads is num_threads above
@@ -76,8 +76,8 @@ struct TrackStageSummary {
   // string length. The trackers work in mm.
   std::string units;
   double mm_per_unit = 1;
-  int64_t frames_without_pose = 0;            // the pose was the prediction
-  bool bow_tracked = false;  // frog and tip labelled in two views: the bow slots written
+  int64_t frames_without_pose = 0;  // the pose was the prediction
+  bool bow_tracked = false;         // frog and tip labelled in two views: the bow slots written
   int64_t bow_frames_without_pose = 0;
   int64_t bow_hand_frames = 0;  // frames read with the right hand in two views or more
   std::vector<TrackCameraSummary> cameras;
@@ -99,4 +99,4 @@ Json ToJson(const TrackStageSummary& summary);
 StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options,
                                           Progress& progress = NoProgress());
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

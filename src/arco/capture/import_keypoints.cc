@@ -1,4 +1,4 @@
-#include "arco/pipeline/import_keypoints.h"
+#include "arco/capture/import_keypoints.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,10 +6,10 @@
 #include <set>
 
 #include "arco/calibration/calibration_file.h"
+#include "arco/capture/capture_checks.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/mmpose_json.h"
 #include "arco/mocap/openpose_json.h"
-#include "arco/pipeline/capture_checks.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/check.h"
 #include "arco/util/file_io.h"
@@ -17,7 +17,7 @@
 #include "arco/util/npy.h"
 #include "arco/util/output_set.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 constexpr char kKeypointsFile[] = "keypoints2d.npy";
@@ -201,4 +201,4 @@ StatusOr<ImportKeypointsSummary> ImportKeypoints(const ImportKeypointsOptions& o
   return out;
 }
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

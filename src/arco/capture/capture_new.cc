@@ -1,4 +1,4 @@
-#include "arco/pipeline/capture_new.h"
+#include "arco/capture/capture_new.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +18,7 @@
 #include "arco/util/number_range.h"
 #include "arco/util/output_set.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 namespace fs = std::filesystem;
@@ -457,4 +457,4 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
   return out;
 }
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

@@ -13,7 +13,7 @@
 #include "arco/audio/sync.h"
 #include "arco/util/status.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 
 struct PitchRunOptions {
   std::string input;        // audio file or video with an audio track
@@ -83,4 +83,4 @@ struct SyncRunResult {
 // Nothing is written on an error.
 StatusOr<SyncRunResult> RunSync(const SyncRunOptions& options);
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

@@ -21,12 +21,12 @@
 #include <vector>
 
 #include "arco/calibration/calibration_file.h"
+#include "arco/capture/capture_new.h"
+#include "arco/capture/track_stage.h"
 #include "arco/media/video_reader.h"
 #include "arco/media/video_writer.h"
 #include "arco/mocap/capture.h"
 #include "arco/mocap/labelme.h"
-#include "arco/pipeline/capture_new.h"
-#include "arco/pipeline/track_stage.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/testing/plane_bow.h"
@@ -37,7 +37,7 @@
 #include "arco/util/npy.h"
 #include "arco/util/stats.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 constexpr int kCameras = 6;
@@ -222,10 +222,10 @@ void MovingBow(bool plain_stick, bool with_hand_too) {
                 tracked->bow_s,
                 kFrames * kCameras,
                 1e3 * tracked->bow_s / (kFrames * kCameras));
-    TriangulateStageOptions t;
+    pipeline::TriangulateStageOptions t;
     t.capture_dir = c.output_dir;
     t.result_dir = dir / ("result_" + name);
-    ASSERT_TRUE(RunTriangulateStage(t).ok());
+    ASSERT_TRUE(pipeline::RunTriangulateStage(t).ok());
     auto kp = ReadNpy<float>(c.output_dir + "/keypoints2d.npy");
     auto p3 = ReadNpy<double>(t.result_dir + "/triangulation/points3d_raw.npy");
     ASSERT_TRUE(kp.ok() && p3.ok());
@@ -301,4 +301,4 @@ TEST(TrackBow, APlainStickMovesOnItsOwn) {
 }
 
 }  // namespace
-}  // namespace arco::pipeline
+}  // namespace arco::capture

@@ -14,7 +14,7 @@
 #include "arco/util/json_io.h"
 #include "arco/util/status.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 
 struct LabelViewsOptions {
   std::string calibration;  // any calibration format LoadCalibration reads
@@ -38,4 +38,4 @@ struct LabelViewsOptions {
 // label triangulated at all.
 StatusOr<Json> TriangulateLabelViews(const LabelViewsOptions& options);
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

@@ -28,7 +28,7 @@
 
 #include "arco/util/status.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 
 struct ImportKeypointsSource {
   std::string camera;  // the capture's camera name or serial
@@ -68,4 +68,4 @@ Eigen::Vector2d RotateDecodedPixel(const Eigen::Vector2d& pixel,
                                    int rotate_deg,
                                    const Eigen::Vector2i& rotated_size);
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

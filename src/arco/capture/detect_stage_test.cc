@@ -2,7 +2,7 @@
 // messi5.jpg): rotation into the calibration's orientation, determinism across thread
 // counts and chunking, the instrument slots and other frames kept, and bad input that
 // changes nothing.
-#include "arco/pipeline/detect_stage.h"
+#include "arco/capture/detect_stage.h"
 
 #include <gtest/gtest.h>
 
@@ -15,18 +15,18 @@
 #include <vector>
 
 #include "arco/calibration/calibration_file.h"
+#include "arco/capture/capture_new.h"
 #include "arco/detect/models_for_test.h"
 #include "arco/detect/wholebody.h"
 #include "arco/media/video_reader.h"
 #include "arco/media/video_writer.h"
 #include "arco/mocap/capture.h"
-#include "arco/pipeline/capture_new.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/testing/temp_dir.h"
 #include "arco/util/json_io.h"
 #include "arco/util/npy.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 namespace fs = std::filesystem;
@@ -358,4 +358,4 @@ TEST(DetectStageOptionsTest, RangesNameTheField) {
 }
 
 }  // namespace
-}  // namespace arco::pipeline
+}  // namespace arco::capture

@@ -1,34 +1,27 @@
-#include "arco/pipeline/track_stage.h"
+#include "arco/capture/track_steps.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <map>
-#include <optional>
 #include <set>
 #include <utility>
 
 #include "arco/calibration/calibration_file.h"
 #include "arco/instrument/instrument_model.h"
 #include "arco/media/video_reader.h"
-#include "arco/mocap/capture.h"
 #include "arco/mocap/labelme.h"
-#include "arco/pipeline/capture_videos.h"
-#include "arco/registry/keypoint_layout.h"
+#include "arco/track/bow_tracker.h"
 #include "arco/util/file_io.h"
-#include "arco/util/npy.h"
-#include "arco/util/output_set.h"
+#include "arco/util/json_io.h"
 #include "arco/util/parallel.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 constexpr float kNaNf = std::numeric_limits<float>::quiet_NaN();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr char kKeypointsFile[] = "keypoints2d.npy";
-constexpr char kReportFile[] = "track.json";
 
 std::string FormatNumber(double v) {
   char text[32];
@@ -110,8 +103,8 @@ StatusOr<double> MmPerWorldUnit(const std::string& units,
   const Eigen::Vector3d nut = 0.5 * (point("nut_l") + point("nut_r"));
   const Eigen::Vector3d bridge = 0.5 * (point("bridge_l") + point("bridge_r"));
   if (!nut.allFinite() || !bridge.allFinite() || !((nut - bridge).norm() > 0)) {
-    return Status::Error(label_files + ": the calibration " + calibration_path +
-                         " is in units '" + units +
+    return Status::Error(label_files + ": the calibration " + calibration_path + " is in units '" +
+                         units +
                          "' (no metric scale): label nut_l, nut_r, bridge_l and bridge_r in two "
                          "views, whose distance gives the scale");
   }
@@ -119,144 +112,66 @@ StatusOr<double> MmPerWorldUnit(const std::string& units,
   return model.string_length_mm() / (nut - bridge).norm();
 }
 
+// The index of point p of view v in frame f (from the first) of keypoints2d.npy.
+size_t KeypointIndex(const TrackCapture& capture, int64_t f, int v, int64_t p) {
+  const int64_t views = capture.views(), points = capture.layout->size();
+  return static_cast<size_t>(((f * views + v) * points + p) * 3);
+}
+
 }  // namespace
 
-StatusOr<TrackLabelsFile> ParseTrackLabelsSpec(const std::string& text) {
-  const size_t eq = text.find('=');
-  const auto bad = [&] {
-    return Status::Error("--labels \"" + text +
-                         "\" must look like CAMERA=FILE or CAMERA@FRAME=FILE");
-  };
-  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) return bad();
-  TrackLabelsFile f;
-  f.path = text.substr(eq + 1);
-  std::string camera = text.substr(0, eq);
-  const size_t at = camera.rfind('@');
-  if (at != std::string::npos) {
-    const std::string frame = camera.substr(at + 1);
-    if (frame.empty() || frame.size() > 12 ||
-        frame.find_first_not_of("0123456789") != std::string::npos) {
-      return bad();
-    }
-    f.frame = std::stoll(frame);
-    camera = camera.substr(0, at);
-  }
-  if (camera.empty()) return bad();
-  f.camera = camera;
-  return f;
-}
-
-Status TrackStageOptions::Validate() const {
-  if (capture_dir.empty()) return Status::Error("capture_dir is empty");
-  if (labels.empty()) return Status::Error("labels is empty (labelme files of two views)");
-  if (labels_frame < -1) return Status::Error("labels_frame must be -1 (the first) or >= 0");
-  ARCO_RETURN_IF_ERROR(CheckInRange("num_threads", num_threads, Closed(0, 1024)));
-  track::InstrumentTrackerOptions t = tracker;
-  t.num_threads = 1;
-  ARCO_RETURN_IF_ERROR(t.Validate().WithContext("tracker"));
-  ARCO_RETURN_IF_ERROR(bow.Validate().WithContext("bow"));
-  ARCO_RETURN_IF_ERROR(CheckInRange("bow_hand_min_score", bow_hand_min_score, Closed(0, 1)));
-  ARCO_RETURN_IF_ERROR(CheckInRange("bow_hand_min_points", bow_hand_min_points, Closed(1, 21)));
-  return Status::Ok();
-}
-
-Json ToJson(const TrackStageOptions& o) {
-  Json labels = Json::array();
-  for (const auto& l : o.labels) {
-    labels.push_back({{"camera", l.camera}, {"frame", l.frame}, {"file", l.path}});
-  }
-  return Json{{"labels", labels},
-              {"labels_frame", o.labels_frame},
-              {"track_bow", o.track_bow},
-              {"bow", ToJson(o.bow)},
-              {"bow_hand_min_score", o.bow_hand_min_score},
-              {"bow_hand_min_points", o.bow_hand_min_points},
-              {"tracker", ToJson(o.tracker)}};
-}
-
-Json ToJson(const TrackStageSummary& s) {
-  Json cameras = Json::array();
-  for (const auto& c : s.cameras) {
-    cameras.push_back({{"camera", c.camera},
-                       {"frames", c.frames},
-                       {"lost_frames", c.lost_frames},
-                       {"reacquired", c.reacquired},
-                       {"mean_inliers", c.mean_inliers},
-                       {"mean_residual_px", c.mean_residual_px},
-                       {"bow_lost_frames", c.bow_lost_frames}});
-  }
-  return Json{{"layout", s.layout},
-              {"first_frame", s.first_frame},
-              {"last_frame", s.last_frame},
-              {"template_frame", s.template_frame},
-              {"tracked_points", s.tracked_points},
-              {"untracked_points", s.untracked_points},
-              {"label_rms_px", s.label_rms_px},
-              {"frames_without_pose", s.frames_without_pose},
-              {"bow_tracked", s.bow_tracked},
-              {"bow_frames_without_pose", s.bow_frames_without_pose},
-              {"bow_hand_frames", s.bow_hand_frames},
-              {"kept_other_points", s.kept_other_points},
-              {"units", s.units},
-              {"mm_per_unit", s.mm_per_unit},
-              {"cameras", cameras},
-              {"warnings", s.warnings},
-              {"decode_s", s.decode_s},
-              {"track_s", s.track_s},
-              {"bow_s", s.bow_s},
-              {"wall_s", s.wall_s}};
-}
-
-StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Progress& progress) {
-  const auto start = std::chrono::steady_clock::now();
-  ARCO_RETURN_IF_ERROR(options.Validate());
-  const std::string& dir = options.capture_dir;
-  const std::string manifest_path = JoinPath(dir, kCaptureManifestName);
-  ARCO_ASSIGN_OR_RETURN(CaptureManifest manifest, ReadCaptureManifest(dir));
-  TrackStageSummary summary;
-
-  // --- Checks before any frame is decoded -------------------------------------------
+StatusOr<TrackCapture> OpenTrackCapture(const std::string& capture_dir) {
+  TrackCapture c;
+  c.dir = capture_dir;
+  c.manifest_path = JoinPath(capture_dir, kCaptureManifestName);
+  ARCO_ASSIGN_OR_RETURN(c.manifest, ReadCaptureManifest(capture_dir));
+  const CaptureManifest& manifest = c.manifest;
   if (manifest.instrument == "none") {
-    return Status::Error(manifest_path + ": instrument is \"none\": nothing to track");
+    return Status::Error(c.manifest_path + ": instrument is \"none\": nothing to track");
   }
-  ARCO_ASSIGN_OR_RETURN(const std::string layout_name, DetectionLayoutName(manifest.instrument));
-  const KeypointLayout* layout = FindKeypointLayout(layout_name);
-  if (layout == nullptr) return Status::Error(manifest_path + ": no layout " + layout_name);
-  const std::vector<int>* instrument_slots = layout->Group("instrument");
-  const std::vector<int>* bow_slots = layout->Group("bow");
-  if (instrument_slots == nullptr || instrument_slots->empty()) {
-    return Status::Error(manifest_path + ": layout " + layout_name + " has no instrument points");
+  ARCO_ASSIGN_OR_RETURN(c.layout_name, DetectionLayoutName(manifest.instrument));
+  c.layout = FindKeypointLayout(c.layout_name);
+  if (c.layout == nullptr) return Status::Error(c.manifest_path + ": no layout " + c.layout_name);
+  c.instrument_slots = c.layout->Group("instrument");
+  c.bow_slots = c.layout->Group("bow");
+  if (c.instrument_slots == nullptr || c.instrument_slots->empty()) {
+    return Status::Error(c.manifest_path + ": layout " + c.layout_name +
+                         " has no instrument points");
   }
-  const int64_t points = layout->size();
-  if (manifest.frame_count <= 0) return Status::Error(manifest_path + ": frames.count is 0");
-  const int64_t first = manifest.frame_first;
-  const int64_t last = manifest.frame_first + manifest.frame_count - 1;
-  ARCO_ASSIGN_OR_RETURN(const std::vector<CaptureVideo> inputs,
-                        OpenCaptureVideos(dir, manifest, first, last));
-  const int views = static_cast<int>(inputs.size());
-  std::vector<Camera> cameras(views);
-  for (int v = 0; v < views; ++v) cameras[v] = inputs[v].calibration;
+  if (manifest.frame_count <= 0) return Status::Error(c.manifest_path + ": frames.count is 0");
+  c.first = manifest.frame_first;
+  c.last = manifest.frame_first + manifest.frame_count - 1;
+  ARCO_ASSIGN_OR_RETURN(c.inputs, OpenCaptureVideos(capture_dir, manifest, c.first, c.last));
+  c.cameras.resize(c.inputs.size());
+  for (size_t v = 0; v < c.inputs.size(); ++v) c.cameras[v] = c.inputs[v].calibration;
+  return c;
+}
 
-  // The labels: per labelled frame, per view, per instrument point.
-  std::vector<std::string> names;  // instrument points, layout order
-  for (int slot : *instrument_slots) names.push_back(layout->names[slot]);
-  std::vector<std::string> bow_names;  // frog, tip
-  if (bow_slots != nullptr)
-    for (int slot : *bow_slots) bow_names.push_back(layout->names[slot]);
-  // frame -> [view][bow point]
-  std::map<int64_t, std::vector<std::vector<Eigen::Vector2d>>> bow_labelled;
+StatusOr<TrackLabels> ReadTrackLabels(const TrackStageOptions& options,
+                                      const TrackCapture& capture,
+                                      std::vector<std::string>* warnings) {
+  const CaptureManifest& manifest = capture.manifest;
+  const KeypointLayout& layout = *capture.layout;
+  const int views = capture.views();
+  const int64_t first = capture.first, last = capture.last;
+  TrackLabels labels;
+  std::vector<std::string>& names = labels.names;
+  std::vector<std::string>& bow_names = labels.bow_names;
+  for (int slot : *capture.instrument_slots) names.push_back(layout.names[slot]);
+  if (capture.bow_slots != nullptr)
+    for (int slot : *capture.bow_slots) bow_names.push_back(layout.names[slot]);
   const int64_t default_frame = options.labels_frame >= 0 ? options.labels_frame : first;
   if (default_frame < first || default_frame > last) {
     return Status::Error("labels_frame " + std::to_string(default_frame) +
                          " is outside the capture's frames " + std::to_string(first) + ":" +
-                         std::to_string(last) + " (" + manifest_path + ")");
+                         std::to_string(last) + " (" + capture.manifest_path + ")");
   }
-  std::map<int64_t, std::vector<std::vector<Eigen::Vector2d>>> labelled;  // frame -> [view][point]
   std::set<std::string> unknown;
   for (const TrackLabelsFile& file : options.labels) {
     const int v = manifest.FindCamera(file.camera);
     if (v < 0) {
-      return Status::Error(file.path + ": camera " + file.camera + " is not in " + manifest_path);
+      return Status::Error(file.path + ": camera " + file.camera + " is not in " +
+                           capture.manifest_path);
     }
     const int64_t frame = file.frame >= 0 ? file.frame : default_frame;
     if (frame < first || frame > last) {
@@ -269,7 +184,7 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
                            std::to_string(frame));
     }
     ARCO_ASSIGN_OR_RETURN(const LabelmeAnnotation a, ReadLabelme(file.path));
-    const Camera& cam = cameras[v];
+    const Camera& cam = capture.cameras[v];
     if ((a.image_width > 0 && a.image_width != cam.width) ||
         (a.image_height > 0 && a.image_height != cam.height)) {
       return Status::Error(file.path + ": image is " + std::to_string(a.image_width) + "x" +
@@ -277,12 +192,12 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
                            std::to_string(cam.width) + "x" + std::to_string(cam.height) +
                            " (label the frame as turned by rotate_deg)");
     }
-    auto& frame_labels = labelled[frame];
+    auto& frame_labels = labels.labelled[frame];
     if (frame_labels.empty()) {
       frame_labels.assign(
           views, std::vector<Eigen::Vector2d>(names.size(), Eigen::Vector2d::Constant(kNaN)));
     }
-    auto& bow_frame_labels = bow_labelled[frame];
+    auto& bow_frame_labels = labels.bow_labelled[frame];
     if (bow_frame_labels.empty()) {
       bow_frame_labels.assign(
           views, std::vector<Eigen::Vector2d>(bow_names.size(), Eigen::Vector2d::Constant(kNaN)));
@@ -320,62 +235,75 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
     }
   }
   for (const auto& u : unknown) {
-    summary.warnings.push_back("label \"" + u + "\" is not a point of the " + manifest.instrument +
-                               " (ignored)");
+    warnings->push_back("label \"" + u + "\" is not a point of the " + manifest.instrument +
+                        " (ignored)");
   }
+  for (const auto& l : options.labels) labels.files += (labels.files.empty() ? "" : ", ") + l.path;
+  return labels;
+}
+
+StatusOr<TrackTemplates> MakeTrackTemplates(const TrackStageOptions& options,
+                                            const TrackCapture& capture,
+                                            const TrackLabels& labels,
+                                            TrackStageSummary* summary) {
+  const CaptureManifest& manifest = capture.manifest;
+  const std::vector<std::string>& names = labels.names;
+  const std::vector<std::string>& bow_names = labels.bow_names;
+  const std::string& label_files = labels.files;
+  TrackTemplates t;
   // The template from the labelled frame with the most views (ties: the earliest).
-  int64_t template_frame = -1;
   int best_views = -1;
-  for (const auto& [frame, per_view] : labelled) {
+  for (const auto& [frame, per_view] : labels.labelled) {
     int n = 0;
     for (const auto& v : per_view)
       n += std::any_of(v.begin(), v.end(), [](const auto& p) { return std::isfinite(p.x()); });
     if (n > best_views) {
       best_views = n;
-      template_frame = frame;
+      t.template_frame = frame;
     }
   }
-  std::string label_files;
-  for (const auto& l : options.labels) label_files += (label_files.empty() ? "" : ", ") + l.path;
-  track::FrameLabels frame_labels{names, labelled[template_frame]};
-  StatusOr<track::RigidTemplate> body = track::TriangulateTemplate(cameras, frame_labels);
+  const int64_t template_frame = t.template_frame;
+  track::FrameLabels frame_labels{names, labels.labelled.at(template_frame)};
+  StatusOr<track::RigidTemplate> body = track::TriangulateTemplate(capture.cameras, frame_labels);
   if (!body.ok()) return Status::Error(label_files + ": " + body.status().message());
+  t.body = std::move(body).value();
   // The trackers' lengths are mm (the bow's slide search, sample step and priors, its
   // minimum length): the world is scaled to mm for them; projections do not change
   // (t and X both times the scale). Outputs are pixels; track.json's 3D points are put
   // back into the calibration's units.
-  const std::string calibration_path = ResolveCapturePath(dir, manifest.calibration);
+  const std::string calibration_path = ResolveCapturePath(capture.dir, manifest.calibration);
   ARCO_ASSIGN_OR_RETURN(const Calibration calibration, LoadCalibration(calibration_path));
-  ARCO_ASSIGN_OR_RETURN(const double mm_per_unit,
+  ARCO_ASSIGN_OR_RETURN(t.mm_per_unit,
                         MmPerWorldUnit(calibration.rig.units,
                                        calibration_path,
                                        manifest.instrument,
                                        names,
-                                       body->points,
+                                       t.body.points,
                                        label_files));
-  summary.units = calibration.rig.units;
-  summary.mm_per_unit = mm_per_unit;
-  for (Camera& c : cameras) c.cam_from_world_translation *= mm_per_unit;
-  for (Eigen::Vector3d& x : body->points) x *= mm_per_unit;
-  body->plane_point *= mm_per_unit;
-  summary.template_frame = template_frame;
-  summary.label_rms_px = body->rms_reprojection_px;
+  const double mm_per_unit = t.mm_per_unit;
+  summary->units = calibration.rig.units;
+  summary->mm_per_unit = mm_per_unit;
+  t.cameras = capture.cameras;
+  for (Camera& c : t.cameras) c.cam_from_world_translation *= mm_per_unit;
+  for (Eigen::Vector3d& x : t.body.points) x *= mm_per_unit;
+  t.body.plane_point *= mm_per_unit;
+  summary->template_frame = template_frame;
+  summary->label_rms_px = t.body.rms_reprojection_px;
   for (size_t p = 0; p < names.size(); ++p) {
-    (std::isfinite(body->points[p].x()) ? summary.tracked_points : summary.untracked_points)
+    (std::isfinite(t.body.points[p].x()) ? summary->tracked_points : summary->untracked_points)
         .push_back(names[p]);
   }
-  for (const auto& n : summary.untracked_points) {
-    summary.warnings.push_back("point " + n + " is labelled in fewer than two views: left NaN");
+  for (const auto& n : summary->untracked_points) {
+    summary->warnings.push_back("point " + n + " is labelled in fewer than two views: left NaN");
   }
   // The bow: a thin rigid body from its frog and tip labelled in two views of the
   // template frame; else its slots are kept.
-  std::optional<track::RigidTemplate> bow_body;
   if (!bow_names.empty() && !options.track_bow) {
-    summary.warnings.push_back(
+    summary->warnings.push_back(
         "the bow is not tracked (track_bow off): its points are kept as they were");
   } else if (!bow_names.empty()) {
-    track::FrameLabels bow_frame_labels{bow_names, bow_labelled[template_frame]};
-    auto bow = track::TriangulateTemplate(cameras, bow_frame_labels, 10, /*thin=*/true);
+    track::FrameLabels bow_frame_labels{bow_names, labels.bow_labelled.at(template_frame)};
+    auto bow = track::TriangulateTemplate(t.cameras, bow_frame_labels, 10, /*thin=*/true);
     size_t bow_points = 0;
     if (bow.ok())
       for (const auto& x : bow->points) bow_points += std::isfinite(x.x());
@@ -388,42 +316,61 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
                              " mm long; scale " + FormatNumber(mm_per_unit) + " mm per " +
                              calibration.rig.units + " unit of " + calibration_path + ")");
       }
-      bow_body = *bow;
-      summary.bow_tracked = true;
+      t.bow = *bow;
+      summary->bow_tracked = true;
     } else {
-      summary.warnings.push_back(
+      summary->warnings.push_back(
           "the bow is not tracked (its frog and tip need labels in two views of frame " +
           std::to_string(template_frame) + "): its points are kept as they were");
     }
   }
+  return t;
+}
 
+StatusOr<NpyArray<float>> StartTrackKeypoints(const TrackCapture& capture,
+                                              TrackStageSummary* summary) {
+  const CaptureManifest& manifest = capture.manifest;
+  const int64_t views = capture.views(), points = capture.layout->size();
   // The keypoints already there are kept (body and hands from `arco detect`, the bow).
   NpyArray<float> out;
   out.shape = {manifest.frame_count, views, points, 3};
   out.data.assign(static_cast<size_t>(manifest.frame_count * views * points * 3), kNaNf);
-  if (!manifest.keypoints2d.empty() && manifest.layout == layout_name) {
-    ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(dir, manifest));
+  if (!manifest.keypoints2d.empty() && manifest.layout == capture.layout_name) {
+    ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(capture.dir, manifest));
     // Each camera's own frames: rewritten as they are.
-    ARCO_ASSIGN_OR_RETURN(NpyArray<double> old,
-                          ReadCaptureKeypoints2d(dir, manifest, KeypointTimes::kAsRecorded));
+    ARCO_ASSIGN_OR_RETURN(
+        NpyArray<double> old,
+        ReadCaptureKeypoints2d(capture.dir, manifest, KeypointTimes::kAsRecorded));
     for (size_t i = 0; i < out.data.size(); ++i) out.data[i] = static_cast<float>(old.data[i]);
-    summary.kept_other_points = true;
+    summary->kept_other_points = true;
   }
-  const auto at = [&](int64_t f, int v, int64_t p) {
-    return static_cast<size_t>(((f * views + v) * points + p) * 3);
-  };
+  return out;
+}
+
+StatusOr<TrackRun> TrackCaptureFrames(const TrackStageOptions& options,
+                                      const TrackCapture& capture,
+                                      const TrackLabels& labels,
+                                      const TrackTemplates& templates,
+                                      const NpyArray<float>& keypoints,
+                                      Progress& progress,
+                                      TrackStageSummary* summary) {
+  const CaptureManifest& manifest = capture.manifest;
+  const int views = capture.views();
+  const int64_t first = capture.first, last = capture.last;
+  const int64_t template_frame = templates.template_frame;
+  const std::vector<Camera>& cameras = templates.cameras;
   // The right hand per view in frame f (capture index): the mean pixel of its points that
   // `arco detect` scored at least bow_hand_min_score, when enough did; NaN otherwise.
-  const std::vector<int>* hand_slots = layout->Group("right_hand");
+  const std::vector<int>* hand_slots = capture.layout->Group("right_hand");
   const auto right_hand = [&](int64_t f, int64_t* frames_with_hand) {
     std::vector<Eigen::Vector2d> px(views, Eigen::Vector2d::Constant(kNaN));
-    if (!summary.kept_other_points || hand_slots == nullptr) return px;
+    if (!summary->kept_other_points || hand_slots == nullptr) return px;
     int seen = 0;
     for (int v = 0; v < views; ++v) {
       Eigen::Vector2d sum = Eigen::Vector2d::Zero();
       int count = 0;
       for (int slot : *hand_slots) {
-        const float* x = &out.data[at(f, v, slot)];
+        const float* x = &keypoints.data[KeypointIndex(capture, f, v, slot)];
         if (!(std::isfinite(x[0]) && std::isfinite(x[1]) && x[2] >= options.bow_hand_min_score))
           continue;
         sum += Eigen::Vector2d(x[0], x[1]);
@@ -438,34 +385,32 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
     return px;
   };
 
-  OutputSet outputs;
-  ARCO_ASSIGN_OR_RETURN(const std::string npy_tmp, outputs.AddFile(JoinPath(dir, kKeypointsFile)));
-  ARCO_ASSIGN_OR_RETURN(const std::string manifest_tmp, outputs.AddFile(manifest_path));
-  ARCO_ASSIGN_OR_RETURN(const std::string report_tmp, outputs.AddFile(JoinPath(dir, kReportFile)));
-
-  // --- The work: forwards from the labelled frame, then backwards ---------------------
+  // Forwards from the labelled frame, then backwards.
   const int threads = ResolveThreadCount(options.num_threads);
   track::InstrumentTrackerOptions tracker_options = options.tracker;
   tracker_options.num_threads = threads;
-  std::vector<track::TrackFrame> results(static_cast<size_t>(manifest.frame_count));
-  std::vector<track::TrackFrame> bow_results(results.size());
+  TrackRun run;
+  std::vector<track::TrackFrame>& results = run.instrument;
+  std::vector<track::TrackFrame>& bow_results = run.bow;
+  results.resize(static_cast<size_t>(manifest.frame_count));
+  bow_results.resize(results.size());
   std::vector<char> done(results.size(), 0);
   const auto track_start = std::chrono::steady_clock::now();
   progress.SetTotal(manifest.frame_count * views);
   for (const int step : {+1, -1}) {
     if (step < 0 && template_frame == first) break;
-    track::InstrumentTracker tracker(cameras, *body, tracker_options);
+    track::InstrumentTracker tracker(cameras, templates.body, tracker_options);
     std::optional<track::BowTracker> bow_tracker;
-    if (bow_body) {
+    if (templates.bow) {
       track::BowTrackerOptions bow_options = options.bow;
       bow_options.num_threads = threads;
-      bow_tracker.emplace(cameras, bow_body->points[0], bow_body->points[1], bow_options);
+      bow_tracker.emplace(cameras, templates.bow->points[0], templates.bow->points[1], bow_options);
     }
     track::TrackFrame bow_r;
-    Frames frames(manifest, inputs);
+    Frames frames(manifest, capture.inputs);
     for (int64_t g = template_frame; g >= first && g <= last; g += step) {
       ARCO_ASSIGN_OR_RETURN(std::vector<const media::Image*> images,
-                            frames.Read(g, threads, &summary.decode_s));
+                            frames.Read(g, threads, &summary->decode_s));
       track::TrackFrame r;
       if (g == template_frame) {
         // A view that dropped the labelled frame starts from a blank picture.
@@ -481,22 +426,22 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
           const auto bow_start = std::chrono::steady_clock::now();
           int64_t with_hand = 0;
           const std::vector<Eigen::Vector2d> hand = right_hand(g - first, &with_hand);
-          if (step > 0) summary.bow_hand_frames += with_hand;
+          if (step > 0) summary->bow_hand_frames += with_hand;
           bow_r = bow_tracker->Start(images, &hand);
-          summary.bow_s += SecondsSince(bow_start);
+          summary->bow_s += SecondsSince(bow_start);
         }
       } else {
-        const auto it = labelled.find(g);
-        r = tracker.Next(images, it != labelled.end() ? &it->second : nullptr);
+        const auto it = labels.labelled.find(g);
+        r = tracker.Next(images, it != labels.labelled.end() ? &it->second : nullptr);
         if (bow_tracker) {
           const auto bow_start = std::chrono::steady_clock::now();
-          const auto bow_it = bow_labelled.find(g);
+          const auto bow_it = labels.bow_labelled.find(g);
           int64_t with_hand = 0;
           const std::vector<Eigen::Vector2d> hand = right_hand(g - first, &with_hand);
           bow_r = bow_tracker->Next(
-              images, bow_it != bow_labelled.end() ? &bow_it->second : nullptr, &hand);
-          summary.bow_s += SecondsSince(bow_start);
-          if (!done[static_cast<size_t>(g - first)]) summary.bow_hand_frames += with_hand;
+              images, bow_it != labels.bow_labelled.end() ? &bow_it->second : nullptr, &hand);
+          summary->bow_s += SecondsSince(bow_start);
+          if (!done[static_cast<size_t>(g - first)]) summary->bow_hand_frames += with_hand;
         }
       }
       const size_t f = static_cast<size_t>(g - first);
@@ -508,23 +453,47 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
       }
     }
   }
-  summary.track_s = SecondsSince(track_start);
+  summary->track_s = SecondsSince(track_start);
+  return run;
+}
 
-  // --- Outputs ------------------------------------------------------------------------
-  summary.layout = layout_name;
-  summary.first_frame = first;
-  summary.last_frame = last;
-  summary.cameras.resize(views);
+Status WriteTrackOutputs(const TrackStageOptions& options,
+                         const TrackCapture& capture,
+                         const TrackLabels& labels,
+                         const TrackTemplates& templates,
+                         const TrackRun& run,
+                         NpyArray<float> keypoints,
+                         const TrackOutputPaths& paths,
+                         TrackStageSummary* summary) {
+  const CaptureManifest& manifest = capture.manifest;
+  const int views = capture.views();
+  const int64_t first = capture.first;
+  const std::vector<std::string>& names = labels.names;
+  const std::vector<std::string>& bow_names = labels.bow_names;
+  const bool bow_tracked = templates.bow.has_value();
+  NpyArray<float>& out = keypoints;
+  summary->layout = capture.layout_name;
+  summary->first_frame = first;
+  summary->last_frame = capture.last;
+  summary->cameras.resize(views);
+  // One tracked point (NaN where not recorded or lost) into slot p of view v in frame f.
+  const auto put = [&](int64_t f, int v, int slot, bool recorded, const track::TrackedPoint& q) {
+    const size_t k = KeypointIndex(capture, f, v, slot);
+    const bool ok = recorded && std::isfinite(q.pixel.x());
+    out.data[k] = ok ? static_cast<float>(q.pixel.x()) : kNaNf;
+    out.data[k + 1] = ok ? static_cast<float>(q.pixel.y()) : kNaNf;
+    out.data[k + 2] = ok ? static_cast<float>(q.score) : kNaNf;
+  };
   Json frames_json = Json::array();
   for (int64_t f = 0; f < manifest.frame_count; ++f) {
-    const track::TrackFrame& r = results[f];
-    if (!r.pose_ok) ++summary.frames_without_pose;
+    const track::TrackFrame& r = run.instrument[f];
+    if (!r.pose_ok) ++summary->frames_without_pose;
     Json view_json = Json::array();
     for (int v = 0; v < views; ++v) {
       const bool recorded = manifest.VideoFrameNumber(v, first + f) >= 0;
       const track::ViewTrackReport& vr = r.views[v];
       view_json.push_back(ViewJson(vr));
-      TrackCameraSummary& c = summary.cameras[v];
+      TrackCameraSummary& c = summary->cameras[v];
       if (recorded) {
         ++c.frames;
         c.lost_frames += vr.lost;
@@ -533,31 +502,21 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
         c.mean_residual_px += vr.residual_px;
       }
       for (size_t p = 0; p < names.size(); ++p) {
-        const size_t k = at(f, v, (*instrument_slots)[p]);
-        const track::TrackedPoint& q = r.points[v][p];
-        const bool ok = recorded && std::isfinite(q.pixel.x());
-        out.data[k] = ok ? static_cast<float>(q.pixel.x()) : kNaNf;
-        out.data[k + 1] = ok ? static_cast<float>(q.pixel.y()) : kNaNf;
-        out.data[k + 2] = ok ? static_cast<float>(q.score) : kNaNf;
+        put(f, v, (*capture.instrument_slots)[p], recorded, r.points[v][p]);
       }
-      for (size_t p = 0; bow_body && p < bow_names.size(); ++p) {
-        const size_t k = at(f, v, (*bow_slots)[p]);
-        const track::TrackedPoint& q = bow_results[f].points[v][p];
-        const bool ok = recorded && std::isfinite(q.pixel.x());
-        out.data[k] = ok ? static_cast<float>(q.pixel.x()) : kNaNf;
-        out.data[k + 1] = ok ? static_cast<float>(q.pixel.y()) : kNaNf;
-        out.data[k + 2] = ok ? static_cast<float>(q.score) : kNaNf;
+      for (size_t p = 0; bow_tracked && p < bow_names.size(); ++p) {
+        put(f, v, (*capture.bow_slots)[p], recorded, run.bow[f].points[v][p]);
       }
     }
     Json bow_json = nullptr;
-    if (bow_body) {
-      const track::TrackFrame& b = bow_results[f];
-      if (!b.pose_ok) ++summary.bow_frames_without_pose;
+    if (bow_tracked) {
+      const track::TrackFrame& b = run.bow[f];
+      if (!b.pose_ok) ++summary->bow_frames_without_pose;
       Json bow_views = Json::array();
       for (const auto& vr : b.views) bow_views.push_back(ViewJson(vr));
       for (int v = 0; v < views; ++v) {
         if (manifest.VideoFrameNumber(v, first + f) < 0) continue;
-        summary.cameras[v].bow_lost_frames += b.views[v].lost;
+        summary->cameras[v].bow_lost_frames += b.views[v].lost;
       }
       bow_json = Json{{"pose_ok", b.pose_ok},
                       {"match_ncc", b.match_ncc},
@@ -572,15 +531,15 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
                            {"views", view_json},
                            {"bow", bow_json}});
   }
-  if (bow_body && summary.bow_frames_without_pose > 0) {
-    summary.warnings.push_back(
-        "the bow was not found in " + std::to_string(summary.bow_frames_without_pose) + " of " +
+  if (bow_tracked && summary->bow_frames_without_pose > 0) {
+    summary->warnings.push_back(
+        "the bow was not found in " + std::to_string(summary->bow_frames_without_pose) + " of " +
         std::to_string(manifest.frame_count) +
         " frames: frog and tip are its predicted positions there, with score 0.1");
   }
   for (int v = 0; v < views; ++v) {
-    TrackCameraSummary& c = summary.cameras[v];
-    c.camera = inputs[v].camera;
+    TrackCameraSummary& c = summary->cameras[v];
+    c.camera = capture.inputs[v].camera;
     if (c.frames > 0) {
       c.mean_inliers /= c.frames;
       c.mean_residual_px /= c.frames;
@@ -588,35 +547,33 @@ StatusOr<TrackStageSummary> RunTrackStage(const TrackStageOptions& options, Prog
   }
   Json template_json = Json::array();
   for (size_t p = 0; p < names.size(); ++p) {
-    const Eigen::Vector3d x = body->points[p] / mm_per_unit;
+    const Eigen::Vector3d x = templates.body.points[p] / templates.mm_per_unit;
     template_json.push_back(
         {{"name", names[p]},
-         {"label_views", body->label_views[p]},
+         {"label_views", templates.body.label_views[p]},
          {"point_in_world",
           std::isfinite(x.x()) ? Json::array({x.x(), x.y(), x.z()}) : Json(nullptr)}});
   }
-  ARCO_RETURN_IF_ERROR(WriteNpy(npy_tmp, out));
-  manifest.keypoints2d = kKeypointsFile;
-  manifest.layout = layout_name;
-  manifest.keypoint_names.clear();
-  ARCO_RETURN_IF_ERROR(WriteJsonFile(manifest_tmp, CaptureManifestToJson(manifest)));
-  Json report_summary = ToJson(summary);
+  ARCO_RETURN_IF_ERROR(WriteNpy(paths.keypoints, out));
+  CaptureManifest written = manifest;
+  written.keypoints2d = kTrackKeypointsFile;
+  written.layout = capture.layout_name;
+  written.keypoint_names.clear();
+  ARCO_RETURN_IF_ERROR(WriteJsonFile(paths.manifest, CaptureManifestToJson(written)));
+  Json report_summary = ToJson(*summary);
   report_summary.erase("decode_s");  // times differ between runs: left out
   report_summary.erase("track_s");
   report_summary.erase("wall_s");
   report_summary.erase("bow_s");
   Json cameras_json = Json::array();
-  for (const auto& in : inputs) cameras_json.push_back(in.camera);
-  ARCO_RETURN_IF_ERROR(WriteJsonFile(report_tmp,
-                                     Json{{"format", "arco-track-report"},
-                                          {"options", ToJson(options)},
-                                          {"summary", report_summary},
-                                          {"template", template_json},
-                                          {"cameras", cameras_json},
-                                          {"frames", frames_json}}));
-  ARCO_RETURN_IF_ERROR(outputs.Commit());
-  summary.wall_s = SecondsSince(start);
-  return summary;
+  for (const auto& in : capture.inputs) cameras_json.push_back(in.camera);
+  return WriteJsonFile(paths.report,
+                       Json{{"format", "arco-track-report"},
+                            {"options", ToJson(options)},
+                            {"summary", report_summary},
+                            {"template", template_json},
+                            {"cameras", cameras_json},
+                            {"frames", frames_json}});
 }
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

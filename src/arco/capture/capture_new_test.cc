@@ -1,6 +1,6 @@
 // `arco capture new` on small generated videos (media/test_video.h), image folders and
 // single images, with a calibration written for them.
-#include "arco/pipeline/capture_new.h"
+#include "arco/capture/capture_new.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -14,7 +14,7 @@
 #include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 namespace fs = std::filesystem;
@@ -326,4 +326,4 @@ TEST(CaptureNewOptions, ValidateNamesTheField) {
 }
 
 }  // namespace
-}  // namespace arco::pipeline
+}  // namespace arco::capture

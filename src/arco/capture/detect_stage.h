@@ -16,7 +16,7 @@
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 
 // Frames per work item. Tracking restarts with person detection at each chunk's first
 // frame, so chunk boundaries are a function of this number only (never of the thread
@@ -75,4 +75,4 @@ Json ToJson(const DetectStageSummary& summary);
 StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options,
                                             Progress& progress = NoProgress());
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

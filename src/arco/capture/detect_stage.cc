@@ -1,4 +1,4 @@
-#include "arco/pipeline/detect_stage.h"
+#include "arco/capture/detect_stage.h"
 
 #include <algorithm>
 #include <array>
@@ -12,16 +12,16 @@
 #include <utility>
 
 #include "arco/calibration/calibration_file.h"
+#include "arco/capture/capture_videos.h"
 #include "arco/media/video_reader.h"
 #include "arco/mocap/capture.h"
-#include "arco/pipeline/capture_videos.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/output_set.h"
 #include "arco/util/parallel.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
@@ -351,4 +351,4 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
   return summary;
 }
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

@@ -1,4 +1,4 @@
-#include "arco/pipeline/label_views.h"
+#include "arco/capture/label_views.h"
 
 #include <cmath>
 #include <map>
@@ -7,7 +7,7 @@
 #include "arco/calibration/calibration_file.h"
 #include "arco/util/file_io.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 struct LoadedView {
@@ -148,4 +148,4 @@ StatusOr<Json> TriangulateLabelViews(const LabelViewsOptions& o) {
   return out;
 }
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

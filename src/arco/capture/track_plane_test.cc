@@ -20,11 +20,11 @@
 #include <string>
 #include <vector>
 
+#include "arco/capture/capture_new.h"
+#include "arco/capture/track_stage.h"
 #include "arco/media/video_reader.h"
 #include "arco/mocap/labelme.h"
 #include "arco/mocap/triangulate_point.h"
-#include "arco/pipeline/capture_new.h"
-#include "arco/pipeline/track_stage.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/testing/plane_scene.h"
@@ -35,7 +35,7 @@
 #include "arco/util/npy.h"
 #include "arco/util/stats.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 namespace fs = std::filesystem;
@@ -262,10 +262,10 @@ TEST_F(TrackPlane, EveryInstrumentPointInEveryViewAndFrame) {
   EXPECT_TRUE(std::isnan(kp->data[0]));
 
   // 3D after `arco triangulate`.
-  TriangulateStageOptions t;
+  pipeline::TriangulateStageOptions t;
   t.capture_dir = s.capture;
   t.result_dir = s.dir / "result";
-  auto triangulated = RunTriangulateStage(t);
+  auto triangulated = pipeline::RunTriangulateStage(t);
   ASSERT_TRUE(triangulated.ok()) << triangulated.status().message();
   auto p3 = ReadNpy<double>(t.result_dir + "/triangulation/points3d_raw.npy");
   ASSERT_TRUE(p3.ok()) << p3.status().message();
@@ -431,4 +431,4 @@ TEST_F(TrackPlane, SameBytesForAnyThreadCount) {
 }
 
 }  // namespace
-}  // namespace arco::pipeline
+}  // namespace arco::capture

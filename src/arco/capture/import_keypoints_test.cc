@@ -1,6 +1,6 @@
 // `arco capture import-keypoints`: hand-written MMPose and OpenPose output into a capture
 // made by CreateCapture from generated videos.
-#include "arco/pipeline/import_keypoints.h"
+#include "arco/capture/import_keypoints.h"
 
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 #include <filesystem>
 
 #include "arco/calibration/calibration_file.h"
+#include "arco/capture/capture_new.h"
 #include "arco/media/test_video.h"
 #include "arco/mocap/capture.h"
-#include "arco/pipeline/capture_new.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/registry/keypoint_layout.h"
@@ -19,7 +19,7 @@
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 namespace fs = std::filesystem;
@@ -294,11 +294,11 @@ TEST(ImportKeypoints, VideosToCaptureToTriangulation) {
   EXPECT_EQ(created->frames, kFrames);
   const auto imported = ImportKeypoints(o);
   ASSERT_TRUE(imported.ok()) << imported.status().message();
-  TriangulateStageOptions t;
+  pipeline::TriangulateStageOptions t;
   t.capture_dir = c.output_dir;
   t.result_dir = dir / "result";
   t.triangulation.point.max_reprojection_px = 1;  // exact data in 128 px images
-  const auto triangulated = RunTriangulateStage(t);
+  const auto triangulated = pipeline::RunTriangulateStage(t);
   ASSERT_TRUE(triangulated.ok()) << triangulated.status().message();
   const auto points = ReadNpy<double>(dir / "result/triangulation/points3d_raw.npy");
   ASSERT_TRUE(points.ok()) << points.status().message();
@@ -374,4 +374,4 @@ TEST(ImportKeypointsOptions, ValidateNamesTheField) {
 }
 
 }  // namespace
-}  // namespace arco::pipeline
+}  // namespace arco::capture

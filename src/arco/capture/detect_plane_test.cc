@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
+#include "arco/capture/capture_new.h"
+#include "arco/capture/detect_stage.h"
 #include "arco/detect/models_for_test.h"
 #include "arco/media/video_reader.h"
-#include "arco/pipeline/capture_new.h"
-#include "arco/pipeline/detect_stage.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/testing/plane_scene.h"
@@ -28,7 +28,7 @@
 #include "arco/util/npy.h"
 #include "arco/util/stats.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 namespace fs = std::filesystem;
@@ -85,10 +85,10 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
   for (const auto& cam : detected->cameras) {
     EXPECT_EQ(cam.tracker.frames_with_person, frames) << cam.camera;
   }
-  TriangulateStageOptions t;
+  pipeline::TriangulateStageOptions t;
   t.capture_dir = c.output_dir;
   t.result_dir = dir / "result";
-  auto triangulated = RunTriangulateStage(t);
+  auto triangulated = pipeline::RunTriangulateStage(t);
   ASSERT_TRUE(triangulated.ok()) << triangulated.status().message();
   auto points = ReadNpy<double>(t.result_dir + "/triangulation/points3d_raw.npy");
   ASSERT_TRUE(points.ok()) << points.status().message();
@@ -145,4 +145,4 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
 }
 
 }  // namespace
-}  // namespace arco::pipeline
+}  // namespace arco::capture

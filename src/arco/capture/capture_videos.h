@@ -15,7 +15,7 @@
 #include "arco/mocap/capture.h"
 #include "arco/util/status.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 
 struct CaptureVideo {
   std::string camera;  // the capture camera's name
@@ -67,4 +67,4 @@ class CaptureFrameReader {
   media::Image decoded_;  // reused when the frame is turned
 };
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

@@ -1,4 +1,4 @@
-#include "arco/pipeline/import_spd.h"
+#include "arco/capture/import_spd.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -9,7 +9,7 @@
 #include "arco/util/atomic_dir.h"
 #include "arco/util/file_io.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 namespace fs = std::filesystem;
 }  // namespace
@@ -136,4 +136,4 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
   return out;
 }
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

@@ -1,4 +1,4 @@
-#include "arco/pipeline/import_spd.h"
+#include "arco/capture/import_spd.h"
 
 #include <gtest/gtest.h>
 
@@ -6,14 +6,14 @@
 #include <filesystem>
 
 #include "arco/calibration/calibration_file.h"
-#include "arco/pipeline/label_views.h"
+#include "arco/capture/label_views.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/testing/synthetic_views.h"
 #include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 using arco::testing::TempDir;
@@ -82,13 +82,13 @@ TEST(ImportSpdCapture, SpdFoldersToCaptureToTriangulation) {
   EXPECT_EQ(manifest->cameras[2].dropped_frames, (std::vector<int64_t>{11}));
   EXPECT_EQ(manifest->VideoFrameNumber(2, 12), 11);
 
-  TriangulateStageOptions t;
+  pipeline::TriangulateStageOptions t;
   t.capture_dir = o.output_dir;
   t.result_dir = dir / "result";
-  auto run = RunTriangulateStage(t);
+  auto run = pipeline::RunTriangulateStage(t);
   ASSERT_TRUE(run.ok()) << run.status().message();
   EXPECT_EQ(run->triangulation.triangulated, 3 * 142);
-  auto points = ResultFolder(t.result_dir).ReadPoints3d(kTriangulationStage);
+  auto points = pipeline::ResultFolder(t.result_dir).ReadPoints3d(pipeline::kTriangulationStage);
   ASSERT_TRUE(points.ok());
   double worst = 0;
   for (size_t i = 0; i < points->data.size(); ++i) {
@@ -116,4 +116,4 @@ TEST(ImportSpdCapture, SpdFoldersToCaptureToTriangulation) {
 }
 
 }  // namespace
-}  // namespace arco::pipeline
+}  // namespace arco::capture

@@ -1,11 +1,11 @@
-#include "arco/pipeline/capture_videos.h"
+#include "arco/capture/capture_videos.h"
 
 #include "arco/calibration/calibration_file.h"
+#include "arco/capture/capture_checks.h"
 #include "arco/media/video_reader.h"
-#include "arco/pipeline/capture_checks.h"
 #include "arco/util/file_io.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 
 StatusOr<std::vector<CaptureVideo>> OpenCaptureVideos(const std::string& dir,
                                                       const CaptureManifest& manifest,
@@ -100,4 +100,4 @@ StatusOr<bool> CaptureFrameReader::Read(int64_t g, media::Image* frame, bool rot
   return true;
 }
 
-}  // namespace arco::pipeline
+}  // namespace arco::capture

@@ -1,5 +1,5 @@
 // `arco pitch` / `arco sync` work functions: outputs, errors, capture manifests.
-#include "arco/pipeline/pitch_sync.h"
+#include "arco/capture/pitch_sync.h"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +15,7 @@
 #include "arco/registry/instruments.h"
 #include "arco/util/file_io.h"
 
-namespace arco::pipeline {
+namespace arco::capture {
 namespace {
 
 namespace testing = audio::testing;
@@ -128,7 +128,8 @@ TEST(RunPitch, DoubleStopsAddTheSecondNoteColumn) {
   EXPECT_GE(found, 0.75 * doubles);  // measured 0.83, octaves included (docs/audio.md)
   std::printf(
       "double-stop frames with the tracker on a note: %lld, second note found on "
-      "%lld; tracker on neither: %lld, unvoiced: %lld; single-note frames without a second: %lld of "
+      "%lld; tracker on neither: %lld, unvoiced: %lld; single-note frames without a second: %lld "
+      "of "
       "%lld\n",
       static_cast<long long>(doubles),
       static_cast<long long>(found),
@@ -153,12 +154,13 @@ TEST(RunPitch, DoubleStopsAddTheSecondNoteColumn) {
     overlaps += (*notes2)[i + 1].onset_s < (*notes2)[i].offset_s;
   }
   EXPECT_GT(overlaps, 0);
-  std::printf("notes.csv: %zu first-voice notes, %d second-voice notes (%d generated double "
-              "stops), %d overlapping neighbours\n",
-              notes1->size(),
-              both->second_voice_notes,
-              static_cast<int>(music.notes.size() / 2),
-              overlaps);
+  std::printf(
+      "notes.csv: %zu first-voice notes, %d second-voice notes (%d generated double "
+      "stops), %d overlapping neighbours\n",
+      notes1->size(),
+      both->second_voice_notes,
+      static_cast<int>(music.notes.size() / 2),
+      overlaps);
   // Every second-voice note lies inside a generated double stop, at its other note.
   for (const audio::Note& n : *notes2) {
     bool first_voice = false;
@@ -175,8 +177,7 @@ TEST(RunPitch, DoubleStopsAddTheSecondNoteColumn) {
                                      100 * played->low_midi),
                  cents_hi = std::abs(1200 * std::log2(n.median_f0_hz / 440.0) + 6900 -
                                      100 * played->high_midi);
-    EXPECT_LT(std::min(cents_lo, cents_hi), 50)
-        << n.onset_s;
+    EXPECT_LT(std::min(cents_lo, cents_hi), 50) << n.onset_s;
   }
 }
 
@@ -469,4 +470,4 @@ TEST(PitchTrackerOptionsFor, TheF0OverridesAreCheckedAgainstTheInstrument) {
 }
 
 }  // namespace
-}  // namespace arco::pipeline
+}  // namespace arco::capture
