@@ -188,7 +188,7 @@ struct PlaneScene {
   std::vector<media::Image> backgrounds;
 };
 
-// The detection plane test's scene (pipeline/detect_plane_test.cc, bench/detect_bench.cc
+// The detection plane test's scene (capture/detect_plane_test.cc, bench/detect_bench.cc
 // BM_DetectStagePlane): `photo` (SPD's example.jpg) at 0.778 mm per pixel (its
 // nut-to-bridge distance, about 895 px, is a cello's 695 mm string), 8 cameras of
 // 1152 x 1328 px (half SPD's portrait frame, focal 1130 px) on a 100 degree arc at 2.5 m,

@@ -70,7 +70,7 @@ class BowTracker {
  public:
   // frog and tip: the labelled frame's triangulated points. The world must be in mm
   // (every length option is mm): a caller with another unit scales the cameras'
-  // translations and the points first (pipeline/track_stage.cc). Throws
+  // translations and the points first (capture/track_steps.cc). Throws
   // std::invalid_argument on invalid options or a bow shorter than kMinBowLengthMm.
   BowTracker(std::vector<Camera> cameras,
              const Eigen::Vector3d& frog,
