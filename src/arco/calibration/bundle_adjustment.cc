@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <memory>
+#include <string>
 
 #include "arco/calibration/bundle_solver.h"
 #include "arco/calibration/pose_parameters.h"
@@ -61,6 +63,35 @@ struct MidpointDistanceCost {
 
 }  // namespace
 
+Status RigAdjustmentOptions::Validate(int num_cameras, int num_template_points) const {
+  const auto camera_ok = [num_cameras](int c) { return c >= 0 && c < num_cameras; };
+  if (!camera_ok(reference_camera)) {
+    return Status::Error("bundle adjustment: reference_camera " + std::to_string(reference_camera) +
+                         " is not a camera of the rig's " + std::to_string(num_cameras));
+  }
+  for (int c : cameras) {
+    if (!camera_ok(c)) {
+      return Status::Error("bundle adjustment: camera " + std::to_string(c) +
+                           " is not a camera of the rig's " + std::to_string(num_cameras));
+    }
+  }
+  if (!(loss_scale_px > 0) || !std::isfinite(loss_scale_px)) {
+    return Status::Error("bundle adjustment: loss_scale_px must be a finite value > 0");
+  }
+  if (max_iterations < 1) return Status::Error("bundle adjustment: max_iterations must be >= 1");
+  for (int k : {scale.a0, scale.a1, scale.b0, scale.b1}) {
+    if (k < 0 || k >= num_template_points) {
+      return Status::Error("bundle adjustment: the scale's template point " + std::to_string(k) +
+                           " is not one of the body's " + std::to_string(num_template_points));
+    }
+  }
+  if (!(scale.length > 0) || !std::isfinite(scale.length) || !(scale.weight > 0) ||
+      !std::isfinite(scale.weight)) {
+    return Status::Error("bundle adjustment: the scale's length and weight must be finite and > 0");
+  }
+  return Status::Ok();
+}
+
 StatusOr<BundleAdjustmentSummary> AdjustRig(const RigAdjustmentOptions& options,
                                             const std::vector<BundleTrack>& tracks,
                                             Rig* rig,
@@ -68,6 +99,29 @@ StatusOr<BundleAdjustmentSummary> AdjustRig(const RigAdjustmentOptions& options,
   const int num_cameras = static_cast<int>(rig->cameras.size());
   const int num_k = static_cast<int>(body->points.size());
   const int num_frames = static_cast<int>(body->rotation.size());
+  ARCO_RETURN_IF_ERROR(options.Validate(num_cameras, num_k));
+  if (body->translation.size() != body->rotation.size() ||
+      body->valid.size() != body->rotation.size()) {
+    return Status::Error(
+        "bundle adjustment: the body's rotations, translations and valid flags "
+        "differ in count");
+  }
+  for (const BundleTrack& track : tracks) {
+    if (track.rigid >= num_k ||
+        (track.rigid >= 0 &&
+         (track.frame < 0 || track.frame >= num_frames || !body->valid[track.frame]))) {
+      return Status::Error(
+          "bundle adjustment: a rigid track's template point or frame is not "
+          "one of the body's");
+    }
+    for (const BundleObservation& o : track.observations) {
+      if (o.camera < 0 || o.camera >= num_cameras) {
+        return Status::Error("bundle adjustment: an observation names camera " +
+                             std::to_string(o.camera) + " of the rig's " +
+                             std::to_string(num_cameras));
+      }
+    }
+  }
   // The parameters in one buffer, in a fixed order (cameras, template, body poses, free
   // points): Ceres orders the blocks of an elimination group by address, so separate
   // allocations would make the solution depend on where the heap put them (the last bits

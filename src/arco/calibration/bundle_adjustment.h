@@ -79,12 +79,16 @@ struct RigAdjustmentOptions {
   double loss_scale_px = 2;
   int max_iterations = 100;
   MidpointDistance scale;  // template indices into body.points
+  // Indices within the rig and the body's template, loss_scale_px finite > 0,
+  // max_iterations >= 1, the scale's length and weight finite > 0.
+  Status Validate(int num_cameras, int num_template_points) const;
 };
 
 // Adjusts `rig` (the poses of options.cameras but the reference's, and fx, fy with
 // refine_focal) and `body` (template points and poses) to the tracks; a free track's point
-// is solved for but not returned. Errors: Ceres's failure. On an error rig and body are
-// unchanged.
+// is solved for but not returned. Errors: invalid options (Validate), a track whose camera,
+// template point or frame is not the rig's or the body's, Ceres's failure. On an error rig
+// and body are unchanged.
 StatusOr<BundleAdjustmentSummary> AdjustRig(const RigAdjustmentOptions& options,
                                             const std::vector<BundleTrack>& tracks,
                                             Rig* rig,

@@ -112,5 +112,47 @@ TEST(AdjustRig, LeavesCamerasItIsNotGivenExactlyAsTheyWere) {
   EXPECT_EQ(rig.cameras[5].fx, input.cameras[5].fx);
 }
 
+TEST(AdjustRig, RefusesIndicesOutsideTheRigOrTheBodyAndLeavesBothUnchanged) {
+  const Scene scene = MakeScene();
+  const auto refused = [&](const RigAdjustmentOptions& options,
+                           const std::vector<BundleTrack>& tracks) {
+    Rig rig = scene.truth;
+    RigidBody body = scene.body;
+    const auto summary = AdjustRig(options, tracks, &rig, &body);
+    EXPECT_EQ(rig.cameras[1].cam_from_world_translation,
+              scene.truth.cameras[1].cam_from_world_translation);
+    EXPECT_EQ(body.points[0], scene.body.points[0]);
+    return !summary.ok() && summary.status().message().find("bundle adjustment") == 0;
+  };
+  const RigAdjustmentOptions good = Options(scene.truth);
+  RigAdjustmentOptions o = good;
+  o.reference_camera = 6;
+  EXPECT_TRUE(refused(o, scene.tracks));
+  o = good;
+  o.cameras.push_back(-1);
+  EXPECT_TRUE(refused(o, scene.tracks));
+  o = good;
+  o.loss_scale_px = NAN;
+  EXPECT_TRUE(refused(o, scene.tracks));
+  o = good;
+  o.max_iterations = 0;
+  EXPECT_TRUE(refused(o, scene.tracks));
+  o = good;
+  o.scale.b1 = 5;  // the body has 5 template points
+  EXPECT_TRUE(refused(o, scene.tracks));
+  o = good;
+  o.scale.length = -0.6;
+  EXPECT_TRUE(refused(o, scene.tracks));
+  std::vector<BundleTrack> tracks = scene.tracks;
+  tracks[0].observations[0].camera = 6;
+  EXPECT_TRUE(refused(good, tracks));
+  tracks = scene.tracks;
+  tracks[0].rigid = 5;
+  EXPECT_TRUE(refused(good, tracks));
+  tracks = scene.tracks;
+  tracks[0].frame = 8;  // a rigid track in a frame the body has no pose for
+  EXPECT_TRUE(refused(good, tracks));
+}
+
 }  // namespace
 }  // namespace arco::calibration
