@@ -9,6 +9,7 @@
 #include "arco/pipeline/capture_context.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/refine/double_stop_refine.h"
+#include "arco/refine/transcription.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/file_io.h"
 
@@ -253,6 +254,13 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
     refine::DoubleStopRefineResult ds =
         refine::RefineSecondVoice(inputs.input, r, inputs.upper_f0_hz, double_stop_options);
     r.hand = std::move(ds.hand);
+    // The pair of fingers may have given first-voice notes another finger: their rows of
+    // fingering.csv follow.
+    if (ds.summary.first_fingers_changed > 0) {
+      r.contacts = std::move(ds.first);
+      r.fingering = refine::Transcribe(
+          *inputs.input.instrument, r.analysis, r.contacts, inputs.input.fps, inputs.input.a4_hz);
+    }
     second = std::move(ds.second);
     double_stop_summary = ds.summary;
   }

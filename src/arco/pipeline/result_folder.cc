@@ -762,6 +762,7 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
                                {"pressed", d.pressed},
                                {"open_string", d.open_string},
                                {"one_finger_fifths", d.one_finger_fifths},
+                               {"first_fingers_changed", d.first_fingers_changed},
                                {"uncertain", d.uncertain},
                                {"joint_limit_violations", d.joint_limit_violations}}}};
   }

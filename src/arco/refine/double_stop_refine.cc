@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <stdexcept>
 
@@ -15,6 +16,112 @@ namespace {
 // Semitones of f0_hz above the open pitch of `string`.
 double SemitonesAboveOpen(const InstrumentModel& model, int string, double f0_hz) {
   return 12.0 * std::log2(f0_hz / model.open_hz(string));
+}
+
+double TipDistance(const hand::HandModel& model,
+                   const hand::HandPose& pose,
+                   int finger,
+                   const Eigen::Vector3d& point) {
+  return (hand::FingertipInWorld(model, pose, static_cast<hand::Finger>(finger)) - point).norm();
+}
+
+// Whether one frame of the hand (registry/instruments.h, FingerReaches: closed or
+// extended) puts finger g1 at stop1 and finger g2 at stop2, each in semitones above its
+// own open string: the two reaches give hand positions within half a semitone.
+bool OneHandFrame(InstrumentKind kind, int g1, double stop1, int g2, double stop2) {
+  for (const FingerSpan& a : FingerReaches(kind, g1)) {
+    for (const FingerSpan& b : FingerReaches(kind, g2)) {
+      if (std::abs((stop1 - a.offset_semitones) - (stop2 - b.offset_semitones)) <= 0.5) return true;
+    }
+  }
+  return false;
+}
+
+double Median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+// Each frame's two stops (semitones above their open strings); `stopped`: the second voice
+// is stopped and waits for its finger.
+struct Stop {
+  bool stopped = false;
+  double first = 0, second = 0;
+  double interval = 0;  // semitones from the first voice's pitch up to the second's
+};
+
+// The fingers of one first-voice note's double-stop frames (`members`: one upper note). kOwn: each
+// frame keeps the first voice's finger; kNearest: the fingertip nearest each frame's contact.
+constexpr int kOwn = 0, kNearest = 0;
+struct FingerPair {
+  int first = kOwn, second = kNearest;
+  bool fifth = false;  // one finger stops both strings
+};
+
+// A fifth (the stops within fifth_semitones) keeps the first voice's finger for both.
+// Otherwise the pair of fingers one hand frame can hold (OneHandFrame, at the note's
+// median stops) whose fingertips, as the cameras saw the hand, lie nearest both contacts
+// over the note's frames: the first voice was decoded alone, and its finger may leave no
+// finger of the same hand for the second stop (a sixth on the cello heard as fingers 1 and
+// 4, two semitones apart where those fingers stand three apart). No such pair: the first
+// voice's finger and the nearest other fingertip, frame by frame.
+FingerPair ChooseFingers(const RefineInput& input,
+                         const std::vector<FrameContact>& first,
+                         const std::vector<FrameContact>& second,
+                         const std::vector<std::optional<hand::HandPose>>& hands,
+                         const std::vector<Stop>& stops,
+                         const std::vector<size_t>& members,
+                         bool may_change_first,
+                         const DoubleStopRefineOptions& options) {
+  std::vector<double> first_stops, second_stops, intervals;
+  int pressed = 0;
+  for (size_t f : members) {
+    first_stops.push_back(stops[f].first);
+    second_stops.push_back(stops[f].second);
+    intervals.push_back(stops[f].interval);
+    pressed += first[f].pressed();
+  }
+  // An octave's upper note is the lower note's 2nd partial as often as a second voice (a
+  // single-note take under --double-stops hears many): it never moves the first voice.
+  if (std::abs(Median(intervals) - 12.0) <= 0.5) may_change_first = false;
+  const bool first_pressed = 2 * pressed > static_cast<int>(members.size());
+  const double stop1 = Median(first_stops), stop2 = Median(second_stops);
+  FingerPair pair;
+  if (first_pressed && std::abs(stop1 - stop2) <= options.fifth_semitones) {
+    pair.fifth = true;
+    return pair;
+  }
+  // The first voice's own finger: its most frequent over the frames.
+  std::array<int, 5> votes{};
+  for (size_t f : members) {
+    if (first[f].pressed()) ++votes[static_cast<size_t>(std::clamp(first[f].finger, 0, 4))];
+  }
+  const int own = static_cast<int>(std::max_element(votes.begin(), votes.end()) - votes.begin());
+  const InstrumentKind kind = input.instrument->kind();
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (int g1 = first_pressed ? 1 : 0; g1 <= (first_pressed ? 4 : 0); ++g1) {
+    if (first_pressed && !may_change_first && g1 != own) continue;
+    for (int g2 = 1; g2 <= 4; ++g2) {
+      if (g2 == g1 || (g1 > 0 && !OneHandFrame(kind, g1, stop1, g2, stop2))) continue;
+      double cost1 = 0, cost2 = 0;
+      int count1 = 0;
+      for (size_t f : members) {
+        const std::optional<hand::HandPose>& seen =
+            input.vision_hand[f] ? input.vision_hand[f] : hands[f];
+        if (g1 > 0 && first[f].pressed()) {
+          cost1 += TipDistance(input.hand_model, *seen, g1, first[f].point_in_world_mm);
+          ++count1;
+        }
+        cost2 += TipDistance(input.hand_model, *seen, g2, second[f].point_in_world_mm);
+      }
+      // Both fingers within reach on average: a pair the hand does not show is no reason
+      // to move the first voice (an upper "note" an octave up may be its own partial).
+      const double reach = options.max_tip_distance_mm;
+      if (cost2 > reach * static_cast<double>(members.size()) || cost1 > reach * count1) continue;
+      if (cost1 + cost2 < best_cost) best_cost = cost1 + cost2, pair.first = g1, pair.second = g2;
+    }
+  }
+  return pair;
 }
 
 }  // namespace
@@ -45,6 +152,7 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
   const InstrumentModel& model = *input.instrument;
   const hand::HandModel& hand_model = input.hand_model;
   DoubleStopRefineResult out;
+  out.first = first.contacts;
   out.second.assign(frames, FrameContact{});
   out.hand = first.hand;
   hand::FingerIkOptions ik;
@@ -70,6 +178,8 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
     std::sort(values.begin(), values.end());
     note_median[note] = values[values.size() / 2];
   }
+  // Pass 1: each frame's second voice up to its finger; `stopped` frames need one.
+  std::vector<Stop> stops(frames);
   for (size_t f = 0; f < frames; ++f) {
     const FrameContact& c1 = first.contacts[f];
     double upper = upper_f0_hz[f];
@@ -123,38 +233,92 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
       ++out.summary.uncertain;
       continue;
     }
-    const Eigen::Vector3d point =
+    c2.point_in_world_mm =
         strings[static_cast<size_t>(string - 1)].PointAtFraction(contact.fraction_from_bridge);
-    c2.point_in_world_mm = point;
     c2.from_nut_mm = model.string_length_mm() - contact.contact_from_bridge_mm;
-    const std::optional<hand::HandPose>& pose = out.hand[f];
-    if (!pose) {
+    if (!out.hand[f]) {
       c2.reason = ContactReason::kNoHand;
       ++out.summary.uncertain;
       continue;
     }
-    // The finger: the nearest fingertip, the first voice's own only for a fifth.
-    const bool fifth = c1.state == ContactState::kPressed &&
-                       std::abs(above_open - first_stop) <= options.fifth_semitones;
-    int best = 0;
-    double best_mm = 0;
-    for (int finger = 1; finger <= 4; ++finger) {
-      if (c1.state == ContactState::kPressed && finger == c1.finger && !fifth) continue;
-      const double d =
-          (hand::FingertipInWorld(hand_model, *pose, static_cast<hand::Finger>(finger)) - point)
-              .norm();
-      if (best == 0 || d < best_mm) best = finger, best_mm = d;
+    stops[f] = {true, first_stop, above_open, 12.0 * std::log2(upper / c1.f0_hz)};
+  }
+
+  // Pass 2: the two fingers of each first-voice note and upper semitone (a frame of its
+  // own without a note). The first voice's finger may change only in a note whose frames
+  // mostly have a second voice: a few frames of an "octave" at a note's edge are more often
+  // the note's own 2nd partial than a double stop.
+  std::vector<FingerPair> fingers(frames);
+  std::map<std::pair<int, long>, std::vector<size_t>> groups;
+  std::map<int, int> note_double_frames;
+  for (size_t f = 0; f < frames; ++f) {
+    if (!stops[f].stopped) continue;
+    const int note = first.contacts[f].note;
+    groups[{note >= 0 ? note : -1 - static_cast<int>(f), std::lround(stops[f].second)}].push_back(
+        f);
+    if (note >= 0) ++note_double_frames[note];
+  }
+  for (const auto& [key, members] : groups) {
+    const int note = key.first;
+    const bool may_change = note >= 0 && 2 * note_double_frames[note] >= note_frames[note];
+    const FingerPair pair = ChooseFingers(
+        input, first.contacts, out.second, out.hand, stops, members, may_change, options);
+    for (size_t f : members) fingers[f] = pair;
+  }
+
+  // Pass 3: the first voice's finger where the pair changed it, then the second finger.
+  for (size_t f = 0; f < frames; ++f) {
+    if (!stops[f].stopped) continue;
+    FrameContact& c1 = out.first[f];
+    FrameContact& c2 = out.second[f];
+    const Eigen::Vector3d& point = c2.point_in_world_mm;
+    const FingerPair& pair = fingers[f];
+    const bool fifth = pair.fifth && c1.pressed();
+    const int g1 = pair.first == kOwn ? c1.finger : pair.first;
+    int g2 = fifth ? c1.finger : pair.second;
+    if (!fifth && (g2 == kNearest || (c1.pressed() && g2 == g1))) {
+      g2 = kNearest;  // the nearest fingertip but the first voice's
+      double best_mm = 0;
+      for (int finger = 1; finger <= 4; ++finger) {
+        if (c1.pressed() && finger == g1) continue;
+        const double d = TipDistance(hand_model, *out.hand[f], finger, point);
+        if (g2 == 0 || d < best_mm) g2 = finger, best_mm = d;
+      }
     }
-    if (fifth) best = c1.finger, best_mm = c1.tip_distance_refined_mm;
-    if (best == 0 || !(best_mm <= options.max_tip_distance_mm || fifth)) {
+    if (c1.state == ContactState::kPressed && g1 != c1.finger) {
+      // The first finger's stop goes to another finger: the old one back where the
+      // cameras saw it, the new one to the first voice's contact.
+      hand::HandPose pose = *out.hand[f];
+      const auto& vision = input.vision_hand[f];
+      if (vision) {
+        for (int d = 0; d < 4; ++d) {
+          const int i =
+              hand::DofIndex(static_cast<hand::Finger>(c1.finger), static_cast<hand::FingerDof>(d));
+          pose.angles_rad[static_cast<size_t>(i)] = vision->angles_rad[static_cast<size_t>(i)];
+        }
+      }
+      const hand::FingerIkResult r = hand::SolveFingertipIk(
+          hand_model, pose, static_cast<hand::Finger>(g1), c1.point_in_world_mm, ik);
+      out.hand[f] = r.status.ok() ? r.pose : pose;
+      c1.finger = g1;
+      if (vision)
+        c1.tip_distance_vision_mm = TipDistance(hand_model, *vision, g1, c1.point_in_world_mm);
+      c1.tip_distance_refined_mm = TipDistance(hand_model, *out.hand[f], g1, c1.point_in_world_mm);
+      ++out.summary.first_fingers_changed;
+    }
+    const double tip_mm =
+        fifth ? c1.tip_distance_refined_mm : TipDistance(hand_model, *out.hand[f], g2, point);
+    // A pair of one hand frame was checked for reach over its note (ChooseFingers).
+    const bool paired = !fifth && pair.second != kNearest && g2 == pair.second;
+    if (!(tip_mm <= options.max_tip_distance_mm || fifth || paired)) {
       c2.reason = ContactReason::kOutOfReach;
       ++out.summary.uncertain;
       continue;
     }
     c2.state = ContactState::kPressed;
     c2.reason = ContactReason::kNone;
-    c2.finger = best;
-    c2.tip_distance_vision_mm = best_mm;
+    c2.finger = g2;
+    c2.tip_distance_vision_mm = tip_mm;
     ++out.summary.pressed;
     if (fifth) {
       ++out.summary.one_finger_fifths;
@@ -163,11 +327,9 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
     }
     // The second finger to its contact, the first voice's finger untouched.
     const hand::FingerIkResult r =
-        hand::SolveFingertipIk(hand_model, *pose, static_cast<hand::Finger>(best), point, ik);
+        hand::SolveFingertipIk(hand_model, *out.hand[f], static_cast<hand::Finger>(g2), point, ik);
     if (r.status.ok()) out.hand[f] = r.pose;
-    c2.tip_distance_refined_mm =
-        (hand::FingertipInWorld(hand_model, *out.hand[f], static_cast<hand::Finger>(best)) - point)
-            .norm();
+    c2.tip_distance_refined_mm = TipDistance(hand_model, *out.hand[f], g2, point);
     out.summary.joint_limit_violations += hand::CountLimitViolations(hand_model, *out.hand[f]) > 0;
   }
   return out;

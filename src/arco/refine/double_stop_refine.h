@@ -15,17 +15,31 @@
 //      open (finger 0).
 //   3. Otherwise the contact (instrument/contact.h, ContactPoint) on that string of the
 //      frame's strings; a playable hand: the two stops at most max_span_semitones apart
-//      along the fingerboard, else uncertain. The finger: the fingertip of the refined hand
-//      nearest the contact (index .. little), but not the first voice's finger unless the
-//      two stops lie within fifth_semitones of each other, where the same finger stops both
-//      strings (a fifth), and not one farther than max_tip_distance_mm (uncertain).
+//      along the fingerboard, else uncertain.
+//   4. The fingers, per first-voice note and upper semitone: a fifth (the two stops within
+//   fifth_semitones)
+//      is stopped by the first voice's finger on both strings. Otherwise the pair of
+//      fingers that one frame of the hand can hold at the two stops (registry/
+//      instruments.h, FingerReaches: the positions the two reaches give within half a
+//      semitone) whose fingertips, as the cameras saw the hand, lie nearest the two
+//      contacts summed over the note's frames. The first voice was decoded alone and may
+//      hold a finger that leaves none of the hand for the second stop (a cello sixth as
+//      fingers 1 and 4 two semitones apart, where they stand three apart): the pair then
+//      changes the first voice's finger too (its old finger back to the cameras' pose,
+//      the new one to the first contact by IK), in a note whose frames mostly have a second
+//      voice and never for an octave (its upper note is as often the lower note's own 2nd
+//      partial: a single-note take under --double-stops hears many). Both fingers within
+//      max_tip_distance_mm of their contacts on average over the frames, or the pair is not taken.
+//      No such pair: the first voice's finger and the nearest other fingertip. A second finger
+//      farther than max_tip_distance_mm from its contact: uncertain.
 //   0. A first-voice note (FrameContact::note) with an upper note on at least half its
 //      frames gets their median on its frames without one, where it lies above the frame's
 //      pitch (fill_notes).
-//   4. IK: that finger's tip to the contact by the hand layer's bounded IK (MCP, PIP, DIP
+//   5. IK: that finger's tip to the contact by the hand layer's bounded IK (MCP, PIP, DIP
 //      within the joint limits, regularised toward the refined pose); a fifth's finger is
 //      left where the first voice put it (its pad covers both strings).
-// Frames are independent; the result does not depend on the thread count.
+// Frames are independent but for the notes of step 4; the result does not depend on the
+// thread count.
 #pragma once
 
 #include <array>
@@ -60,11 +74,13 @@ struct DoubleStopRefineSummary {
   int frames = 0;                    // frames with an upper note and a first voice
   int pressed = 0, open_string = 0;  // second voices assigned
   int one_finger_fifths = 0;         // pressed by the first voice's finger
+  int first_fingers_changed = 0;     // first-voice frames given another finger (step 4)
   int uncertain = 0;                 // no playable string / hand
   int joint_limit_violations = 0;    // refined poses outside the limits (must stay 0)
 };
 
 struct DoubleStopRefineResult {
+  std::vector<FrameContact> first;                  // the first voice, its fingers per step 4
   std::vector<FrameContact> second;                 // one per frame (kRest: none)
   std::vector<std::optional<hand::HandPose>> hand;  // the hand with the second finger
   DoubleStopRefineSummary summary;

@@ -82,6 +82,48 @@ TEST(RefineSecondVoice, SixthFifthAndOpenStringOnTheNextHigherString) {
   EXPECT_NEAR(filled.second[2].f0_hz, fx.UpperHz(2), 1e-9);
 }
 
+TEST(RefineSecondVoice, ThePairOfFingersCorrectsTheFirstVoicesFinger) {
+  const Fixture fx;
+  const size_t n = fx.scene.input.pitch.size();
+  // As if the first voice had been decoded alone onto the ring finger: the hand the
+  // cameras saw stops B4 with finger 1, and a sixth above it (E string, 4 semitones) lies
+  // under finger 2. Fingers 3 and 4 would also fit one hand frame at these stops, but
+  // their tips are far from both contacts.
+  RefineResult wrong = fx.first;
+  for (FrameContact& c : wrong.contacts) {
+    if (c.pressed()) c.finger = 3;
+  }
+  std::vector<double> upper(n, 0.0);
+  for (size_t f = 2; f < 18; ++f) upper[f] = fx.UpperHz(4);
+  const DoubleStopRefineResult r = RefineSecondVoice(fx.scene.input, wrong, upper, {});
+  ASSERT_EQ(r.first.size(), n);
+  int changed = 0;
+  for (size_t f = 0; f < n; ++f) {
+    if (!r.second[f].pressed()) continue;
+    EXPECT_EQ(r.first[f].finger, 1) << f;
+    EXPECT_EQ(r.second[f].finger, 2) << f;
+    EXPECT_LT(r.first[f].tip_distance_refined_mm, 5.0) << f;
+    // The ring finger is back where the cameras saw it.
+    for (int d = 0; d < 4; ++d) {
+      const int i = hand::DofIndex(hand::Finger::kRing, static_cast<hand::FingerDof>(d));
+      EXPECT_EQ(r.hand[f]->angles_rad[static_cast<size_t>(i)],
+                fx.scene.input.vision_hand[f]->angles_rad[static_cast<size_t>(i)]);
+    }
+    ++changed;
+  }
+  EXPECT_EQ(changed, r.summary.first_fingers_changed);
+  EXPECT_GE(changed, 16);
+  EXPECT_EQ(r.summary.joint_limit_violations, 0);
+  // An upper note on 2 of the note's 20 frames (an octave's partial at a note's edge is
+  // more often the note's own) leaves the first voice's finger alone.
+  std::vector<double> brief(n, 0.0);
+  brief[5] = brief[6] = fx.UpperHz(4);
+  const DoubleStopRefineResult kept = RefineSecondVoice(fx.scene.input, wrong, brief, {});
+  EXPECT_EQ(kept.summary.first_fingers_changed, 0);
+  EXPECT_EQ(kept.first[5].finger, 3);
+  EXPECT_NE(kept.second[5].finger, 3);
+}
+
 TEST(RefineSecondVoice, NoHigherStringOrAnUnplayableSpanIsUncertain) {
   const Fixture fx;
   const size_t n = fx.scene.input.pitch.size();
