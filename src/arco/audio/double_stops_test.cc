@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "arco/audio/double_stop_music.h"
+#include "arco/audio/double_stops_csv.h"
 #include "arco/audio/test_signals.h"
 
 namespace arco::audio {
@@ -176,6 +177,39 @@ TEST(PitchCsv, SecondNoteColumnIsOptionalAndRoundTrips) {
   std::string bad = text;
   bad.replace(bad.find("329.6276"), 8, "-1");
   EXPECT_FALSE(ParsePitchCsv(bad, "test", &read).ok());
+}
+
+TEST(DoubleStopsCsv, RoundTripsTheFramesTheRefinementUsesAndRejectsBadRows) {
+  std::vector<PolyPitchFrame> frames(3);
+  for (int i = 0; i < 3; ++i) frames[i].frame = i, frames[i].time_s = 0.5 + i / 30.0;
+  frames[1].count = 1, frames[1].notes[0] = {220.01234, 3.0};
+  frames[2].count = 2, frames[2].notes = {PolyNote{246.94165, 2.0}, PolyNote{415.30469, 1.0}};
+  const std::string text = FormatDoubleStopsCsv(frames);
+  EXPECT_EQ(text.substr(0, text.find('\n')), kDoubleStopsCsvHeader);
+  auto read = ParseDoubleStopsCsv(text, "double_stops.csv");
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  ASSERT_EQ(read->size(), 3u);
+  EXPECT_EQ((*read)[0].count, 0);
+  EXPECT_EQ((*read)[1].count, 1);
+  EXPECT_EQ((*read)[1].notes[0].f0_hz, 220.0123);  // to 1e-4 Hz
+  EXPECT_EQ((*read)[2].count, 2);
+  EXPECT_EQ((*read)[2].notes[0].f0_hz, 246.9417);
+  EXPECT_EQ((*read)[2].notes[1].f0_hz, 415.3047);
+  EXPECT_NEAR((*read)[2].time_s, 0.5 + 2 / 30.0, 1e-6);
+  EXPECT_EQ(FormatDoubleStopsCsv(*read), text);  // what is read writes the same text
+  // Bad rows name the file and say what is wrong.
+  const auto error = [&](const std::string& from, const std::string& to) {
+    std::string bad = text;
+    bad.replace(bad.find(from), from.size(), to);
+    const auto r = ParseDoubleStopsCsv(bad, "double_stops.csv");
+    EXPECT_FALSE(r.ok()) << bad;
+    return r.ok() ? std::string() : r.status().message();
+  };
+  EXPECT_NE(error("415.3047", "200.0000").find("f0_low_hz <= f0_high_hz"), std::string::npos);
+  EXPECT_NE(error("\n2,", "\n7,").find("out of order"), std::string::npos);
+  EXPECT_NE(error(",1,220.0123", ",3,220.0123").find("notes must be 0, 1 or 2"), std::string::npos);
+  EXPECT_NE(error("220.0123", "nan").find("double_stops.csv"), std::string::npos);
+  EXPECT_FALSE(ParseDoubleStopsCsv("frame,time_s,notes\n0,0,0\n", "x.csv").ok());
 }
 
 struct MusicScore {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "arco/audio/double_stops.h"
 #include "arco/audio/notes.h"
 #include "arco/audio/pitch_tracker.h"
 #include "arco/capture/pitch_sync.h"
@@ -64,6 +65,24 @@ StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
   summary.voiced_fraction = tracked.voiced_fraction;
   summary.notes = static_cast<int64_t>(record.notes.notes.size());
   record.a4_hz = m.tuning_a4_hz;
+  if (options.double_stops) {
+    // A second pass over the audio, one frame per row of pitch.csv.
+    audio::DoubleStopOptions d;
+    ARCO_ASSIGN_OR_RETURN(d.range, audio::InstrumentRangeByName(capture.instrument->name()));
+    d.fps = m.fps;
+    d.start_s = m.audio_offset_s;
+    d.max_frames = static_cast<int64_t>(frames.size());
+    d.a4_hz = m.tuning_a4_hz;
+    ARCO_RETURN_IF_ERROR(d.Validate());
+    ARCO_ASSIGN_OR_RETURN(auto poly_reader, OpenCaptureAudio(capture, audio_path));
+    ARCO_ASSIGN_OR_RETURN(record.double_stops,
+                          audio::TrackDoubleStops(std::move(poly_reader), d, nullptr));
+    record.double_stops.resize(frames.size());  // audio shorter than the video: none
+    for (size_t i = 0; i < frames.size(); ++i) {
+      record.double_stops[i].frame = frames[i].frame;
+      record.double_stops[i].time_s = frames[i].time_s;
+    }
+  }
   record.inputs = SelectInputs(capture.inputs, {kManifestInput, kAudioInput});
   ARCO_RETURN_IF_ERROR(ResultFolder(options.result_dir).WritePitch(record));
   return record;

@@ -1,7 +1,10 @@
 // Stage 4: the pitch of the capture's audio at the video frames (audio/pitch_tracker.h)
 // and its notes (audio/notes.h); writes pitch.csv and notes.csv into RESULT_DIR itself
-// (pipeline/result_folder.h). Without audio in the capture the stage does nothing and
-// says so in a warning.
+// (pipeline/result_folder.h). With double_stops also up to two simultaneous notes per
+// video frame (audio/double_stops.h, a second pass over the audio) into double_stops.csv,
+// which the refinement reads (refine_stage.h, AddDoubleStops) in `arco run` and in
+// `arco refine` alike. Without audio in the capture the stage does nothing and says so in
+// a warning.
 #pragma once
 
 #include <string>
@@ -16,6 +19,7 @@ namespace arco::pipeline {
 
 struct PitchStageOptions {
   std::string result_dir;
+  bool double_stops = false;  // `arco run --double-stops`
   Status Validate() const;
 };
 

@@ -105,7 +105,19 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
     // have none: frames are then assigned by their own pitch).
     ARCO_ASSIGN_OR_RETURN(records.notes, result.ReadNotes());
   }
-  return MakeRefineInputs(result_dir, records);
+  ARCO_ASSIGN_OR_RETURN(RefineInputs inputs, MakeRefineInputs(result_dir, records));
+  // double_stops.csv (`arco run --double-stops`): the two voices the run refined.
+  if (has_pitch) {
+    ARCO_ASSIGN_OR_RETURN(const std::vector<audio::PolyPitchFrame> double_stops,
+                          result.ReadDoubleStops());
+    if (double_stops.size() > inputs.input.pitch.size()) {
+      return Status::Error(result.ManifestPath() + ": double_stops.csv has " +
+                           std::to_string(double_stops.size()) + " rows for " +
+                           std::to_string(inputs.input.pitch.size()) + " frames");
+    }
+    if (!double_stops.empty()) AddDoubleStops(double_stops, &inputs);
+  }
+  return inputs;
 }
 
 StatusOr<RefineInputs> MakeRefineInputs(const std::string& result_dir,

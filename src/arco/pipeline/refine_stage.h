@@ -36,12 +36,14 @@ struct RefineInputs {
   std::vector<double> upper_f0_hz;
 };
 
-// Puts a polyphonic tracker's two notes (audio/double_stops.h, one frame per video frame)
-// into the inputs: on each frame with two notes, the lower becomes the frame's pitch
-// (confidence 1: both notes were found) and the upper goes to upper_f0_hz. Throws
-// std::invalid_argument when the frame counts differ.
+// Puts a polyphonic tracker's two notes (audio/double_stops.h, one frame per video frame;
+// the pitch stage's double_stops.csv, read back by LoadRefineInputs) into the inputs: on
+// each frame with two notes, the lower becomes the frame's pitch (confidence 1: both notes
+// were found) and the upper goes to upper_f0_hz. Throws std::invalid_argument when the
+// frame counts differ.
 void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly, RefineInputs* inputs);
-// Errors name the file: no hand or instrument stage, shapes that disagree.
+// Errors name the file: no hand or instrument stage, shapes that disagree, a
+// double_stops.csv with more rows than frames. With double_stops.csv, AddDoubleStops.
 StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir);
 
 // What the refinement reads of stages 1-4, as their files hold it: `arco run` passes

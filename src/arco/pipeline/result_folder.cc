@@ -10,6 +10,7 @@
 #include <sstream>
 #include <type_traits>
 
+#include "arco/audio/double_stops_csv.h"
 #include "arco/hand/hand_params.h"
 #include "arco/refine/contacts_csv.h"
 #include "arco/util/csv.h"
@@ -33,6 +34,7 @@ constexpr char kBoneLengthsFile[] = "bone_lengths_mm.npy";
 constexpr char kRestPointsFile[] = "rest_points_mm.npy";
 constexpr char kPitchCsvFile[] = "pitch.csv";
 constexpr char kNotesCsvFile[] = "notes.csv";
+constexpr char kDoubleStopsCsvFile[] = "double_stops.csv";
 constexpr char kContactsCsvFile[] = "contacts.csv";
 constexpr char kSecondContactsCsvFile[] = "contacts_2.csv";  // double stops' upper notes
 constexpr char kFingeringCsvFile[] = "fingering.csv";
@@ -677,20 +679,35 @@ StatusOr<HandRecord> ResultFolder::ReadHand() const {
 Status ResultFolder::WritePitch(const PitchRecord& r) const {
   ARCO_ASSIGN_OR_RETURN(Json manifest, ReadManifest());
   ARCO_RETURN_IF_ERROR(MakeDirectories(dir_));
-  // pitch.csv, notes.csv and result.json change together or not at all.
+  // pitch.csv, notes.csv, double_stops.csv and result.json change together or not at all.
   OutputSet outputs;
   ARCO_ASSIGN_OR_RETURN(const std::string pitch_tmp, outputs.AddFile(PitchPath()));
   ARCO_ASSIGN_OR_RETURN(const std::string notes_tmp,
                         outputs.AddFile(JoinPath(dir_, kNotesCsvFile)));
+  const std::string double_stops_path = JoinPath(dir_, kDoubleStopsCsvFile);
+  std::string double_stops_tmp;
+  if (!r.double_stops.empty()) {
+    ARCO_ASSIGN_OR_RETURN(double_stops_tmp, outputs.AddFile(double_stops_path));
+  } else {
+    ARCO_RETURN_IF_ERROR(outputs.AddRemoval(double_stops_path));  // an earlier run's
+  }
   ARCO_ASSIGN_OR_RETURN(const std::string manifest_tmp, outputs.AddFile(ManifestPath()));
   ARCO_RETURN_IF_ERROR(RemoveLaterStages(kPitchStage, &outputs, &manifest).status());
   ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(pitch_tmp, r.frames));
   ARCO_RETURN_IF_ERROR(audio::WriteNotesCsv(notes_tmp, r.notes));
-  const Json entry = {{"dir", "."},
-                      {"files", {{"pitch", kPitchCsvFile}, {"notes", kNotesCsvFile}}},
-                      {"a4_hz", r.a4_hz},
-                      {"audio", r.summary.audio},
-                      {"summary", ToJson(r.summary)}};
+  Json entry = {{"dir", "."},
+                {"files", {{"pitch", kPitchCsvFile}, {"notes", kNotesCsvFile}}},
+                {"a4_hz", r.a4_hz},
+                {"audio", r.summary.audio},
+                {"summary", ToJson(r.summary)}};
+  if (!r.double_stops.empty()) {
+    ARCO_RETURN_IF_ERROR(
+        AtomicWriteFile(double_stops_tmp, audio::FormatDoubleStopsCsv(r.double_stops)));
+    int64_t two = 0;
+    for (const audio::PolyPitchFrame& f : r.double_stops) two += f.count == 2;
+    entry["files"]["double_stops"] = kDoubleStopsCsvFile;
+    entry["double_stops"] = {{"frames_with_two_notes", two}};
+  }
   manifest = WithStage(manifest, kPitchStage, entry);
   RecordStageInputs(&manifest, kPitchStage, r.inputs);
   ARCO_RETURN_IF_ERROR(WriteJsonFile(manifest_tmp, manifest));
@@ -701,6 +718,12 @@ std::string ResultFolder::PitchPath() const { return JoinPath(dir_, kPitchCsvFil
 
 StatusOr<std::vector<audio::PitchFrame>> ResultFolder::ReadPitch() const {
   return audio::ReadPitchCsv(PitchPath());
+}
+
+StatusOr<std::vector<audio::PolyPitchFrame>> ResultFolder::ReadDoubleStops() const {
+  const std::string path = JoinPath(dir_, kDoubleStopsCsvFile);
+  if (!FileExists(path)) return std::vector<audio::PolyPitchFrame>();
+  return audio::ReadDoubleStopsCsv(path);
 }
 
 StatusOr<std::vector<audio::Note>> ResultFolder::ReadNotes() const {

@@ -15,7 +15,8 @@
 //   hand/                       hand_params.npy (F, 26), bone_lengths_mm.npy (21),
 //                               rest_points_mm.npy (21, 3)
 //   pitch.csv, notes.csv        the audio layer's formats (audio/pitch_tracker.h,
-//                               audio/notes.h), in the folder itself
+//                               audio/notes.h), in the folder itself; with double stops
+//                               double_stops.csv (audio/double_stops_csv.h)
 //   vision/ paper/ arco/        points3d.npy (refine/method_result.h), hand_params.npy,
 //                               contacts.csv (refine/contacts_csv.h) and fingering.csv
 //                               (kFingeringCsvHeader) for paper and arco
@@ -41,6 +42,7 @@
 #include <string>
 #include <vector>
 
+#include "arco/audio/double_stops.h"
 #include "arco/audio/notes.h"
 #include "arco/audio/pitch_tracker.h"
 #include "arco/hand/hand_model.h"
@@ -117,6 +119,8 @@ struct HandRecord {
 // pitch.csv, notes.csv and the pitch entry.
 struct PitchRecord {
   std::vector<audio::PitchFrame> frames;  // one per video frame
+  // With double stops, one per video frame (double_stops.csv); empty: none, no file.
+  std::vector<audio::PolyPitchFrame> double_stops;
   audio::NoteAnalysis notes;
   double a4_hz = 440.0;
   PitchStageSummary summary;  // summary.audio: the file tracked
@@ -237,6 +241,8 @@ class ResultFolder {
   Status WritePitch(const PitchRecord& record) const;
   StatusOr<std::vector<audio::PitchFrame>> ReadPitch() const;
   std::string PitchPath() const;
+  // double_stops.csv (audio/double_stops_csv.h); empty when the result has none.
+  StatusOr<std::vector<audio::PolyPitchFrame>> ReadDoubleStops() const;
   // The notes of notes.csv (empty when the file is absent: results of older versions).
   StatusOr<std::vector<audio::Note>> ReadNotes() const;
 

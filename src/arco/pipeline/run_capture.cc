@@ -3,6 +3,7 @@
 #include <chrono>
 #include <utility>
 
+#include "arco/audio/double_stops_csv.h"
 #include "arco/hand/hand_params.h"
 #include "arco/pipeline/capture_checks.h"
 #include "arco/pipeline/capture_context.h"
@@ -51,6 +52,7 @@ HandStageOptions RunOptions::ForHands() const {
 PitchStageOptions RunOptions::ForPitch() const {
   PitchStageOptions o = pitch;
   o.result_dir = result_dir;
+  o.double_stops = double_stops;
   return o;
 }
 
@@ -132,18 +134,6 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
   ARCO_ASSIGN_OR_RETURN(const PitchRecord pitch,
                         RunPitchStage(options.ForPitch(), capture, progress));
   summary.pitch = pitch.summary;
-  std::vector<audio::PolyPitchFrame> poly;  // double stops, one per video frame
-  if (options.double_stops && summary.pitch.ran) {
-    audio::DoubleStopOptions d;
-    ARCO_ASSIGN_OR_RETURN(d.range, audio::InstrumentRangeByName(capture.instrument->name()));
-    d.fps = capture.manifest.fps;
-    d.start_s = capture.manifest.audio_offset_s;
-    d.max_frames = static_cast<int64_t>(pitch.frames.size());
-    d.a4_hz = capture.manifest.tuning_a4_hz;
-    ARCO_RETURN_IF_ERROR(d.Validate());
-    ARCO_ASSIGN_OR_RETURN(auto reader, OpenCaptureAudio(capture, summary.pitch.audio));
-    ARCO_ASSIGN_OR_RETURN(poly, audio::TrackDoubleStops(std::move(reader), d, nullptr));
-  }
   capture.audio_bytes.reset();  // the last stage that decodes the audio (up to 256 MiB)
   if (summary.pitch.ran) summary.timings.push_back({"pitch", SecondsSince(start)});
   Append(&summary.warnings, summary.pitch.warnings);
@@ -170,8 +160,14 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
     ARCO_ASSIGN_OR_RETURN(records.notes,
                           audio::ParseNotesCsv(audio::FormatNotesCsv(pitch.notes), pitch_path));
   }
+  std::vector<audio::PolyPitchFrame> double_stops_as_written;
+  if (!pitch.double_stops.empty()) {
+    ARCO_ASSIGN_OR_RETURN(
+        double_stops_as_written,
+        audio::ParseDoubleStopsCsv(audio::FormatDoubleStopsCsv(pitch.double_stops), pitch_path));
+  }
   ARCO_ASSIGN_OR_RETURN(RefineInputs inputs, MakeRefineInputs(options.result_dir, records));
-  if (!poly.empty()) AddDoubleStops(poly, &inputs);
+  if (!double_stops_as_written.empty()) AddDoubleStops(double_stops_as_written, &inputs);
   std::vector<refine::RefineMode> modes = {refine::RefineMode::kVision};
   if (inputs.has_pitch) {
     modes.push_back(refine::RefineMode::kPaper);
