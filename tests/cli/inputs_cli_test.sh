@@ -14,7 +14,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 
-"$arco" synth --duration-s 1.5 --seed 5 -o "$tmp/good" >"$tmp/synth.log" 2>&1
+"$arco" synth --duration-s 1 --seed 5 -o "$tmp/good" >"$tmp/synth.log" 2>&1
 rc=$?
 check '[ $rc -eq 0 ]' "synth the good capture: $(tail -1 "$tmp/synth.log")"
 rm -rf "$tmp/good/truth"
