@@ -20,7 +20,7 @@ w=$tmp/w
 SNAPSHOT_DIR=$w
 mkdir -p "$tmp/pristine"
 
-"$arco" synth --duration-s 1.5 --seed 3 -o "$tmp/pristine/cap" >"$tmp/log" 2>&1
+"$arco" synth --duration-s 1 --seed 3 -o "$tmp/pristine/cap" >"$tmp/log" 2>&1
 check '[ $? -eq 0 ] && [ -f "$tmp/pristine/cap/audio.wav" ]' "synth: $(tail -1 "$tmp/log")"
 # Given relative, the capture is recorded relative ("../cap"): copies of the pair stay a pair.
 (cd "$tmp/pristine" && "$arco" run cap -o res --threads 2) >"$tmp/log" 2>&1
@@ -106,9 +106,10 @@ rm "$w/cap/audio.wav"
 refused "audio gone" audio.wav "it is gone; "
 # The whole capture replaced (another seed): its manifest is named first.
 fresh
-"$arco" synth --duration-s 1.5 --seed 4 -o "$w/cap" --overwrite >"$tmp/log" 2>&1
+"$arco" synth --duration-s 1 --seed 4 -o "$w/cap" --overwrite >"$tmp/log" 2>&1
 check '[ $? -eq 0 ]' "synth --overwrite: $(tail -1 "$tmp/log")"
 refused "capture replaced" capture.json
+cp -r "$w/cap" "$tmp/replaced"  # the replaced capture, for the re-run below
 
 # A result of an older arco (no "inputs" anywhere) is read as before, even over a changed
 # capture: there is nothing to compare.
@@ -127,7 +128,7 @@ ok "export of a result without fingerprints" export "$w/res" --format csv --meth
 # Re-running the first stage into the full result, after the capture changed: it is the
 # writer, so it runs; the stages made from the old triangulation go, and are named.
 fresh
-"$arco" synth --duration-s 1.5 --seed 4 -o "$w/cap" --overwrite >"$tmp/log" 2>&1
+rm -rf "$w/cap" && cp -r "$tmp/replaced" "$w/cap"
 "$arco" triangulate "$w/cap" -o "$w/res" >"$tmp/out" 2>"$tmp/err"
 check '[ $? -eq 0 ]' "triangulate into the result: $(cat "$tmp/err")"
 check 'grep -q "^removed the later stages made from the old triangulation: instrument, hand, pitch, arco, paper, vision (arco run redoes them)$" "$tmp/out"' \
