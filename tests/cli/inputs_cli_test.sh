@@ -23,7 +23,7 @@ rm -rf "$tmp/good/truth"
 defect() { rm -rf "$tmp/$1"; cp -r "$tmp/good" "$tmp/$1"; }
 # json NAME PYTHON: edits $tmp/NAME/capture.json as the dict `j` (text edits with sed).
 json() {
-  python3 - "$tmp/$1/capture.json" "$2" <<'EOF'
+  /usr/bin/python3 - "$tmp/$1/capture.json" "$2" <<'EOF'
 import json, sys
 path, code = sys.argv[1], sys.argv[2]
 j = json.load(open(path))
@@ -34,7 +34,7 @@ EOF
 # npy NAME DESCR FRAMES: rewrites keypoints2d.npy with another dtype and/or frame count
 # (0: the same).
 npy() {
-  python3 - "$tmp/$1/keypoints2d.npy" "$2" "$3" <<'EOF'
+  /usr/bin/python3 - "$tmp/$1/keypoints2d.npy" "$2" "$3" <<'EOF'
 import ast, math, struct, sys
 path, descr, frames = sys.argv[1], sys.argv[2], int(sys.argv[3])
 raw = open(path, "rb").read()

@@ -47,7 +47,7 @@ bad_at "import-spd under a file" "$w/file/imp" "${I[@]}" -o "$w/file/imp"
 
 # capture new: a capture folder referencing its videos (here one 2300x2656 image, SPD's
 # rotated frame size); capture import-keypoints: keypoints2d.npy and capture.json together.
-python3 - "$tmp/in/frame.png" <<'PY'
+/usr/bin/python3 - "$tmp/in/frame.png" <<'PY'
 import struct, sys, zlib
 def chunk(kind, data):
     return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))

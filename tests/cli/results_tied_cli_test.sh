@@ -26,7 +26,7 @@ check '[ $? -eq 0 ] && [ -f "$tmp/pristine/cap/audio.wav" ]' "synth: $(tail -1 "
 (cd "$tmp/pristine" && "$arco" run cap -o res --threads 2) >"$tmp/log" 2>&1
 check '[ $? -eq 0 ] && [ -d "$tmp/pristine/res/arco" ]' "run: $(tail -1 "$tmp/log")"
 check 'grep -q "\"capture\": \"../cap\"" "$tmp/pristine/res/result.json"' "the result names ../cap"
-camera=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["cameras"][0]["name"])' \
+camera=$(/usr/bin/python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["cameras"][0]["name"])' \
   "$tmp/pristine/cap/capture.json")
 
 # fresh: $w holds a copy of the capture and its result (the result names ../cap).
@@ -70,7 +70,7 @@ done
 
 # edit FILE PYTHON: rewrites $w/cap/FILE's bytes `b` (a bytearray) with PYTHON.
 edit() {
-  python3 - "$w/cap/$1" "$2" <<'EOF'
+  /usr/bin/python3 - "$w/cap/$1" "$2" <<'EOF'
 import sys
 path, code = sys.argv[1], sys.argv[2]
 b = bytearray(open(path, "rb").read())
@@ -81,7 +81,7 @@ EOF
 
 # The manifest: the audio offset moved by a millisecond (what `arco sync --capture` does).
 fresh
-python3 - "$w/cap/capture.json" <<'EOF'
+/usr/bin/python3 - "$w/cap/capture.json" <<'EOF'
 import json, sys
 j = json.load(open(sys.argv[1]))
 j["audio"]["offset_s"] += 0.001
@@ -114,7 +114,7 @@ cp -r "$w/cap" "$tmp/replaced"  # the replaced capture, for the re-run below
 # A result of an older arco (no "inputs" anywhere) is read as before, even over a changed
 # capture: there is nothing to compare.
 fresh
-python3 - "$w/res/result.json" <<'EOF'
+/usr/bin/python3 - "$w/res/result.json" <<'EOF'
 import json, sys
 j = json.load(open(sys.argv[1]))
 j.pop("inputs")
@@ -135,7 +135,7 @@ check 'grep -q "^removed the later stages made from the old triangulation: instr
   "triangulate names the removed stages: $(cat "$tmp/out")"
 check '[ "$(ls "$w/res")" = "$(printf "result.json\ntriangulation")" ]' \
   "stale stages left: $(ls "$w/res")"
-check 'python3 -c "
+check '/usr/bin/python3 -c "
 import json, sys
 j = json.load(open(sys.argv[1]))
 assert list(j[\"stages\"]) == [\"triangulation\"], j[\"stages\"].keys()
