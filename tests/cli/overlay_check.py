@@ -33,7 +33,7 @@ def probe(path, count_frames=True):
 
 
 def decode(path, w, h, only=None):
-    """Every frame of PATH, or with ONLY (frame indices) just those, in that order."""
+    """Every frame of PATH; with ONLY (frame indices), a dict of just those frames."""
     select = []
     if only is not None:
         only = sorted(set(only))
