@@ -137,14 +137,15 @@ if source:
     turned = lambda img, deg: np.rot90(img, -deg // 90)  # clockwise
     n = int(1 / scale)
     for k in compared:
-        img = turned(src[first - frame_first + k], rotate).astype(float)
+        # The n x n block means, summed in float (no float copy of the full-size frame).
+        img = turned(src[first - frame_first + k], rotate)
         hh, ww = img.shape[0] // n, img.shape[1] // n
-        small = img[:hh * n, :ww * n].reshape(hh, n, ww, n, 3).mean(axis=(1, 3))
+        small = img[:hh * n, :ww * n].reshape(hh, n, ww, n, 3).mean(axis=(1, 3), dtype=float)
         out = pix[k, :hh, :ww].astype(float)
         # Compare away from the drawing: the bottom-right quarter's median difference.
         diff = np.median(np.abs(out[hh // 2:, ww // 2:] - small[hh // 2:, ww // 2:]))
-        wrong = turned(src[first - frame_first + k], (rotate + 180) % 360).astype(float)
-        wrong = wrong[:hh * n, :ww * n].reshape(hh, n, ww, n, 3).mean(axis=(1, 3))
+        wrong = turned(src[first - frame_first + k], (rotate + 180) % 360)
+        wrong = wrong[:hh * n, :ww * n].reshape(hh, n, ww, n, 3).mean(axis=(1, 3), dtype=float)
         diff_wrong = np.median(np.abs(out[hh // 2:, ww // 2:] - wrong[hh // 2:, ww // 2:]))
         if not (diff < 8 and diff_wrong > 3 * diff + 8):
             errors.append(f"frame {k}: background differs from the turned source by {diff:.1f} "
