@@ -23,12 +23,14 @@ ok() {
 }
 
 # expect_error NAME PATTERN ARGS...: `arco ARGS` exits 1 with one stderr line matching
-# "arco: error: PATTERN" (a shell glob: quote literal parts) and changes nothing.
+# "arco: error: PATTERN" (a shell glob: quote literal parts) and changes nothing. The
+# line stays in $error_line, for further checks of its words without running arco again.
 expect_error() {
   local name=$1 pattern=$2; shift 2
   local before; before=$(snapshot)
   local line; line=$("$arco" "$@" 2>&1 >/dev/null)
   local rc=$?
+  error_line=$line
   local one_line=0
   if [ -n "$line" ] && [[ "$line" != *$'\n'* ]]; then one_line=1; fi
   check '[ $rc -eq 1 ] && [ $one_line -eq 1 ] && [[ "$line" == "arco: error: "$pattern ]]' \

@@ -47,7 +47,7 @@ bad_at "import-spd under a file" "$w/file/imp" "${I[@]}" -o "$w/file/imp"
 
 # capture new: a capture folder referencing its videos (here one 2300x2656 image, SPD's
 # rotated frame size); capture import-keypoints: keypoints2d.npy and capture.json together.
-python3 - "$tmp/in/frame.png" <<'PY'
+/usr/bin/python3 - "$tmp/in/frame.png" <<'PY'
 import struct, sys, zlib
 def chunk(kind, data):
     return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
@@ -187,9 +187,8 @@ rmdir "$w/r2.report.json"
 rm "$w/rig.report.json"
 
 # calibrate refine: the same for its calibration and report; an existing file only with
-# --overwrite.
-"$arco" synth --duration-s 1 --no-audio -o "$tmp/cap" >/dev/null 2>&1
-R=(calibrate refine "$tmp/cap" --max-frames 5)
+# --overwrite (on synth's capture from above, which it only reads).
+R=(calibrate refine "$w/cap" --max-frames 5)
 bad_at "calibrate refine into a folder" "$w/dir" "${R[@]}" -o "$w/dir"
 bad_at "calibrate refine into a missing folder" "$w/nodir/r.json" "${R[@]}" -o "$w/nodir/r.json"
 bad_at "calibrate refine under a file" "$w/file/r.json" "${R[@]}" -o "$w/file/r.json"

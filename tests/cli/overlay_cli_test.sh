@@ -25,7 +25,7 @@ trap 'rm -rf "$tmp"' EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 SNAPSHOT_DIR=$tmp/w
 
-"$arco" synth -o "$tmp/cap" --duration-s 2 >/dev/null 2>&1 &&
+"$arco" synth -o "$tmp/cap" --duration-s 1 >/dev/null 2>&1 &&
   "$arco" run "$tmp/cap" -o "$tmp/res" >/dev/null 2>&1 ||
   { echo "FAILED: synth + run"; exit 1; }
 frames=$("$py" -c "import json,sys; print(json.load(open(sys.argv[1]))['frames']['count'])" \

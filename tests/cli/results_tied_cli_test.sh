@@ -20,13 +20,13 @@ w=$tmp/w
 SNAPSHOT_DIR=$w
 mkdir -p "$tmp/pristine"
 
-"$arco" synth --duration-s 1.5 --seed 3 -o "$tmp/pristine/cap" >"$tmp/log" 2>&1
+"$arco" synth --duration-s 1 --seed 3 -o "$tmp/pristine/cap" >"$tmp/log" 2>&1
 check '[ $? -eq 0 ] && [ -f "$tmp/pristine/cap/audio.wav" ]' "synth: $(tail -1 "$tmp/log")"
 # Given relative, the capture is recorded relative ("../cap"): copies of the pair stay a pair.
 (cd "$tmp/pristine" && "$arco" run cap -o res --threads 2) >"$tmp/log" 2>&1
 check '[ $? -eq 0 ] && [ -d "$tmp/pristine/res/arco" ]' "run: $(tail -1 "$tmp/log")"
 check 'grep -q "\"capture\": \"../cap\"" "$tmp/pristine/res/result.json"' "the result names ../cap"
-camera=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["cameras"][0]["name"])' \
+camera=$(/usr/bin/python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["cameras"][0]["name"])' \
   "$tmp/pristine/cap/capture.json")
 
 # fresh: $w holds a copy of the capture and its result (the result names ../cap).
@@ -70,7 +70,7 @@ done
 
 # edit FILE PYTHON: rewrites $w/cap/FILE's bytes `b` (a bytearray) with PYTHON.
 edit() {
-  python3 - "$w/cap/$1" "$2" <<'EOF'
+  /usr/bin/python3 - "$w/cap/$1" "$2" <<'EOF'
 import sys
 path, code = sys.argv[1], sys.argv[2]
 b = bytearray(open(path, "rb").read())
@@ -81,7 +81,7 @@ EOF
 
 # The manifest: the audio offset moved by a millisecond (what `arco sync --capture` does).
 fresh
-python3 - "$w/cap/capture.json" <<'EOF'
+/usr/bin/python3 - "$w/cap/capture.json" <<'EOF'
 import json, sys
 j = json.load(open(sys.argv[1]))
 j["audio"]["offset_s"] += 0.001
@@ -106,14 +106,15 @@ rm "$w/cap/audio.wav"
 refused "audio gone" audio.wav "it is gone; "
 # The whole capture replaced (another seed): its manifest is named first.
 fresh
-"$arco" synth --duration-s 1.5 --seed 4 -o "$w/cap" --overwrite >"$tmp/log" 2>&1
+"$arco" synth --duration-s 1 --seed 4 -o "$w/cap" --overwrite >"$tmp/log" 2>&1
 check '[ $? -eq 0 ]' "synth --overwrite: $(tail -1 "$tmp/log")"
 refused "capture replaced" capture.json
+cp -r "$w/cap" "$tmp/replaced"  # the replaced capture, for the re-run below
 
 # A result of an older arco (no "inputs" anywhere) is read as before, even over a changed
 # capture: there is nothing to compare.
 fresh
-python3 - "$w/res/result.json" <<'EOF'
+/usr/bin/python3 - "$w/res/result.json" <<'EOF'
 import json, sys
 j = json.load(open(sys.argv[1]))
 j.pop("inputs")
@@ -127,14 +128,14 @@ ok "export of a result without fingerprints" export "$w/res" --format csv --meth
 # Re-running the first stage into the full result, after the capture changed: it is the
 # writer, so it runs; the stages made from the old triangulation go, and are named.
 fresh
-"$arco" synth --duration-s 1.5 --seed 4 -o "$w/cap" --overwrite >"$tmp/log" 2>&1
+rm -rf "$w/cap" && cp -r "$tmp/replaced" "$w/cap"
 "$arco" triangulate "$w/cap" -o "$w/res" >"$tmp/out" 2>"$tmp/err"
 check '[ $? -eq 0 ]' "triangulate into the result: $(cat "$tmp/err")"
 check 'grep -q "^removed the later stages made from the old triangulation: instrument, hand, pitch, arco, paper, vision (arco run redoes them)$" "$tmp/out"' \
   "triangulate names the removed stages: $(cat "$tmp/out")"
 check '[ "$(ls "$w/res")" = "$(printf "result.json\ntriangulation")" ]' \
   "stale stages left: $(ls "$w/res")"
-check 'python3 -c "
+check '/usr/bin/python3 -c "
 import json, sys
 j = json.load(open(sys.argv[1]))
 assert list(j[\"stages\"]) == [\"triangulation\"], j[\"stages\"].keys()
