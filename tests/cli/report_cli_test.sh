@@ -63,6 +63,36 @@ for b in bad[:10]: print("FAILED: " + b)
 sys.exit(1 if bad else 0)
 PY
 
+# Double stops: a row holds both notes where arco's fingering_2.csv has a second voice.
+"$arco" synth --duration-s 6 --piece double-stops --instrument violin -o "$tmp/ds" >/dev/null 2>&1 &&
+  "$arco" run "$tmp/ds" -o "$tmp/ds_res" --double-stops >/dev/null 2>&1 ||
+  { echo "FAILED: synth + run --double-stops"; exit 1; }
+ok "report of double stops" report "$tmp/ds_res" -o "$tmp/ds_report.html"
+/usr/bin/python3 - "$tmp/ds_report.html" "$tmp/ds_res/arco/fingering.csv" \
+  "$tmp/ds_res/arco/fingering_2.csv" <<'PY' || fail=1
+import csv, re, sys
+page, fingering, second = sys.argv[1:]
+text = open(page).read()
+rows = dict(re.findall(r'<tr class="note[^"]*" data-note="(\d+)">(.*?)</tr>', text))
+upper = {u["note"]: u for u in csv.DictReader(open(second)) if u["state"] in ("pressed", "open")}
+bad = []
+if not upper: bad.append("no second voice in fingering_2.csv")
+for n in csv.DictReader(open(fingering)):
+    cells = re.findall(r"<td[^>]*>(.*?)</td>", rows.get(n["note"], ""))
+    if not cells: bad.append("note %s missing" % n["note"]); continue
+    u = upper.get(n["note"])
+    want = n["note_name"] + (" + " + u["note_name"] if u else "")
+    if cells[2] != want: bad.append("note %s: %r, want %r" % (n["note"], cells[2], want))
+    if u and u["state"] == "pressed" and not cells[4].endswith(" + " + u["finger"]):
+        bad.append("note %s: fingers %r, second %s" % (n["note"], cells[4], u["finger"]))
+m = re.search(r"<b>(\d+)</b>double stops", text)
+if not m or int(m.group(1)) != len(upper):
+    bad.append("summary %s double stops for %d" % (m and m.group(1), len(upper)))
+print("%d double stops in the report" % len(upper))
+for b in bad[:10]: print("FAILED: " + b)
+sys.exit(1 if bad else 0)
+PY
+
 # Bad input: one line, nothing written.
 SNAPSHOT_DIR=$tmp
 mkdir -p "$tmp/empty"

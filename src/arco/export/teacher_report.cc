@@ -77,6 +77,7 @@ struct Row {
   const refine::NoteFingering* note = nullptr;
   const audio::Note* audio = nullptr;        // its vibrato; null when not found
   const refine::BowingNote* bow = nullptr;   // null without bowing
+  const refine::NoteFingering* upper = nullptr;  // a double stop's second voice, or null
   bool shift = false;                        // the hand moved since the previous pressed note
 };
 
@@ -119,6 +120,8 @@ StatusOr<std::string> BuildTeacherReport(const TeacherReportOptions& options,
     return Status::Error(result.FingeringPath(options.method) +
                          ": no notes (run arco run, or arco refine --mode " + options.method + ")");
   }
+  ARCO_ASSIGN_OR_RETURN(const std::vector<refine::NoteFingering> second,
+                        result.ReadSecondFingering(options.method));
   ARCO_ASSIGN_OR_RETURN(const std::vector<audio::Note> audio_notes, result.ReadNotes());
   ARCO_ASSIGN_OR_RETURN(const std::vector<refine::BowingNote> bowing,
                         result.ReadBowingNotes(options.method));
@@ -136,6 +139,12 @@ StatusOr<std::string> BuildTeacherReport(const TeacherReportOptions& options,
 
   std::map<int, const refine::BowingNote*> bow_of;
   for (const refine::BowingNote& b : bowing) bow_of[b.note] = &b;
+  std::map<int, const refine::NoteFingering*> upper_of;
+  // An uncertain second voice (unplayable with the first, out of the hand's reach) is
+  // most often a partial of the first heard as a note: not reported as a double stop.
+  for (const refine::NoteFingering& u : second) {
+    if (u.state == "pressed" || u.state == "open") upper_of[u.note] = &u;
+  }
   std::vector<Row> rows;
   double last_position = NAN;
   for (const refine::NoteFingering& n : fingering) {
@@ -145,6 +154,7 @@ StatusOr<std::string> BuildTeacherReport(const TeacherReportOptions& options,
       r.audio = &audio_notes[static_cast<size_t>(n.note)];
     }
     if (auto it = bow_of.find(n.note); it != bow_of.end()) r.bow = it->second;
+    if (auto it = upper_of.find(n.note); it != upper_of.end()) r.upper = it->second;
     if (std::isfinite(n.position_semitones)) {
       r.shift = std::isfinite(last_position) &&
                 std::abs(n.position_semitones - last_position) >= 0.75;
@@ -176,7 +186,7 @@ StatusOr<std::string> BuildTeacherReport(const TeacherReportOptions& options,
   };
 
   // Whole-take figures.
-  int in_tune = 0, tuned = 0, vibrato = 0, shifts = 0, disagree = 0;
+  int in_tune = 0, tuned = 0, vibrato = 0, shifts = 0, disagree = 0, double_stops = 0;
   std::vector<double> abs_cents, rates, widths, sounding;
   for (const Row& r : rows) {
     if (r.note->state == "pressed" || r.note->state == "open") {
@@ -190,6 +200,7 @@ StatusOr<std::string> BuildTeacherReport(const TeacherReportOptions& options,
       widths.push_back(r.audio->vibrato_extent_cents);
     }
     shifts += r.shift;
+    double_stops += r.upper != nullptr;
     if (r.bow) {
       disagree += !r.bow->strings_agree;
       sounding.push_back(r.bow->sounding_point_mm);
@@ -215,6 +226,7 @@ StatusOr<std::string> BuildTeacherReport(const TeacherReportOptions& options,
     << (rates.empty() ? "" : Num(FiniteMedian(rates), "%.1f") + " Hz, &plusmn;" +
                                  Num(FiniteMedian(widths), "%.0f") + " cents")
     << "</div><div><b>" << shifts << "</b>shifts</div>";
+  if (double_stops > 0) h << "<div><b>" << double_stops << "</b>double stops</div>";
   if (!bowing.empty()) {
     h << "<div><b>" << Num(FiniteMedian(sounding), "%.0f") << " mm</b>sounding point (median)</div>"
       << "<div><b>" << disagree << "</b>notes bowed on another string</div>";
@@ -271,12 +283,20 @@ StatusOr<std::string> BuildTeacherReport(const TeacherReportOptions& options,
     for (size_t i = first; i < last; ++i) {
       const Row& r = rows[i];
       const refine::NoteFingering& n = *r.note;
-      h << "<tr class=\"note" << (r.shift ? " shift" : "") << "\" data-note=\"" << n.note
-        << "\"><td>" << (i + 1) << "</td><td>" << Clock(n.onset_s) << "</td><td class=\"name\">"
-        << Html(refine::MidiNoteName(n.midi_note)) << "</td><td>" << string_name(n.string)
-        << "</td><td>" << (n.state == "pressed" ? FingerName(n.finger) : n.state == "open" ? "open" : "&ndash;")
-        << "</td><td>" << Num(n.position_semitones, "%.1f") << "</td><td class=\""
-        << tune_class(n.cents_off) << "\">" << Num(n.cents_off, "%+.0f") << "</td><td>";
+      // A double stop: both notes, strings, fingers and intonations, lower first.
+      const refine::NoteFingering* u = r.upper;
+      auto finger = [](const refine::NoteFingering& x) -> std::string {
+        return x.state == "pressed" ? FingerName(x.finger) : x.state == "open" ? "open" : "&ndash;";
+      };
+      h << "<tr class=\"note" << (r.shift ? " shift" : "") << (u ? " double-stop" : "")
+        << "\" data-note=\"" << n.note << "\"><td>" << (i + 1) << "</td><td>" << Clock(n.onset_s)
+        << "</td><td class=\"name\">" << Html(refine::MidiNoteName(n.midi_note))
+        << (u ? " + " + Html(refine::MidiNoteName(u->midi_note)) : "") << "</td><td>"
+        << string_name(n.string) << (u ? " + " + string_name(u->string) : "") << "</td><td>"
+        << finger(n) << (u ? " + " + finger(*u) : "") << "</td><td>"
+        << Num(n.position_semitones, "%.1f") << "</td><td class=\"" << tune_class(n.cents_off)
+        << "\">" << Num(n.cents_off, "%+.0f") << (u ? " / " + Num(u->cents_off, "%+.0f") : "")
+        << "</td><td>";
       if (r.audio && r.audio->vibrato_rate_hz > 0) {
         h << Num(r.audio->vibrato_rate_hz, "%.1f") << " Hz &plusmn;"
           << Num(r.audio->vibrato_extent_cents, "%.0f") << "&cent;";

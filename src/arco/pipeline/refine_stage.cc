@@ -294,6 +294,10 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
       *spd, r.hand, options.mode == refine::RefineMode::kVision ? nullptr : &r.contacts);
   out.hands = r.hand;
   out.contacts = r.contacts;
+  if (!second.empty()) {
+    out.second_fingering = refine::TranscribeSecondVoice(
+        *inputs.input.instrument, r.fingering, second, inputs.input.a4_hz);
+  }
   out.second_contacts = std::move(second);
   out.double_stop_options = double_stop_options;
   out.double_stop_summary = double_stop_summary;

@@ -38,6 +38,7 @@ constexpr char kDoubleStopsCsvFile[] = "double_stops.csv";
 constexpr char kContactsCsvFile[] = "contacts.csv";
 constexpr char kSecondContactsCsvFile[] = "contacts_2.csv";  // double stops' upper notes
 constexpr char kFingeringCsvFile[] = "fingering.csv";
+constexpr char kSecondFingeringCsvFile[] = "fingering_2.csv";  // double stops' upper notes
 constexpr char kBowingCsvFile[] = "bowing.csv";
 constexpr char kBowingNotesCsvFile[] = "bowing_notes.csv";
 
@@ -168,7 +169,15 @@ StatusOr<std::vector<refine::BowingNote>> ResultFolder::ReadBowingNotes(
 
 StatusOr<std::vector<refine::NoteFingering>> ResultFolder::ReadFingering(
     const std::string& method) const {
-  const std::string path = FingeringPath(method);
+  return ReadFingeringCsv(FingeringPath(method));
+}
+
+StatusOr<std::vector<refine::NoteFingering>> ResultFolder::ReadSecondFingering(
+    const std::string& method) const {
+  return ReadFingeringCsv(StagePath(method, kSecondFingeringCsvFile));
+}
+
+StatusOr<std::vector<refine::NoteFingering>> ReadFingeringCsv(const std::string& path) {
   std::vector<refine::NoteFingering> rows;
   if (!FileExists(path)) return rows;
   std::vector<std::string> required;
@@ -741,6 +750,7 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
     files["fingering"] = kFingeringCsvFile;
   }
   if (!r.second_contacts.empty()) files["contact_2"] = kSecondContactsCsvFile;
+  if (!r.second_fingering.empty()) files["fingering_2"] = kSecondFingeringCsvFile;
   if (r.bowing) {
     files["bowing"] = kBowingCsvFile;
     files["bowing_notes"] = kBowingNotesCsvFile;
@@ -756,6 +766,10 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
     if (!r.second_contacts.empty()) {
       ARCO_RETURN_IF_ERROR(
           refine::WriteContactsCsv(JoinPath(dir, kSecondContactsCsvFile), r.second_contacts));
+    }
+    if (!r.second_fingering.empty()) {
+      ARCO_RETURN_IF_ERROR(
+          WriteFingeringCsv(JoinPath(dir, kSecondFingeringCsvFile), r.second_fingering));
     }
     if (r.bowing) {
       ARCO_RETURN_IF_ERROR(refine::WriteBowingCsv(JoinPath(dir, kBowingCsvFile), r.bowing->frames));

@@ -137,6 +137,8 @@ struct MethodRecord {
   // The upper notes of double stops (arco with double stops): contacts_2.csv, in
   // contacts.csv's format; empty: none.
   std::vector<refine::FrameContact> second_contacts;
+  // Their notes (fingering_2.csv, fingering.csv's format); empty: none.
+  std::vector<refine::NoteFingering> second_fingering;
   // Recorded as the stage's "double_stops" (options and counts) when second_contacts is.
   refine::DoubleStopRefineOptions double_stop_options;
   refine::DoubleStopRefineSummary double_stop_summary;
@@ -253,6 +255,10 @@ class ResultFolder {
   // method has none (vision). Errors name the file and line: a missing column, a short
   // row, an unparsable number.
   StatusOr<std::vector<refine::NoteFingering>> ReadFingering(const std::string& method) const;
+  // <method>/fingering_2.csv: the second voice of double stops, one row per first-voice
+  // note that has one (refine/transcription.h, TranscribeSecondVoice), in fingering.csv's
+  // format; empty when the method has none.
+  StatusOr<std::vector<refine::NoteFingering>> ReadSecondFingering(const std::string& method) const;
   // A method's bowing_notes.csv (refine/bowing.h); empty when it has none.
   StatusOr<std::vector<refine::BowingNote>> ReadBowingNotes(const std::string& method) const;
 
@@ -276,6 +282,10 @@ class ResultFolder {
 
   std::string dir_;
 };
+
+// A fingering.csv (kFingeringCsvHeader; columns found by name), empty when the file is
+// absent. Errors name the file and line.
+StatusOr<std::vector<refine::NoteFingering>> ReadFingeringCsv(const std::string& path);
 
 // Point `point` of frame `frame` of a (F, P, 3) points array (NaN where missing).
 inline Eigen::Vector3d PointAt(const NpyArray<double>& points, int64_t frame, int64_t point) {

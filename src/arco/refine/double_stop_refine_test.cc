@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "arco/refine/test_scene.h"
+#include "arco/refine/transcription.h"
 
 namespace arco::refine {
 namespace {
@@ -122,6 +123,40 @@ TEST(RefineSecondVoice, ThePairOfFingersCorrectsTheFirstVoicesFinger) {
   EXPECT_EQ(kept.summary.first_fingers_changed, 0);
   EXPECT_EQ(kept.first[5].finger, 3);
   EXPECT_NE(kept.second[5].finger, 3);
+}
+
+TEST(TranscribeSecondVoice, OneRowPerFirstVoiceNoteWithASecondVoice) {
+  const Fixture fx;
+  const size_t n = fx.scene.input.pitch.size();
+  // A sixth (finger 2 on the E string) over most of the note: one row, in the first
+  // voice's note and frames, its pitch the second voice's and its hand position the first's.
+  std::vector<double> upper(n, 0.0);
+  for (size_t f = 2; f < 18; ++f) upper[f] = fx.UpperHz(4);
+  const DoubleStopRefineResult r = RefineSecondVoice(fx.scene.input, fx.first, upper, {});
+  ASSERT_FALSE(fx.first.fingering.empty());
+  const std::vector<NoteFingering> rows =
+      TranscribeSecondVoice(*fx.scene.model, fx.first.fingering, r.second, 440.0);
+  ASSERT_EQ(rows.size(), 1u);
+  const NoteFingering& row = rows[0];
+  const NoteFingering& lower = fx.first.fingering[0];
+  EXPECT_EQ(row.note, lower.note);
+  EXPECT_EQ(row.first_frame, lower.first_frame);
+  EXPECT_EQ(row.last_frame, lower.last_frame);
+  EXPECT_EQ(row.state, "pressed");
+  EXPECT_EQ(row.string, 1);
+  EXPECT_EQ(row.finger, 2);
+  EXPECT_EQ(row.midi_note, 76 + 4);  // E5 + 4 semitones: G#5
+  EXPECT_NEAR(row.f0_hz, fx.UpperHz(4), 1e-9);
+  EXPECT_EQ(row.position_semitones, lower.position_semitones);
+  EXPECT_GE(row.pressed_frames, 16);
+  // A second voice on a few frames only (a partial at the note's edge): no row.
+  std::vector<double> brief(n, 0.0);
+  brief[5] = brief[6] = fx.UpperHz(4);
+  DoubleStopRefineOptions per_frame;
+  per_frame.fill_notes = false;
+  const DoubleStopRefineResult few = RefineSecondVoice(fx.scene.input, fx.first, brief, per_frame);
+  EXPECT_TRUE(
+      TranscribeSecondVoice(*fx.scene.model, fx.first.fingering, few.second, 440.0).empty());
 }
 
 TEST(RefineSecondVoice, NoHigherStringOrAnUnplayableSpanIsUncertain) {

@@ -99,4 +99,87 @@ std::vector<NoteFingering> Transcribe(const InstrumentModel& model,
   return out;
 }
 
+std::vector<NoteFingering> TranscribeSecondVoice(const InstrumentModel& model,
+                                                 const std::vector<NoteFingering>& first,
+                                                 const std::vector<FrameContact>& second,
+                                                 double a4_hz) {
+  std::vector<NoteFingering> out;
+  for (const NoteFingering& lower : first) {
+    NoteFingering row;
+    row.note = lower.note;
+    row.first_frame = lower.first_frame;
+    row.last_frame = lower.last_frame;
+    row.onset_s = lower.onset_s;
+    row.duration_s = lower.duration_s;
+    std::map<std::pair<int, int>, int> pressed_votes;  // (string, finger) -> frames
+    std::map<int, int> open_votes;
+    std::vector<double> f0;
+    int64_t frames = 0;
+    for (int64_t f = lower.first_frame; f <= lower.last_frame; ++f) {
+      if (f < 0 || f >= static_cast<int64_t>(second.size())) continue;
+      ++frames;
+      const FrameContact& c = second[static_cast<size_t>(f)];
+      if (c.state == ContactState::kRest) continue;
+      if (c.f0_hz > 0) f0.push_back(c.f0_hz);
+      if (c.state == ContactState::kPressed) {
+        ++row.pressed_frames;
+        ++pressed_votes[{c.string, c.finger}];
+      } else if (c.state == ContactState::kOpenString) {
+        ++row.open_frames;
+        ++open_votes[c.string];
+      } else {
+        ++row.uncertain_frames;
+      }
+    }
+    const int64_t heard = row.pressed_frames + row.open_frames + row.uncertain_frames;
+    if (f0.empty() || 2 * heard < frames) continue;
+    row.f0_hz = UpperMedian(f0);
+    const double midi = 69.0 + 12.0 * std::log2(row.f0_hz / a4_hz);
+    row.midi_note = static_cast<int>(std::lround(midi));
+    row.cents_off = 100.0 * (midi - row.midi_note);
+    if (row.pressed_frames > 0 && row.pressed_frames >= row.open_frames &&
+        row.pressed_frames >= row.uncertain_frames) {
+      row.state = "pressed";
+      int best = -1;
+      for (const auto& [key, votes] : pressed_votes) {  // ordered: ties to the lower key
+        if (votes > best) {
+          best = votes;
+          row.string = key.first;
+          row.finger = key.second;
+        }
+      }
+      std::vector<double> from_nut;
+      for (int64_t f = lower.first_frame; f <= lower.last_frame; ++f) {
+        if (f < 0 || f >= static_cast<int64_t>(second.size())) continue;
+        const FrameContact& c = second[static_cast<size_t>(f)];
+        if (c.pressed() && c.string == row.string && c.finger == row.finger &&
+            std::isfinite(c.from_nut_mm)) {
+          from_nut.push_back(c.from_nut_mm);
+        }
+      }
+      if (!from_nut.empty()) row.from_nut_mm = UpperMedian(from_nut);
+      row.position_semitones =
+          lower.state == "pressed"
+              ? lower.position_semitones
+              : HandPositionsSemitones(
+                    model.kind(),
+                    {{CentsBetween(model.open_hz(row.string), row.f0_hz) / 100.0, row.finger}})
+                    .front();
+    } else if (row.open_frames > 0 && row.open_frames >= row.uncertain_frames) {
+      row.state = "open";
+      int best = -1;
+      for (const auto& [string, votes] : open_votes) {
+        if (votes > best) {
+          best = votes;
+          row.string = string;
+        }
+      }
+    } else {
+      row.state = "uncertain";
+    }
+    out.push_back(row);
+  }
+  return out;
+}
+
 }  // namespace arco::refine
