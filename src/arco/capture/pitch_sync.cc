@@ -119,12 +119,14 @@ StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, Progress& progress) 
   ARCO_RETURN_IF_ERROR(
       audio::WritePitchCsv(pitch_tmp, track.frames, o.double_stops ? &second_f0_hz : nullptr));
   if (!fine_tmp.empty()) ARCO_RETURN_IF_ERROR(audio::WritePitchCsv(fine_tmp, track.fine));
-  if (!notes_tmp.empty() && o.double_stops) {
-    // The second voice's notes merged by onset (the MIDI file keeps the first voice).
-    audio::NoteAnalysis both = notes;
-    const audio::NoteAnalysis second =
-        audio::SecondVoiceNotes(track.frames, second_f0_hz, t.fps, note_options);
+  audio::NoteAnalysis second;  // the second voice's notes (double stops)
+  if (o.double_stops) {
+    second = audio::SecondVoiceNotes(track.frames, second_f0_hz, t.fps, note_options);
     result.second_voice_notes = static_cast<int>(second.notes.size());
+  }
+  if (!notes_tmp.empty() && o.double_stops) {
+    // The second voice's notes merged by onset.
+    audio::NoteAnalysis both = notes;
     both.notes.insert(both.notes.end(), second.notes.begin(), second.notes.end());
     std::stable_sort(
         both.notes.begin(), both.notes.end(), [](const audio::Note& a, const audio::Note& b) {
@@ -135,10 +137,23 @@ StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, Progress& progress) 
     ARCO_RETURN_IF_ERROR(audio::WriteNotesCsv(notes_tmp, notes));
   }
   if (!midi_tmp.empty()) {
-    ARCO_RETURN_IF_ERROR(audio::WriteMidiFile(
-        midi_tmp,
-        audio::NotesToMidi(
-            notes, track.fine, note_options, audio::GmProgramForInstrument(t.range.name))));
+    const int program = audio::GmProgramForInstrument(t.range.name);
+    audio::MidiFile midi = audio::NotesToMidi(notes, track.fine, note_options, program);
+    if (o.double_stops) {
+      // The second voice on a track and channel of its own (a pitch bend applies to a whole
+      // channel), its bends from f0_2_hz at the video rate.
+      std::vector<audio::PitchFrame> voice = track.frames;
+      for (size_t i = 0; i < voice.size(); ++i) {
+        voice[i].f0_hz = second_f0_hz[i];
+        voice[i].voiced = second_f0_hz[i] > 0;
+      }
+      audio::MidiTrack upper =
+          audio::NotesToMidi(second, voice, note_options, program).tracks.front();
+      upper.name = "arco pitch, second voice";
+      upper.channel = 1;
+      midi.tracks.push_back(std::move(upper));
+    }
+    ARCO_RETURN_IF_ERROR(audio::WriteMidiFile(midi_tmp, midi));
   }
   ARCO_RETURN_IF_ERROR(outputs.Commit());
   return result;

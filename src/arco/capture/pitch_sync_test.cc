@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
 
 #include "arco/audio/double_stop_music.h"
@@ -85,6 +86,7 @@ TEST(RunPitch, DoubleStopsAddTheSecondNoteColumn) {
   o.double_stops = true;
   o.output = testing::TempPath("pitch_double.csv");
   o.notes_output = testing::TempPath("notes_double.csv");
+  o.midi_output = testing::TempPath("notes_double.mid");
   auto both = RunPitch(o);
   ASSERT_TRUE(both.ok()) << both.status().message();
   auto text2 = ReadFileToString(o.output);
@@ -154,6 +156,21 @@ TEST(RunPitch, DoubleStopsAddTheSecondNoteColumn) {
     overlaps += (*notes2)[i + 1].onset_s < (*notes2)[i].offset_s;
   }
   EXPECT_GT(overlaps, 0);
+  // The MIDI file: the first voice on channel 0, the second on a track and channel of
+  // its own, one note-on per note of each voice.
+  auto midi = ReadFileToString(o.midi_output);
+  ASSERT_TRUE(midi.ok());
+  auto parsed = audio::ParseMidi(*midi);
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  std::map<int, int> note_ons_per_channel;
+  std::map<int, int> channels_of_track;
+  for (const auto& e : parsed->events) {
+    if (e.type == 0x90 && e.data2 > 0) ++note_ons_per_channel[e.channel];
+    channels_of_track[e.track] = e.channel;
+  }
+  EXPECT_EQ(note_ons_per_channel[0], static_cast<int>(notes1->size()));
+  EXPECT_EQ(note_ons_per_channel[1], both->second_voice_notes);
+  EXPECT_NE(channels_of_track.size(), 1u);
   std::printf(
       "notes.csv: %zu first-voice notes, %d second-voice notes (%d generated double "
       "stops), %d overlapping neighbours\n",
