@@ -11,6 +11,74 @@
 
 namespace arco::refine {
 
+namespace {
+
+// The majority state, string and finger of the frames first..last of `contacts` that
+// `belongs` accepts (pressed, open, else uncertain: ties to pressed, then open), into
+// `row`'s counts, state, string and finger, with the median from_nut_mm of the frames in
+// that span pressed by that string and finger. Returns whether the state is pressed.
+template <typename Belongs>
+bool VoteNote(const std::vector<FrameContact>& contacts,
+              int64_t first,
+              int64_t last,
+              const Belongs& belongs,
+              NoteFingering* row) {
+  std::map<std::pair<int, int>, int> pressed_votes;  // (string, finger) -> frames
+  std::map<int, int> open_votes;
+  first = std::max<int64_t>(first, 0);
+  last = std::min<int64_t>(last, static_cast<int64_t>(contacts.size()) - 1);
+  for (int64_t f = first; f <= last; ++f) {
+    const FrameContact& c = contacts[static_cast<size_t>(f)];
+    if (!belongs(c)) continue;
+    if (c.state == ContactState::kPressed) {
+      ++row->pressed_frames;
+      ++pressed_votes[{c.string, c.finger}];
+    } else if (c.state == ContactState::kOpenString) {
+      ++row->open_frames;
+      ++open_votes[c.string];
+    } else {
+      ++row->uncertain_frames;
+    }
+  }
+  if (row->pressed_frames > 0 && row->pressed_frames >= row->open_frames &&
+      row->pressed_frames >= row->uncertain_frames) {
+    row->state = "pressed";
+    int best = -1;
+    for (const auto& [key, votes] : pressed_votes) {  // ordered: ties to the lower key
+      if (votes > best) {
+        best = votes;
+        row->string = key.first;
+        row->finger = key.second;
+      }
+    }
+    std::vector<double> from_nut;
+    for (int64_t f = first; f <= last; ++f) {
+      const FrameContact& c = contacts[static_cast<size_t>(f)];
+      if (c.pressed() && c.string == row->string && c.finger == row->finger &&
+          std::isfinite(c.from_nut_mm)) {
+        from_nut.push_back(c.from_nut_mm);
+      }
+    }
+    if (!from_nut.empty()) row->from_nut_mm = UpperMedian(from_nut);  // a measured position
+    return true;
+  }
+  if (row->open_frames > 0 && row->open_frames >= row->uncertain_frames) {
+    row->state = "open";
+    int best = -1;
+    for (const auto& [string, votes] : open_votes) {
+      if (votes > best) {
+        best = votes;
+        row->string = string;
+      }
+    }
+  } else {
+    row->state = "uncertain";
+  }
+  return false;
+}
+
+}  // namespace
+
 std::vector<NoteFingering> Transcribe(const InstrumentModel& model,
                                       const PitchAnalysis& analysis,
                                       const std::vector<FrameContact>& contacts,
@@ -30,56 +98,15 @@ std::vector<NoteFingering> Transcribe(const InstrumentModel& model,
     const double midi = 69.0 + 12.0 * std::log2(note.f0_hz / a4_hz);
     row.midi_note = static_cast<int>(std::lround(midi));
     row.cents_off = 100.0 * (midi - row.midi_note);
-    std::map<std::pair<int, int>, int> pressed_votes;  // (string, finger) -> frames
-    std::map<int, int> open_votes;
-    std::vector<double> from_nut;
-    for (int64_t f = note.first_frame; f <= note.last_frame; ++f) {
-      const FrameContact& c = contacts[static_cast<size_t>(f)];
-      if (c.note != static_cast<int>(i)) continue;
-      if (c.state == ContactState::kPressed) {
-        ++row.pressed_frames;
-        ++pressed_votes[{c.string, c.finger}];
-      } else if (c.state == ContactState::kOpenString) {
-        ++row.open_frames;
-        ++open_votes[c.string];
-      } else {
-        ++row.uncertain_frames;
-      }
-    }
-    if (row.pressed_frames > 0 && row.pressed_frames >= row.open_frames &&
-        row.pressed_frames >= row.uncertain_frames) {
-      row.state = "pressed";
-      int best = -1;
-      for (const auto& [key, votes] : pressed_votes) {  // ordered: ties to the lower key
-        if (votes > best) {
-          best = votes;
-          row.string = key.first;
-          row.finger = key.second;
-        }
-      }
-      for (int64_t f = note.first_frame; f <= note.last_frame; ++f) {
-        const FrameContact& c = contacts[static_cast<size_t>(f)];
-        if (c.pressed() && c.string == row.string && c.finger == row.finger &&
-            std::isfinite(c.from_nut_mm)) {
-          from_nut.push_back(c.from_nut_mm);
-        }
-      }
-      if (!from_nut.empty()) {
-        row.from_nut_mm = UpperMedian(from_nut);  // one of the measured positions
-      }
+    const int index = static_cast<int>(i);
+    if (VoteNote(
+            contacts,
+            note.first_frame,
+            note.last_frame,
+            [index](const FrameContact& c) { return c.note == index; },
+            &row)) {
       // The hand position, set below from the whole sequence (hand_position.h).
       row.position_semitones = CentsBetween(model.open_hz(row.string), note.f0_hz) / 100.0;
-    } else if (row.open_frames > 0 && row.open_frames >= row.uncertain_frames) {
-      row.state = "open";
-      int best = -1;
-      for (const auto& [string, votes] : open_votes) {
-        if (votes > best) {
-          best = votes;
-          row.string = string;
-        }
-      }
-    } else {
-      row.state = "uncertain";
     }
     out.push_back(row);
   }
@@ -111,53 +138,28 @@ std::vector<NoteFingering> TranscribeSecondVoice(const InstrumentModel& model,
     row.last_frame = lower.last_frame;
     row.onset_s = lower.onset_s;
     row.duration_s = lower.duration_s;
-    std::map<std::pair<int, int>, int> pressed_votes;  // (string, finger) -> frames
-    std::map<int, int> open_votes;
     std::vector<double> f0;
-    int64_t frames = 0;
+    int64_t frames = 0, heard = 0;
     for (int64_t f = lower.first_frame; f <= lower.last_frame; ++f) {
       if (f < 0 || f >= static_cast<int64_t>(second.size())) continue;
       ++frames;
       const FrameContact& c = second[static_cast<size_t>(f)];
       if (c.state == ContactState::kRest) continue;
+      ++heard;
       if (c.f0_hz > 0) f0.push_back(c.f0_hz);
-      if (c.state == ContactState::kPressed) {
-        ++row.pressed_frames;
-        ++pressed_votes[{c.string, c.finger}];
-      } else if (c.state == ContactState::kOpenString) {
-        ++row.open_frames;
-        ++open_votes[c.string];
-      } else {
-        ++row.uncertain_frames;
-      }
     }
-    const int64_t heard = row.pressed_frames + row.open_frames + row.uncertain_frames;
     if (f0.empty() || 2 * heard < frames) continue;
     row.f0_hz = UpperMedian(f0);
     const double midi = 69.0 + 12.0 * std::log2(row.f0_hz / a4_hz);
     row.midi_note = static_cast<int>(std::lround(midi));
     row.cents_off = 100.0 * (midi - row.midi_note);
-    if (row.pressed_frames > 0 && row.pressed_frames >= row.open_frames &&
-        row.pressed_frames >= row.uncertain_frames) {
-      row.state = "pressed";
-      int best = -1;
-      for (const auto& [key, votes] : pressed_votes) {  // ordered: ties to the lower key
-        if (votes > best) {
-          best = votes;
-          row.string = key.first;
-          row.finger = key.second;
-        }
-      }
-      std::vector<double> from_nut;
-      for (int64_t f = lower.first_frame; f <= lower.last_frame; ++f) {
-        if (f < 0 || f >= static_cast<int64_t>(second.size())) continue;
-        const FrameContact& c = second[static_cast<size_t>(f)];
-        if (c.pressed() && c.string == row.string && c.finger == row.finger &&
-            std::isfinite(c.from_nut_mm)) {
-          from_nut.push_back(c.from_nut_mm);
-        }
-      }
-      if (!from_nut.empty()) row.from_nut_mm = UpperMedian(from_nut);
+    const bool pressed = VoteNote(
+        second,
+        lower.first_frame,
+        lower.last_frame,
+        [](const FrameContact& c) { return c.state != ContactState::kRest; },
+        &row);
+    if (pressed) {
       row.position_semitones =
           lower.state == "pressed"
               ? lower.position_semitones
@@ -165,17 +167,6 @@ std::vector<NoteFingering> TranscribeSecondVoice(const InstrumentModel& model,
                     model.kind(),
                     {{CentsBetween(model.open_hz(row.string), row.f0_hz) / 100.0, row.finger}})
                     .front();
-    } else if (row.open_frames > 0 && row.open_frames >= row.uncertain_frames) {
-      row.state = "open";
-      int best = -1;
-      for (const auto& [string, votes] : open_votes) {
-        if (votes > best) {
-          best = votes;
-          row.string = string;
-        }
-      }
-    } else {
-      row.state = "uncertain";
     }
     out.push_back(row);
   }
