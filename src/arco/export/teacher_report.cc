@@ -56,14 +56,8 @@ const char* FingerName(int finger) {
 
 // Least-squares slope of y over x (NaN with fewer than two distinct x).
 double Slope(const std::vector<std::pair<double, double>>& xy) {
-  if (xy.size() < 2) return NAN;
-  double mx = 0, my = 0;
-  for (const auto& [x, y] : xy) mx += x, my += y;
-  mx /= static_cast<double>(xy.size());
-  my /= static_cast<double>(xy.size());
-  double sxx = 0, sxy = 0;
-  for (const auto& [x, y] : xy) sxx += (x - mx) * (x - mx), sxy += (x - mx) * (y - my);
-  return sxx > 0 ? sxy / sxx : NAN;
+  double intercept = 0, slope = NAN;
+  return FitLine(xy, &intercept, &slope) ? slope : NAN;
 }
 
 // The median of the finite values (NaN when there are none).

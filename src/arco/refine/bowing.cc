@@ -57,21 +57,6 @@ void LineToSegment(const Eigen::Vector3d& p,
   *distance = (p + *a * u - q).norm();
 }
 
-// Least-squares line through (t, p) samples: p = c0 + c1 t. False with fewer than 2.
-bool FitLine(const std::vector<std::pair<double, double>>& samples, double* c0, double* c1) {
-  if (samples.size() < 2) return false;
-  double st = 0, sp = 0;
-  for (const auto& [t, p] : samples) st += t, sp += p;
-  const double n = static_cast<double>(samples.size());
-  const double mt = st / n, mp = sp / n;
-  double stt = 0, stp = 0;
-  for (const auto& [t, p] : samples) stt += (t - mt) * (t - mt), stp += (t - mt) * (p - mp);
-  if (!(stt > 0)) return false;
-  *c1 = stp / stt;
-  *c0 = mp - *c1 * mt;
-  return true;
-}
-
 // The upper median of the finite values (NaN when there are none).
 double FiniteMedian(std::vector<double> v) {
   v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }),

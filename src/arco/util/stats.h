@@ -1,12 +1,13 @@
-// Small order statistics shared by the layers: one median, its variants, and the robust
-// scale (MAD). Outputs depend bit for bit on which median a call site uses, so the
-// variants are named and each says where it differs (stats_test.cc shows the cases).
+// Small statistics shared by the layers: one median, its variants, the robust scale (MAD),
+// quantiles and a least-squares line. Outputs depend bit for bit on which median a call site uses,
+// so the variants are named and each says where it differs (stats_test.cc shows the cases).
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <iterator>
+#include <utility>
 #include <vector>
 
 namespace arco {
@@ -66,6 +67,25 @@ inline double InterpolatedQuantile(std::vector<double> v, double q) {
   const size_t lo = static_cast<size_t>(std::floor(pos));
   const size_t hi = std::min(v.size() - 1, lo + 1);
   return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+// Least-squares line y = intercept + slope x through the (x, y) samples (means first,
+// then the centred sums). False, leaving both untouched, with fewer than two samples or
+// no spread in x.
+inline bool FitLine(const std::vector<std::pair<double, double>>& xy,
+                    double* intercept,
+                    double* slope) {
+  if (xy.size() < 2) return false;
+  double sx = 0, sy = 0;
+  for (const auto& [x, y] : xy) sx += x, sy += y;
+  const double n = static_cast<double>(xy.size());
+  const double mx = sx / n, my = sy / n;
+  double sxx = 0, sxy = 0;
+  for (const auto& [x, y] : xy) sxx += (x - mx) * (x - mx), sxy += (x - mx) * (y - my);
+  if (!(sxx > 0)) return false;
+  *slope = sxy / sxx;
+  *intercept = my - *slope * mx;
+  return true;
 }
 
 }  // namespace arco

@@ -75,5 +75,21 @@ TEST(InterpolatedQuantile, InterpolatesBetweenOrderStatistics) {
   EXPECT_EQ(InterpolatedQuantile({7}, 0.3), 7);
 }
 
+TEST(FitLine, RecoversALineAndRefusesTooFewOrNoSpread) {
+  double intercept = 7, slope = 7;
+  EXPECT_TRUE(FitLine({{0, 1}, {1, 3}, {2, 5}, {3, 7}}, &intercept, &slope));
+  EXPECT_DOUBLE_EQ(slope, 2.0);
+  EXPECT_DOUBLE_EQ(intercept, 1.0);
+  // Noisy points: the least-squares fit (numpy.polyfit gives 1.3 and 0.3 for these).
+  EXPECT_TRUE(FitLine({{0, 0}, {1, 2}, {2, 3}, {3, 4}}, &intercept, &slope));
+  EXPECT_NEAR(slope, 1.3, 1e-12);
+  EXPECT_NEAR(intercept, 0.3, 1e-12);
+  intercept = slope = 7;
+  EXPECT_FALSE(FitLine({{1, 2}}, &intercept, &slope));
+  EXPECT_FALSE(FitLine({{1, 2}, {1, 5}}, &intercept, &slope));
+  EXPECT_EQ(slope, 7);  // untouched
+  EXPECT_EQ(intercept, 7);
+}
+
 }  // namespace
 }  // namespace arco
