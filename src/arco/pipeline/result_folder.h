@@ -184,10 +184,10 @@ class ResultFolder {
   // Reads result.json from disk whenever it needs it: the folder may have been written
   // by anyone since.
   explicit ResultFolder(std::string dir) : dir_(std::move(dir)) {}
-  // A folder that this object and its copies alone write while they live (`arco run`'s
-  // hidden temporary result): they share the manifest, read from disk at most once (an
-  // absent one is empty) and from then on the one their last write committed, so that
-  // nothing the run wrote is read back. A write that fails leaves it as it was (the
+  // A folder that this object and its copies alone write, one call at a time, while they
+  // live (`arco run`'s hidden temporary result): they share the manifest, read from disk
+  // at most once (an absent one is empty), then the one their last write committed, so
+  // that nothing the run wrote is read back. A failed write leaves it as it was (the
   // manifest changes only once its OutputSet is committed).
   static ResultFolder Exclusive(std::string dir);
 
