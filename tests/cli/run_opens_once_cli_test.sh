@@ -31,7 +31,11 @@ opens() {
 import os, re, sys
 pending = {}
 for line in open(sys.argv[1]):
-    pid, _, rest = line.rstrip("\n").partition(" ")
+    # "PID  call": strace pads the pid to five columns.
+    m = re.match(r"(\d+)\s+(.*)", line.rstrip("\n"))
+    if not m:
+        continue
+    pid, rest = m.group(1), m.group(2)
     if rest.endswith("<unfinished ...>"):
         pending[pid] = rest[: -len("<unfinished ...>")]
         continue
