@@ -7,18 +7,29 @@ namespace arco::cli {
 
 void AddCaptureInputs(PathRoles* roles, const std::string& label, const std::string& capture_dir) {
   if (capture_dir.empty()) return;
-  roles->AddInput(label, capture_dir);
   auto manifest = ReadCaptureManifest(capture_dir);
-  if (!manifest.ok()) return;
+  if (!manifest.ok()) {
+    roles->AddInput(label, capture_dir);
+    return;
+  }
+  AddCaptureInputs(roles, label, capture_dir, *manifest);
+}
+
+void AddCaptureInputs(PathRoles* roles,
+                      const std::string& label,
+                      const std::string& capture_dir,
+                      const CaptureManifest& manifest) {
+  if (capture_dir.empty()) return;
+  roles->AddInput(label, capture_dir);
   const auto add = [&](const std::string& what, const std::string& entry) {
     if (!entry.empty()) {
       roles->AddInput("the " + what + " of " + label, ResolveCapturePath(capture_dir, entry));
     }
   };
-  add("calibration", manifest->calibration);
-  add("audio", manifest->audio);
-  add("2D keypoints", manifest->keypoints2d);
-  for (const CaptureCamera& camera : manifest->cameras) {
+  add("calibration", manifest.calibration);
+  add("audio", manifest.audio);
+  add("2D keypoints", manifest.keypoints2d);
+  for (const CaptureCamera& camera : manifest.cameras) {
     add("video of camera " + camera.name, camera.video);
   }
 }

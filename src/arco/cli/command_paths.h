@@ -9,11 +9,21 @@
 
 #include "arco/util/path_roles.h"
 
+namespace arco {
+struct CaptureManifest;
+}
+
 namespace arco::cli {
 
 // The capture folder (`label`, e.g. "CAPTURE" or "--capture") and its capture.json's
 // calibration, audio, 2D keypoints and each camera's video or image folder.
 void AddCaptureInputs(PathRoles* roles, const std::string& label, const std::string& capture_dir);
+// The same from its manifest already read (`arco run`'s opened capture: capture.json is
+// read once).
+void AddCaptureInputs(PathRoles* roles,
+                      const std::string& label,
+                      const std::string& capture_dir,
+                      const CaptureManifest& manifest);
 
 // The result folder and the capture its result.json names (with that capture's files).
 void AddResultInputs(PathRoles* roles, const std::string& label, const std::string& result_dir);

@@ -2,6 +2,8 @@
 // (pipeline/run_capture.h), with progress per stage and a final summary.
 #include <cstdio>
 #include <memory>
+#include <optional>
+#include <utility>
 
 #include "arco/cli/command.h"
 #include "arco/cli/command_paths.h"
@@ -18,12 +20,38 @@ namespace {
 struct RunArgs {
   pipeline::RunOptions o;  // bound to the flags: --help shows the library's defaults
   bool average_palm = false;  // o.hands.palm.enabled = !average_palm
+  // The capture as opened to list its files (the paths' check before the run), which the
+  // run then takes: capture.json is read once. Empty when it did not open: RunCapture
+  // opens it again and reports why, in the order of its checks.
+  std::optional<pipeline::CaptureContext> opened;
 };
 
-int RunRun(const RunArgs& a) {
+// The capture folder and the files its manifest names (cli/command_paths.h), from the
+// capture opened once (kept in a.opened for the run).
+PathRoles RunPaths(RunArgs& a) {
+  PathRoles roles;
+  StatusOr<pipeline::CaptureContext> opened = pipeline::OpenCapture(a.o.capture_dir);
+  if (opened.ok()) {
+    AddCaptureInputs(&roles, "CAPTURE", a.o.capture_dir, opened->manifest);
+    a.opened = std::move(opened).value();
+  } else {
+    AddCaptureInputs(&roles, "CAPTURE", a.o.capture_dir);
+  }
+  roles.AddOutput("-o", a.o.result_dir);
+  return roles;
+}
+
+int RunRun(RunArgs& a) {
   const pipeline::RunOptions& o = a.o;
   ProgressBar progress;
-  auto summary = pipeline::RunCapture(o, progress);
+  StatusOr<pipeline::RunSummary> summary = Status::Error("not run");
+  if (a.opened) {
+    pipeline::CaptureContext opened = std::move(*a.opened);
+    a.opened.reset();
+    summary = pipeline::RunCapture(o, std::move(opened), progress);
+  } else {
+    summary = pipeline::RunCapture(o, progress);
+  }
   progress.Finish();
   if (!summary.ok()) return PrintError(summary.status().message());
   double total_s = 0;
@@ -79,13 +107,7 @@ CommandRun SetupRun(CLI::App& app) {
     const Status valid = a->o.Validate();
     if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kRefineFlags)));
   });
-  return CommandRun([a]() { return RunRun(*a); },
-                    [a] {
-                      PathRoles roles;
-                      AddCaptureInputs(&roles, "CAPTURE", a->o.capture_dir);
-                      roles.AddOutput("-o", a->o.result_dir);
-                      return roles;
-                    });
+  return CommandRun([a]() { return RunRun(*a); }, [a] { return RunPaths(*a); });
 }
 
 }  // namespace

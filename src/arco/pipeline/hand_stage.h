@@ -44,6 +44,13 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
                                   const TriangulateStageResult& triangulation,
                                   const InstrumentRecord& instrument,
                                   Progress& progress = NoProgress());
+// The same into `result` (options.result_dir's folder: `arco run`'s one ResultFolder).
+StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
+                                  const CaptureContext& capture,
+                                  const ResultFolder& result,
+                                  const TriangulateStageResult& triangulation,
+                                  const InstrumentRecord& instrument,
+                                  Progress& progress = NoProgress());
 // The same on the stages in options.result_dir, which must come from `capture`.
 StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
                                         const CaptureContext& capture,

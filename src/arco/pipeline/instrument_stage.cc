@@ -68,16 +68,25 @@ StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions
   triangulation.summary.units = manifest.value("units", "unknown");
   ARCO_ASSIGN_OR_RETURN(triangulation.points3d, result.ReadPoints3d(kTriangulationStage));
   ARCO_ASSIGN_OR_RETURN(InstrumentRecord record,
-                        RunInstrumentStage(options, capture, triangulation, progress));
+                        RunInstrumentStage(options, capture, result, triangulation, progress));
   return std::move(record.summary);
 }
 
 StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& options,
                                               const CaptureContext& capture,
                                               const TriangulateStageResult& triangulation,
+                                              Progress& progress) {
+  return RunInstrumentStage(
+      options, capture, ResultFolder(options.result_dir), triangulation, progress);
+}
+
+StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& options,
+                                              const CaptureContext& capture,
+                                              const ResultFolder& result,
+                                              const TriangulateStageResult& triangulation,
                                               Progress& /*progress*/) {
   ARCO_RETURN_IF_ERROR(options.Validate());
-  const ResultFolder result(options.result_dir);
+  result.RequireDir(options.result_dir);
   const NpyArray<double>& points = triangulation.points3d;
   const InstrumentModel& model = *capture.instrument;
   const int64_t frames = points.shape[0];

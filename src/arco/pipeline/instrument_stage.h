@@ -42,6 +42,12 @@ StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& opti
                                               const CaptureContext& capture,
                                               const TriangulateStageResult& triangulation,
                                               Progress& progress = NoProgress());
+// The same into `result` (options.result_dir's folder: `arco run`'s one ResultFolder).
+StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& options,
+                                              const CaptureContext& capture,
+                                              const ResultFolder& result,
+                                              const TriangulateStageResult& triangulation,
+                                              Progress& progress = NoProgress());
 // The same on the triangulation in options.result_dir, which must come from `capture`.
 StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions& options,
                                                     const CaptureContext& capture,

@@ -19,9 +19,17 @@ Status PitchStageOptions::Validate() const {
 StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
                                     const CaptureContext& capture,
                                     Progress& progress) {
+  return RunPitchStage(options, capture, ResultFolder(options.result_dir), progress);
+}
+
+StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
+                                    const CaptureContext& capture,
+                                    const ResultFolder& result,
+                                    Progress& progress) {
   ARCO_RETURN_IF_ERROR(options.Validate());
+  result.RequireDir(options.result_dir);
   // The result it joins must come from the capture given.
-  ARCO_RETURN_IF_ERROR(ResultFolder(options.result_dir).CheckInputsMatch(capture.inputs));
+  ARCO_RETURN_IF_ERROR(result.CheckInputsMatch(capture.inputs));
   const CaptureManifest& m = capture.manifest;
   PitchRecord record;
   PitchStageSummary& summary = record.summary;
@@ -84,7 +92,7 @@ StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
     }
   }
   record.inputs = SelectInputs(capture.inputs, {kManifestInput, kAudioInput});
-  ARCO_RETURN_IF_ERROR(ResultFolder(options.result_dir).WritePitch(record));
+  ARCO_RETURN_IF_ERROR(result.WritePitch(record));
   return record;
 }
 

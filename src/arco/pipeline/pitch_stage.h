@@ -30,5 +30,10 @@ struct PitchStageOptions {
 StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
                                     const CaptureContext& capture,
                                     Progress& progress = NoProgress());
+// The same into `result` (options.result_dir's folder: `arco run`'s one ResultFolder).
+StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
+                                    const CaptureContext& capture,
+                                    const ResultFolder& result,
+                                    Progress& progress = NoProgress());
 
 }  // namespace arco::pipeline

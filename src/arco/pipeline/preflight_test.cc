@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <stdexcept>
 
 #include "arco/audio/test_signals.h"
 #include "arco/pipeline/capture_checks.h"
@@ -70,6 +71,35 @@ TEST(PreflightRun, AcceptsAGoodCaptureAndCreatesNothing) {
   ASSERT_TRUE(audio.ok()) << audio.status().message();
   EXPECT_DOUBLE_EQ(audio->duration_s, 2.0);
   EXPECT_EQ(audio->path, c.dir / "audio.wav");
+}
+
+// `arco run` opens the capture for its paths' check and preflights what it opened:
+// capture.json is not read again, and the context is the one PreflightRun makes alone.
+TEST(PreflightRun, OnAnOpenedCaptureIsThePreflightOfTheFolder) {
+  TestCapture c;
+  auto opened = OpenCapture(c.dir.path());
+  ASSERT_TRUE(opened.ok()) << opened.status().message();
+  // capture.json changed after it was opened: the opened manifest is the one preflighted.
+  CaptureManifest changed = c.manifest;
+  changed.instrument = "none";
+  ASSERT_TRUE(WriteCaptureManifest(c.dir.path(), changed).ok());
+  auto from_opened = PreflightRun(c.Options(), *opened);
+  ASSERT_TRUE(from_opened.ok()) << from_opened.status().message();
+  c.Write();
+  auto alone = PreflightRun(c.Options());
+  ASSERT_TRUE(alone.ok()) << alone.status().message();
+  ASSERT_EQ(from_opened->inputs.size(), alone->inputs.size());
+  for (const auto& [role, input] : alone->inputs) {
+    ASSERT_EQ(from_opened->inputs.count(role), 1u) << role;
+    EXPECT_EQ(from_opened->inputs.at(role).file, input.file) << role;
+    EXPECT_TRUE(from_opened->inputs.at(role).fingerprint == input.fingerprint) << role;
+  }
+  EXPECT_EQ(from_opened->manifest.instrument, "cello");
+  EXPECT_FALSE(fs::exists(c.dir / "result"));
+  // Another folder's capture is a caller bug.
+  RunOptions other = c.Options();
+  other.capture_dir = c.dir / "elsewhere";
+  EXPECT_THROW(PreflightRun(other, *opened).status(), std::invalid_argument);
 }
 
 TEST(PreflightRun, AnOffsetOutsideTheAudioNamesCaptureJson) {

@@ -252,7 +252,13 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
                                                const RefineInputs& inputs,
                                                const refine::RefineOptions& options,
                                                const refine::BowingOptions& bowing) {
-  const ResultFolder result(result_dir);
+  return RefineAndWrite(ResultFolder(result_dir), inputs, options, bowing);
+}
+
+StatusOr<refine::RefineSummary> RefineAndWrite(const ResultFolder& result,
+                                               const RefineInputs& inputs,
+                                               const refine::RefineOptions& options,
+                                               const refine::BowingOptions& bowing) {
   if (options.mode != refine::RefineMode::kVision && !inputs.has_pitch) {
     return Status::Error(result.ManifestPath() +
                          ": no pitch stage (the capture has no audio); only vision can be written");

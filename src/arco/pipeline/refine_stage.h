@@ -70,6 +70,11 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
                                                const RefineInputs& inputs,
                                                const refine::RefineOptions& options,
                                                const refine::BowingOptions& bowing = {});
+// The same into `result` (`arco run`'s one ResultFolder).
+StatusOr<refine::RefineSummary> RefineAndWrite(const ResultFolder& result,
+                                               const RefineInputs& inputs,
+                                               const refine::RefineOptions& options,
+                                               const refine::BowingOptions& bowing = {});
 
 // LoadRefineInputs + RefineAndWrite.
 StatusOr<refine::RefineSummary> RunRefineStage(const RefineStageOptions& options);

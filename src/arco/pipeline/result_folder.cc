@@ -8,6 +8,7 @@
 #include <iterator>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 #include <type_traits>
 
 #include "arco/audio/double_stops_csv.h"
@@ -236,14 +237,34 @@ StatusOr<std::vector<refine::NoteFingering>> ReadFingeringCsv(const std::string&
   return rows;
 }
 
+ResultFolder ResultFolder::Exclusive(std::string dir) {
+  ResultFolder folder(std::move(dir));
+  folder.held_ = std::make_shared<HeldManifest>();
+  return folder;
+}
+
 StatusOr<Json> ResultFolder::ReadManifest() const {
+  if (held_ && held_->manifest) return *held_->manifest;
   const std::string path = ManifestPath();
-  if (!FileExists(path)) return Json::object();
-  ARCO_ASSIGN_OR_RETURN(Json j, ReadJsonFile(path));
-  if (!j.is_object() || j.value("format", "") != "arco-result") {
-    return Status::Error(path + ": not an arco result manifest (\"format\": \"arco-result\")");
+  Json j = Json::object();
+  if (FileExists(path)) {
+    ARCO_ASSIGN_OR_RETURN(j, ReadJsonFile(path));
+    if (!j.is_object() || j.value("format", "") != "arco-result") {
+      return Status::Error(path + ": not an arco result manifest (\"format\": \"arco-result\")");
+    }
   }
+  if (held_) held_->manifest = j;
   return j;
+}
+
+void ResultFolder::RequireDir(const std::string& result_dir) const {
+  if (result_dir != dir_) {
+    throw std::invalid_argument("result folder " + dir_ + " given with result_dir " + result_dir);
+  }
+}
+
+void ResultFolder::Committed(const Json& manifest) const {
+  if (held_) held_->manifest = manifest;
 }
 
 StatusOr<ResultHeader> ResultFolder::ReadHeader(InputCheck check) const {
@@ -482,7 +503,9 @@ Status ResultFolder::WriteStageFolder(const std::string& stage,
   manifest = WithStage(manifest, stage, entry);
   RecordStageInputs(&manifest, stage, inputs);
   ARCO_RETURN_IF_ERROR(WriteJsonFile(tmp_manifest, manifest));
-  return outputs.Commit();
+  ARCO_RETURN_IF_ERROR(outputs.Commit());
+  Committed(manifest);
+  return Status::Ok();
 }
 
 Status ResultFolder::WriteRunOptions(const Json& options) const {
@@ -491,7 +514,9 @@ Status ResultFolder::WriteRunOptions(const Json& options) const {
   OutputSet outputs;
   ARCO_ASSIGN_OR_RETURN(const std::string tmp_manifest, outputs.AddFile(ManifestPath()));
   ARCO_RETURN_IF_ERROR(WriteJsonFile(tmp_manifest, manifest));
-  return outputs.Commit();
+  ARCO_RETURN_IF_ERROR(outputs.Commit());
+  Committed(manifest);
+  return Status::Ok();
 }
 
 // ---- triangulation/
@@ -557,6 +582,7 @@ StatusOr<std::vector<std::string>> ResultFolder::WriteTriangulation(
   RecordStageInputs(&result, kTriangulationStage, record.inputs);
   ARCO_RETURN_IF_ERROR(WriteJsonFile(manifest_tmp, result));
   ARCO_RETURN_IF_ERROR(outputs.Commit());
+  Committed(result);
   return removed;
 }
 
@@ -720,7 +746,9 @@ Status ResultFolder::WritePitch(const PitchRecord& r) const {
   manifest = WithStage(manifest, kPitchStage, entry);
   RecordStageInputs(&manifest, kPitchStage, r.inputs);
   ARCO_RETURN_IF_ERROR(WriteJsonFile(manifest_tmp, manifest));
-  return outputs.Commit();
+  ARCO_RETURN_IF_ERROR(outputs.Commit());
+  Committed(manifest);
+  return Status::Ok();
 }
 
 std::string ResultFolder::PitchPath() const { return JoinPath(dir_, kPitchCsvFile); }

@@ -26,6 +26,11 @@
 // Each writer writes its files and its entry in result.json (keeping the earlier stages',
 // removing the later ones) as one transaction (util/output_set.h): all of them or none.
 //
+// result.json is read at most once by an Exclusive folder: `arco run` makes one for its
+// temporary result and hands it (and its copies, which share the manifest) to every
+// stage, so that the run never reads back what it wrote; every other ResultFolder (the
+// standalone stages, `arco refine`, `arco eval`) reads result.json from disk each time.
+//
 // Tied to the capture (docs/architecture.md, "Results are tied to their inputs"): every
 // stage records the fingerprints of the capture files it read (capture_inputs.h) in its
 // entry's "inputs", and result.json "inputs" holds them all; ReadHeader, which every
@@ -38,6 +43,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -177,8 +183,20 @@ enum class InputCheck {
 
 class ResultFolder {
  public:
+  // Reads result.json from disk whenever it needs it: the folder may have been written
+  // by anyone since.
   explicit ResultFolder(std::string dir) : dir_(std::move(dir)) {}
+  // A folder that this object and its copies alone write, one call at a time, while they
+  // live (`arco run`'s hidden temporary result): they share the manifest, read from disk
+  // at most once (an absent one is empty), then the one their last write committed, so
+  // that nothing the run wrote is read back. A failed write leaves it as it was (the
+  // manifest changes only once its OutputSet is committed).
+  static ResultFolder Exclusive(std::string dir);
+
   const std::string& dir() const { return dir_; }
+  // Throws std::invalid_argument (a caller bug) when `result_dir` is not dir(): a stage
+  // given both its options' result_dir and a ResultFolder writes the one named by both.
+  void RequireDir(const std::string& result_dir) const;
   std::string ManifestPath() const;
   // RESULT_DIR/<stage>/<file>.
   std::string StagePath(const std::string& stage, const std::string& file) const;
@@ -195,6 +213,7 @@ class ResultFolder {
   Status CheckWritable() const;
 
   // result.json: an empty object when absent; an error when it is not an arco result.
+  // An Exclusive folder's is the one held once read or written.
   StatusOr<Json> ReadManifest() const;
   // With kCompare, CheckInputs first: a result whose capture changed is an error.
   StatusOr<ResultHeader> ReadHeader(InputCheck check = InputCheck::kCompare) const;
@@ -279,8 +298,15 @@ class ResultFolder {
   StatusOr<std::vector<std::string>> RemoveLaterStages(const std::string& stage,
                                                        OutputSet* outputs,
                                                        Json* manifest) const;
+  // Once `manifest` is committed as result.json: an Exclusive folder holds it.
+  void Committed(const Json& manifest) const;
 
   std::string dir_;
+  // An Exclusive folder's result.json, shared by its copies; null: read from disk.
+  struct HeldManifest {
+    std::optional<Json> manifest;  // empty until read or written
+  };
+  std::shared_ptr<HeldManifest> held_;
 };
 
 // A fingering.csv (kFingeringCsvHeader; columns found by name), empty when the file is

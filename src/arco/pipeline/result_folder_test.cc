@@ -197,5 +197,40 @@ TEST(ResultFolder, WriteMethodFailsWholeWithoutPartialOutput) {
   EXPECT_FALSE(FileExists(dir / "arco"));
 }
 
+// `arco run`'s one ResultFolder: result.json read at most once, then held as its last
+// committed write made it (shared by the copies), never read back; a failed write leaves
+// it as it was. A plain ResultFolder reads the file.
+TEST(ResultFolder, ExclusiveHoldsTheManifestItReadOrCommitted) {
+  TempDir dir;
+  PitchRecord pitch;
+  pitch.a4_hz = 442;
+  {
+    const std::string path = dir / "failed/result.json";
+    ASSERT_TRUE(MakeDirectories(dir / "failed").ok());
+    // A later stage that names a folder outside the result: writing the pitch fails whole.
+    const Json escaping = {{"format", "arco-result"},
+                           {"stages", {{"arco", {{"dir", "../escape"}}}}}};
+    ASSERT_TRUE(WriteJsonFile(path, escaping).ok());
+    const ResultFolder held = ResultFolder::Exclusive(dir / "failed");
+    const ResultFolder copy = held;
+    EXPECT_FALSE(held.WritePitch(pitch).ok());
+    EXPECT_FALSE(FileExists(dir / "failed/pitch.csv"));
+    ASSERT_TRUE(WriteJsonFile(path, Json{{"format", "arco-result"}}).ok());  // not read again
+    const auto m = copy.ReadManifest();
+    ASSERT_TRUE(m.ok()) << m.status().message();
+    EXPECT_EQ(*m, escaping);
+  }
+  const ResultFolder held = ResultFolder::Exclusive(dir / "ok");
+  ASSERT_TRUE(held.WritePitch(pitch).ok());
+  ASSERT_TRUE(WriteJsonFile(dir / "ok/result.json", Json{{"format", "arco-result"}}).ok());
+  const ResultFolder copy = held;
+  const auto m = copy.ReadManifest();
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  EXPECT_EQ((*m)["stages"]["pitch"]["a4_hz"], 442);
+  const auto disk = ResultFolder(dir / "ok").ReadManifest();
+  ASSERT_TRUE(disk.ok()) << disk.status().message();
+  EXPECT_FALSE(disk->contains("stages"));
+}
+
 }  // namespace
 }  // namespace arco::pipeline

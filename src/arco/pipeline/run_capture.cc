@@ -1,6 +1,7 @@
 #include "arco/pipeline/run_capture.h"
 
 #include <chrono>
+#include <stdexcept>
 #include <utility>
 
 #include "arco/audio/double_stops_csv.h"
@@ -95,8 +96,10 @@ FolderReplace RunOptions::Replace() const {
 
 namespace {
 
-// Every stage, in order, into options.result_dir.
+// Every stage, in order, into `result` (options.result_dir's folder, Exclusive: its
+// result.json is held, never read back).
 StatusOr<RunSummary> RunStages(const RunOptions& options,
+                               const ResultFolder& result,
                                CaptureContext capture,
                                Progress& progress) {
   RunSummary summary;
@@ -109,14 +112,14 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
   // the result folder (the files hold the same values).
   auto start = stage(1, "triangulate");
   ARCO_ASSIGN_OR_RETURN(const TriangulateStageResult triangulation,
-                        RunTriangulateStage(options.ForTriangulate(), capture, progress));
+                        RunTriangulateStage(options.ForTriangulate(), capture, result, progress));
   summary.triangulate = triangulation.summary;
   summary.timings.push_back({"triangulate", SecondsSince(start)});
 
   start = stage(2, "instrument");
   ARCO_ASSIGN_OR_RETURN(
       const InstrumentRecord instrument,
-      RunInstrumentStage(options.ForInstrument(), capture, triangulation, progress));
+      RunInstrumentStage(options.ForInstrument(), capture, result, triangulation, progress));
   summary.instrument = instrument.summary;
   summary.timings.push_back({"instrument", SecondsSince(start)});
   Append(&summary.warnings, summary.instrument.warnings);
@@ -124,7 +127,7 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
   start = stage(3, "hands");
   ARCO_ASSIGN_OR_RETURN(
       HandRecord hand,
-      RunHandStage(options.ForHands(), capture, triangulation, instrument, progress));
+      RunHandStage(options.ForHands(), capture, result, triangulation, instrument, progress));
   summary.hands = hand.summary;
   summary.timings.push_back({"hands", SecondsSince(start)});
   capture.keypoints2d.reset();  // the last stage that reads the 2D keypoints
@@ -132,7 +135,7 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
 
   start = stage(4, "pitch");
   ARCO_ASSIGN_OR_RETURN(const PitchRecord pitch,
-                        RunPitchStage(options.ForPitch(), capture, progress));
+                        RunPitchStage(options.ForPitch(), capture, result, progress));
   summary.pitch = pitch.summary;
   capture.audio_bytes.reset();  // the last stage that decodes the audio (up to 256 MiB)
   if (summary.pitch.ran) summary.timings.push_back({"pitch", SecondsSince(start)});
@@ -142,10 +145,9 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
   // notes go through their files' encodings (in memory), so that the run refines exactly
   // what `arco refine` reads from the folder.
   start = stage(5, "refine");
-  const std::string pitch_path = ResultFolder(options.result_dir).PitchPath();
-  ARCO_ASSIGN_OR_RETURN(hand.hands,
-                        hand::HandsFromParams(hand::HandParams(hand.hands),
-                                              ResultFolder(options.result_dir).HandParamsPath()));
+  const std::string pitch_path = result.PitchPath();
+  ARCO_ASSIGN_OR_RETURN(
+      hand.hands, hand::HandsFromParams(hand::HandParams(hand.hands), result.HandParamsPath()));
   StageRecords records;
   records.fps = capture.manifest.fps;
   records.points3d_in_world = &triangulation.points3d;
@@ -176,8 +178,7 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
   progress.SetTotal(static_cast<int64_t>(modes.size()));
   for (refine::RefineMode mode : modes) {
     const RefineStageOptions ro = options.ForRefine(mode);
-    ARCO_ASSIGN_OR_RETURN(refine::RefineSummary s,
-                          RefineAndWrite(options.result_dir, inputs, ro.refine));
+    ARCO_ASSIGN_OR_RETURN(refine::RefineSummary s, RefineAndWrite(result, inputs, ro.refine));
     summary.methods.push_back(s);
     progress.Advance(1);
   }
@@ -185,12 +186,8 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
   return summary;
 }
 
-}  // namespace
-
-StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
-  ARCO_RETURN_IF_ERROR(options.Validate());
-  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options.result_dir, options.Replace()));
-  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, OpenCapture(options.capture_dir));
+// PreflightRun's checks after the capture is opened.
+StatusOr<CaptureContext> PreflightOpened(const RunOptions& options, CaptureContext capture) {
   const CaptureManifest& m = capture.manifest;
   ARCO_RETURN_IF_ERROR(LoadCaptureCalibration(&capture));
   // Read once here, checked, parsed and fingerprinted from the same bytes; the stages of
@@ -225,9 +222,10 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
   return capture;
 }
 
-StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
-  // Every input checked before the first stage (and before the result folder exists).
-  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, PreflightRun(options));
+// The stages of a preflighted capture.
+StatusOr<RunSummary> RunPreflighted(const RunOptions& options,
+                                    CaptureContext capture,
+                                    Progress& progress) {
   // The stages fill a hidden temporary result folder, moved into place once all are done:
   // a failed run leaves no result folder and an old one as it was.
   RunSummary summary;
@@ -235,7 +233,10 @@ StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
       options.result_dir, options.Replace(), [&](const std::string& tmp_dir) -> Status {
         RunOptions staged = options;
         staged.result_dir = tmp_dir;
-        StatusOr<RunSummary> ran = RunStages(staged, std::move(capture), progress);
+        // The one ResultFolder of the run: every stage writes through it (or its copies),
+        // which hold result.json as last written.
+        const ResultFolder result = ResultFolder::Exclusive(tmp_dir);
+        StatusOr<RunSummary> ran = RunStages(staged, result, std::move(capture), progress);
         if (!ran.ok()) {
           // Messages name the result folder the user gave, not its temporary.
           std::string message = ran.status().message();
@@ -247,9 +248,41 @@ StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
           return Status::Error(message);
         }
         summary = std::move(ran).value();
-        return ResultFolder(tmp_dir).WriteRunOptions(ToJson(options));
+        return result.WriteRunOptions(ToJson(options));
       }));
   return summary;
+}
+
+}  // namespace
+
+StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options.result_dir, options.Replace()));
+  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, OpenCapture(options.capture_dir));
+  return PreflightOpened(options, std::move(capture));
+}
+
+StatusOr<CaptureContext> PreflightRun(const RunOptions& options, CaptureContext opened) {
+  if (opened.capture_dir != options.capture_dir) {
+    throw std::invalid_argument("PreflightRun: capture " + opened.capture_dir +
+                                " opened for capture_dir " + options.capture_dir);
+  }
+  ARCO_RETURN_IF_ERROR(options.Validate());
+  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options.result_dir, options.Replace()));
+  return PreflightOpened(options, std::move(opened));
+}
+
+StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
+  // Every input checked before the first stage (and before the result folder exists).
+  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, PreflightRun(options));
+  return RunPreflighted(options, std::move(capture), progress);
+}
+
+StatusOr<RunSummary> RunCapture(const RunOptions& options,
+                                CaptureContext opened,
+                                Progress& progress) {
+  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, PreflightRun(options, std::move(opened)));
+  return RunPreflighted(options, std::move(capture), progress);
 }
 
 }  // namespace arco::pipeline

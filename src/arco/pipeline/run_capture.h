@@ -1,5 +1,6 @@
-// `arco run CAPTURE -o RESULT` as a library call: every stage, in order, each reading what
-// the earlier ones wrote into the result folder (pipeline/result_folder.h):
+// `arco run CAPTURE -o RESULT` as a library call: every stage, in order, each taking the
+// records of the earlier ones as made and writing its own into the result folder
+// (pipeline/result_folder.h) through the run's one ResultFolder (nothing is read back):
 //   1. triangulate  triangulation/   pipeline/triangulate_stage.h
 //   2. instrument   instrument/      pipeline/instrument_stage.h
 //   3. hands        hand/            pipeline/hand_stage.h
@@ -89,8 +90,16 @@ inline constexpr int kRunStages = 5;
 // from its header; the instrument's string ends present), the filters, the audio and its offset.
 // Returns the opened capture.
 StatusOr<CaptureContext> PreflightRun(const RunOptions& options);
+// The same on a capture already opened (OpenCapture(options.capture_dir), e.g. by `arco
+// run` to list its files before anything is written): capture.json is not read again.
+// Throws std::invalid_argument when `opened` is another folder's (a caller bug).
+StatusOr<CaptureContext> PreflightRun(const RunOptions& options, CaptureContext opened);
 
 // Progress: StartStage(i, 5, name) for each stage, then that stage's SetTotal / Advance.
 StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress = NoProgress());
+// The same on a capture already opened (PreflightRun(options, opened)).
+StatusOr<RunSummary> RunCapture(const RunOptions& options,
+                                CaptureContext opened,
+                                Progress& progress = NoProgress());
 
 }  // namespace arco::pipeline

@@ -65,8 +65,16 @@ StatusOr<CaptureContext> OpenForTriangulation(const TriangulateStageOptions& o) 
 StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptions& o,
                                                      const CaptureContext& capture,
                                                      Progress& progress) {
+  return RunTriangulateStage(o, capture, ResultFolder(o.result_dir), progress);
+}
+
+StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptions& o,
+                                                     const CaptureContext& capture,
+                                                     const ResultFolder& result,
+                                                     Progress& progress) {
   ARCO_RETURN_IF_ERROR(o.Validate());
-  ARCO_RETURN_IF_ERROR(ResultFolder(o.result_dir).CheckWritable());  // before the work
+  result.RequireDir(o.result_dir);
+  ARCO_RETURN_IF_ERROR(result.CheckWritable());  // before the work
   const CaptureManifest& manifest = capture.manifest;
   const KeypointLayout& layout = capture.layout;
   const std::string manifest_path = JoinPath(capture.capture_dir, kCaptureManifestName);
@@ -100,9 +108,8 @@ StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptio
   record.summary = Summarize(raw);
   record.options = ToJson(o);
   TriangulateStageSummary& summary = out.summary;
-  ARCO_ASSIGN_OR_RETURN(
-      summary.removed_stages,
-      ResultFolder(o.result_dir).WriteTriangulation(manifest, layout, raw, filtered, record));
+  ARCO_ASSIGN_OR_RETURN(summary.removed_stages,
+                        result.WriteTriangulation(manifest, layout, raw, filtered, record));
   summary.triangulation = record.summary;
   summary.units = record.units;
   summary.views = static_cast<int64_t>(capture.view_to_camera.size());

@@ -18,6 +18,8 @@
 
 namespace arco::pipeline {
 
+class ResultFolder;
+
 struct TriangulateStageOptions {
   std::string capture_dir;
   std::string result_dir;
@@ -45,6 +47,12 @@ struct TriangulateStageResult {
 // frame count, advanced per frame from worker threads.
 StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptions& options,
                                                      const CaptureContext& capture,
+                                                     Progress& progress = NoProgress());
+// The same into `result` (options.result_dir's folder, result_folder.h: `arco run` hands
+// every stage its one ResultFolder).
+StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptions& options,
+                                                     const CaptureContext& capture,
+                                                     const ResultFolder& result,
                                                      Progress& progress = NoProgress());
 
 // `arco triangulate CAPTURE`: opens options.capture_dir (no instrument needed) and runs

@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# `arco run` opens its capture once and never reads back what it wrote (docs/architecture.md,
+# "The pipeline"): traced with strace (openat), each capture file the run reads (capture.json,
+# the calibration, keypoints2d.npy) is opened for reading exactly once and the audio at most
+# twice (a file too large to hold is streamed by each reader), and no file under the result
+# folder, its hidden temporary included (result.json, the stages' arrays), is opened for
+# reading at all. On a cello capture and on a violin one with --double-stops.
+# Needs strace (scripts/setup); without it, or where ptrace is not allowed, it skips
+# (exit 77) unless CI is set.
+# usage: run_opens_once_cli_test.sh ARCO_BINARY [SHARED_DATA_DIR]
+set -uo pipefail
+arco=$(realpath "$1")
+[ -n "${2:-}" ] && export ARCO_SHARED_DATA_DIR=$2
+skip() {
+  echo "$1"
+  [ -n "${CI:-}" ] && exit 1
+  exit 77
+}
+command -v strace >/dev/null || skip "strace is missing: run scripts/setup"
+strace -f -qq -e trace=openat -o /dev/null true 2>/dev/null || skip "strace cannot trace here"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+tmp=$(realpath "$tmp")
+source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
+mkdir -p "$tmp/in" "$tmp/out"
+
+# opens TRACE: one line per successful openat for reading of a file (not a folder):
+# "PATH" normalised, the calls split by threads (<unfinished ...> / <... resumed>) joined.
+opens() {
+  /usr/bin/python3 - "$1" <<'PY'
+import os, re, sys
+pending = {}
+for line in open(sys.argv[1]):
+    # "PID  call": strace pads the pid to five columns.
+    m = re.match(r"(\d+)\s+(.*)", line.rstrip("\n"))
+    if not m:
+        continue
+    pid, rest = m.group(1), m.group(2)
+    if rest.endswith("<unfinished ...>"):
+        pending[pid] = rest[: -len("<unfinished ...>")]
+        continue
+    m = re.match(r"<\.\.\. openat resumed>(.*)", rest)
+    if m:
+        rest = pending.pop(pid, "") + m.group(1)
+    m = re.match(r'openat\(AT_FDCWD, "((?:[^"\\]|\\.)*)", ([A-Z_|]+)(?:, \d+)?\)\s*= (-?\d+)', rest)
+    if not m:
+        continue
+    path, flags, rc = m.group(1), m.group(2).split("|"), int(m.group(3))
+    if rc < 0 or "O_DIRECTORY" in flags or "O_WRONLY" in flags or "O_RDWR" in flags:
+        continue
+    print(os.path.normpath(path))
+PY
+}
+
+# traced_run NAME CAPTURE ARGS...: `arco run CAPTURE -o $tmp/out/NAME ARGS` under strace;
+# checks what it opened for reading.
+traced_run() {
+  local name=$1 cap=$2; shift 2
+  local res=$tmp/out/$name trace=$tmp/$name.trace
+  strace -f -qq -e trace=openat -o "$trace" "$arco" run "$cap" -o "$res" "$@" \
+    >"$tmp/log" 2>&1
+  check '[ $? -eq 0 ] && [ -f "$res/arco/points3d.npy" ]' "$name: run: $(tail -1 "$tmp/log")"
+  opens "$trace" >"$tmp/$name.opens"
+  local f n most
+  for f in capture.json calibration.json keypoints2d.npy audio.wav; do
+    n=$(grep -cxF "$cap/$f" "$tmp/$name.opens")
+    most=1
+    [ $f = audio.wav ] && most=2
+    check '[ "$n" -ge 1 ] && [ "$n" -le $most ]' \
+      "$name: $cap/$f opened for reading $n times (1 to $most expected)"
+  done
+  # Everything under out/: the result folder and its hidden temporary sibling.
+  local read_back
+  read_back=$(grep -F "$tmp/out/" "$tmp/$name.opens" | sort | uniq -c)
+  check '[ -z "$read_back" ]' "$name: the run read back what it wrote:
+$read_back"
+}
+
+"$arco" synth --duration-s 2 --seed 3 -o "$tmp/in/cello" >"$tmp/log" 2>&1
+check '[ $? -eq 0 ] && [ -f "$tmp/in/cello/audio.wav" ]' "synth cello: $(tail -1 "$tmp/log")"
+traced_run cello "$tmp/in/cello" --threads 2
+
+"$arco" synth --piece double-stops --instrument violin --duration-s 2 --seed 3 \
+  -o "$tmp/in/violin" >"$tmp/log" 2>&1
+check '[ $? -eq 0 ] && [ -f "$tmp/in/violin/audio.wav" ]' "synth violin: $(tail -1 "$tmp/log")"
+traced_run violin "$tmp/in/violin" --threads 2 --double-stops
+check '[ -f "$tmp/out/violin/double_stops.csv" ]' "violin: no double_stops.csv"
+
+exit $fail
