@@ -5,19 +5,21 @@
 # twice (a file too large to hold is streamed by each reader), and no file under the result
 # folder, its hidden temporary included (result.json, the stages' arrays), is opened for
 # reading at all. On a cello capture and on a violin one with --double-stops.
-# Needs strace (scripts/setup); without it, or where ptrace is not allowed, it skips
-# (exit 77) unless CI is set.
+# Needs strace (scripts/setup installs it): without it the test skips (exit 77), and fails
+# when CI is set; where ptrace is not allowed (a container without it) it skips.
 # usage: run_opens_once_cli_test.sh ARCO_BINARY [SHARED_DATA_DIR]
 set -uo pipefail
 arco=$(realpath "$1")
 [ -n "${2:-}" ] && export ARCO_SHARED_DATA_DIR=$2
-skip() {
-  echo "$1"
+if ! command -v strace >/dev/null; then
+  echo "strace is missing: run scripts/setup"
   [ -n "${CI:-}" ] && exit 1
   exit 77
-}
-command -v strace >/dev/null || skip "strace is missing: run scripts/setup"
-strace -f -qq -e trace=openat -o /dev/null true 2>/dev/null || skip "strace cannot trace here"
+fi
+if ! strace -f -qq -e trace=openat -o /dev/null true 2>/dev/null; then
+  echo "SKIPPED: strace cannot trace here (ptrace not allowed)"
+  exit 77
+fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 tmp=$(realpath "$tmp")
