@@ -9,6 +9,7 @@
 #include "arco/hand/ik.h"
 #include "arco/hand/kinematics.h"
 #include "arco/instrument/contact.h"
+#include "arco/util/stats.h"
 
 namespace arco::refine {
 namespace {
@@ -35,11 +36,6 @@ bool OneHandFrame(InstrumentKind kind, int g1, double stop1, int g2, double stop
     }
   }
   return false;
-}
-
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
 }
 
 // Each frame's two stops (semitones above their open strings); `stopped`: the second voice
@@ -83,9 +79,9 @@ FingerPair ChooseFingers(const RefineInput& input,
   }
   // An octave's upper note is the lower note's 2nd partial as often as a second voice (a
   // single-note take under --double-stops hears many): it never moves the first voice.
-  if (std::abs(Median(intervals) - 12.0) <= 0.5) may_change_first = false;
+  if (std::abs(UpperMedian(intervals) - 12.0) <= 0.5) may_change_first = false;
   const bool first_pressed = 2 * pressed > static_cast<int>(members.size());
-  const double stop1 = Median(first_stops), stop2 = Median(second_stops);
+  const double stop1 = UpperMedian(first_stops), stop2 = UpperMedian(second_stops);
   FingerPair pair;
   if (first_pressed && std::abs(stop1 - stop2) <= options.fifth_semitones) {
     pair.fifth = true;
@@ -175,8 +171,7 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
   std::map<int, double> note_median;
   for (auto& [note, values] : note_upper) {
     if (2 * static_cast<int>(values.size()) < note_frames[note]) continue;
-    std::sort(values.begin(), values.end());
-    note_median[note] = values[values.size() / 2];
+    note_median[note] = UpperMedian(values);
   }
   // Pass 1: each frame's second voice up to its finger; `stopped` frames need one.
   std::vector<Stop> stops(frames);
