@@ -54,6 +54,7 @@ Status DoubleStopOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(
       CheckInRange("max_span_semitones", max_span_semitones, kDoubleStopSpanRangeSemitones));
   ARCO_RETURN_IF_ERROR(CheckInRange("silence_db", silence_db, kDoubleStopSilenceRangeDb));
+  ARCO_RETURN_IF_ERROR(CheckInRange("consistency_s", consistency_s, kDoubleStopConsistencyRangeS));
   const double top_hz = range.analysis_rate_hz / 4.0;
   if (!(range.min_f0_hz >= 20 && range.min_f0_hz < range.max_f0_hz && range.max_f0_hz <= top_hz)) {
     return Status::Error("double stops: min_f0_hz = " + NumberText(range.min_f0_hz) +
@@ -373,6 +374,80 @@ int DoubleStopAnalyzer::Analyze(const float* x, std::array<PolyNote, 2>* notes) 
   return 2;
 }
 
+namespace {
+
+// Semitones on the MIDI scale at A4 = 440 Hz: only intervals and same-pair keys are taken
+// from it, so the take's tuning plays no part.
+double MidiOf(double f0_hz) { return 69.0 + 12.0 * std::log2(f0_hz / 440.0); }
+
+// A pair's notes as the nearest semitones (the same pair on two frames has the same key).
+std::array<int64_t, 2> PairKey(const PolyPitchFrame& f) {
+  return {std::llround(MidiOf(f.notes[0].f0_hz)), std::llround(MidiOf(f.notes[1].f0_hz))};
+}
+
+// Whether every note of `heard` is a note of `pair` or its 2nd, 3rd or 4th partial (within
+// half a semitone; fractional MIDI pitches).
+bool ExplainedBy(const PolyPitchFrame& pair, const PolyPitchFrame& heard) {
+  for (int n = 0; n < 2; ++n) {
+    const double q = MidiOf(heard.notes[n].f0_hz);
+    bool explained = false;
+    for (int k = 0; k < 2 && !explained; ++k) {
+      const double base = MidiOf(pair.notes[k].f0_hz);
+      for (int h = 1; h <= 4 && !explained; ++h)
+        explained = std::abs(q - base - 12.0 * std::log2(static_cast<double>(h))) <= 0.5;
+    }
+    if (!explained) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void ConsistentDoubleStops(int window_frames, std::vector<PolyPitchFrame>* frames) {
+  if (window_frames <= 0) return;
+  const std::vector<PolyPitchFrame> heard = *frames;
+  const int64_t n = static_cast<int64_t>(heard.size());
+  auto is_pair = [&](int64_t j) {
+    return heard[j].count == 2 && heard[j].notes[0].f0_hz > 0 && heard[j].notes[1].f0_hz > 0;
+  };
+  for (int64_t i = 0; i < n; ++i) {
+    if (!is_pair(i)) continue;
+    const auto own = PairKey(heard[i]);
+    const int64_t lo = std::max<int64_t>(0, i - window_frames);
+    const int64_t hi = std::min<int64_t>(n - 1, i + window_frames);
+    int64_t best = -1;  // nearest frame of the chosen pair
+    int best_support = 0;
+    std::array<int64_t, 2> best_key{};
+    // Candidates in order of distance from i (earlier first on a tie), so the first frame
+    // of each key met is its nearest.
+    for (int64_t d = 1; d <= window_frames; ++d) {
+      for (const int64_t j : {i - d, i + d}) {
+        if (j < lo || j > hi || !is_pair(j)) continue;
+        const auto key = PairKey(heard[j]);
+        if (key == own || !ExplainedBy(heard[j], heard[i])) continue;
+        bool before = false, after = false;
+        int support = 0;
+        for (int64_t k = lo; k <= hi; ++k) {
+          if (!is_pair(k) || PairKey(heard[k]) != key) continue;
+          ++support;
+          before |= k < i;
+          after |= k > i;
+        }
+        if (!before || !after) continue;
+        if (support > best_support || (support == best_support && key < best_key)) {
+          best = j;
+          best_support = support;
+          best_key = key;
+        }
+      }
+    }
+    if (best >= 0) {
+      (*frames)[i].notes = heard[best].notes;
+      (*frames)[i].count = 2;
+    }
+  }
+}
+
 std::vector<double> SecondNoteHz(const std::vector<PitchFrame>& frames,
                                  const std::vector<PolyPitchFrame>& poly,
                                  double match_cents) {
@@ -434,6 +509,8 @@ StatusOr<std::vector<PolyPitchFrame>> TrackDoubleStops(std::unique_ptr<AudioRead
     f.count = analyzer.Analyze(buffer.data(), &f.notes);
     frames.push_back(f);
   }
+  ConsistentDoubleStops(static_cast<int>(std::llround(options.consistency_s * options.fps)),
+                        &frames);
   if (summary != nullptr) {
     *summary = DoubleStopSummary();
     summary->frames = static_cast<int64_t>(frames.size());

@@ -48,6 +48,7 @@ inline constexpr NumberRange kDoubleStopGridRangeCents = Closed(1, 50);
 inline constexpr NumberRange kDoubleStopRatioRange = Closed(0, 1);
 inline constexpr NumberRange kDoubleStopSpanRangeSemitones = Closed(0, 24);
 inline constexpr NumberRange kDoubleStopSilenceRangeDb = Closed(-120, 0);
+inline constexpr NumberRange kDoubleStopConsistencyRangeS = Closed(0, 2);
 
 struct DoubleStopOptions {
   InstrumentRange range;    // f0 limits and analysis rate (InstrumentRangeByName)
@@ -68,6 +69,11 @@ struct DoubleStopOptions {
   // nut): 7 spans unisons (open string + 4th finger) to octaves (1st + 4th finger).
   double max_span_semitones = 7.0;
   double silence_db = -50.0;  // window RMS below this (dBFS): no note
+  // ConsistentDoubleStops' window each side, after the frames are analysed (rounded to
+  // frames at fps; 0: off). 0.17 s (5 frames at 30 fps): on the synthetic double-stop
+  // pieces 3 frames left alternations of the viola's thirds, 8 and 12 took the bass's
+  // pairs across note changes (docs/audio.md, "Double stops").
+  double consistency_s = 0.17;
   Status Validate() const;
 };
 
@@ -142,6 +148,19 @@ class DoubleStopAnalyzer {
   void* spectrum_ = nullptr;
   void* plan_ = nullptr;
 };
+
+// Pairs made consistent over time (issue 27; docs/audio.md, "Double stops"). A frame's
+// analysis alone can take a pair's partials for the pair: a viola's E3 + G#3 heard as
+// G#4 + B4 (the upper note's 2nd partial and the lower's 3rd) or as G#3 + E4, an octave
+// E3 + E4 as E4 + B4, alternating frame by frame while the notes sound. A pair of frame i
+// is replaced by another pair K found on frames on both sides of it (within window_frames
+// before and after) when every note of frame i's pair is one of K's notes or its 2nd, 3rd
+// or 4th partial (within half a semitone): the simpler explanation the neighbours confirm.
+// Among such K, the one on most frames of the window (then the lowest); its f0s and
+// saliences are those of its nearest frame (the earlier on a tie). Frames with fewer than
+// two notes are left as they are; decisions are made on the input, so the order of frames
+// plays no part. window_frames 0: unchanged.
+void ConsistentDoubleStops(int window_frames, std::vector<PolyPitchFrame>* frames);
 
 // The second note beside the single-note tracker's f0, one per tracker frame (poly[i] must
 // be frame i at the same time; rows past the end of `poly` get 0): when frame i has two

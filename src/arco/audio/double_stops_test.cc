@@ -34,6 +34,9 @@ TEST(DoubleStopOptions, ValidateRejectsValuesOutsideTheirRanges) {
   o.window_s = NAN;
   EXPECT_FALSE(o.Validate().ok());
   o = Options("cello");
+  o.consistency_s = 2.5;
+  EXPECT_FALSE(o.Validate().ok());
+  o = Options("cello");
   o.range.max_f0_hz = 5000;  // above the cello's 16 kHz / 4
   EXPECT_FALSE(o.Validate().ok());
   EXPECT_THROW(DoubleStopAnalyzer{o}, std::invalid_argument);
@@ -129,6 +132,71 @@ TEST(DoubleStopAnalyzer, FindsALowerNoteWhoseFundamentalIsWeak) {
   ASSERT_EQ(analyzer.Analyze(x.data(), &notes), 2);
   EXPECT_LT(std::abs(Cents(notes[0].f0_hz, hi)), 10) << notes[0].f0_hz;
   EXPECT_LT(std::abs(Cents(notes[1].f0_hz, 2 * lo)), 10) << notes[1].f0_hz;
+}
+
+PolyPitchFrame Pair(double low_hz, double high_hz) {
+  PolyPitchFrame f;
+  f.count = 2;
+  f.notes = {PolyNote{low_hz, 1}, PolyNote{high_hz, 2}};
+  return f;
+}
+
+PolyPitchFrame Single(double hz) {
+  PolyPitchFrame f;
+  f.count = 1;
+  f.notes = {PolyNote{hz, 1}, PolyNote{}};
+  return f;
+}
+
+// The viola's third E3 + G#3 (164.8, 207.7 Hz) as the analysis heard it on the synthetic
+// double-stop piece: frames of G#4 + B4 (the upper note's 2nd partial, the lower's 3rd)
+// and G#3 + E4 (the lower's 2nd) between the true pair.
+TEST(ConsistentDoubleStops, APairHeardAsItsPartialsBecomesThePairAround) {
+  const PolyPitchFrame third = Pair(164.8, 207.7), partials = Pair(415.3, 493.9),
+                       octave_up = Pair(207.7, 329.6);
+  std::vector<PolyPitchFrame> frames = {
+      third, partials, partials, third, octave_up, third, Single(164.8), partials};
+  for (size_t i = 0; i < frames.size(); ++i) frames[i].frame = static_cast<int64_t>(i);
+  std::vector<PolyPitchFrame> made = frames;
+  ConsistentDoubleStops(3, &made);
+  for (int i : {1, 2, 4}) {
+    EXPECT_EQ(made[i].count, 2) << i;
+    EXPECT_EQ(made[i].notes[0].f0_hz, 164.8) << i;
+    EXPECT_EQ(made[i].notes[1].f0_hz, 207.7) << i;
+    EXPECT_EQ(made[i].frame, i);  // only the notes are taken
+  }
+  // The single note is left (the refinement's fill_notes completes notes); the last frame
+  // has the true pair on one side only: a note change is not smoothed over.
+  EXPECT_EQ(made[6].count, 1);
+  EXPECT_EQ(made[7].notes[0].f0_hz, 415.3);
+  for (int i : {0, 3, 5}) EXPECT_EQ(made[i].notes[1].f0_hz, 207.7);
+  // Window 0: unchanged; a window too short to see the pair on both sides: unchanged.
+  std::vector<PolyPitchFrame> same = frames;
+  ConsistentDoubleStops(0, &same);
+  EXPECT_EQ(same[1].notes[0].f0_hz, 415.3);
+  same = {third, partials, partials, partials, third};
+  ConsistentDoubleStops(1, &same);
+  EXPECT_EQ(same[2].notes[0].f0_hz, 415.3);
+}
+
+// A real change of double stop is kept, even where the new pair's notes are partials of the
+// old (E3 + G#3 -> G#3 + E4, whose E4 is E3's 2nd partial); so is a pair that no
+// neighbour explains.
+TEST(ConsistentDoubleStops, KeepsNoteChangesAndPairsNoNeighbourExplains) {
+  std::vector<PolyPitchFrame> frames = {Pair(164.8, 207.7),
+                                        Pair(164.8, 207.7),
+                                        Pair(164.8, 207.7),
+                                        Pair(207.7, 329.6),
+                                        Pair(207.7, 329.6),
+                                        Pair(207.7, 329.6),
+                                        Pair(261.6, 392.0),
+                                        Pair(207.7, 329.6)};
+  std::vector<PolyPitchFrame> made = frames;
+  ConsistentDoubleStops(5, &made);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(made[i].notes[0].f0_hz, frames[i].notes[0].f0_hz) << i;
+    EXPECT_EQ(made[i].notes[1].f0_hz, frames[i].notes[1].f0_hz) << i;
+  }
 }
 
 TEST(SecondNoteHz, TheNoteBesideTheTrackersF0) {
