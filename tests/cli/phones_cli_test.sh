@@ -187,6 +187,9 @@ if [ -f "$src/tools/view/node_modules/three/build/three.min.js" ]; then
 else
   echo "note: the viewer is not checked: three.js is not installed (scripts/fetch_view_tools)"
 fi
+ok "overlay" overlay result --camera left -o left_overlay.mp4
+check '[ "$(ffprobe -v error -count_frames -select_streams v -show_entries stream=nb_read_frames -of csv=p=0 left_overlay.mp4)" = 240 ]' \
+  "the overlay video has every frame: $(cat "$tmp/out")"
 
 # When a step fails: the guide's lines.
 SNAPSHOT_DIR=$tmp/w
