@@ -136,9 +136,15 @@ EOF
 ffmpeg -v error -y -f lavfi -i "testsrc2=size=320x240:rate=30" -t 4 \
   -vf "select='not(between(n\,30\,39))'" -fps_mode vfr -c:v libx264 -preset ultrafast \
   -pix_fmt yuv420p gap.mp4
+# A 90 kHz time base keeps the jitter (in the default 1/30 s base the timestamps came out
+# regular, and the check below tested nothing).
 ffmpeg -v error -y -f lavfi -i "testsrc2=size=320x240:rate=30" -t 4 \
-  -vf "setpts='PTS+0.3*sin(N)/TB/30'" -fps_mode vfr -c:v libx264 -preset ultrafast \
+  -vf "settb=1/90000,setpts='N/30/TB+0.3*sin(N)/30/TB'" -fps_mode vfr \
+  -enc_time_base 1/90000 -video_track_timescale 90000 -c:v libx264 -preset ultrafast \
   -pix_fmt yuv420p jitter.mp4
+check 'ffprobe -v error -select_streams v -show_entries packet=pts_time -of csv=p=0 jitter.mp4 | sort -g |
+       awk "NR > 1 { d = \$1 - p; if (d < 0.030 || d > 0.0367) irregular++ } { p = \$1 } END { exit !(irregular > 60) }"' \
+  "jitter.mp4 has a variable frame rate"
 ok "a video whose timestamps jump" capture new --calibration rig.json --video "$A=gap.mp4" -o caps/gap
 check 'grep -q "^warning: gap.mp4: timestamps jump 1 time (the largest by 0.367 s, 11.0 frames at 30 fps, before 1.333 s)" "$tmp/err"' \
   "the jump is reported: $(cat "$tmp/err")"
