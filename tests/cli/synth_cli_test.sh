@@ -37,6 +37,8 @@ check '/usr/bin/python3 -c "import json,sys; m=json.load(open(sys.argv[1]))[\"me
 
 # Bad input.
 bad_input "unknown piece" --piece bolero --calibration "$spd/cello_1113_scale_camera.xml"
+check 'grep -q "^arco: error: --piece '"'"'bolero'"'"' is unknown (built-in pieces: scale-2oct, " "$tmp/err"' \
+  "unknown piece: the flag is named, not the calibration: $(cat "$tmp/err")"
 bad_input "unknown instrument" --instrument lute --calibration "$spd/cello_1113_scale_camera.xml"
 check 'grep -qx "arco: error: --instrument '"'"'lute'"'"' is unknown (violin, viola, cello, double_bass)" "$tmp/err"' \
   "unknown instrument: the flag is named, not the calibration: $(cat "$tmp/err")"

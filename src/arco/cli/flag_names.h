@@ -50,6 +50,7 @@ inline constexpr FieldFlag kExportFlags[] = {
     {"result_dir", "RESULT_DIR"}, {"format", "--format"}, {"method", "--method"}};
 // Synthesis (CaptureWriteOptions, as set by `arco synth`).
 inline constexpr FieldFlag kSynthFlags[] = {{"instrument", "--instrument"},
+                                            {"piece", "--piece"},
                                             {"overwrite", "--overwrite"},
                                             {"max_duration_s", "--duration-s"},
                                             {"noise_px", "--noise-px"},

@@ -268,7 +268,7 @@ TEST(Generate, BadInput) {
   o.piece = "bolero";
   auto a = Generate(SpdRig(), o);
   ASSERT_FALSE(a.ok());
-  EXPECT_NE(a.status().message().find("unknown piece 'bolero'"), std::string::npos);
+  EXPECT_NE(a.status().message().find("piece 'bolero' is unknown"), std::string::npos);
   o = {};
   o.instrument = "lute";
   EXPECT_FALSE(Generate(SpdRig(), o).ok());

@@ -7,6 +7,7 @@
 #include "arco/registry/instruments.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/synth/midi_reader.h"
+#include "arco/synth/score.h"
 #include "arco/synth/synth_instrument.h"
 
 namespace arco::synth {
@@ -26,6 +27,15 @@ Status SynthOptions::Validate() const {
   if (!ParseInstrumentKind(instrument).ok())
     return Status::Error("instrument '" + instrument +
                          "' is unknown (violin, viola, cello, double_bass)");
+  // So is a built-in piece's name (a MIDI file is read, and named, later).
+  if (midi_path.empty()) {
+    const auto& pieces = BuiltInPieceNames();
+    if (std::find(pieces.begin(), pieces.end(), piece) == pieces.end()) {
+      std::string list;
+      for (const auto& n : pieces) list += (list.empty() ? "" : ", ") + n;
+      return Status::Error("piece '" + piece + "' is unknown (built-in pieces: " + list + ")");
+    }
+  }
   if (!(fps >= 1 && fps <= 1000)) return Status::Error("fps must be in [1, 1000]");
   if (!(tempo_scale > 0.05 && tempo_scale < 20))
     return Status::Error("tempo scale must be in (0.05, 20)");
