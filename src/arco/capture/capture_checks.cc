@@ -23,10 +23,6 @@ std::string Seconds(double s) {
   return buffer;
 }
 
-std::string ManifestPath(const std::string& capture_dir) {
-  return JoinPath(capture_dir, kCaptureManifestName);
-}
-
 }  // namespace
 
 Status CheckCaptureInputFile(const std::string& capture_dir,
@@ -34,7 +30,7 @@ Status CheckCaptureInputFile(const std::string& capture_dir,
                              const std::string& entry,
                              const std::string& path) {
   std::error_code ec;
-  const std::string where = ManifestPath(capture_dir) + ": " + field + " \"" + entry + "\"";
+  const std::string where = CaptureManifestPath(capture_dir) + ": " + field + " \"" + entry + "\"";
   if (!fs::exists(path, ec)) return Status::Error(where + ": " + path + " not found");
   if (fs::is_directory(path, ec)) return Status::Error(where + ": " + path + " is a folder");
   return Status::Ok();
@@ -50,8 +46,8 @@ StatusOr<std::vector<int>> MatchCaptureCameras(const std::string& capture_dir,
     int c = rig.FindCamera(cam.name);
     if (c < 0 && !cam.serial.empty()) c = rig.FindCamera(cam.serial);
     if (c < 0) {
-      return Status::Error(ManifestPath(capture_dir) + ": camera \"" + cam.name + "\" is not in " +
-                           calibration_path);
+      return Status::Error(CaptureManifestPath(capture_dir) + ": camera \"" + cam.name +
+                           "\" is not in " + calibration_path);
     }
     view_to_camera.push_back(c);
   }
@@ -63,7 +59,7 @@ StatusOr<CaptureAudioCheck> CheckCaptureAudio(const std::string& capture_dir,
                                               const CaptureAudioOpener& open) {
   CaptureAudioCheck check;
   if (manifest.audio.empty()) return check;
-  const std::string where = ManifestPath(capture_dir);
+  const std::string where = CaptureManifestPath(capture_dir);
   check.path = ResolveCapturePath(capture_dir, manifest.audio);
   ARCO_RETURN_IF_ERROR(
       CheckCaptureInputFile(capture_dir, "audio.file", manifest.audio, check.path));

@@ -11,7 +11,7 @@ StatusOr<std::vector<CaptureVideo>> OpenCaptureVideos(const std::string& dir,
                                                       const CaptureManifest& manifest,
                                                       int64_t first,
                                                       int64_t last) {
-  const std::string manifest_path = JoinPath(dir, kCaptureManifestName);
+  const std::string manifest_path = CaptureManifestPath(dir);
   const std::string calibration_path = ResolveCapturePath(dir, manifest.calibration);
   StatusOr<Calibration> calibration = LoadCalibration(calibration_path);
   if (!calibration.ok()) return calibration.status().WithContext(manifest_path + ": calibration");
@@ -38,7 +38,7 @@ StatusOr<CaptureVideo> OpenCaptureVideo(const std::string& dir,
                                         const std::string& calibration_path,
                                         int64_t first,
                                         int64_t last) {
-  const std::string manifest_path = JoinPath(dir, kCaptureManifestName);
+  const std::string manifest_path = CaptureManifestPath(dir);
   const CaptureCamera& cam = manifest.cameras.at(v);
   CaptureVideo in;
   in.camera = cam.name;

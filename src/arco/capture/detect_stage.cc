@@ -144,7 +144,7 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
   const auto start = std::chrono::steady_clock::now();
   ARCO_RETURN_IF_ERROR(options.Validate());
   const std::string& dir = options.capture_dir;
-  const std::string manifest_path = JoinPath(dir, kCaptureManifestName);
+  const std::string manifest_path = CaptureManifestPath(dir);
   ARCO_ASSIGN_OR_RETURN(CaptureManifest manifest, ReadCaptureManifest(dir));
 
   // --- Checks before any frame is decoded -------------------------------------------

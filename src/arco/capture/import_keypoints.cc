@@ -66,7 +66,7 @@ Status ImportKeypointsOptions::Validate() const {
 StatusOr<ImportKeypointsSummary> ImportKeypoints(const ImportKeypointsOptions& o) {
   ARCO_RETURN_IF_ERROR(o.Validate());
   ARCO_ASSIGN_OR_RETURN(CaptureManifest m, ReadCaptureManifest(o.capture_dir));
-  const std::string manifest_path = JoinPath(o.capture_dir, kCaptureManifestName);
+  const std::string manifest_path = CaptureManifestPath(o.capture_dir);
   if (!m.keypoints2d.empty() && !o.overwrite) {
     return Status::Error(manifest_path + ": already names 2D keypoints (" + m.keypoints2d +
                          "); overwrite replaces them");

@@ -59,7 +59,7 @@ StatusOr<PitchRunResult> RunPitch(const PitchRunOptions& o, Progress& progress) 
     ARCO_ASSIGN_OR_RETURN(const CaptureManifest manifest, ReadCaptureManifest(o.capture_dir));
     if (result.input.empty()) {
       if (manifest.audio.empty()) {
-        return Status::Error(JoinPath(o.capture_dir, kCaptureManifestName) +
+        return Status::Error(CaptureManifestPath(o.capture_dir) +
                              ": no audio file in the manifest; give one on the command line");
       }
       result.input = ResolveCapturePath(o.capture_dir, manifest.audio);
@@ -191,7 +191,7 @@ StatusOr<SyncRunResult> RunSync(const SyncRunOptions& o) {
         }
       }
       if (views.empty()) {
-        return Status::Error(JoinPath(o.capture_dir, kCaptureManifestName) +
+        return Status::Error(CaptureManifestPath(o.capture_dir) +
                              ": no camera names a video; give one or more videos");
       }
     }

@@ -391,7 +391,7 @@ TEST(RunSync, CamerasAgreeOnceTheirDroppedFramesAreCounted) {
 TEST(RunSync, NoEventWritesNothing) {
   const ClapCapture c = WriteClapCapture("clap_capture_silent", 1, false);
   ASSERT_TRUE(testing::WriteWav(c.wav, std::vector<float>(4 * 44100, 0.0f), 44100).ok());
-  const auto before = ReadFileToString(JoinPath(c.dir, kCaptureManifestName));
+  const auto before = ReadFileToString(CaptureManifestPath(c.dir));
   ASSERT_TRUE(before.ok());
   SyncRunOptions s;
   s.audio = c.wav;
@@ -399,7 +399,7 @@ TEST(RunSync, NoEventWritesNothing) {
   auto sync = RunSync(s);
   ASSERT_FALSE(sync.ok());
   EXPECT_NE(sync.status().message().find("no sound event"), std::string::npos);
-  EXPECT_EQ(*ReadFileToString(JoinPath(c.dir, kCaptureManifestName)), *before);
+  EXPECT_EQ(*ReadFileToString(CaptureManifestPath(c.dir)), *before);
 }
 
 // A WAV cut short: arco sync and arco pitch give the same warning (audio::TruncationWarning).

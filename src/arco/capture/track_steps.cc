@@ -123,7 +123,7 @@ size_t KeypointIndex(const TrackCapture& capture, int64_t f, int v, int64_t p) {
 StatusOr<TrackCapture> OpenTrackCapture(const std::string& capture_dir) {
   TrackCapture c;
   c.dir = capture_dir;
-  c.manifest_path = JoinPath(capture_dir, kCaptureManifestName);
+  c.manifest_path = CaptureManifestPath(capture_dir);
   ARCO_ASSIGN_OR_RETURN(c.manifest, ReadCaptureManifest(capture_dir));
   const CaptureManifest& manifest = c.manifest;
   if (manifest.instrument == "none") {

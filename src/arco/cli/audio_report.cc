@@ -104,7 +104,7 @@ std::string FormatSyncReport(const capture::SyncRunOptions& o, const capture::Sy
   }
   if (run.wrote_capture) {
     out += "wrote audio.offset_s and audio.sync_confidence to " +
-           JoinPath(o.capture_dir, kCaptureManifestName) + "\n";
+           CaptureManifestPath(o.capture_dir) + "\n";
   }
   return out;
 }

@@ -308,13 +308,13 @@ StatusOr<OverlaySummary> WriteOverlay(const OverlayOptions& options,
   if (view < 0) {
     std::string names;
     for (const auto& c : manifest.cameras) names += (names.empty() ? "" : ", ") + c.name;
-    return Status::Error(JoinPath(header.capture_dir, kCaptureManifestName) + ": no camera '" +
+    return Status::Error(CaptureManifestPath(header.capture_dir) + ": no camera '" +
                          options.camera + "' (cameras: " + names + ")");
   }
   const std::string calibration_path = ResolveCapturePath(header.capture_dir, manifest.calibration);
   StatusOr<Calibration> calibration = LoadCalibration(calibration_path);
   if (!calibration.ok()) {
-    return calibration.status().WithContext(JoinPath(header.capture_dir, kCaptureManifestName) +
+    return calibration.status().WithContext(CaptureManifestPath(header.capture_dir) +
                                             ": calibration");
   }
   ARCO_ASSIGN_OR_RETURN(const std::vector<int> rig_index,

@@ -289,7 +289,7 @@ StatusOr<CaptureManifest> ParseCaptureManifest(const std::string& text, const st
 }
 
 StatusOr<CaptureManifest> ReadCaptureManifest(const std::string& capture_dir) {
-  const std::string path = JoinPath(capture_dir, kCaptureManifestName);
+  const std::string path = CaptureManifestPath(capture_dir);
   ARCO_ASSIGN_OR_RETURN(std::string text, ReadFileToString(path));
   return ParseCaptureManifest(text, path);
 }
@@ -331,8 +331,11 @@ Json CaptureManifestToJson(const CaptureManifest& m) {
 
 Status WriteCaptureManifest(const std::string& capture_dir, const CaptureManifest& manifest) {
   ARCO_RETURN_IF_ERROR(MakeDirectories(capture_dir));
-  return WriteJsonFile(JoinPath(capture_dir, kCaptureManifestName),
-                       CaptureManifestToJson(manifest));
+  return WriteJsonFile(CaptureManifestPath(capture_dir), CaptureManifestToJson(manifest));
+}
+
+std::string CaptureManifestPath(const std::string& capture_dir) {
+  return JoinPath(capture_dir, kCaptureManifestName);
 }
 
 std::string ResolveCapturePath(const std::string& dir, const std::string& entry) {
@@ -348,7 +351,7 @@ StatusOr<std::string> DetectionLayoutName(const std::string& instrument) {
 
 Status CheckCaptureHasKeypoints2d(const std::string& capture_dir, const CaptureManifest& m) {
   if (!m.keypoints2d.empty()) return Status::Ok();
-  return Status::Error(JoinPath(capture_dir, kCaptureManifestName) +
+  return Status::Error(CaptureManifestPath(capture_dir) +
                        ": no 2D keypoints yet (no \"keypoints2d\" entry); run `arco detect " +
                        capture_dir + "` (or `arco capture import-keypoints`) first");
 }
@@ -379,7 +382,7 @@ Status CheckKeypoints2dHeader(const std::string& capture_dir,
                               const CaptureManifest& m,
                               const std::string& path,
                               const NpyHeader& header) {
-  const std::string manifest_path = JoinPath(capture_dir, kCaptureManifestName);
+  const std::string manifest_path = CaptureManifestPath(capture_dir);
   ARCO_RETURN_IF_ERROR(CheckKeypoints2dDtype(path, header.dtype, header.is_float));
   StatusOr<KeypointLayout> layout = m.Layout();
   if (!layout.ok()) return layout.status().WithContext(manifest_path);

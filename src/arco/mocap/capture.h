@@ -92,6 +92,9 @@ StatusOr<CaptureManifest> ReadCaptureManifest(const std::string& capture_dir);
 Json CaptureManifestToJson(const CaptureManifest& manifest);
 Status WriteCaptureManifest(const std::string& capture_dir, const CaptureManifest& manifest);
 
+// The manifest of a capture folder: CAPTURE_DIR/capture.json (how every message names it).
+std::string CaptureManifestPath(const std::string& capture_dir);
+
 // Path of a manifest entry: relative entries are resolved against `dir` (the writers
 // store them with PathRelativeTo, util/file_io.h).
 std::string ResolveCapturePath(const std::string& dir, const std::string& entry);

@@ -21,10 +21,6 @@ std::string Seconds(double s) {
   return buffer;
 }
 
-std::string ManifestPath(const std::string& capture_dir) {
-  return JoinPath(capture_dir, kCaptureManifestName);
-}
-
 }  // namespace
 
 Status CheckCaptureCalibration(const std::string& capture_dir, const CaptureManifest& manifest) {
@@ -45,7 +41,7 @@ Status LoadCaptureCalibration(CaptureContext* capture) {
   StatusOr<Calibration> calibration =
       text.ok() ? ParseCalibration(*text, path) : StatusOr<Calibration>(text.status());
   if (!calibration.ok()) {
-    return calibration.status().WithContext(ManifestPath(capture_dir) + ": calibration");
+    return calibration.status().WithContext(CaptureManifestPath(capture_dir) + ": calibration");
   }
   ARCO_ASSIGN_OR_RETURN(
       capture->view_to_camera,

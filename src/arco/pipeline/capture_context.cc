@@ -37,7 +37,7 @@ StatusOr<std::unique_ptr<audio::AudioReader>> OpenCaptureAudio(const CaptureCont
 StatusOr<CaptureContext> OpenCapture(const std::string& capture_dir) {
   CaptureContext c;
   c.capture_dir = capture_dir;
-  const std::string where = JoinPath(capture_dir, kCaptureManifestName);
+  const std::string where = CaptureManifestPath(capture_dir);
   // Read once: parsed here, and its fingerprint taken of the same bytes.
   ARCO_ASSIGN_OR_RETURN(const std::string text, ReadFileToString(where));
   ARCO_ASSIGN_OR_RETURN(c.manifest, ParseCaptureManifest(text, where));

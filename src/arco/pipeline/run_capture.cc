@@ -201,11 +201,8 @@ StatusOr<CaptureContext> PreflightOpened(const RunOptions& options, CaptureConte
     capture.inputs[kKeypoints2dInput] = {m.keypoints2d, FingerprintBytes(bytes.view())};
   }
   ARCO_RETURN_IF_ERROR(CheckCaptureInstrumentPoints(capture));
-  ARCO_RETURN_IF_ERROR(
-      CheckTriangulationFilters(options.ForTriangulate(),
-                                capture.layout,
-                                m.fps,
-                                JoinPath(options.capture_dir, kCaptureManifestName)));
+  ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(
+      options.ForTriangulate(), capture.layout, m.fps, CaptureManifestPath(options.capture_dir)));
   // The audio is read once; the check, its fingerprint and the pitch stage use the bytes.
   ReadCaptureAudioBytes(&capture);
   ARCO_RETURN_IF_ERROR(CheckCaptureAudio(capture).status());

@@ -36,7 +36,7 @@ StatusOr<CaptureContext> OpenForTriangulation(const TriangulateStageOptions& o) 
   capture.capture_dir = o.capture_dir;
   ARCO_ASSIGN_OR_RETURN(capture.manifest, ReadCaptureManifest(o.capture_dir));
   const CaptureManifest& manifest = capture.manifest;
-  const std::string manifest_path = JoinPath(o.capture_dir, kCaptureManifestName);
+  const std::string manifest_path = CaptureManifestPath(o.capture_dir);
   ARCO_ASSIGN_OR_RETURN(capture.layout, [&]() -> StatusOr<KeypointLayout> {
     ARCO_RETURN_IF_ERROR(CheckCaptureHasKeypoints2d(o.capture_dir, manifest));
     auto l = manifest.Layout();
@@ -77,7 +77,7 @@ StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptio
   ARCO_RETURN_IF_ERROR(result.CheckWritable());  // before the work
   const CaptureManifest& manifest = capture.manifest;
   const KeypointLayout& layout = capture.layout;
-  const std::string manifest_path = JoinPath(capture.capture_dir, kCaptureManifestName);
+  const std::string manifest_path = CaptureManifestPath(capture.capture_dir);
   ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(o, layout, manifest.fps, manifest_path));
   std::vector<const std::vector<int>*> filter_groups;
   for (const auto& entry : o.filters) filter_groups.push_back(layout.Group(entry.first));

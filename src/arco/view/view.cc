@@ -220,7 +220,7 @@ StatusOr<std::string> VideoKey(const ViewOptions& options,
     }
   }
   ARCO_RETURN_IF_ERROR(
-      HashWholeFile(hash, "capture.json", JoinPath(header.capture_dir, kCaptureManifestName)));
+      HashWholeFile(hash, "capture.json", CaptureManifestPath(header.capture_dir)));
   ARCO_RETURN_IF_ERROR(HashWholeFile(
       hash, "calibration", ResolveCapturePath(header.capture_dir, capture.calibration)));
   const std::string& video = capture.cameras[v].video;
@@ -343,8 +343,8 @@ StatusOr<std::vector<ViewVideo>> WriteVideos(const ViewOptions& options,
     if (v < 0) {
       std::string names;
       for (const auto& c : capture.cameras) names += (names.empty() ? "" : ", ") + c.name;
-      return Status::Error(JoinPath(header.capture_dir, kCaptureManifestName) + ": no camera '" +
-                           id + "' (cameras: " + names + ")");
+      return Status::Error(CaptureManifestPath(header.capture_dir) + ": no camera '" + id +
+                           "' (cameras: " + names + ")");
     }
     if (std::find(views.begin(), views.end(), v) == views.end()) views.push_back(v);
   }
