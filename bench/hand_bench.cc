@@ -49,8 +49,8 @@ void BM_TriangulateDlt21(benchmark::State& state) {
       std::vector<DltObservation> obs;
       for (size_t v = 0; v < views.size(); ++v) {
         DltObservation o;
-        o.projection << f.cameras[v].cam_from_world_rotation,
-            f.cameras[v].cam_from_world_translation;
+        o.projection << f.cameras[v].cam_from_world.rotation,
+            f.cameras[v].cam_from_world.translation;
         o.point = f.cameras[v].PixelToNormalized(views[v].pixels[k]);
         o.weight = views[v].scores[k];
         obs.push_back(o);
@@ -106,8 +106,8 @@ void BM_FingertipIk(benchmark::State& state) {
   for (int i = 0; i < 32; ++i) {
     const HandPose ref = testing::RandomPose(model, rng, 0.1);
     HandPose other = testing::RandomPose(model, rng, 0.1);
-    other.world_from_wrist_rotation = ref.world_from_wrist_rotation;
-    other.wrist_in_world_mm = ref.wrist_in_world_mm;
+    other.world_from_wrist.rotation = ref.world_from_wrist.rotation;
+    other.world_from_wrist.translation = ref.world_from_wrist.translation;
     // Only the index finger's free joints differ, so the target is reachable.
     std::vector<bool> free(kNumJointDofs, false);
     for (FingerDof slot : FreeDofs(static_cast<FingerIkJoints>(state.range(0)))) {
@@ -117,7 +117,7 @@ void BM_FingertipIk(benchmark::State& state) {
       if (!free[d]) other.angles_rad[d] = ref.angles_rad[d];
     }
     Eigen::Vector3d target = FingertipInWorld(model, other, Finger::kIndex);
-    if (state.range(1) == 1) target += ref.world_from_wrist_rotation * Eigen::Vector3d(10, 0, 0);
+    if (state.range(1) == 1) target += ref.world_from_wrist.rotation * Eigen::Vector3d(10, 0, 0);
     refs.push_back(ref);
     targets.push_back(target);
   }

@@ -137,7 +137,7 @@ StatusOr<BundleAdjustmentSummary> AdjustRig(const RigAdjustmentOptions& options,
   for (int c = 0; c < num_cameras; ++c) {
     const Camera& cam = rig->cameras[c];
     PoseToParams(
-        cam.cam_from_world_rotation, cam.cam_from_world_translation, &x[c * kCameraStride]);
+        cam.cam_from_world.rotation, cam.cam_from_world.translation, &x[c * kCameraStride]);
     const auto intrinsics = cam.Intrinsics();
     std::copy(intrinsics.begin(), intrinsics.end(), &x[c * kCameraStride + kPoseParams]);
   }
@@ -225,7 +225,7 @@ StatusOr<BundleAdjustmentSummary> AdjustRig(const RigAdjustmentOptions& options,
     const double* p = &x[c * kCameraStride];
     // The reference's pose exactly as given (not through angle-axis and back).
     if (c != options.reference_camera)
-      ParamsToPose(p, &cam.cam_from_world_rotation, &cam.cam_from_world_translation);
+      ParamsToPose(p, &cam.cam_from_world.rotation, &cam.cam_from_world.translation);
     cam.fx = p[kPoseParams + kFx];
     cam.fy = p[kPoseParams + kFy];
   }

@@ -67,9 +67,9 @@ TEST(AdjustRig, BringsATurnedAndShiftedCameraBackAndHoldsTheGauge) {
   const Scene scene = MakeScene();
   Rig rig = scene.truth;
   Camera& moved = rig.cameras[3];
-  moved.cam_from_world_rotation =
-      RotationFromAxisAngle(Eigen::Vector3d(0.02, -0.01, 0.015)) * moved.cam_from_world_rotation;
-  moved.cam_from_world_translation += Eigen::Vector3d(0.03, -0.02, 0.01);
+  moved.cam_from_world.rotation =
+      RotationFromAxisAngle(Eigen::Vector3d(0.02, -0.01, 0.015)) * moved.cam_from_world.rotation;
+  moved.cam_from_world.translation += Eigen::Vector3d(0.03, -0.02, 0.01);
   RigidBody body = scene.body;
   for (Eigen::Vector3d& p : body.points) p *= 1.1;  // the scale off by 10 %
 
@@ -79,12 +79,12 @@ TEST(AdjustRig, BringsATurnedAndShiftedCameraBackAndHoldsTheGauge) {
   EXPECT_LT(summary->final_cost, 1e-12);
   EXPECT_GT(summary->residual_blocks, 0);
   // The reference exactly as given (not through angle-axis and back).
-  EXPECT_EQ(rig.cameras[0].cam_from_world_rotation, scene.truth.cameras[0].cam_from_world_rotation);
-  EXPECT_EQ(rig.cameras[0].cam_from_world_translation,
-            scene.truth.cameras[0].cam_from_world_translation);
+  EXPECT_EQ(rig.cameras[0].cam_from_world.rotation, scene.truth.cameras[0].cam_from_world.rotation);
+  EXPECT_EQ(rig.cameras[0].cam_from_world.translation,
+            scene.truth.cameras[0].cam_from_world.translation);
   for (size_t c = 0; c < rig.cameras.size(); ++c) {
-    EXPECT_LT(RotationAngleBetween(rig.cameras[c].cam_from_world_rotation,
-                                   scene.truth.cameras[c].cam_from_world_rotation),
+    EXPECT_LT(RotationAngleBetween(rig.cameras[c].cam_from_world.rotation,
+                                   scene.truth.cameras[c].cam_from_world.rotation),
               1e-7)
         << c;
     EXPECT_LT((rig.cameras[c].CenterInWorld() - scene.truth.cameras[c].CenterInWorld()).norm(),
@@ -100,15 +100,15 @@ TEST(AdjustRig, BringsATurnedAndShiftedCameraBackAndHoldsTheGauge) {
 TEST(AdjustRig, LeavesCamerasItIsNotGivenExactlyAsTheyWere) {
   const Scene scene = MakeScene();
   Rig rig = scene.truth;
-  rig.cameras[5].cam_from_world_translation += Eigen::Vector3d(0.01, 0, 0);
+  rig.cameras[5].cam_from_world.translation += Eigen::Vector3d(0.01, 0, 0);
   const Rig input = rig;
   RigidBody body = scene.body;
   RigAdjustmentOptions options = Options(rig);
   options.cameras = {0, 1, 2, 3, 4};
   options.refine_focal = true;
   ASSERT_TRUE(AdjustRig(options, scene.tracks, &rig, &body).ok());
-  EXPECT_EQ(rig.cameras[5].cam_from_world_rotation, input.cameras[5].cam_from_world_rotation);
-  EXPECT_EQ(rig.cameras[5].cam_from_world_translation, input.cameras[5].cam_from_world_translation);
+  EXPECT_EQ(rig.cameras[5].cam_from_world.rotation, input.cameras[5].cam_from_world.rotation);
+  EXPECT_EQ(rig.cameras[5].cam_from_world.translation, input.cameras[5].cam_from_world.translation);
   EXPECT_EQ(rig.cameras[5].fx, input.cameras[5].fx);
 }
 
@@ -119,8 +119,8 @@ TEST(AdjustRig, RefusesIndicesOutsideTheRigOrTheBodyAndLeavesBothUnchanged) {
     Rig rig = scene.truth;
     RigidBody body = scene.body;
     const auto summary = AdjustRig(options, tracks, &rig, &body);
-    EXPECT_EQ(rig.cameras[1].cam_from_world_translation,
-              scene.truth.cameras[1].cam_from_world_translation);
+    EXPECT_EQ(rig.cameras[1].cam_from_world.translation,
+              scene.truth.cameras[1].cam_from_world.translation);
     EXPECT_EQ(body.points[0], scene.body.points[0]);
     return !summary.ok() && summary.status().message().find("bundle adjustment") == 0;
   };

@@ -40,9 +40,9 @@ void ExpectSameRig(const Rig& a, const Rig& b, double tolerance, bool names_kept
     EXPECT_EQ(x.width, y.width);
     EXPECT_EQ(x.height, y.height);
     EXPECT_LE((x.K() - y.K()).cwiseAbs().maxCoeff(), tolerance) << x.name;
-    EXPECT_LE((x.cam_from_world_rotation - y.cam_from_world_rotation).cwiseAbs().maxCoeff(),
+    EXPECT_LE((x.cam_from_world.rotation - y.cam_from_world.rotation).cwiseAbs().maxCoeff(),
               tolerance);
-    EXPECT_LE((x.cam_from_world_translation - y.cam_from_world_translation).cwiseAbs().maxCoeff(),
+    EXPECT_LE((x.cam_from_world.translation - y.cam_from_world.translation).cwiseAbs().maxCoeff(),
               tolerance);
     EXPECT_EQ(x.distortion.k1, y.distortion.k1);
     EXPECT_EQ(x.distortion.k2, y.distortion.k2);
@@ -148,7 +148,7 @@ TEST_F(SaveCalibrationTest, RefusesUnknownExtensionAndInvalidRigWithoutLeavingAF
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("rig.txt"), std::string::npos);
   Rig bad = cal->rig;
-  bad.cameras[3].cam_from_world_rotation(0, 0) = 5;
+  bad.cameras[3].cam_from_world.rotation(0, 0) = 5;
   s = SaveCalibration(Path("rig.yaml"), bad);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("rotation"), std::string::npos) << s.message();

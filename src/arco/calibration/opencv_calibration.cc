@@ -84,8 +84,8 @@ StatusOr<Camera> ReadCamera(const cv::FileNode& n, size_t index) {
   cam.cx = k[2];
   cam.fy = k[4];
   cam.cy = k[5];
-  cam.cam_from_world_rotation = Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(r.data());
-  cam.cam_from_world_translation = Eigen::Vector3d(t[0], t[1], t[2]);
+  cam.cam_from_world.rotation = Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(r.data());
+  cam.cam_from_world.translation = Eigen::Vector3d(t[0], t[1], t[2]);
   ARCO_RETURN_IF_ERROR(ValidateCamera(cam));
   return cam;
 }
@@ -142,9 +142,9 @@ StatusOr<std::string> WriteOpenCvCalibration(const Rig& rig, bool yaml) {
       for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j) {
           k.at<double>(i, j) = kk(i, j);
-          r.at<double>(i, j) = cam.cam_from_world_rotation(i, j);
+          r.at<double>(i, j) = cam.cam_from_world.rotation(i, j);
         }
-        t.at<double>(i, 0) = cam.cam_from_world_translation[i];
+        t.at<double>(i, 0) = cam.cam_from_world.translation[i];
       }
       const Distortion& d = cam.distortion;
       cv::Mat dist = (cv::Mat_<double>(1, 5) << d.k1, d.k2, d.p1, d.p2, d.k3);

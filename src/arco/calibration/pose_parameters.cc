@@ -16,6 +16,18 @@ void ParamsToPose(const double* params, Eigen::Matrix3d* R, Eigen::Vector3d* t) 
   *t = Eigen::Vector3d(params[3], params[4], params[5]);
 }
 
+std::array<double, kPoseParams> ParamsFromRigid(const RigidMatrix3d& pose) {
+  std::array<double, kPoseParams> params;
+  PoseToParams(pose.rotation, pose.translation, params.data());
+  return params;
+}
+
+RigidMatrix3d RigidFromParams(const double* params) {
+  RigidMatrix3d pose;
+  ParamsToPose(params, &pose.rotation, &pose.translation);
+  return pose;
+}
+
 double Rms(const std::vector<double>& values) {
   if (values.empty()) return 0;
   double sum = 0;

@@ -6,7 +6,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
+
+#include "arco/geometry/transform.h"
 
 namespace arco::calibration {
 
@@ -15,6 +18,9 @@ inline constexpr int kPoseParams = 6;
 // params[0..2] = angle-axis of R, params[3..5] = t.
 void PoseToParams(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, double* params);
 void ParamsToPose(const double* params, Eigen::Matrix3d* R, Eigen::Vector3d* t);
+// The same for a whole pose: its 6 parameters, and the pose from them.
+std::array<double, kPoseParams> ParamsFromRigid(const RigidMatrix3d& pose);
+RigidMatrix3d RigidFromParams(const double* params);
 
 // Root mean square of the values; 0 for none (a camera with no observations left).
 double Rms(const std::vector<double>& values);

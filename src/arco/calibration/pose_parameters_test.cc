@@ -24,6 +24,18 @@ TEST(PoseParameters, RoundTripKeepsThePose) {
   EXPECT_EQ(t2, t);
 }
 
+TEST(PoseParameters, ARigidPoseGivesTheSameParametersAsItsRotationAndTranslation) {
+  const RigidMatrix3d pose(RotationFromAxisAngle(Eigen::Vector3d(-0.4, 0.9, 0.1)),
+                           Eigen::Vector3d(10, 20, -30));
+  double params[kPoseParams];
+  PoseToParams(pose.rotation, pose.translation, params);
+  const std::array<double, kPoseParams> from_rigid = ParamsFromRigid(pose);
+  for (int i = 0; i < kPoseParams; ++i) EXPECT_EQ(from_rigid[i], params[i]);
+  const RigidMatrix3d back = RigidFromParams(from_rigid.data());
+  EXPECT_LT((back.rotation - pose.rotation).norm(), 1e-12);
+  EXPECT_EQ(back.translation, pose.translation);
+}
+
 TEST(Rms, OfNoneIsZeroAndOfValuesTheirQuadraticMean) {
   EXPECT_EQ(Rms({}), 0);
   EXPECT_DOUBLE_EQ(Rms({3, -4}), std::sqrt(12.5));

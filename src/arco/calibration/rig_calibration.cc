@@ -28,41 +28,19 @@
 namespace arco::calibration {
 namespace {
 
-// A rigid transform b_from_a: x_b = R x_a + t.
-struct Pose {
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d t = Eigen::Vector3d::Zero();
-  Pose operator*(const Pose& o) const { return {R * o.R, R * o.t + t}; }
-  Eigen::Vector3d operator*(const Eigen::Vector3d& p) const { return R * p + t; }
-  Pose Inverse() const { return {R.transpose(), -R.transpose() * t}; }
-};
-
-// pose_parameters.h's converters for this file's Pose.
-std::array<double, kPoseParams> PoseToParams(const Pose& pose) {
-  std::array<double, kPoseParams> params;
-  calibration::PoseToParams(pose.R, pose.t, params.data());
-  return params;
-}
-
-Pose PoseFromParams(const double* p) {
-  Pose pose;
-  ParamsToPose(p, &pose.R, &pose.t);
-  return pose;
-}
-
 Camera CameraWithIntrinsics(const std::array<double, kNumIntrinsics>& intrinsics,
-                            const Pose& cam_from_world) {
+                            const RigidMatrix3d& cam_from_world) {
   Camera camera;
   camera.SetIntrinsics(intrinsics);
-  camera.cam_from_world_rotation = cam_from_world.R;
-  camera.cam_from_world_translation = cam_from_world.t;
+  camera.cam_from_world.rotation = cam_from_world.rotation;
+  camera.cam_from_world.translation = cam_from_world.translation;
   return camera;
 }
 
 // The pixel residuals of a view for a board pose (cam_from_board); `reversed` reads the
 // ids backwards (a chessboard's corners reported from the opposite corner).
 std::vector<double> ViewErrors(const std::array<double, kNumIntrinsics>& intrinsics,
-                               const Pose& cam_from_board,
+                               const RigidMatrix3d& cam_from_board,
                                const std::vector<Eigen::Vector3d>& points,
                                const BoardView& view,
                                bool reversed) {
@@ -195,9 +173,9 @@ StatusOr<std::array<double, kNumIntrinsics>> CalibrateIntrinsics(
 }
 
 // cam_from_board of one view by PnP (OpenCV's iterative solver from the homography).
-std::optional<Pose> BoardPose(const std::array<double, kNumIntrinsics>& in,
-                              const std::vector<Eigen::Vector3d>& points,
-                              const BoardView& view) {
+std::optional<RigidMatrix3d> BoardPose(const std::array<double, kNumIntrinsics>& in,
+                                       const std::vector<Eigen::Vector3d>& points,
+                                       const BoardView& view) {
   if (view.point_ids.size() < 4) return std::nullopt;
   // cv::Mat (64-byte aligned) for the same reason as in CalibrateIntrinsics.
   const int n = static_cast<int>(view.point_ids.size());
@@ -216,10 +194,11 @@ std::optional<Pose> BoardPose(const std::array<double, kNumIntrinsics>& in,
   } catch (const cv::Exception&) {
     return std::nullopt;
   }
-  Pose pose;
-  pose.R = RotationFromAxisAngle(Eigen::Vector3d(rvec[0], rvec[1], rvec[2]));
-  pose.t = Eigen::Vector3d(tvec[0], tvec[1], tvec[2]);
-  if (!pose.R.allFinite() || !pose.t.allFinite() || pose.t.z() <= 0) return std::nullopt;
+  RigidMatrix3d pose;
+  pose.rotation = RotationFromAxisAngle(Eigen::Vector3d(rvec[0], rvec[1], rvec[2]));
+  pose.translation = Eigen::Vector3d(tvec[0], tvec[1], tvec[2]);
+  if (!pose.rotation.allFinite() || !pose.translation.allFinite() || pose.translation.z() <= 0)
+    return std::nullopt;
   return pose;
 }
 
@@ -227,26 +206,26 @@ std::optional<Pose> BoardPose(const std::array<double, kNumIntrinsics>& in,
 // (within 5 degrees and 10 % of the baseline + 10 mm: loose, as one view's PnP of a small or
 // distant board is; a backward chessboard or another instant is far off), then the mean of
 // those that agree; *support = how many agree.
-Pose ConsensusPose(const std::vector<Pose>& candidates, int* support) {
+RigidMatrix3d ConsensusPose(const std::vector<RigidMatrix3d>& candidates, int* support) {
   ARCO_CHECK(!candidates.empty());
-  auto agree = [](const Pose& a, const Pose& b) {
-    return RotationAngleBetween(a.R, b.R) < 5.0 * M_PI / 180 &&
-           (a.t - b.t).norm() < 0.1 * a.t.norm() + 10.0;
+  auto agree = [](const RigidMatrix3d& a, const RigidMatrix3d& b) {
+    return RotationAngleBetween(a.rotation, b.rotation) < 5.0 * M_PI / 180 &&
+           (a.translation - b.translation).norm() < 0.1 * a.translation.norm() + 10.0;
   };
   size_t best = 0;
   int best_count = -1;
   for (size_t i = 0; i < candidates.size(); ++i) {
     int count = 0;
-    for (const Pose& other : candidates) count += agree(candidates[i], other);
+    for (const RigidMatrix3d& other : candidates) count += agree(candidates[i], other);
     if (count > best_count) best_count = count, best = i;
   }
   Eigen::Matrix3d rotation_sum = Eigen::Matrix3d::Zero();
   Eigen::Vector3d translation_sum = Eigen::Vector3d::Zero();
   int n = 0;
-  for (const Pose& other : candidates)
+  for (const RigidMatrix3d& other : candidates)
     if (agree(candidates[best], other)) {
-      rotation_sum += other.R;
-      translation_sum += other.t;
+      rotation_sum += other.rotation;
+      translation_sum += other.translation;
       ++n;
     }
   *support = n;
@@ -393,7 +372,7 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   }
 
   // 2. Board pose in every view; frames -> views.
-  std::vector<std::vector<std::optional<Pose>>> cam_from_board(num_cameras);
+  std::vector<std::vector<std::optional<RigidMatrix3d>>> cam_from_board(num_cameras);
   std::map<int64_t, std::vector<std::pair<int, int>>> frames;  // frame -> (camera, view)
   for (int c = 0; c < num_cameras; ++c) {
     cam_from_board[c].resize(cameras[c].views.size());
@@ -457,11 +436,11 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   }
 
   // 4. cam_from_world along the tree.
-  std::vector<Pose> cam_from_world(num_cameras);
+  std::vector<RigidMatrix3d> cam_from_world(num_cameras);
   std::vector<CalibrationWarning> weak_links;
   for (size_t k = 1; k < order.size(); ++k) {
     const int c = order[k], p = parent[c];
-    std::vector<Pose> candidates;
+    std::vector<RigidMatrix3d> candidates;
     for (const auto& [frame, views] : frames) {
       int vp = -1, vc = -1;
       for (const auto& [cam, view] : views) {
@@ -496,17 +475,17 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   const bool chessboard = board.kind == BoardKind::kChessboard;
   const double reject_px = std::max(20.0, 10 * options.loss_scale_px);
   std::vector<int64_t> ba_frames;
-  std::vector<Pose> world_from_board;
+  std::vector<RigidMatrix3d> world_from_board;
   std::vector<std::vector<UsedView>> ba_views;
   for (const auto& [frame, views] : frames) {
     if (views.size() < 2 && !options.refine_intrinsics) continue;
     double best_cost = std::numeric_limits<double>::infinity();
-    Pose best;
+    RigidMatrix3d best;
     for (const auto& [cam, view] : views) {
-      const Pose candidate = cam_from_world[cam].Inverse() * *cam_from_board[cam][view];
+      const RigidMatrix3d candidate = cam_from_world[cam].Inverse() * *cam_from_board[cam][view];
       std::vector<double> medians;
       for (const auto& [cam2, view2] : views) {
-        const Pose cb = cam_from_world[cam2] * candidate;
+        const RigidMatrix3d cb = cam_from_world[cam2] * candidate;
         std::vector<double> e =
             ViewErrors(intrinsics[cam2], cb, points, cameras[cam2].views[view2], false);
         medians.push_back(Median(e));
@@ -516,7 +495,7 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
     }
     std::vector<UsedView> used;
     for (const auto& [cam, view] : views) {
-      const Pose cb = cam_from_world[cam] * best;
+      const RigidMatrix3d cb = cam_from_world[cam] * best;
       const BoardView& v = cameras[cam].views[view];
       const double forward = Median(ViewErrors(intrinsics[cam], cb, points, v, false));
       const double backward =
@@ -546,9 +525,10 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   progress.StartStage(2, 3, "bundle adjustment");
   const auto start = std::chrono::steady_clock::now();
   std::vector<std::array<double, 6>> camera_params(num_cameras);
-  for (int c = 0; c < num_cameras; ++c) camera_params[c] = PoseToParams(cam_from_world[c]);
+  for (int c = 0; c < num_cameras; ++c) camera_params[c] = ParamsFromRigid(cam_from_world[c]);
   std::vector<std::array<double, 6>> board_params(ba_frames.size());
-  for (size_t f = 0; f < ba_frames.size(); ++f) board_params[f] = PoseToParams(world_from_board[f]);
+  for (size_t f = 0; f < ba_frames.size(); ++f)
+    board_params[f] = ParamsFromRigid(world_from_board[f]);
   // Every camera's pose and intrinsics in one buffer, camera after camera. Ceres orders the
   // blocks of an elimination group by their addresses (ParameterBlockOrdering keeps a
   // std::set<double*>): with the poses and the intrinsics in two separate allocations, their
@@ -612,19 +592,19 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
 
   // 7. World frame, the rig and the report.
   progress.StartStage(3, 3, "report");
-  Pose world_from_new = Pose();  // the chosen world in the adjustment's world
+  RigidMatrix3d world_from_new;  // the chosen world in the adjustment's world
   report.origin = cameras[root].camera;
   if (board_origin) {
     for (size_t f = 0; f < ba_frames.size(); ++f)
       if (ba_views[f].size() >= 2) {
-        world_from_new = PoseFromParams(board_params[f].data());
+        world_from_new = RigidFromParams(board_params[f].data());
         report.origin = "board@" + std::to_string(ba_frames[f]);
         break;
       }
   }
   result.rig.units = "mm";
   for (int c = 0; c < num_cameras; ++c) {
-    const Pose pose = PoseFromParams(camera_params[c].data()) * world_from_new;
+    const RigidMatrix3d pose = RigidFromParams(camera_params[c].data()) * world_from_new;
     Camera camera = CameraWithIntrinsics(intrinsics[c], pose);
     camera.name = cameras[c].camera;
     camera.width = cameras[c].width;
@@ -649,13 +629,16 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
   std::vector<std::vector<double>> errors(num_cameras);
   std::vector<int> views_used(num_cameras, 0);
   for (size_t f = 0; f < ba_frames.size(); ++f) {
-    const Pose board_pose = world_from_new.Inverse() * PoseFromParams(board_params[f].data());
+    const RigidMatrix3d new_from_board =
+        world_from_new.Inverse() * RigidFromParams(board_params[f].data());
     for (const UsedView& u : ba_views[f]) {
       const Camera& cam = result.rig.cameras[u.camera];
-      const Pose cb{cam.cam_from_world_rotation * board_pose.R,
-                    cam.cam_from_world_rotation * board_pose.t + cam.cam_from_world_translation};
-      const std::vector<double> e =
-          ViewErrors(intrinsics[u.camera], cb, points, cameras[u.camera].views[u.view], u.reversed);
+      const RigidMatrix3d cam_from_board = cam.cam_from_world * new_from_board;
+      const std::vector<double> e = ViewErrors(intrinsics[u.camera],
+                                               cam_from_board,
+                                               points,
+                                               cameras[u.camera].views[u.view],
+                                               u.reversed);
       errors[u.camera].insert(errors[u.camera].end(), e.begin(), e.end());
       ++views_used[u.camera];
     }
@@ -691,8 +674,8 @@ StatusOr<RigCalibration> CalibrateRig(const RigCalibrationOptions& options,
     for (const UsedView& u : ba_views[f]) {
       const Camera& cam = result.rig.cameras[u.camera];
       Matrix34d P;
-      P.leftCols<3>() = cam.cam_from_world_rotation;
-      P.col(3) = cam.cam_from_world_translation;
+      P.leftCols<3>() = cam.cam_from_world.rotation;
+      P.col(3) = cam.cam_from_world.translation;
       const BoardView& v = cameras[u.camera].views[u.view];
       for (size_t i = 0; i < v.point_ids.size(); ++i) {
         const int id = u.reversed ? n_points - 1 - v.point_ids[i] : v.point_ids[i];

@@ -40,7 +40,7 @@ Relative RelativeToFirst(const Rig& rig, int c) {
   const Camera& c0 = rig.cameras[0];
   const Camera& ci = rig.cameras[c];
   Relative r;
-  r.R = ci.cam_from_world_rotation * c0.cam_from_world_rotation.transpose();
+  r.R = ci.cam_from_world.rotation * c0.cam_from_world.rotation.transpose();
   r.centre_in_cam0 = c0.PointInCamera(ci.CenterInWorld());
   return r;
 }
@@ -51,8 +51,8 @@ double MaxIntrinsicsDisagreementPx(const Camera& truth,
                                    const Camera& estimate,
                                    const std::vector<Eigen::Vector2d>& pixels) {
   Camera a = truth, b = estimate;
-  a.cam_from_world_rotation = b.cam_from_world_rotation = Eigen::Matrix3d::Identity();
-  a.cam_from_world_translation = b.cam_from_world_translation = Eigen::Vector3d::Zero();
+  a.cam_from_world.rotation = b.cam_from_world.rotation = Eigen::Matrix3d::Identity();
+  a.cam_from_world.translation = b.cam_from_world.translation = Eigen::Vector3d::Zero();
   double worst = 0;
   for (const Eigen::Vector2d& pixel : pixels) {
     const Eigen::Vector2d n = a.PixelToNormalized(pixel);
@@ -234,11 +234,11 @@ TEST(CalibrateRig, SurvivesBackwardChessboardViewsAndABadDetection) {
   ASSERT_TRUE(again.ok());
   for (int c = 0; c < options.num_cameras; ++c) {
     EXPECT_EQ(again->rig.cameras[c].Intrinsics(), result->rig.cameras[c].Intrinsics()) << c;
-    EXPECT_EQ(again->rig.cameras[c].cam_from_world_rotation,
-              result->rig.cameras[c].cam_from_world_rotation)
+    EXPECT_EQ(again->rig.cameras[c].cam_from_world.rotation,
+              result->rig.cameras[c].cam_from_world.rotation)
         << c;
-    EXPECT_EQ(again->rig.cameras[c].cam_from_world_translation,
-              result->rig.cameras[c].cam_from_world_translation)
+    EXPECT_EQ(again->rig.cameras[c].cam_from_world.translation,
+              result->rig.cameras[c].cam_from_world.translation)
         << c;
   }
   EXPECT_EQ(again->report.rms_px, result->report.rms_px);
@@ -628,7 +628,7 @@ TEST(CalibrateRig, AgreesWithOpenCvStereoCalibrateOnItsStereoPairs) {
 
   const Relative arco = RelativeToFirst(result->rig, 1);
   const Camera& cam1 = result->rig.cameras[1];
-  const Eigen::Vector3d arco_T = cam1.cam_from_world_translation;  // world = left camera
+  const Eigen::Vector3d arco_T = cam1.cam_from_world.translation;  // world = left camera
   const double rotation_deg = RotationAngleBetween(arco.R, cv_R) * 180 / M_PI;
   const double baseline_rel = std::abs(arco_T.norm() - cv_T.norm()) / cv_T.norm();
   std::printf(

@@ -103,8 +103,8 @@ Status ValidateCamera(const Camera& camera) {
   if (!AllFinite({d.k1, d.k2, d.k3, d.p1, d.p2})) {
     return Status::Error(who + ": distortion coefficients are not finite numbers");
   }
-  const Eigen::Matrix3d& r = camera.cam_from_world_rotation;
-  if (!r.allFinite() || !camera.cam_from_world_translation.allFinite()) {
+  const Eigen::Matrix3d& r = camera.cam_from_world.rotation;
+  if (!r.allFinite() || !camera.cam_from_world.translation.allFinite()) {
     return Status::Error(who + ": pose is not finite");
   }
   const double orthonormality =
@@ -142,11 +142,11 @@ nlohmann::ordered_json CameraToJson(const Camera& camera) {
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) {
       jk.push_back(k(r, c));
-      jr.push_back(camera.cam_from_world_rotation(r, c));
+      jr.push_back(camera.cam_from_world.rotation(r, c));
     }
   }
   auto& jt = j["t"] = nlohmann::ordered_json::array();
-  for (int r = 0; r < 3; ++r) jt.push_back(camera.cam_from_world_translation[r]);
+  for (int r = 0; r < 3; ++r) jt.push_back(camera.cam_from_world.translation[r]);
   const Distortion& d = camera.distortion;
   j["distortion"] = {{"k1", d.k1}, {"k2", d.k2}, {"k3", d.k3}, {"p1", d.p1}, {"p2", d.p2}};
   return j;

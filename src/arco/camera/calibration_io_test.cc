@@ -267,9 +267,9 @@ void ExpectSameRig(const Rig& a, const Rig& b, double tolerance) {
     EXPECT_EQ(x.width, y.width);
     EXPECT_EQ(x.height, y.height);
     EXPECT_LE((x.K() - y.K()).cwiseAbs().maxCoeff(), tolerance) << x.name;
-    EXPECT_LE((x.cam_from_world_rotation - y.cam_from_world_rotation).cwiseAbs().maxCoeff(),
+    EXPECT_LE((x.cam_from_world.rotation - y.cam_from_world.rotation).cwiseAbs().maxCoeff(),
               tolerance);
-    EXPECT_LE((x.cam_from_world_translation - y.cam_from_world_translation).cwiseAbs().maxCoeff(),
+    EXPECT_LE((x.cam_from_world.translation - y.cam_from_world.translation).cwiseAbs().maxCoeff(),
               tolerance);
     const Distortion& d = x.distortion;
     const Distortion& e = y.distortion;

@@ -103,8 +103,8 @@ StatusOr<Camera> ReadSpdCamera(const std::string& name, const Json& j) {
     cam.distortion.p2 = dist[2];
     cam.distortion.k3 = dist.size() == 5 ? dist[4] : 0.0;
   }
-  cam.cam_from_world_rotation = Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(r.data());
-  cam.cam_from_world_translation = Eigen::Vector3d(t[0], t[1], t[2]);
+  cam.cam_from_world.rotation = Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(r.data());
+  cam.cam_from_world.translation = Eigen::Vector3d(t[0], t[1], t[2]);
   ARCO_RETURN_IF_ERROR(ValidateCamera(cam));
   return cam;
 }
@@ -162,8 +162,8 @@ StatusOr<std::string> WriteSpdJson(const Rig& rig) {
   for (size_t i = 0; i < rig.cameras.size(); ++i) {
     const Camera& cam = rig.cameras[i];
     const std::string& key = keys[i];
-    const Eigen::Matrix3d& r = cam.cam_from_world_rotation;
-    const Eigen::Vector3d& t = cam.cam_from_world_translation;
+    const Eigen::Matrix3d& r = cam.cam_from_world.rotation;
+    const Eigen::Vector3d& t = cam.cam_from_world.translation;
     const Distortion& d = cam.distortion;
     out[key] = {
         {"K", {cam.fx, cam.skew, cam.cx + 0.5, 0, cam.fy, cam.cy + 0.5, 0, 0, 1}},
@@ -214,8 +214,8 @@ StatusOr<Camera> ReadArcoCamera(size_t index, const Json& j) {
   cam.cx = k[2];
   cam.fy = k[4];
   cam.cy = k[5];
-  cam.cam_from_world_rotation = Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(r.data());
-  cam.cam_from_world_translation = Eigen::Vector3d(t[0], t[1], t[2]);
+  cam.cam_from_world.rotation = Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(r.data());
+  cam.cam_from_world.translation = Eigen::Vector3d(t[0], t[1], t[2]);
   if (auto dist = j.find("distortion"); dist != j.end()) {
     if (!dist->is_object()) return Status::Error(who + " \"distortion\" is not an object");
     Distortion& d = cam.distortion;

@@ -57,9 +57,9 @@ Differences CompareXmlWithJson(const std::string& xml_name, const std::string& j
     EXPECT_EQ(x.height, y.height);
     auto track = [](double* m, double v) { *m = std::max(*m, std::abs(v)); };
     track(&max.rotation,
-          (x.cam_from_world_rotation - y.cam_from_world_rotation).cwiseAbs().maxCoeff());
+          (x.cam_from_world.rotation - y.cam_from_world.rotation).cwiseAbs().maxCoeff());
     track(&max.translation,
-          (x.cam_from_world_translation - y.cam_from_world_translation).cwiseAbs().maxCoeff());
+          (x.cam_from_world.translation - y.cam_from_world.translation).cwiseAbs().maxCoeff());
     track(&max.focal_px, std::max(std::abs(x.fx - y.fx), std::abs(x.fy - y.fy)));
     track(&max.principal_px, std::max(std::abs(x.cx - y.cx), std::abs(x.cy - y.cy)));
     const Distortion& a = x.distortion;

@@ -40,17 +40,17 @@ void Camera::SetIntrinsics(const std::array<double, kNumIntrinsics>& i) {
 
 Eigen::Matrix<double, 3, 4> Camera::ProjectionMatrix() const {
   Eigen::Matrix<double, 3, 4> rt;
-  rt.leftCols<3>() = cam_from_world_rotation;
-  rt.col(3) = cam_from_world_translation;
+  rt.leftCols<3>() = cam_from_world.rotation;
+  rt.col(3) = cam_from_world.translation;
   return K() * rt;
 }
 
 Eigen::Vector3d Camera::CenterInWorld() const {
-  return -cam_from_world_rotation.transpose() * cam_from_world_translation;
+  return -cam_from_world.rotation.transpose() * cam_from_world.translation;
 }
 
 Eigen::Vector3d Camera::PointInCamera(const Eigen::Vector3d& point_in_world) const {
-  return cam_from_world_rotation * point_in_world + cam_from_world_translation;
+  return cam_from_world * point_in_world;
 }
 
 bool Camera::ProjectWithJacobian(const Eigen::Vector3d& point_in_world,
@@ -59,8 +59,8 @@ bool Camera::ProjectWithJacobian(const Eigen::Vector3d& point_in_world,
   // Values in ProjectToPixel's order of operations, so the pixel is identical.
   double p[3];
   for (int r = 0; r < 3; ++r) {
-    p[r] = cam_from_world_translation[r];
-    for (int c = 0; c < 3; ++c) p[r] += cam_from_world_rotation(r, c) * point_in_world[c];
+    p[r] = cam_from_world.translation[r];
+    for (int c = 0; c < 3; ++c) p[r] += cam_from_world.rotation(r, c) * point_in_world[c];
   }
   if (!(p[2] > 0)) return false;
   const double x = p[0] / p[2], y = p[1] / p[2];
@@ -74,7 +74,7 @@ bool Camera::ProjectWithJacobian(const Eigen::Vector3d& point_in_world,
   const double iz = 1.0 / p[2];
   Eigen::Matrix<double, 2, 3> normalise;  // d(x, y) / d(point in camera)
   normalise << iz, 0.0, -x * iz, 0.0, iz, -y * iz;
-  *d_pixel_d_point = (k * dist) * normalise * cam_from_world_rotation;
+  *d_pixel_d_point = (k * dist) * normalise * cam_from_world.rotation;
   return true;
 }
 
@@ -116,7 +116,7 @@ Eigen::Vector2d Camera::UndistortPixel(const Eigen::Vector2d& pixel) const {
 
 Eigen::Vector3d Camera::RayInWorld(const Eigen::Vector2d& pixel) const {
   const Eigen::Vector2d n = PixelToNormalized(pixel);
-  return (cam_from_world_rotation.transpose() * Eigen::Vector3d(n.x(), n.y(), 1.0)).normalized();
+  return (cam_from_world.rotation.transpose() * Eigen::Vector3d(n.x(), n.y(), 1.0)).normalized();
 }
 
 }  // namespace arco

@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "arco/geometry/transform.h"
+
 namespace arco {
 
 // The intrinsics as one parameter block, for solvers that refine them (arco calibrate's
@@ -64,8 +66,7 @@ struct Camera {
   int width = 0, height = 0;
   double fx = 0, fy = 0, cx = 0, cy = 0, skew = 0;
   Distortion distortion;
-  Eigen::Matrix3d cam_from_world_rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d cam_from_world_translation = Eigen::Vector3d::Zero();
+  RigidMatrix3d cam_from_world;  // x_cam = R X_world + t (mm or the calibration's units)
 
   Eigen::Matrix3d K() const;
   // fx fy cx cy skew k1 k2 k3 p1 p2 (IntrinsicIndex order), and back.
@@ -116,8 +117,8 @@ template <typename T>
 bool Camera::ProjectToPixel(const T* point_in_world, T* pixel) const {
   T p[3];
   for (int r = 0; r < 3; ++r) {
-    p[r] = T(cam_from_world_translation[r]);
-    for (int c = 0; c < 3; ++c) p[r] += T(cam_from_world_rotation(r, c)) * point_in_world[c];
+    p[r] = T(cam_from_world.translation[r]);
+    for (int c = 0; c < 3; ++c) p[r] += T(cam_from_world.rotation(r, c)) * point_in_world[c];
   }
   const std::array<double, kNumIntrinsics> d = Intrinsics();
   T intrinsics[kNumIntrinsics];

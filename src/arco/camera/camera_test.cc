@@ -18,9 +18,9 @@ Camera MakeDistortedCamera() {
   cam.cx = 1144.1;
   cam.cy = 1319.0;
   cam.distortion = {-0.0809, 0.0662, 0.0195, -0.00035, 0.00062};
-  cam.cam_from_world_rotation =
+  cam.cam_from_world.rotation =
       Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, 1, 0.1).normalized()).toRotationMatrix();
-  cam.cam_from_world_translation = Eigen::Vector3d(0.1, -0.2, 2.5);
+  cam.cam_from_world.translation = Eigen::Vector3d(0.1, -0.2, 2.5);
   return cam;
 }
 
@@ -31,7 +31,7 @@ TEST(Camera, ProjectThenUnprojectRoundTrips) {
   for (int i = 0; i < 200; ++i) {
     Eigen::Vector3d p_cam(u(rng), u(rng) * 1.2, 2.0 + u(rng));
     Eigen::Vector3d p_world =
-        cam.cam_from_world_rotation.transpose() * (p_cam - cam.cam_from_world_translation);
+        cam.cam_from_world.rotation.transpose() * (p_cam - cam.cam_from_world.translation);
     auto pixel = cam.Project(p_world);
     ASSERT_TRUE(pixel.has_value());
     Eigen::Vector2d n = cam.PixelToNormalized(*pixel);
@@ -65,7 +65,7 @@ TEST(Camera, NewtonUndistortionMatchesTheGaussNewtonOne) {
 
 TEST(Camera, PointBehindCameraDoesNotProject) {
   const Camera cam = MakeDistortedCamera();
-  Eigen::Vector3d behind = cam.CenterInWorld() - cam.cam_from_world_rotation.row(2).transpose();
+  Eigen::Vector3d behind = cam.CenterInWorld() - cam.cam_from_world.rotation.row(2).transpose();
   EXPECT_FALSE(cam.Project(behind).has_value());
 }
 
@@ -91,7 +91,7 @@ TEST(Camera, UndistortPixelGivesThePinholeProjection) {
   std::uniform_real_distribution<double> u(-0.5, 0.5);
   for (int i = 0; i < 100; ++i) {
     const Eigen::Vector3d p_world =
-        cam.CenterInWorld() + cam.cam_from_world_rotation.transpose() *
+        cam.CenterInWorld() + cam.cam_from_world.rotation.transpose() *
                                   Eigen::Vector3d(u(rng), u(rng) * 1.2, 2.0 + u(rng));
     const Eigen::Vector2d distorted = *cam.Project(p_world);
     const Eigen::Vector2d ideal = *pinhole.Project(p_world);
@@ -102,7 +102,7 @@ TEST(Camera, UndistortPixelGivesThePinholeProjection) {
 TEST(Camera, AutodiffJacobianMatchesFiniteDifferences) {
   const Camera cam = MakeDistortedCamera();
   using Jet = ceres::Jet<double, 3>;
-  const Eigen::Vector3d p = cam.CenterInWorld() + cam.cam_from_world_rotation.transpose() *
+  const Eigen::Vector3d p = cam.CenterInWorld() + cam.cam_from_world.rotation.transpose() *
                                                       Eigen::Vector3d(0.3, -0.4, 2.2);
   Jet point[3], pixel[2];
   for (int k = 0; k < 3; ++k) point[k] = Jet(p[k], k);
@@ -131,7 +131,7 @@ TEST(Camera, ProjectWithJacobianMatchesAutodiff) {
   for (int i = 0; i < 200; ++i) {
     const Eigen::Vector3d in_camera(u(rng), u(rng), z(rng));
     const Eigen::Vector3d p =
-        cam.cam_from_world_rotation.transpose() * (in_camera - cam.cam_from_world_translation);
+        cam.cam_from_world.rotation.transpose() * (in_camera - cam.cam_from_world.translation);
     Jet point[3], pixel[2];
     for (int k = 0; k < 3; ++k) point[k] = Jet(p[k], k);
     ASSERT_TRUE(cam.ProjectToPixel(point, pixel));
@@ -150,7 +150,7 @@ TEST(Camera, ProjectWithJacobianMatchesAutodiff) {
   Eigen::Vector2d px;
   Eigen::Matrix<double, 2, 3> d;
   EXPECT_FALSE(cam.ProjectWithJacobian(
-      cam.CenterInWorld() - cam.cam_from_world_rotation.row(2).transpose(), &px, &d));
+      cam.CenterInWorld() - cam.cam_from_world.rotation.row(2).transpose(), &px, &d));
 }
 
 TEST(Camera, MetashapeAndOpenCvTangentialRolesAreSwapped) {

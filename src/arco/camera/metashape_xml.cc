@@ -316,8 +316,8 @@ StatusOr<Calibration> ParseChunk(const XMLElement* chunk) {
     const Eigen::Vector3d center_in_world =
         world_from_chunk.scale * world_from_chunk.rotation * chunk_from_cam.topRightCorner<3, 1>() +
         world_from_chunk.translation;
-    cam.cam_from_world_rotation = world_from_cam_rotation.transpose();
-    cam.cam_from_world_translation = -(cam.cam_from_world_rotation * center_in_world);
+    cam.cam_from_world.rotation = world_from_cam_rotation.transpose();
+    cam.cam_from_world.translation = -(cam.cam_from_world.rotation * center_in_world);
     ARCO_RETURN_IF_ERROR(ValidateCamera(cam));
     result.rig.cameras.push_back(std::move(cam));
   }

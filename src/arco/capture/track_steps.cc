@@ -284,7 +284,7 @@ StatusOr<TrackTemplates> MakeTrackTemplates(const TrackStageOptions& options,
   summary->units = calibration.rig.units;
   summary->mm_per_unit = mm_per_unit;
   t.cameras = capture.cameras;
-  for (Camera& c : t.cameras) c.cam_from_world_translation *= mm_per_unit;
+  for (Camera& c : t.cameras) c.cam_from_world.translation *= mm_per_unit;
   for (Eigen::Vector3d& x : t.body.points) x *= mm_per_unit;
   t.body.plane_point *= mm_per_unit;
   summary->template_frame = template_frame;

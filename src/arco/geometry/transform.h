@@ -33,6 +33,35 @@ struct Rigid3d {
   Rigid3d operator*(const Rigid3d& other) const;
 };
 
+// x -> R x + t with R held as a 3x3 matrix: the same map as Rigid3d for code whose
+// numbers are matrix products throughout (synth's stage, the calibrations' poses), where
+// a round trip through a quaternion would move the last bits of every output. Each
+// operation is the plain matrix expression (no re-orthonormalisation), so composing and
+// inverting gives exactly what the hand-written R, t code it replaces gave.
+struct RigidMatrix3d {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  RigidMatrix3d() = default;
+  // Takes `rotation` as given (no check): callers build it from a rotation.
+  RigidMatrix3d(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation)
+      : rotation(rotation), translation(translation) {}
+  explicit RigidMatrix3d(const Rigid3d& rigid)
+      : rotation(rigid.RotationMatrix()), translation(rigid.translation) {}
+
+  // Throws std::invalid_argument unless `rotation` is a proper rotation matrix.
+  Rigid3d ToRigid3d() const { return Rigid3d(rotation, translation); }
+  Eigen::Vector3d operator*(const Eigen::Vector3d& point) const {
+    return rotation * point + translation;
+  }
+  RigidMatrix3d operator*(const RigidMatrix3d& other) const {
+    return {rotation * other.rotation, rotation * other.translation + translation};
+  }
+  RigidMatrix3d Inverse() const {
+    return {rotation.transpose(), -(rotation.transpose() * translation)};
+  }
+};
+
 // x -> s R x + t with s > 0.
 struct Sim3d {
   double scale = 1.0;

@@ -27,13 +27,13 @@ struct PoseParams {
   double aa[3], t[3], angles[kNumJointDofs];
   explicit PoseParams(const HandPose& pose) {
     const Eigen::Vector3d a = pose.WristAngleAxis();
-    for (int i = 0; i < 3; ++i) aa[i] = a[i], t[i] = pose.wrist_in_world_mm[i];
+    for (int i = 0; i < 3; ++i) aa[i] = a[i], t[i] = pose.world_from_wrist.translation[i];
     std::copy(pose.angles_rad.begin(), pose.angles_rad.end(), angles);
   }
   HandPose ToPose(const HandModel& model) const {
     HandPose pose;
     pose.SetWristAngleAxis(Eigen::Vector3d(aa[0], aa[1], aa[2]));
-    pose.wrist_in_world_mm = Eigen::Vector3d(t[0], t[1], t[2]);
+    pose.world_from_wrist.translation = Eigen::Vector3d(t[0], t[1], t[2]);
     std::copy(angles, angles + kNumJointDofs, pose.angles_rad.begin());
     return ClampToLimits(model, pose);  // Ceres keeps bounds; this guards rounding
   }
@@ -109,7 +109,7 @@ HandPointsMm TriangulateKeypoints(const std::vector<Camera>& cameras,
     for (size_t v = 0; v < views.size(); ++v) {
       if (!usable_view[v] || !Usable(views[v], k, min_score)) continue;
       DltObservation o;
-      o.projection << cameras[v].cam_from_world_rotation, cameras[v].cam_from_world_translation;
+      o.projection << cameras[v].cam_from_world.rotation, cameras[v].cam_from_world.translation;
       o.point = cameras[v].PixelToNormalized(views[v].pixels[k]);
       o.weight = views[v].scores[k];
       obs.push_back(o);
@@ -156,8 +156,8 @@ std::optional<HandPose> AlignPalm(const HandModel& model, const HandPointsMm& po
   const std::optional<AlignmentResult> fit = AlignPoints(source, target, {}, AlignmentOptions{});
   if (!fit) return std::nullopt;
   HandPose pose;
-  pose.world_from_wrist_rotation = fit->target_from_source.RotationMatrix();
-  pose.wrist_in_world_mm = fit->target_from_source.translation;
+  pose.world_from_wrist.rotation = fit->target_from_source.RotationMatrix();
+  pose.world_from_wrist.translation = fit->target_from_source.translation;
   return pose;
 }
 
@@ -170,8 +170,8 @@ HandFit3dResult FitHandToPoints3d(const HandModel& model,
   HandFit3dResult result;
   for (const auto& p : points_in_world_mm) result.num_points += p.allFinite();
   std::optional<HandPose> start;
-  if (initial && initial->world_from_wrist_rotation.allFinite() &&
-      initial->wrist_in_world_mm.allFinite()) {
+  if (initial && initial->world_from_wrist.rotation.allFinite() &&
+      initial->world_from_wrist.translation.allFinite()) {
     start = initial;
   } else {
     start = AlignPalm(model, points_in_world_mm);
@@ -226,8 +226,8 @@ HandFitResult FitHandMultiView(const HandModel& model,
   result.view_residual_px.assign(num_views, kNaN);
   result.pose = ClampToLimits(model, init.previous_pose.value_or(HandPose{}));
   const bool has_previous = init.previous_pose.has_value() &&
-                            init.previous_pose->world_from_wrist_rotation.allFinite() &&
-                            init.previous_pose->wrist_in_world_mm.allFinite();
+                            init.previous_pose->world_from_wrist.rotation.allFinite() &&
+                            init.previous_pose->world_from_wrist.translation.allFinite();
 
   std::vector<uint8_t> usable(num_views, 0);
   for (int v = 0; v < num_views; ++v) {
@@ -276,8 +276,8 @@ HandFitResult FitHandMultiView(const HandModel& model,
         params.angles);
     if (has_previous) {
       const HandPose& prev = *init.previous_pose;
-      TemporalResiduals temporal{prev.world_from_wrist_rotation,
-                                 prev.wrist_in_world_mm,
+      TemporalResiduals temporal{prev.world_from_wrist.rotation,
+                                 prev.world_from_wrist.translation,
                                  ClampToLimits(model, prev).angles_rad,
                                  options.temporal_rotation_weight_px_per_rad,
                                  options.temporal_translation_weight_px_per_mm,

@@ -61,15 +61,19 @@ void ExpectSameNormalEquations(bool hide_a_finger) {
   }
   // Evaluated away from the truth, as in the solver's first iterations.
   HandPose start = truth;
-  start.wrist_in_world_mm += Eigen::Vector3d(4, -3, 5);
+  start.world_from_wrist.translation += Eigen::Vector3d(4, -3, 5);
   for (double& a : start.angles_rad) a += 0.05;
   start = ClampToLimits(model, start);
   const Eigen::Vector3d aa = start.WristAngleAxis();
   const ReprojectionResiduals residuals{&model, &observations, 5.0 * 5.0};
-  const Normal full = Evaluate(HandCostFunction<ReprojectionResiduals>(residuals), aa.data(),
-                               start.wrist_in_world_mm.data(), start.angles_rad.data());
-  const Normal compressed = Evaluate(CompressedReprojectionCost(residuals), aa.data(),
-                                     start.wrist_in_world_mm.data(), start.angles_rad.data());
+  const Normal full = Evaluate(HandCostFunction<ReprojectionResiduals>(residuals),
+                               aa.data(),
+                               start.world_from_wrist.translation.data(),
+                               start.angles_rad.data());
+  const Normal compressed = Evaluate(CompressedReprojectionCost(residuals),
+                                     aa.data(),
+                                     start.world_from_wrist.translation.data(),
+                                     start.angles_rad.data());
   ASSERT_EQ(compressed.jtj.rows(), kParams);
   EXPECT_NEAR(compressed.rr, full.rr, 1e-9 * full.rr);
   const double scale = full.jtj.cwiseAbs().maxCoeff();

@@ -25,7 +25,7 @@ Eigen::Vector3d RigFocus(const std::vector<Camera>& cameras) {
   Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   for (const Camera& c : cameras) {
-    const Eigen::Vector3d d = c.cam_from_world_rotation.row(2).transpose();
+    const Eigen::Vector3d d = c.cam_from_world.rotation.row(2).transpose();
     const Eigen::Matrix3d p = Eigen::Matrix3d::Identity() - d * d.transpose();
     a += p;
     b += p * c.CenterInWorld();
@@ -41,7 +41,7 @@ TEST(FitHandMultiView, RecoversGeneratedHandsInTheRealSpdRig) {
   ASSERT_TRUE(calibration.ok()) << calibration.status().message();
   std::vector<Camera> cameras = calibration->rig.cameras;
   ASSERT_EQ(cameras.size(), 20u);
-  for (Camera& c : cameras) c.cam_from_world_translation *= kMmPerUnit;
+  for (Camera& c : cameras) c.cam_from_world.translation *= kMmPerUnit;
   const Eigen::Vector3d focus = RigFocus(cameras);
 
   const HandModel model = HandModel::Default(HandSide::kLeft);

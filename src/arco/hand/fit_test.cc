@@ -126,7 +126,7 @@ TEST(FitHandMultiView, TracksASequenceFromThePreviousFrame) {
   for (int frame = 0; frame < 10; ++frame) {
     for (double& a : truth.angles_rad) a += 0.02;
     truth = ClampToLimits(model, truth);
-    truth.wrist_in_world_mm += Eigen::Vector3d(2, 0, -1);
+    truth.world_from_wrist.translation += Eigen::Vector3d(2, 0, -1);
     const auto views =
         testing::ProjectHand(cameras, ForwardKinematics(model, truth), 1.0, 0.0, rng);
     const HandFitResult r = FitHandMultiView(model, cameras, views, init, HandFitOptions{});
@@ -175,7 +175,7 @@ TEST(FitHandMultiView, SurvivesNanAndDegenerateInput) {
   // A previous pose with NaN is not used as an initialisation.
   HandFitInit init;
   init.previous_pose = truth;
-  init.previous_pose->wrist_in_world_mm.x() = std::nan("");
+  init.previous_pose->world_from_wrist.translation.x() = std::nan("");
   r = FitHandMultiView(model, cameras, views, init, HandFitOptions{});
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(CountLimitViolations(model, r.pose), 0);

@@ -71,7 +71,7 @@ FusedHand FuseViewHands(const HandModel& model,
         p[0].z() > 0 ? Eigen::Vector3d(-p[0].normalized()) : Eigen::Vector3d(0, 0, -1);
     const double cosine = std::abs(normal.normalized().dot(to_camera));
     // Into world orientation, wrist at the origin, model size.
-    const Eigen::Matrix3d world_from_cam = cameras[v].cam_from_world_rotation.transpose();
+    const Eigen::Matrix3d world_from_cam = cameras[v].cam_from_world.rotation.transpose();
     HandPointsMm q;
     for (int k = 0; k < kNumHandKeypoints; ++k) q[k] = world_from_cam * (p[k] - p[0]);
     if (options.normalise_scale) {
@@ -119,8 +119,8 @@ FusedHand FuseViewHands(const HandModel& model,
     if (out.view_weights[v] > 0) local[v] = LocalJointRotations(model, poses[v]);
   }
   HandPose fused;
-  fused.world_from_wrist_rotation =
-      average([&](size_t v) { return poses[v].world_from_wrist_rotation; }).toRotationMatrix();
+  fused.world_from_wrist.rotation =
+      average([&](size_t v) { return poses[v].world_from_wrist.rotation; }).toRotationMatrix();
   for (int f = 0; f < kNumFingers; ++f) {
     const Finger finger = static_cast<Finger>(f);
     const int k0 = KeypointIndex(finger, 0);

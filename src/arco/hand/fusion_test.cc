@@ -37,7 +37,7 @@ std::vector<ViewHand3d> MakeViewHands(const HandModel& model,
     const double scale = 0.9 + 0.2 * u(rng);
     for (int k = 0; k < kNumHandKeypoints; ++k) {
       views[v].points_in_camera_mm[k] = c.PointInCamera(world[0]) +
-                                        scale * c.cam_from_world_rotation * (world[k] - world[0]) +
+                                        scale * c.cam_from_world.rotation * (world[k] - world[0]) +
                                         noise_mm * Eigen::Vector3d(n(rng), n(rng), n(rng));
     }
     views[v].confidence = 0.6 + 0.4 * u(rng);
@@ -61,16 +61,16 @@ TEST(FuseViewHands, RecoversJointAnglesFromNoisyPerViewHands) {
   const int trials = 10;
   for (int trial = 0; trial < trials; ++trial) {
     HandPose truth = testing::RandomPose(model, rng, 0.1);
-    truth.wrist_in_world_mm.setZero();
+    truth.world_from_wrist.translation.setZero();
     const std::vector<ViewHand3d> views = MakeViewHands(model, truth, cameras, rng);
     const FusedHand fused = FuseViewHands(model, cameras, views, HandFusionOptions{});
     ASSERT_TRUE(fused.ok) << fused.problem;
     EXPECT_EQ(fused.num_views_used, 12);
     EXPECT_EQ(CountLimitViolations(model, fused.pose, 0.0), 0);
-    EXPECT_EQ(fused.pose.wrist_in_world_mm, Eigen::Vector3d::Zero());
+    EXPECT_EQ(fused.pose.world_from_wrist.translation, Eigen::Vector3d::Zero());
     mean_mm += WristFrameMpjpe(model, fused.pose, truth) / trials;
     const Eigen::Matrix3d d =
-        fused.pose.world_from_wrist_rotation.transpose() * truth.world_from_wrist_rotation;
+        fused.pose.world_from_wrist.rotation.transpose() * truth.world_from_wrist.rotation;
     mean_rot_deg += Eigen::AngleAxisd(d).angle() / kDeg / trials;
     // Baseline: one view alone (the first), fitted the same way.
     const FusedHand single = FuseViewHands(model, {cameras[0]}, {views[0]}, HandFusionOptions{});
@@ -92,7 +92,7 @@ TEST(FuseViewHands, IndependentOfViewOrder) {
   std::vector<Camera> cameras = testing::MakeRingRig(9, 2500, Eigen::Vector3d::Zero());
   std::mt19937 rng(8);
   HandPose truth = testing::RandomPose(model, rng, 0.1);
-  truth.wrist_in_world_mm.setZero();
+  truth.world_from_wrist.translation.setZero();
   std::vector<ViewHand3d> views = MakeViewHands(model, truth, cameras, rng);
   const FusedHand a = FuseViewHands(model, cameras, views, HandFusionOptions{});
   std::vector<int> order = {4, 8, 0, 2, 7, 1, 6, 3, 5};
@@ -103,7 +103,7 @@ TEST(FuseViewHands, IndependentOfViewOrder) {
   ASSERT_TRUE(a.ok && b.ok);
   for (int d = 0; d < kNumJointDofs; ++d)
     EXPECT_NEAR(a.pose.angles_rad[d], b.pose.angles_rad[d], 1e-9);
-  EXPECT_TRUE(a.pose.world_from_wrist_rotation.isApprox(b.pose.world_from_wrist_rotation, 1e-9));
+  EXPECT_TRUE(a.pose.world_from_wrist.rotation.isApprox(b.pose.world_from_wrist.rotation, 1e-9));
   for (size_t i = 0; i < order.size(); ++i)
     EXPECT_NEAR(b.view_weights[i], a.view_weights[order[i]], 1e-12);
 }
@@ -114,9 +114,9 @@ TEST(FuseViewHands, FaceOnViewsOutweighEdgeOnViews) {
   std::vector<Camera> cameras = testing::MakeRingRig(2, 2500, Eigen::Vector3d::Zero());
   // Camera 0 looks down the palm normal, camera 1 along the palm plane.
   auto look = [](Camera* c, const Eigen::Vector3d& center, const Eigen::Vector3d& up) {
-    c->cam_from_world_rotation =
+    c->cam_from_world.rotation =
         arco::testing::CamFromWorldLookingAt(center, Eigen::Vector3d::Zero(), up);
-    c->cam_from_world_translation = -c->cam_from_world_rotation * center;
+    c->cam_from_world.translation = -c->cam_from_world.rotation * center;
   };
   look(&cameras[0], Eigen::Vector3d(0, 0, 2000), Eigen::Vector3d::UnitY());
   look(&cameras[1], Eigen::Vector3d(2000, 0, 0), Eigen::Vector3d::UnitY());

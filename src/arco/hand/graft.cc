@@ -70,14 +70,13 @@ WristGraftResult GraftHandAtWrist(const HandModel& model,
     out.problem = "fewer than 3 usable, non-collinear hand keypoints from the body detector";
     return out;
   }
-  out.rotation = fit->target_from_source.RotationMatrix();
-  out.translation = fit->target_from_source.translation;
+  out.moved_from_input.rotation = fit->target_from_source.RotationMatrix();
+  out.moved_from_input.translation = fit->target_from_source.translation;
   if (options.pin_wrist) {
     // p -> R (p - m_wrist) + b_wrist (drop the tiny residual translation).
-    out.translation = body_wrist - out.rotation * model_points[0];
+    out.moved_from_input.translation = body_wrist - out.moved_from_input.rotation * model_points[0];
   }
-  out.pose.world_from_wrist_rotation = out.rotation * hand.world_from_wrist_rotation;
-  out.pose.wrist_in_world_mm = out.rotation * hand.wrist_in_world_mm + out.translation;
+  out.pose.world_from_wrist = out.moved_from_input * hand.world_from_wrist;
   const HandPointsMm moved = ForwardKinematics(model, out.pose);
   double sum = 0, sum_w = 0;
   for (int k = 0; k < kNumHandKeypoints; ++k) {

@@ -25,8 +25,9 @@ struct WristGraftResult {
   bool ok = false;
   std::string problem;
   HandPose pose;  // the grafted pose (the input pose when !ok)
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // applied R
-  Eigen::Vector3d translation = Eigen::Vector3d::Zero();   // applied t
+  // The move applied to the input pose (world to world): pose.world_from_wrist =
+  // moved_from_input * hand.world_from_wrist.
+  RigidMatrix3d moved_from_input;
   double rms_mm = 0;  // weighted rms joint distance after the graft
   int num_points = 0;
 };

@@ -18,14 +18,14 @@ TEST(GraftHandAtWrist, RecoversAKnownRigidTransform) {
   for (int trial = 0; trial < 20; ++trial) {
     const HandPose hand = testing::RandomPose(model, rng, 0.1);
     const Eigen::Matrix3d r =
-        testing::RandomPose(model, rng).world_from_wrist_rotation;  // any rotation
+        testing::RandomPose(model, rng).world_from_wrist.rotation;  // any rotation
     const Eigen::Vector3d t(300.0 * trial, -50, 80);
     HandPointsMm body = ForwardKinematics(model, hand);
     for (auto& p : body) p = r * p + t;
     const WristGraftResult g = GraftHandAtWrist(model, hand, body, {}, WristGraftOptions{});
     ASSERT_TRUE(g.ok) << g.problem;
-    EXPECT_TRUE(g.rotation.isApprox(r, 1e-9));
-    EXPECT_LT((g.translation - t).norm(), 1e-6);
+    EXPECT_TRUE(g.moved_from_input.rotation.isApprox(r, 1e-9));
+    EXPECT_LT((g.moved_from_input.translation - t).norm(), 1e-6);
     EXPECT_LT(g.rms_mm, 1e-6);
     EXPECT_EQ(g.pose.angles_rad, hand.angles_rad);
     const HandPointsMm moved = ForwardKinematics(model, g.pose);
@@ -48,21 +48,21 @@ TEST(GraftHandAtWrist, WeightsMissingPointsOutliersAndPinnedWrist) {
   weights[12] = 0.0;  // ... that its score flags
   WristGraftResult g = GraftHandAtWrist(model, hand, body, weights, WristGraftOptions{});
   ASSERT_TRUE(g.ok);
-  EXPECT_TRUE(g.rotation.isApprox(r, 1e-9));
+  EXPECT_TRUE(g.moved_from_input.rotation.isApprox(r, 1e-9));
   EXPECT_EQ(g.num_points, 19);
   // Same outlier with full weight but a robust loss.
   WristGraftOptions robust;
   robust.robust_loss_mm = 5;
   g = GraftHandAtWrist(model, hand, body, {}, robust);
   ASSERT_TRUE(g.ok);
-  EXPECT_LT(Eigen::AngleAxisd(g.rotation.transpose() * r).angle(), 0.01);
+  EXPECT_LT(Eigen::AngleAxisd(g.moved_from_input.rotation.transpose() * r).angle(), 0.01);
   // Pinned wrist: the model wrist lands exactly on a (shifted) body wrist.
   body[0] += Eigen::Vector3d(5, 0, 0);
   WristGraftOptions pinned;
   pinned.pin_wrist = true;
   g = GraftHandAtWrist(model, hand, body, weights, pinned);
   ASSERT_TRUE(g.ok);
-  EXPECT_LT((g.pose.wrist_in_world_mm - body[0]).norm(), 1e-9);
+  EXPECT_LT((g.pose.world_from_wrist.translation - body[0]).norm(), 1e-9);
 }
 
 TEST(GraftHandAtWrist, FlagsTooFewPoints) {

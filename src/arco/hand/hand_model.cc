@@ -246,13 +246,13 @@ RestPointsMm HandModel::rest_points_mm() const {
 }
 
 Eigen::Vector3d HandPose::WristAngleAxis() const {
-  const Eigen::AngleAxisd aa(world_from_wrist_rotation);
+  const Eigen::AngleAxisd aa(world_from_wrist.rotation);
   return aa.angle() * aa.axis();
 }
 
 void HandPose::SetWristAngleAxis(const Eigen::Vector3d& angle_axis) {
   const double angle = angle_axis.norm();
-  world_from_wrist_rotation = angle < 1e-300
+  world_from_wrist.rotation = angle < 1e-300
                                   ? Eigen::Matrix3d::Identity()
                                   : Eigen::AngleAxisd(angle, angle_axis / angle).toRotationMatrix();
 }

@@ -29,6 +29,7 @@
 #include <array>
 #include <string>
 
+#include "arco/geometry/transform.h"
 #include "arco/util/status.h"
 
 namespace arco::hand {
@@ -122,10 +123,10 @@ class HandModel {
   std::array<double, kNumJointDofs> min_rad_, max_rad_;
 };
 
-// Per-frame state. world_from_wrist maps wrist-frame mm into world mm.
+// Per-frame state. world_from_wrist maps wrist-frame mm into world mm: its translation is
+// the wrist's position in the world, mm.
 struct HandPose {
-  Eigen::Matrix3d world_from_wrist_rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d wrist_in_world_mm = Eigen::Vector3d::Zero();
+  RigidMatrix3d world_from_wrist;
   std::array<double, kNumJointDofs> angles_rad{};
 
   double angle_rad(Finger f, FingerDof d) const { return angles_rad[DofIndex(f, d)]; }

@@ -190,13 +190,13 @@ TEST(HandPose, WristAngleAxisRoundTrip) {
   const HandModel model = HandModel::Default(HandSide::kRight);
   for (int trial = 0; trial < 20; ++trial) {
     HandPose pose = testing::RandomPose(model, rng);
-    const Eigen::Matrix3d r = pose.world_from_wrist_rotation;
+    const Eigen::Matrix3d r = pose.world_from_wrist.rotation;
     pose.SetWristAngleAxis(pose.WristAngleAxis());
-    EXPECT_TRUE(pose.world_from_wrist_rotation.isApprox(r, 1e-12));
+    EXPECT_TRUE(pose.world_from_wrist.rotation.isApprox(r, 1e-12));
   }
   HandPose identity;
   identity.SetWristAngleAxis(Eigen::Vector3d::Zero());
-  EXPECT_TRUE(identity.world_from_wrist_rotation.isIdentity());
+  EXPECT_TRUE(identity.world_from_wrist.rotation.isIdentity());
 }
 
 // Autodiff Jacobian of HandPointsInWorld (26 parameters -> 63 outputs) against
@@ -210,7 +210,7 @@ TEST(HandKinematics, AutodiffJacobianMatchesCentralDifferences) {
     if (trial == 0) pose.SetWristAngleAxis(Eigen::Vector3d(1e-9, -2e-9, 0));
     double x[26];
     const Eigen::Vector3d aa = pose.WristAngleAxis();
-    for (int i = 0; i < 3; ++i) x[i] = aa[i], x[3 + i] = pose.wrist_in_world_mm[i];
+    for (int i = 0; i < 3; ++i) x[i] = aa[i], x[3 + i] = pose.world_from_wrist.translation[i];
     for (int d = 0; d < kNumJointDofs; ++d) x[6 + d] = pose.angles_rad[d];
     Jet jx[26];
     for (int i = 0; i < 26; ++i) jx[i] = Jet(x[i], i);
@@ -256,7 +256,7 @@ TEST(HandKinematics, FastJacobiansMatchFullAutodiff) {
     if (trial == 0) pose.SetWristAngleAxis(Eigen::Vector3d::Zero());
     double x[26];
     const Eigen::Vector3d aa = pose.WristAngleAxis();
-    for (int i = 0; i < 3; ++i) x[i] = aa[i], x[3 + i] = pose.wrist_in_world_mm[i];
+    for (int i = 0; i < 3; ++i) x[i] = aa[i], x[3 + i] = pose.world_from_wrist.translation[i];
     for (int d = 0; d < kNumJointDofs; ++d) x[6 + d] = pose.angles_rad[d];
     Jet jx[26];
     for (int i = 0; i < 26; ++i) jx[i] = Jet(x[i], i);

@@ -17,7 +17,7 @@ NpyArray<double> HandParams(const std::vector<std::optional<HandPose>>& hands) {
     const Eigen::Vector3d aa = h->WristAngleAxis();
     for (int c = 0; c < 3; ++c) {
       out.at(f, c) = aa[c];
-      out.at(f, 3 + c) = h->wrist_in_world_mm[c];
+      out.at(f, 3 + c) = h->world_from_wrist.translation[c];
     }
     for (int d = 0; d < kNumJointDofs; ++d)
       out.at(f, 6 + d) = h->angles_rad[static_cast<size_t>(d)];
@@ -37,7 +37,8 @@ StatusOr<std::vector<std::optional<HandPose>>> HandsFromParams(const NpyArray<do
     if (!finite) continue;
     HandPose pose;
     pose.SetWristAngleAxis(Eigen::Vector3d(params.at(f, 0), params.at(f, 1), params.at(f, 2)));
-    pose.wrist_in_world_mm = Eigen::Vector3d(params.at(f, 3), params.at(f, 4), params.at(f, 5));
+    pose.world_from_wrist.translation =
+        Eigen::Vector3d(params.at(f, 3), params.at(f, 4), params.at(f, 5));
     for (int d = 0; d < kNumJointDofs; ++d)
       pose.angles_rad[static_cast<size_t>(d)] = params.at(f, 6 + d);
     out[static_cast<size_t>(f)] = pose;

@@ -13,7 +13,7 @@ TEST(HandParams, RoundTrip) {
   for (int f = 0; f < 4; ++f) {
     HandPose p;
     p.SetWristAngleAxis(Eigen::Vector3d(0.3, -0.2 * f, 0.1));
-    p.wrist_in_world_mm = Eigen::Vector3d(10.0 * f, -5, 250);
+    p.world_from_wrist.translation = Eigen::Vector3d(10.0 * f, -5, 250);
     for (int d = 0; d < kNumJointDofs; ++d)
       p.angles_rad[static_cast<size_t>(d)] = 0.01 * d + 0.1 * f;
     hands[static_cast<size_t>(f)] = p;

@@ -22,8 +22,8 @@ inline HandPose RandomPose(const HandModel& model,
     pose.angles_rad[d] = lo + margin * w + u(rng) * (1 - 2 * margin) * w;
   }
   Eigen::Quaterniond q(n(rng), n(rng), n(rng), n(rng));
-  pose.world_from_wrist_rotation = q.normalized().toRotationMatrix();
-  pose.wrist_in_world_mm = center_mm + Eigen::Vector3d(n(rng), n(rng), n(rng)) * 30.0;
+  pose.world_from_wrist.rotation = q.normalized().toRotationMatrix();
+  pose.world_from_wrist.translation = center_mm + Eigen::Vector3d(n(rng), n(rng), n(rng)) * 30.0;
   return pose;
 }
 

@@ -386,8 +386,8 @@ FingerIkResult SolveFingertipIk(const HandModel& model,
   for (int d = 0; d < kNumJointDofs; ++d) {
     if (!(reference.angles_rad[d] == result.pose.angles_rad[d])) ++result.clamped_reference_dofs;
   }
-  if (!target_in_world_mm.allFinite() || !reference.world_from_wrist_rotation.allFinite() ||
-      !reference.wrist_in_world_mm.allFinite()) {
+  if (!target_in_world_mm.allFinite() || !reference.world_from_wrist.rotation.allFinite() ||
+      !reference.world_from_wrist.translation.allFinite()) {
     result.status =
         Status::Error(std::string("fingertip IK: non-finite ") +
                       (target_in_world_mm.allFinite() ? "reference wrist pose" : "target"));
@@ -400,8 +400,8 @@ FingerIkResult SolveFingertipIk(const HandModel& model,
   s.model = &model;
   s.finger = finger;
   for (int i = 0; i < 4; ++i) s.reference[i] = result.pose.angles_rad[4 * f + i];
-  s.rotation = reference.world_from_wrist_rotation;
-  s.translation = reference.wrist_in_world_mm;
+  s.rotation = reference.world_from_wrist.rotation;
+  s.translation = reference.world_from_wrist.translation;
   s.target = target_in_world_mm;
   if (options.pip_target_in_world_mm && options.pip_weight > 0) {
     s.pip_weight = options.pip_weight;

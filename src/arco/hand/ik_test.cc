@@ -179,7 +179,7 @@ TEST(SolveFingertipIk, BadInputGivesStatusAndAPoseWithinLimits) {
   EXPECT_EQ(CountLimitViolations(model, ok.pose, 0.0), 0);
 
   HandPose bad_wrist;
-  bad_wrist.wrist_in_world_mm.x() = INFINITY;
+  bad_wrist.world_from_wrist.translation.x() = INFINITY;
   EXPECT_FALSE(
       SolveFingertipIk(model, bad_wrist, Finger::kIndex, Eigen::Vector3d::Zero(), FingerIkOptions{})
           .status.ok());

@@ -55,14 +55,14 @@ HandPointsMm ForwardKinematicsInWrist(const HandModel& model, const HandPose& po
 
 HandPointsMm ForwardKinematics(const HandModel& model, const HandPose& pose) {
   HandPointsMm out = ForwardKinematicsInWrist(model, pose);
-  for (auto& p : out) p = pose.world_from_wrist_rotation * p + pose.wrist_in_world_mm;
+  for (auto& p : out) p = pose.world_from_wrist * p;
   return out;
 }
 
 Eigen::Vector3d FingertipInWorld(const HandModel& model, const HandPose& pose, Finger finger) {
   Eigen::Vector3d points[4];
   FingerPointsInWrist(model, finger, pose.angles_rad.data() + 4 * static_cast<int>(finger), points);
-  return pose.world_from_wrist_rotation * points[3] + pose.wrist_in_world_mm;
+  return pose.world_from_wrist * points[3];
 }
 
 std::array<Eigen::Matrix3d, kNumHandKeypoints> LocalJointRotations(const HandModel& model,

@@ -28,9 +28,9 @@ inline std::vector<Camera> MakeRingRig(int n, double radius_mm, const Eigen::Vec
     c.cx = 1149.5;
     c.cy = 1327.5;
     c.distortion.k1 = -0.08;
-    c.cam_from_world_rotation =
+    c.cam_from_world.rotation =
         arco::testing::CamFromWorldLookingAt(center, target, Eigen::Vector3d::UnitY());
-    c.cam_from_world_translation = -c.cam_from_world_rotation * center;
+    c.cam_from_world.translation = -c.cam_from_world.rotation * center;
   }
   return cameras;
 }

@@ -57,8 +57,8 @@ RealFrame LoadFrame128() {
       const Eigen::Vector2d pixel(shape["points"][0][0].get<double>() - 0.5,
                                   shape["points"][0][1].get<double>() - 0.5);
       DltObservation o;
-      o.projection.leftCols<3>() = camera.cam_from_world_rotation;
-      o.projection.col(3) = camera.cam_from_world_translation;
+      o.projection.leftCols<3>() = camera.cam_from_world.rotation;
+      o.projection.col(3) = camera.cam_from_world.translation;
       o.point = camera.PixelToNormalized(pixel);
       observations[shape["label"].get<std::string>()].push_back(o);
     }

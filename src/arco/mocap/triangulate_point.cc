@@ -65,8 +65,8 @@ Triangulator::Triangulator(const Rig& rig, const TriangulationOptions& options)
   for (const Camera& c : rig_.cameras) {
     focal_px_.push_back(std::sqrt(c.fx * c.fy));
     Matrix34d rt;
-    rt.leftCols<3>() = c.cam_from_world_rotation;
-    rt.col(3) = c.cam_from_world_translation;
+    rt.leftCols<3>() = c.cam_from_world.rotation;
+    rt.col(3) = c.cam_from_world.translation;
     conditioned_cam_from_world_.push_back(ConditionProjection(rt, conditioning_));
   }
   const int n = static_cast<int>(rig_.cameras.size());

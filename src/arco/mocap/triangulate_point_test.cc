@@ -131,8 +131,8 @@ TEST(TriangulateRobust, CheiralityRejectsPointsBehindCameras) {
   const Camera& c1 = rig.cameras[1];
   // A point 1 m behind camera 0, off its axis.
   const Eigen::Vector3d behind = c0.CenterInWorld() -
-                                 c0.cam_from_world_rotation.row(2).transpose() * 1.0 +
-                                 c0.cam_from_world_rotation.row(0).transpose() * 0.1;
+                                 c0.cam_from_world.rotation.row(2).transpose() * 1.0 +
+                                 c0.cam_from_world.rotation.row(0).transpose() * 0.1;
   const Eigen::Vector3d in0 = c0.PointInCamera(behind);
   ASSERT_LT(in0.z(), 0);
   // Its pinhole image in camera 0 ignoring the sign of depth, and its image in camera 1.

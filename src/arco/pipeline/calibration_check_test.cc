@@ -63,9 +63,9 @@ TEST(CheckCalibration, FlagsOnlyACameraTurnedByOneDegree) {
   Rig moved = rig;
   Camera& turned = moved.cameras[3];
   const Eigen::Vector3d centre = turned.CenterInWorld();
-  turned.cam_from_world_rotation =
-      RotationFromAxisAngle(Eigen::Vector3d(0, M_PI / 180, 0)) * turned.cam_from_world_rotation;
-  turned.cam_from_world_translation = -turned.cam_from_world_rotation * centre;
+  turned.cam_from_world.rotation =
+      RotationFromAxisAngle(Eigen::Vector3d(0, M_PI / 180, 0)) * turned.cam_from_world.rotation;
+  turned.cam_from_world.translation = -turned.cam_from_world.rotation * centre;
   ASSERT_TRUE(SaveCalibration(dir / "moved.json", moved).ok());
   options.calibration = dir / "moved.json";
   auto bad = CheckCalibration(options);
@@ -107,9 +107,9 @@ TEST(CheckCalibration, ResultFolderUsesItsPointsAndItsCapture) {
   Rig moved = rig;
   Camera& turned = moved.cameras[3];
   const Eigen::Vector3d centre = turned.CenterInWorld();
-  turned.cam_from_world_rotation =
-      RotationFromAxisAngle(Eigen::Vector3d(0, M_PI / 180, 0)) * turned.cam_from_world_rotation;
-  turned.cam_from_world_translation = -turned.cam_from_world_rotation * centre;
+  turned.cam_from_world.rotation =
+      RotationFromAxisAngle(Eigen::Vector3d(0, M_PI / 180, 0)) * turned.cam_from_world.rotation;
+  turned.cam_from_world.translation = -turned.cam_from_world.rotation * centre;
   ASSERT_TRUE(SaveCalibration(dir / "moved.json", moved).ok());
   options.calibration = dir / "moved.json";
   auto bad = CheckCalibration(options);
@@ -144,9 +144,9 @@ TEST(CheckCalibration, RealSpdLabelledViews) {
   Rig moved = loaded->rig;
   Camera& turned = moved.cameras[moved.FindCamera("21334211")];
   const Eigen::Vector3d centre = turned.CenterInWorld();
-  turned.cam_from_world_rotation =
-      RotationFromAxisAngle(Eigen::Vector3d(M_PI / 180, 0, 0)) * turned.cam_from_world_rotation;
-  turned.cam_from_world_translation = -turned.cam_from_world_rotation * centre;
+  turned.cam_from_world.rotation =
+      RotationFromAxisAngle(Eigen::Vector3d(M_PI / 180, 0, 0)) * turned.cam_from_world.rotation;
+  turned.cam_from_world.translation = -turned.cam_from_world.rotation * centre;
   ASSERT_TRUE(SaveCalibration(dir / "moved.json", moved).ok());
   options.calibration = dir / "moved.json";
   auto bad = CheckCalibration(options);

@@ -10,6 +10,7 @@
 
 #include "arco/calibration/calibration_file.h"
 #include "arco/geometry/rotation.h"
+#include "arco/geometry/transform.h"
 #include "arco/instrument/instrument_model.h"
 #include "arco/instrument/nominal_keypoints.h"
 #include "arco/media/video_reader.h"
@@ -24,20 +25,20 @@ namespace {
 // Shared frames the medoid looks at, at most (evenly spread): it is quadratic in them.
 constexpr int kMaxMedoidFrames = 300;
 
-struct Pose {
+// One view's PnP solution in one frame.
+struct ViewPose {
   bool valid = false;
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // cam_from_instrument
-  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  RigidMatrix3d cam_from_instrument;
   double rms_px = 0;
 };
 
 // One view's pose of the instrument: EPnP in RANSAC, then Levenberg-Marquardt on the
 // inliers (undistorted pinhole: the intrinsics here have no distortion).
-Pose SolveView(const std::vector<cv::Point3d>& object,
-               const std::vector<cv::Point2d>& image,
-               const cv::Matx33d& K,
-               double gate_px) {
-  Pose pose;
+ViewPose SolveView(const std::vector<cv::Point3d>& object,
+                   const std::vector<cv::Point2d>& image,
+                   const cv::Matx33d& K,
+                   double gate_px) {
+  ViewPose pose;
   cv::Mat rvec, tvec;
   std::vector<int> inliers;
   if (!cv::solvePnPRansac(object,
@@ -69,11 +70,11 @@ Pose SolveView(const std::vector<cv::Point3d>& object,
   cv::Matx33d R;
   cv::Rodrigues(rvec, R);
   for (int r = 0; r < 3; ++r) {
-    pose.translation[r] = tvec.at<double>(r);
-    for (int c = 0; c < 3; ++c) pose.rotation(r, c) = R(r, c);
+    pose.cam_from_instrument.translation[r] = tvec.at<double>(r);
+    for (int c = 0; c < 3; ++c) pose.cam_from_instrument.rotation(r, c) = R(r, c);
   }
   // In front of the camera, and agreeing with its inliers.
-  pose.valid = pose.translation.z() > 0 && pose.rms_px <= gate_px;
+  pose.valid = pose.cam_from_instrument.translation.z() > 0 && pose.rms_px <= gate_px;
   return pose;
 }
 
@@ -83,10 +84,12 @@ struct Relative {
   Eigen::Vector3d centre_mm;  // camera c's centre in camera 0's frame
 };
 
-Relative RelativePose(const Pose& c, const Pose& zero) {
+Relative RelativePose(const RigidMatrix3d& c_from_instrument,
+                      const RigidMatrix3d& zero_from_instrument) {
   Relative r;
-  r.rotation = c.rotation * zero.rotation.transpose();
-  const Eigen::Vector3d t = c.translation - r.rotation * zero.translation;
+  r.rotation = c_from_instrument.rotation * zero_from_instrument.rotation.transpose();
+  const Eigen::Vector3d t =
+      c_from_instrument.translation - r.rotation * zero_from_instrument.translation;
   r.centre_mm = -r.rotation.transpose() * t;
   return r;
 }
@@ -252,7 +255,7 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
     return Status::Error(manifest_file + ": layout " + manifest.layout + " has " +
                          std::to_string(rigid.size()) + " of the " + manifest.instrument +
                          "'s rigid points, a pose needs " + std::to_string(options.min_points));
-  std::vector<std::vector<Pose>> poses(num_views, std::vector<Pose>(frames));
+  std::vector<std::vector<ViewPose>> poses(num_views, std::vector<ViewPose>(frames));
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   for (int v = 0; v < num_views; ++v) {
@@ -309,7 +312,9 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
   // relative[v][i]: camera v in camera 0's frame in shared frame i.
   std::vector<std::vector<Relative>> relative(num_views);
   for (int v = 1; v < num_views; ++v)
-    for (int64_t f : shared) relative[v].push_back(RelativePose(poses[v][f], poses[0][f]));
+    for (int64_t f : shared)
+      relative[v].push_back(
+          RelativePose(poses[v][f].cam_from_instrument, poses[0][f].cam_from_instrument));
   // Degrees plus centimetres: a degree of a camera 2-3 m away moves its view about as
   // much as a centimetre.
   auto distance = [&](int i, int j) {
@@ -331,8 +336,8 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
   for (int v = 1; v < num_views; ++v) {
     Camera& cam = rig.cameras[v];
     const Relative& r = relative[v][best];
-    cam.cam_from_world_rotation = r.rotation;
-    cam.cam_from_world_translation = -r.rotation * r.centre_mm;
+    cam.cam_from_world.rotation = r.rotation;
+    cam.cam_from_world.translation = -r.rotation * r.centre_mm;
     std::vector<double> deg, mm;
     for (int i = 0; i < n; ++i) {
       deg.push_back(RotationAngleBetween(relative[v][i].rotation, r.rotation) * 180 / M_PI);

@@ -61,7 +61,7 @@ struct RelativeError {
 RelativeError CompareRelative(const Rig& truth, const Rig& estimate) {
   auto relative = [](const Rig& rig, Eigen::Matrix3d* R, Eigen::Vector3d* centre) {
     const Camera &a = rig.cameras[0], &b = rig.cameras[1];
-    *R = b.cam_from_world_rotation * a.cam_from_world_rotation.transpose();
+    *R = b.cam_from_world.rotation * a.cam_from_world.rotation.transpose();
     *centre = a.PointInCamera(b.CenterInWorld());  // camera 1's centre in camera 0's frame
   };
   Eigen::Matrix3d Rt, Re;
@@ -160,11 +160,11 @@ TEST(CalibrateFromInstrument, RecoversTwoCamerasWithTheTrueAndAWrongFocal) {
   // the run with the truth. The estimate's world is its first camera's; the truth's is
   // SPD's: the estimate is put in the truth's world through the first camera (the gauge no
   // image measures), so that eval compares like with like.
-  const Eigen::Matrix3d R0 = truth->rig.cameras[0].cam_from_world_rotation;
-  const Eigen::Vector3d t0 = truth->rig.cameras[0].cam_from_world_translation;
+  const Eigen::Matrix3d R0 = truth->rig.cameras[0].cam_from_world.rotation;
+  const Eigen::Vector3d t0 = truth->rig.cameras[0].cam_from_world.translation;
   for (Camera& cam : wrong_focal_rig.cameras) {
-    cam.cam_from_world_translation += cam.cam_from_world_rotation * t0;
-    cam.cam_from_world_rotation = cam.cam_from_world_rotation * R0;
+    cam.cam_from_world.translation += cam.cam_from_world.rotation * t0;
+    cam.cam_from_world.rotation = cam.cam_from_world.rotation * R0;
   }
   fs::create_directories(dir / "truth_run");
   fs::create_directories(dir / "estimate_run");

@@ -402,7 +402,7 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
     r.rms_before_px = Rms(errors_before[c]);
     r.rms_after_px = Rms(errors_after[c]);
     r.rotation_change_deg =
-        RotationAngleBetween(a.cam_from_world_rotation, b.cam_from_world_rotation) * 180 / M_PI;
+        RotationAngleBetween(a.cam_from_world.rotation, b.cam_from_world.rotation) * 180 / M_PI;
     r.centre_change_mm = (a.CenterInWorld() - b.CenterInWorld()).norm() / units_per_mm;
     r.focal_change_rel = b.fx / a.fx - 1;
     summary.cameras.push_back(r);

@@ -60,8 +60,8 @@ Rig Perturb(const Rig& truth, uint32_t seed) {
     const Eigen::Vector3d dir = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
     const double a = angle_deg(rng) * M_PI / 180, s = shift_mm(rng);
     const Eigen::Vector3d centre = cam.CenterInWorld() + s * dir;
-    cam.cam_from_world_rotation = RotationFromAxisAngle(a * axis) * cam.cam_from_world_rotation;
-    cam.cam_from_world_translation = -cam.cam_from_world_rotation * centre;
+    cam.cam_from_world.rotation = RotationFromAxisAngle(a * axis) * cam.cam_from_world.rotation;
+    cam.cam_from_world.translation = -cam.cam_from_world.rotation * centre;
   }
   return rig;
 }
@@ -74,8 +74,8 @@ RigError Compare(const Rig& truth, const Rig& estimate) {
   RigError e;
   for (size_t c = 0; c < truth.cameras.size(); ++c) {
     e.worst_deg = std::max(e.worst_deg,
-                           RotationAngleBetween(truth.cameras[c].cam_from_world_rotation,
-                                                estimate.cameras[c].cam_from_world_rotation) *
+                           RotationAngleBetween(truth.cameras[c].cam_from_world.rotation,
+                                                estimate.cameras[c].cam_from_world.rotation) *
                                180 / M_PI);
     e.worst_mm =
         std::max(e.worst_mm,

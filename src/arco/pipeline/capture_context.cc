@@ -79,7 +79,7 @@ std::vector<Camera> ViewCamerasInMm(const CaptureContext& capture, double world_
   std::vector<Camera> cameras;
   for (const int c : capture.view_to_camera) {
     Camera camera = capture.calibration.rig.cameras.at(static_cast<size_t>(c));
-    camera.cam_from_world_translation /= world_units_per_mm;
+    camera.cam_from_world.translation /= world_units_per_mm;
     cameras.push_back(camera);
   }
   return cameras;

@@ -71,9 +71,9 @@ Camera MakeCamera(const std::string& name,
   c.distortion.p2 = d[3];
   c.distortion.k3 = d[4];
   const double* r = CheckedShape(R, "R", {3, 3});
-  for (int i = 0; i < 9; ++i) c.cam_from_world_rotation(i / 3, i % 3) = r[i];
+  for (int i = 0; i < 9; ++i) c.cam_from_world.rotation(i / 3, i % 3) = r[i];
   const double* tt = CheckedShape(t, "t", {3});
-  c.cam_from_world_translation = Eigen::Vector3d(tt[0], tt[1], tt[2]);
+  c.cam_from_world.translation = Eigen::Vector3d(tt[0], tt[1], tt[2]);
   CheckValid(ValidateCamera(c));
   return c;
 }
@@ -124,12 +124,12 @@ void BindCalibration(py::module_& m) {
           "(5,) k1 k2 p1 p2 k3 (OpenCV order)")
       .def_property_readonly(
           "R",
-          [](const Camera& c) { return MatrixToArray(c.cam_from_world_rotation); },
+          [](const Camera& c) { return MatrixToArray(c.cam_from_world.rotation); },
           "(3, 3) rotation cam_from_world")
       .def_property_readonly(
           "t",
           [](const Camera& c) {
-            const Eigen::Vector3d& t = c.cam_from_world_translation;
+            const Eigen::Vector3d& t = c.cam_from_world.translation;
             return VectorToArray(std::vector<double>{t.x(), t.y(), t.z()});
           },
           "(3,) translation cam_from_world (world units)")

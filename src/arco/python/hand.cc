@@ -66,7 +66,7 @@ PyHandModel MakeHandModel(const std::string& side,
 hand::HandPose PoseFromRow(const double* row) {
   hand::HandPose pose;
   pose.SetWristAngleAxis(Eigen::Vector3d(row[0], row[1], row[2]));
-  pose.wrist_in_world_mm = Eigen::Vector3d(row[3], row[4], row[5]);
+  pose.world_from_wrist.translation = Eigen::Vector3d(row[3], row[4], row[5]);
   std::copy(row + 6, row + hand::kHandParamsColumns, pose.angles_rad.begin());
   return pose;
 }
@@ -76,7 +76,7 @@ std::vector<double> RowFromPose(const hand::HandPose& pose) {
   const Eigen::Vector3d aa = pose.WristAngleAxis();
   for (int k = 0; k < 3; ++k) {
     row[k] = aa[k];
-    row[3 + k] = pose.wrist_in_world_mm[k];
+    row[3 + k] = pose.world_from_wrist.translation[k];
   }
   std::copy(pose.angles_rad.begin(), pose.angles_rad.end(), row.begin() + 6);
   return row;

@@ -224,7 +224,7 @@ bool ApplyArcoIk(const DecodeContext& context,
     const Eigen::Vector3d shift = HandShift(context, options, f, c->point_in_world_mm - tip);
     if (shift_out != nullptr) *shift_out = shift;
     if (options.move_hand) {
-      pose.wrist_in_world_mm += shift;
+      pose.world_from_wrist.translation += shift;
       distance =
           (hand::FingertipInWorld(context.input->hand_model, pose, finger) - c->point_in_world_mm)
               .norm();
@@ -367,7 +367,7 @@ std::vector<std::optional<hand::HandPose>> SolveArcoIk(const DecodeContext& cont
       }
       if (count == 0) return;
       hand::HandPose start = *context.input->vision_hand[static_cast<size_t>(f)];
-      start.wrist_in_world_mm += sum / count;
+      start.world_from_wrist.translation += sum / count;
       FrameContact alt = c;
       alt.state = ContactState::kPressed;
       retry_ik[static_cast<size_t>(r)] = SolveArcoFrame(context, alt, f, options, nullptr, &start);

@@ -291,7 +291,7 @@ TEST(ArcoIk, ARejectedFrameStartsFromItsNeighboursHandShift) {
   testing::Scene scene = testing::MakeScene(InstrumentKind::kCello, notes);
   for (int f = 20; f < 40; ++f) {
     const Eigen::Vector3d toward_nut = scene.pose[static_cast<size_t>(f)].rotation.col(0);
-    scene.input.vision_hand[static_cast<size_t>(f)]->wrist_in_world_mm -=
+    scene.input.vision_hand[static_cast<size_t>(f)]->world_from_wrist.translation -=
         (f == 30 ? 22.0 : 12.0) * toward_nut;
   }
   // The flexion chain only: with the MCP's abduction free too, frame 30's finger comes
@@ -318,7 +318,8 @@ TEST(ArcoIk, ARejectedFrameStartsFromItsNeighboursHandShift) {
   EXPECT_GT(d.contacts[30].tip_distance_refined_mm, 3.0);
   for (size_t f = 0; f < d.hand.size(); ++f) {
     if (!d.hand[f]) continue;
-    EXPECT_EQ(d.hand[f]->wrist_in_world_mm, scene.input.vision_hand[f]->wrist_in_world_mm)
+    EXPECT_EQ(d.hand[f]->world_from_wrist.translation,
+              scene.input.vision_hand[f]->world_from_wrist.translation)
         << "frame " << f;
   }
   RefineOptions off = flexion;
@@ -341,7 +342,8 @@ TEST(NoteBoundaries, ResultsDoNotDependOnTheThreadCount) {
       ASSERT_EQ(one.hand[f].has_value(), many.hand[f].has_value());
       if (one.hand[f]) {
         EXPECT_EQ(one.hand[f]->angles_rad, many.hand[f]->angles_rad);
-        EXPECT_EQ(one.hand[f]->wrist_in_world_mm, many.hand[f]->wrist_in_world_mm);
+        EXPECT_EQ(one.hand[f]->world_from_wrist.translation,
+                  many.hand[f]->world_from_wrist.translation);
       }
       EXPECT_EQ(one.contacts[f].reason, many.contacts[f].reason);
     }

@@ -35,7 +35,7 @@ void ExpectSameResult(const RefineResult& a, const RefineResult& b) {
     ASSERT_EQ(a.hand[f].has_value(), b.hand[f].has_value());
     if (a.hand[f]) {
       EXPECT_EQ(a.hand[f]->angles_rad, b.hand[f]->angles_rad) << "frame " << f;
-      EXPECT_EQ(a.hand[f]->wrist_in_world_mm, b.hand[f]->wrist_in_world_mm);
+      EXPECT_EQ(a.hand[f]->world_from_wrist.translation, b.hand[f]->world_from_wrist.translation);
     }
     const FrameContact& ca = a.contacts[f];
     const FrameContact& cb = b.contacts[f];
@@ -81,7 +81,8 @@ TEST(Refine, NeverViolatesAJointLimitEvenOnHarshInput) {
         for (size_t f = 0; f < r.contacts.size(); ++f) {
           const FrameContact& c = r.contacts[f];
           if (!r.hand[f]) continue;
-          EXPECT_EQ(r.hand[f]->wrist_in_world_mm, scene.input.vision_hand[f]->wrist_in_world_mm);
+          EXPECT_EQ(r.hand[f]->world_from_wrist.translation,
+                    scene.input.vision_hand[f]->world_from_wrist.translation);
           if (!c.pressed() || !std::isfinite(c.tip_distance_refined_mm)) continue;
           const Eigen::Vector3d tip = hand::FingertipInWorld(
               scene.input.hand_model, *r.hand[f], static_cast<hand::Finger>(c.finger));

@@ -62,8 +62,9 @@ testing::Scene Cello(const std::vector<SceneNote>& notes, testing::SceneOptions 
 bool SamePose(const std::optional<hand::HandPose>& a, const std::optional<hand::HandPose>& b) {
   if (a.has_value() != b.has_value()) return false;
   if (!a) return true;
-  return a->angles_rad == b->angles_rad && a->wrist_in_world_mm == b->wrist_in_world_mm &&
-         a->world_from_wrist_rotation == b->world_from_wrist_rotation;
+  return a->angles_rad == b->angles_rad &&
+         a->world_from_wrist.translation == b->world_from_wrist.translation &&
+         a->world_from_wrist.rotation == b->world_from_wrist.rotation;
 }
 
 // Frames [first, last] of the scene note `index` (notes laid out back to back).
@@ -368,7 +369,8 @@ TEST(Refine, LiftTestRejectsContactsTheFingerCannotReach) {
   // The fitted hand of the second note sits 70 mm away from the strings.
   for (int f = 20; f < 40; ++f) {
     hand::HandPose& h = *scene.input.vision_hand[static_cast<size_t>(f)];
-    h.wrist_in_world_mm += scene.pose[static_cast<size_t>(f)].rotation * Eigen::Vector3d(0, 0, 70);
+    h.world_from_wrist.translation +=
+        scene.pose[static_cast<size_t>(f)].rotation * Eigen::Vector3d(0, 0, 70);
   }
   const RefineResult r = Refine(scene.input, Options(RefineMode::kArco));
   for (int f = 20; f < 40; ++f) {

@@ -86,7 +86,7 @@ inline hand::HandPose PlayingPose(const hand::HandModel& hand_model,
   r.col(0) = x;
   r.col(1) = y;
   r.col(2) = x.cross(y);  // palmar: toward the fingerboard
-  pose.world_from_wrist_rotation = r;
+  pose.world_from_wrist.rotation = r;
   for (int k = 1; k <= 4; ++k) {
     pose.angles_rad[4 * k + 0] = 35 * M_PI / 180;  // MCP flexion
     pose.angles_rad[4 * k + 2] = 55 * M_PI / 180;  // PIP
@@ -98,12 +98,12 @@ inline hand::HandPose PlayingPose(const hand::HandModel& hand_model,
   };
   const Eigen::Vector3d contact = place(semitones);
   const hand::Finger f = static_cast<hand::Finger>(finger);
-  pose.wrist_in_world_mm = contact - hand::FingertipInWorld(hand_model, pose, f);
+  pose.world_from_wrist.translation = contact - hand::FingertipInWorld(hand_model, pose, f);
   hand::FingerIkOptions ik;
   ik.joints = hand::FingerIkJoints::kAll;
   hand::FingerIkResult r1 = hand::SolveFingertipIk(hand_model, pose, f, contact, ik);
   pose = r1.pose;
-  pose.wrist_in_world_mm += contact - hand::FingertipInWorld(hand_model, pose, f);
+  pose.world_from_wrist.translation += contact - hand::FingertipInWorld(hand_model, pose, f);
   for (int j = 1; j <= 4; ++j) {
     if (j == finger) continue;
     const double st = semitones + FingerOffsetSemitones(model.kind(), j) -
@@ -116,8 +116,8 @@ inline hand::HandPose PlayingPose(const hand::HandModel& hand_model,
 
 inline hand::HandPose ToWorld(const hand::HandPose& in_instrument, const InstrumentPose& p) {
   hand::HandPose out = in_instrument;
-  out.world_from_wrist_rotation = p.rotation * in_instrument.world_from_wrist_rotation;
-  out.wrist_in_world_mm = p.ToWorld(in_instrument.wrist_in_world_mm);
+  out.world_from_wrist.rotation = p.rotation * in_instrument.world_from_wrist.rotation;
+  out.world_from_wrist.translation = p.ToWorld(in_instrument.world_from_wrist.translation);
   return out;
 }
 
@@ -165,7 +165,7 @@ inline Scene MakeScene(InstrumentKind kind,
       Eigen::Vector3d contact = Eigen::Vector3d::Constant(kNaN);
       if (stopped) {  // vibrato rocks the whole hand along the string
         contact = ContactInInstrument(model, strings, note.string, f0);
-        hp.wrist_in_world_mm +=
+        hp.world_from_wrist.translation +=
             contact - ContactInInstrument(model, strings, note.string, centre_hz);
       }
       const hand::HandPose truth = ToWorld(hp, p);
@@ -186,7 +186,7 @@ inline Scene MakeScene(InstrumentKind kind,
       for (double& angle : vision.angles_rad)
         angle += options.angle_noise_deg * M_PI / 180 * noise(rng);
       for (int c = 0; c < 3; ++c)
-        vision.wrist_in_world_mm[c] += options.wrist_noise_mm * noise(rng);
+        vision.world_from_wrist.translation[c] += options.wrist_noise_mm * noise(rng);
       scene.input.vision_hand.push_back(hand::ClampToLimits(hand_model, vision));
       scene.input.pitch.push_back({f0, sounding ? 0.9 : 0.0});
     }

@@ -93,8 +93,8 @@ Eigen::Matrix3d Sway::InstrumentRotation(double t) const {
   return RotY(a(3)) * RotX(a(4)) * RotZ(a(5));
 }
 
-Rigid InstrumentRestPose(InstrumentKind kind, double scale) {
-  Rigid pose;
+RigidMatrix3d InstrumentRestPose(InstrumentKind kind, double scale) {
+  RigidMatrix3d pose;
   if (kind == InstrumentKind::kViolin || kind == InstrumentKind::kViola) {
     // Scroll forward-left, slightly up; top plate up, tilted 25 degrees so the
     // high-string side (-y) is lower (towards the player's right front).
@@ -126,7 +126,7 @@ Rigid InstrumentRestPose(InstrumentKind kind, double scale) {
 }
 
 Eigen::Vector3d InstrumentPivot(InstrumentKind kind, double scale) {
-  const Rigid rest = InstrumentRestPose(kind, scale);
+  const RigidMatrix3d rest = InstrumentRestPose(kind, scale);
   if (kind == InstrumentKind::kViolin || kind == InstrumentKind::kViola) {
     return {60, 600, 60};
   }

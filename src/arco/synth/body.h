@@ -13,23 +13,13 @@
 #include <array>
 #include <cstdint>
 
+#include "arco/geometry/transform.h"
 #include "arco/instrument/instrument_model.h"
 #include "arco/registry/keypoint_layout.h"
 
 namespace arco::synth {
 
 // Point indices: wholebody:: in registry/keypoint_layout.h.
-
-// A rigid transform: point_in_parent = rotation * point + translation.
-struct Rigid {
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
-  Eigen::Vector3d operator*(const Eigen::Vector3d& p) const { return rotation * p + translation; }
-  Rigid operator*(const Rigid& o) const {
-    return {rotation * o.rotation, rotation * o.translation + translation};
-  }
-  Rigid Inverse() const { return {rotation.transpose(), -(rotation.transpose() * translation)}; }
-};
 
 struct SwayOptions {
   double torso_deg = 2.0;       // amplitude of each torso rotation component
@@ -55,7 +45,7 @@ class Sway {
 // synth_instrument.h). Cello and double bass stand on the end pin between the
 // knees with the neck beside the left side of the head; violin and viola rest on
 // the left shoulder pointing forward-left, the top tilted towards the right.
-Rigid InstrumentRestPose(InstrumentKind kind, double scale);
+RigidMatrix3d InstrumentRestPose(InstrumentKind kind, double scale);
 
 // Pivot of the instrument's sway in the performer frame (the end pin on the
 // floor, or the chin rest).

@@ -175,9 +175,9 @@ BowFrame BowAnimator::At(double t) const {
   r.col(2) = z_hand;
   r.col(0) = y_hand.cross(z_hand);
   out.right_hand = hold_;
-  out.right_hand.world_from_wrist_rotation = r;
+  out.right_hand.world_from_wrist.rotation = r;
   const Eigen::Vector3d mcp = out.frog_mm + 35 * up + 25 * u;
-  out.right_hand.wrist_in_world_mm =
+  out.right_hand.world_from_wrist.translation =
       mcp - r * right_hand_.rest_point_mm(hand::KeypointIndex(hand::Finger::kMiddle, 0));
   return out;
 }

@@ -218,8 +218,8 @@ LeftHandFrame LeftHandAnimator::Next(double t) {
     out.contact_mm = contact;
   }
   hand::HandPose pose = previous_ ? *previous_ : press_pose_;
-  pose.world_from_wrist_rotation = wrist_rotation_;
-  pose.wrist_in_world_mm = anchor - wrist_rotation_ * middle_mcp_in_wrist_;
+  pose.world_from_wrist.rotation = wrist_rotation_;
+  pose.world_from_wrist.translation = anchor - wrist_rotation_ * middle_mcp_in_wrist_;
 
   // Idle fingers (and the thumb behind the neck) relax towards a hovering curl
   // with a time constant of relax_s, so a finger that stops pressing lifts off
@@ -278,7 +278,7 @@ LeftHandFrame LeftHandAnimator::Next(double t) {
     // Take up what the joints could not reach by moving the whole hand.
     const Eigen::Vector3d residual = place(hn.fingering.finger, target_first);
     out.residual_shift_mm = residual.norm();
-    pose.wrist_in_world_mm += residual;
+    pose.world_from_wrist.translation += residual;
   }
   if (second_pressed && !fifth) {
     Eigen::Vector3d residual = place(hn.fingering.second_finger, out.second_contact_mm);
@@ -287,14 +287,14 @@ LeftHandFrame LeftHandAnimator::Next(double t) {
       // two fingertips share the miss the joints cannot take up (the first was exact).
       Eigen::Vector3d first = Eigen::Vector3d::Zero();
       for (int round = 0; round < 6 && std::max(first.norm(), residual.norm()) > 0.5; ++round) {
-        pose.wrist_in_world_mm += 0.5 * (first + residual);
+        pose.world_from_wrist.translation += 0.5 * (first + residual);
         first = place(hn.fingering.finger, target_first);
         residual = place(hn.fingering.second_finger, out.second_contact_mm);
       }
       out.second_residual_mm = std::max(first.norm(), residual.norm());
     } else {
       out.residual_shift_mm = residual.norm();
-      pose.wrist_in_world_mm += residual;
+      pose.world_from_wrist.translation += residual;
     }
   }
   out.pose = pose;

@@ -31,7 +31,7 @@ double DistanceToSegment(const Eigen::Vector3d& p,
   return (p - (a + t * ab)).norm();
 }
 
-Rigid ToRigid(const Sim3d& s) { return {s.RotationMatrix(), s.translation}; }
+RigidMatrix3d ToRigid(const Sim3d& s) { return {s.RotationMatrix(), s.translation}; }
 
 bool SeesAll(const Camera& cam, const std::vector<Eigen::Vector3d>& points) {
   for (const Eigen::Vector3d& x : points) {
@@ -235,9 +235,9 @@ StatusOr<SyntheticCapture> GenerateFromMotion(const Rig& rig, const MotionOption
   // keypoints onto the template at its rest pose on the stage.
   ARCO_ASSIGN_OR_RETURN(cap.stage, PlaceStage(rig, options.stage));
   cap.rig_mm = ScaleRigToMm(rig, cap.stage.mm_per_unit);
-  const Rigid world_from_performer{cap.stage.world_from_performer_rotation,
-                                   cap.stage.performer_origin_in_world_mm};
-  const Rigid world_from_rest = world_from_performer * InstrumentRestPose(kind, tmpl.scale);
+  const RigidMatrix3d world_from_performer{cap.stage.world_from_performer_rotation,
+                                           cap.stage.performer_origin_in_world_mm};
+  const RigidMatrix3d world_from_rest = world_from_performer * InstrumentRestPose(kind, tmpl.scale);
   std::vector<int> rigid_points;  // instrument keypoints of the template (not frog, tip)
   for (int i = 0; i < cap.num_instrument_points; ++i)
     if (tmpl.keypoints_mm[static_cast<size_t>(i)].allFinite()) rigid_points.push_back(i);
@@ -257,7 +257,7 @@ StatusOr<SyntheticCapture> GenerateFromMotion(const Rig& rig, const MotionOption
   if (!placed) {
     return Status::Error(path + ": the instrument's keypoints are degenerate (cannot place it)");
   }
-  const Rigid world_from_recorded = ToRigid(placed->target_from_source);
+  const RigidMatrix3d world_from_recorded = ToRigid(placed->target_from_source);
 
   // The moved take.
   cap.num_frames = frames;
@@ -308,7 +308,7 @@ StatusOr<SyntheticCapture> GenerateFromMotion(const Rig& rig, const MotionOption
       return Status::Error(path + ": frame " + std::to_string(f) +
                            ": the instrument's keypoints are degenerate");
     }
-    const Rigid world_from_instrument = ToRigid(fitted->target_from_source);
+    const RigidMatrix3d world_from_instrument = ToRigid(fitted->target_from_source);
     Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
     m.topLeftCorner<3, 3>() = world_from_instrument.rotation;
     m.topRightCorner<3, 1>() = world_from_instrument.translation;

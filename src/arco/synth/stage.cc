@@ -26,7 +26,7 @@ Status StageOptions::Validate() const {
 
 Rig ScaleRigToMm(const Rig& rig, double mm_per_unit) {
   Rig out = rig;
-  for (Camera& c : out.cameras) c.cam_from_world_translation *= mm_per_unit;
+  for (Camera& c : out.cameras) c.cam_from_world.translation *= mm_per_unit;
   out.units = "mm";
   return out;
 }
@@ -37,7 +37,7 @@ double MedianCameraDistance(const Rig& rig, Eigen::Vector3d* focus_out) {
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   for (const Camera& cam : rig.cameras) {
     const Eigen::Vector3d c = cam.CenterInWorld();
-    const Eigen::Vector3d d = cam.cam_from_world_rotation.row(2).transpose().normalized();
+    const Eigen::Vector3d d = cam.cam_from_world.rotation.row(2).transpose().normalized();
     const Eigen::Matrix3d p = Eigen::Matrix3d::Identity() - d * d.transpose();
     a += p;
     b += p * c;
@@ -59,7 +59,7 @@ StatusOr<Stage> PlaceStage(const Rig& rig, const StageOptions& options) {
   // Optical axes must not all be parallel, or there is no focus.
   Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
   for (const Camera& cam : rig.cameras) {
-    const Eigen::Vector3d d = cam.cam_from_world_rotation.row(2).transpose().normalized();
+    const Eigen::Vector3d d = cam.cam_from_world.rotation.row(2).transpose().normalized();
     spread += Eigen::Matrix3d::Identity() - d * d.transpose();
   }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(spread);
@@ -87,7 +87,7 @@ StatusOr<Stage> PlaceStage(const Rig& rig, const StageOptions& options) {
   stage.median_camera_distance_mm = median_units * mm_per_unit;
 
   Eigen::Vector3d up = Eigen::Vector3d::Zero();
-  for (const Camera& cam : rig.cameras) up -= cam.cam_from_world_rotation.row(1).transpose();
+  for (const Camera& cam : rig.cameras) up -= cam.cam_from_world.rotation.row(1).transpose();
   if (!(up.norm() > 1e-6)) return Status::Error("cannot tell up from the cameras");
   up.normalize();
   Eigen::Vector3d forward = Eigen::Vector3d::Zero();

@@ -15,7 +15,7 @@ namespace {
 
 constexpr int kContactExtras = 13;
 
-Rigid RotationAbout(const Eigen::Matrix3d& r, const Eigen::Vector3d& pivot) {
+RigidMatrix3d RotationAbout(const Eigen::Matrix3d& r, const Eigen::Vector3d& pivot) {
   return {r, pivot - r * pivot};
 }
 
@@ -99,8 +99,8 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
   // Stage and rig in mm.
   ARCO_ASSIGN_OR_RETURN(cap.stage, PlaceStage(rig, options.stage));
   cap.rig_mm = ScaleRigToMm(rig, cap.stage.mm_per_unit);
-  const Rigid world_from_performer{cap.stage.world_from_performer_rotation,
-                                   cap.stage.performer_origin_in_world_mm};
+  const RigidMatrix3d world_from_performer{cap.stage.world_from_performer_rotation,
+                                           cap.stage.performer_origin_in_world_mm};
 
   // Layout: the SPD layout of the instrument, plus the 13 contact-stage extras in truth.
   const bool violin_like = kind == InstrumentKind::kViolin || kind == InstrumentKind::kViola;
@@ -117,7 +117,7 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
   const int tip = wholebody::kNumPoints + model.KeypointIndex("tip");
 
   // Animators.
-  const Rigid rest = InstrumentRestPose(kind, tmpl.scale);
+  const RigidMatrix3d rest = InstrumentRestPose(kind, tmpl.scale);
   const Eigen::Vector3d pivot = InstrumentPivot(kind, tmpl.scale);
   const hand::HandModel left_model = hand::HandModel::Default(hand::HandSide::kLeft);
   const hand::HandModel right_model = hand::HandModel::Default(hand::HandSide::kRight);
@@ -145,10 +145,12 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
       for (int c = 0; c < 3; ++c) cap.points3d.at(fr, p, c) = x[c];
     };
     const Eigen::Matrix3d torso = sway.TorsoRotation(t);
-    Rigid performer_from_instrument = RotationAbout(sway.InstrumentRotation(t), pivot) * rest;
+    RigidMatrix3d performer_from_instrument =
+        RotationAbout(sway.InstrumentRotation(t), pivot) * rest;
     if (violin_like)
-      performer_from_instrument = Rigid{torso, Eigen::Vector3d::Zero()} * performer_from_instrument;
-    const Rigid world_from_instrument = world_from_performer * performer_from_instrument;
+      performer_from_instrument =
+          RigidMatrix3d{torso, Eigen::Vector3d::Zero()} * performer_from_instrument;
+    const RigidMatrix3d world_from_instrument = world_from_performer * performer_from_instrument;
     Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
     m.topLeftCorner<3, 3>() = world_from_instrument.rotation;
     m.topRightCorner<3, 1>() = world_from_instrument.translation;
@@ -159,9 +161,7 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     cap.max_residual_shift_mm = std::max(cap.max_residual_shift_mm, lh.residual_shift_mm);
     cap.max_second_residual_mm = std::max(cap.max_second_residual_mm, lh.second_residual_mm);
     hand::HandPose lw = lh.pose;
-    lw.world_from_wrist_rotation =
-        world_from_instrument.rotation * lh.pose.world_from_wrist_rotation;
-    lw.wrist_in_world_mm = world_from_instrument * lh.pose.wrist_in_world_mm;
+    lw.world_from_wrist = world_from_instrument * lh.pose.world_from_wrist;
     cap.left_hand[static_cast<size_t>(fr)] = lw;
     const hand::HandPointsMm left_pts = hand::ForwardKinematics(left_model, lw);
     for (int k = 0; k < wholebody::kNumHandPoints; ++k)
@@ -177,9 +177,7 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     bow_truth.sounding_point_mm = bf.string > 0 ? bf.sounding_point_mm : NAN;
     bow_truth.bow_position = bf.bow_position;
     hand::HandPose rw = bf.right_hand;
-    rw.world_from_wrist_rotation =
-        world_from_instrument.rotation * bf.right_hand.world_from_wrist_rotation;
-    rw.wrist_in_world_mm = world_from_instrument * bf.right_hand.wrist_in_world_mm;
+    rw.world_from_wrist = world_from_instrument * bf.right_hand.world_from_wrist;
     cap.right_hand[static_cast<size_t>(fr)] = rw;
     const hand::HandPointsMm right_pts = hand::ForwardKinematics(right_model, rw);
     for (int k = 0; k < wholebody::kNumHandPoints; ++k)
@@ -194,7 +192,7 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     set(tip, world_from_instrument * bf.tip_mm);
 
     // Body from the wrists (performer frame).
-    const Rigid performer_from_world = world_from_performer.Inverse();
+    const RigidMatrix3d performer_from_world = world_from_performer.Inverse();
     std::array<Eigen::Vector3d, wholebody::kNumPoints> body;
     BodyKeypoints(torso,
                   performer_from_world * left_pts[0],

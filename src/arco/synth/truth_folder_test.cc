@@ -44,7 +44,7 @@ TruthFolder SmallTruth() {
   for (int i = 0; i < 18; ++i) t.points3d.data.push_back(0.1 * i - 0.7);
   hand::HandPose pose;
   pose.SetWristAngleAxis(Eigen::Vector3d(0.2, -0.1, 0.3));
-  pose.wrist_in_world_mm = Eigen::Vector3d(10, 20, 30);
+  pose.world_from_wrist.translation = Eigen::Vector3d(10, 20, 30);
   for (int d = 0; d < hand::kNumJointDofs; ++d) pose.angles_rad[static_cast<size_t>(d)] = 0.05 * d;
   t.left_hand = {pose, std::nullopt};
   t.right_hand = {pose, pose};
@@ -122,9 +122,9 @@ TEST(TruthFolder, WrittenFolderReadsBackEqual) {
     for (size_t f = 0; f < want->size(); ++f) {
       ASSERT_EQ((*got)[f].has_value(), (*want)[f].has_value()) << f;
       if (!(*want)[f]) continue;
-      EXPECT_TRUE((*got)[f]->world_from_wrist_rotation.isApprox(
-          (*want)[f]->world_from_wrist_rotation, 1e-14));
-      EXPECT_EQ((*got)[f]->wrist_in_world_mm, (*want)[f]->wrist_in_world_mm);
+      EXPECT_TRUE((*got)[f]->world_from_wrist.rotation.isApprox(
+          (*want)[f]->world_from_wrist.rotation, 1e-14));
+      EXPECT_EQ((*got)[f]->world_from_wrist.translation, (*want)[f]->world_from_wrist.translation);
       EXPECT_EQ((*got)[f]->angles_rad, (*want)[f]->angles_rad);
     }
   }

@@ -242,9 +242,9 @@ void PlaneRenderer::Render(const Rigid3d& world_from_plane,
 
   // cam_from_plane; plane point (X, Y, 0) -> X r1 + Y r2 + t = H (X, Y, 1), so the ray
   // (x, y, 1) meets the plane at H^-1 (x, y, 1) = (X, Y, 1) / depth: depth > 0 in front.
-  const Eigen::Matrix3d r = camera_.cam_from_world_rotation * world_from_plane.RotationMatrix();
-  const Eigen::Vector3d t = camera_.cam_from_world_rotation * world_from_plane.translation +
-                            camera_.cam_from_world_translation;
+  const Eigen::Matrix3d r = camera_.cam_from_world.rotation * world_from_plane.RotationMatrix();
+  const Eigen::Vector3d t = camera_.cam_from_world.rotation * world_from_plane.translation +
+                            camera_.cam_from_world.translation;
   Eigen::Matrix3d h;
   h << r.col(0), r.col(1), t;
   // det H = t . r3: zero when the camera centre lies in the plane (seen edge-on),
@@ -441,8 +441,8 @@ Rig MakePlaneRig(const PlaneRigOptions& o) {
     rotation.row(0) = x.transpose();
     rotation.row(1) = y.transpose();
     rotation.row(2) = z.transpose();
-    cam.cam_from_world_rotation = rotation;
-    cam.cam_from_world_translation = -rotation * center;
+    cam.cam_from_world.rotation = rotation;
+    cam.cam_from_world.translation = -rotation * center;
     rig.cameras.push_back(cam);
   }
   return rig;

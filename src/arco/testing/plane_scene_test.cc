@@ -169,7 +169,7 @@ TEST(ProjectPlanePoint, BehindTheCameraOutsideTheViewAndBeyondTheLens) {
   const PlaneTexture texture = DotTexture(200, 100);
   Camera camera = SmallRig(1, 1.0).cameras[0];
   // The plane behind the camera: nothing projects, the render is the background.
-  const Rigid3d camera_in_world(Eigen::Quaterniond(camera.cam_from_world_rotation.transpose()),
+  const Rigid3d camera_in_world(Eigen::Quaterniond(camera.cam_from_world.rotation.transpose()),
                                 camera.CenterInWorld());
   const Rigid3d behind =
       camera_in_world * Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, -500));

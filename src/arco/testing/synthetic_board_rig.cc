@@ -40,8 +40,8 @@ SyntheticBoardRig MakeSyntheticBoardRig(const BoardSpec& board,
                                    options.camera_height_mm + 100 * uniform(rng));
     const Eigen::Vector3d target =
         centre + Eigen::Vector3d(100 * uniform(rng), 100 * uniform(rng), 0);
-    cam.cam_from_world_rotation = CamFromWorldLookingAt(position, target);
-    cam.cam_from_world_translation = -cam.cam_from_world_rotation * position;
+    cam.cam_from_world.rotation = CamFromWorldLookingAt(position, target);
+    cam.cam_from_world.translation = -cam.cam_from_world.rotation * position;
     rig.truth.cameras.push_back(cam);
     CameraBoardViews views;
     views.camera = cam.name;
@@ -118,7 +118,7 @@ media::Image BoardRenderer::Render(const Eigen::Isometry3d& world_from_board) co
   image.pixels.assign(static_cast<size_t>(image.width) * image.height, 128);
   const Eigen::Isometry3d board_from_world = world_from_board.inverse();
   const Eigen::Matrix3d board_from_cam =
-      board_from_world.linear() * camera.cam_from_world_rotation.transpose();
+      board_from_world.linear() * camera.cam_from_world.rotation.transpose();
   const Eigen::Vector3d origin = board_from_world * camera.CenterInWorld();
   const double s = board.square_mm;
   // The squares span [-s, inner_cols * s] x [-s, inner_rows * s] (corner ids at multiples

@@ -42,8 +42,8 @@ Rig MakeSyntheticRig(const SyntheticRigOptions& options) {
     cam.cy = 1327.5 - 8.5;
     if (options.distortion) cam.distortion = {-0.081, 0.066, 0.0195, -0.00035, 0.00062};
     // Portrait cameras (like SPD's rotated images): image y points down the world z axis.
-    cam.cam_from_world_rotation = CamFromWorldLookingAt(center, aim);
-    cam.cam_from_world_translation = -cam.cam_from_world_rotation * center;
+    cam.cam_from_world.rotation = CamFromWorldLookingAt(center, aim);
+    cam.cam_from_world.translation = -cam.cam_from_world.rotation * center;
     rig.cameras.push_back(cam);
   }
   return rig;

@@ -30,8 +30,8 @@ struct LineResidual {
     AlongStick(frog, direction, u, x);
     T c[3];
     for (int r = 0; r < 3; ++r) {
-      c[r] = T(camera->cam_from_world_translation[r]);
-      for (int k = 0; k < 3; ++k) c[r] += T(camera->cam_from_world_rotation(r, k)) * x[k];
+      c[r] = T(camera->cam_from_world.translation[r]);
+      for (int k = 0; k < 3; ++k) c[r] += T(camera->cam_from_world.rotation(r, k)) * x[k];
     }
     if (!(c[2] > T(1e-6))) return false;
     const T xn = c[0] / c[2], yn = c[1] / c[2];

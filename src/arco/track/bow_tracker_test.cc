@@ -27,8 +27,8 @@ std::vector<Camera> Rig3() {
     const double a = (i - 1) * 0.6;
     const Eigen::Vector3d centre(2500 * std::sin(a), -2500 * std::cos(a), 300.0 * (i - 1));
     const Eigen::Matrix3d r = testing::CamFromWorldLookingAt(centre, Eigen::Vector3d::Zero());
-    c.cam_from_world_rotation = r;
-    c.cam_from_world_translation = -r * centre;
+    c.cam_from_world.rotation = r;
+    c.cam_from_world.translation = -r * centre;
     cams.push_back(c);
   }
   return cams;

@@ -28,8 +28,8 @@ std::vector<Camera> Rig3() {
     const double a = (i - 1) * 0.6;
     const Eigen::Vector3d centre(2500 * std::sin(a), -2500 * std::cos(a), 100.0 * i);
     const Eigen::Matrix3d R = testing::CamFromWorldLookingAt(centre, Eigen::Vector3d::Zero());
-    c.cam_from_world_rotation = R;
-    c.cam_from_world_translation = -R * centre;
+    c.cam_from_world.rotation = R;
+    c.cam_from_world.translation = -R * centre;
     cams.push_back(c);
   }
   return cams;
