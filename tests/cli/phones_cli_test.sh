@@ -200,7 +200,7 @@ ffmpeg -v error -y -loop 1 -framerate 30 -i right.png -t 8 -c:v libx264 -preset 
 bad_at "a muted phone" "mute.mp4" "${N[@]}" --video left=left.mp4 --video right=mute.mp4
 check '[[ "$error_line" == *"no audio stream"* ]]' "a muted phone: $error_line"
 video fast.mp4 right.png right.wav 60
-bad "two frame rates" "fast.mp4: 60 --fps, but left.mp4 has 30 --fps" "${N[@]}" \
+bad "two frame rates" "fast.mp4: 60 fps, but left.mp4 has 30 fps" "${N[@]}" \
   --video left=left.mp4 --video right=fast.mp4
 ffmpeg -v error -y -i "$spd/pgy.wav" -t 8 other.wav && video other.mp4 right.png other.wav 30
 bad "another performance" "other.mp4 against left.mp4: ambiguous alignment" "${N[@]}" \

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
 #include "arco/testing/temp_dir.h"
 #include "arco/util/number_range.h"
@@ -112,6 +113,20 @@ class AppOptions : public ::testing::Test {
   // Nothing was written: the parse only checks.
   void ExpectNothingWritten() const { EXPECT_TRUE(fs::is_empty(dir_)) << dir_; }
 };
+
+// A library message names a field; the CLI names its flag, but not a file's field, a
+// path's part or a unit after a number.
+TEST(WithFlagNames, NamesTheFlagsOfFieldsButNotFileFieldsPathsOrUnits) {
+  constexpr FieldFlag kNames[] = {{"fps", "--fps"}, {"start_s", "--start-s"}};
+  EXPECT_EQ(WithFlagNames("fps must be in [1, 1000]", kNames), "--fps must be in [1, 1000]");
+  EXPECT_EQ(WithFlagNames("start_s = -1 is before fps", kNames), "--start-s = -1 is before --fps");
+  for (const std::string kept : {"right.mp4: 60 fps, but left.mp4 has 30 fps",
+                                 "capture.json: \"fps\" must be > 0",
+                                 "capture.json: audio.start_s is not a number",
+                                 "/data/fps/capture.json: file not found"}) {
+    EXPECT_EQ(WithFlagNames(kept, kNames), kept);
+  }
+}
 
 TEST_F(AppOptions, EveryNumericOptionHasARange) {
   App app = BuildApp();

@@ -66,7 +66,8 @@ inline constexpr FieldFlag kSynthFlags[] = {{"instrument", "--instrument"},
 // `text` with every whole-word field name of `names` replaced by its flag. A name quoted
 // or qualified (`"fps"`, `audio.offset_s`) is a file's field (mocap/capture.h writes
 // them so), and one between slashes part of a path: never rewritten (a message about
-// capture.json must not name a flag).
+// capture.json must not name a flag). Nor is a name right after a number and a space: a
+// unit ("right.mp4: 60 fps, but left.mp4 has 30 fps" is about the videos, not --fps).
 template <size_t N>
 std::string WithFlagNames(std::string text, const FieldFlag (&names)[N]) {
   auto word_char = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
@@ -77,7 +78,9 @@ std::string WithFlagNames(std::string text, const FieldFlag (&names)[N]) {
       const bool whole = (at == 0 || !word_char(text[at - 1])) &&
                          (end == text.size() || (!word_char(text[end]) && text[end] != '/')) &&
                          (at == 0 || (text[at - 1] != '-' && text[at - 1] != '"' &&
-                                      text[at - 1] != '.' && text[at - 1] != '/'));
+                                      text[at - 1] != '.' && text[at - 1] != '/')) &&
+                         !(at >= 2 && text[at - 1] == ' ' &&
+                           std::isdigit(static_cast<unsigned char>(text[at - 2])));
       if (!whole) {
         at = end;
         continue;
