@@ -178,6 +178,19 @@ bool ScoreInstrument::InRange(int midi_note) const {
   return false;
 }
 
+std::string BuiltInPieceList() {
+  std::string list;
+  for (const auto& n : BuiltInPieceNames()) list += (list.empty() ? "" : ", ") + n;
+  return list;
+}
+
+Status CheckBuiltInPieceName(const std::string& name) {
+  const auto& pieces = BuiltInPieceNames();
+  if (std::find(pieces.begin(), pieces.end(), name) != pieces.end()) return Status::Ok();
+  return Status::Error("piece '" + name + "' is unknown (built-in pieces: " + BuiltInPieceList() +
+                       ")");
+}
+
 const std::vector<std::string>& BuiltInPieceNames() {
   static const std::vector<std::string> names = {
       "scale-2oct", "arpeggios", "slow-melody", "fast-passage", "open-strings", "double-stops"};
@@ -221,9 +234,8 @@ StatusOr<Score> MakeBuiltInPiece(const std::string& name,
   } else if (name == "double-stops") {
     score = DoubleStops(instrument, tempo_scale);
   } else {
-    std::string list;
-    for (const auto& n : BuiltInPieceNames()) list += (list.empty() ? "" : ", ") + n;
-    return Status::Error("unknown piece '" + name + "' (built-in pieces: " + list + ")");
+    return Status::Error("unknown piece '" + name + "' (built-in pieces: " + BuiltInPieceList() +
+                         ")");
   }
   ARCO_RETURN_IF_ERROR(ValidateScore(score, instrument, "piece " + name));
   return score;

@@ -55,6 +55,10 @@ struct Score {
 
 // Names of the built-in pieces, in the order `arco synth --help` lists them.
 const std::vector<std::string>& BuiltInPieceNames();
+// The built-in pieces' names, comma-separated (for messages).
+std::string BuiltInPieceList();
+// Ok for a built-in piece's name; else "piece 'NAME' is unknown (built-in pieces: ...)".
+Status CheckBuiltInPieceName(const std::string& name);
 
 // One-line description of a built-in piece (for --help and docs).
 std::string DescribeBuiltInPiece(const std::string& name);

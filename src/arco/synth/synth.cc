@@ -28,14 +28,7 @@ Status SynthOptions::Validate() const {
     return Status::Error("instrument '" + instrument +
                          "' is unknown (violin, viola, cello, double_bass)");
   // So is a built-in piece's name (a MIDI file is read, and named, later).
-  if (midi_path.empty()) {
-    const auto& pieces = BuiltInPieceNames();
-    if (std::find(pieces.begin(), pieces.end(), piece) == pieces.end()) {
-      std::string list;
-      for (const auto& n : pieces) list += (list.empty() ? "" : ", ") + n;
-      return Status::Error("piece '" + piece + "' is unknown (built-in pieces: " + list + ")");
-    }
-  }
+  if (midi_path.empty()) ARCO_RETURN_IF_ERROR(CheckBuiltInPieceName(piece));
   if (!(fps >= 1 && fps <= 1000)) return Status::Error("fps must be in [1, 1000]");
   if (!(tempo_scale > 0.05 && tempo_scale < 20))
     return Status::Error("tempo scale must be in (0.05, 20)");
