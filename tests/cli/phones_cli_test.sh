@@ -227,7 +227,7 @@ bad "run before detect" "undetected/capture.json: no 2D keypoints yet" run undet
 "$arco" capture new --calibration phones.json --video left=left.mp4 --sync audio --instrument cello \
   -o one >/dev/null && "$arco" detect one --frames 1:2 >/dev/null ||
   { echo "FAILED: a one-camera capture"; fail=1; }
-bad "one phone: run" "one/keypoints2d.npy: no frame shows the cello's nut_l, nut_r, bridge_l and bridge_r in two views each" \
+bad "one phone: run" "one/keypoints2d.npy: no frame shows the cello's nut_l, nut_r, bridge_l and bridge_r in its view" \
   run one -o w/res
 bad "one phone: calibrate" "one/capture.json: calibrating from the instrument needs at least two cameras, the capture has 1" \
   calibrate from-instrument one -o w/rig.json

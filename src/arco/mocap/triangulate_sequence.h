@@ -31,6 +31,10 @@ struct SequenceTriangulation {
   NpyArray<int32_t> num_inliers;        // (F, P) inlier views, 0 when not triangulated
   NpyArray<int32_t> num_views;          // (F, P) usable views (finite, score >= min_score)
   NpyArray<uint8_t> inlier_mask;        // (F, P, V) 1 where view v is an inlier
+  // (F, P) where each point's depth came from when the capture has one camera
+  // (track/monocular_lift.h LiftDepth; triangulation/depth_source.npy); empty when the
+  // points were triangulated from several views.
+  NpyArray<uint8_t> depth_source;
 };
 
 struct SequenceTriangulationSummary {

@@ -89,15 +89,17 @@ Status CheckCaptureInstrumentPoints(const CaptureContext& capture) {
     ends.push_back(capture.layout.Find(model.keypoint_names()[i]));
   }
   const int64_t frames = k.shape[0], views = k.shape[1], points = k.shape[2];
+  // Two views place a point; one camera places the instrument by PnP from its one view.
+  const int needed = views == 1 ? 1 : 2;
   for (int64_t f = 0; f < frames; ++f) {
     bool all = true;
     for (const int p : ends) {
       int seen = 0;
-      for (int64_t v = 0; v < views && seen < 2; ++v) {
+      for (int64_t v = 0; v < views && seen < needed; ++v) {
         const double* q = &k.data[static_cast<size_t>(((f * views + v) * points + p) * 3)];
         if (std::isfinite(q[0]) && std::isfinite(q[1]) && q[2] > 0) ++seen;
       }
-      if (seen < 2) {
+      if (seen < needed) {
         all = false;
         break;
       }
@@ -106,7 +108,9 @@ Status CheckCaptureInstrumentPoints(const CaptureContext& capture) {
   }
   return Status::Error(ResolveCapturePath(capture.capture_dir, m.keypoints2d) +
                        ": no frame shows the " + m.instrument +
-                       "'s nut_l, nut_r, bridge_l and bridge_r in two views each (the strings "
+                       "'s nut_l, nut_r, bridge_l and bridge_r in " +
+                       (views == 1 ? "its view" : "two views each") +
+                       " (the strings "
                        "cannot be placed); a capture made from videos gets them from `arco "
                        "track` after `arco detect`");
 }

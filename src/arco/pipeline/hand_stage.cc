@@ -24,6 +24,7 @@ Status HandStageOptions::Validate() const {
   if (num_threads < 0) return Status::Error("num_threads must be >= 0");
   ARCO_RETURN_IF_ERROR(bones.Validate().WithContext("bones"));
   ARCO_RETURN_IF_ERROR(palm.Validate().WithContext("palm"));
+  ARCO_RETURN_IF_ERROR(one_view_depth.Validate().WithContext("one_view_depth"));
   return fit.Validate().WithContext("fit");
 }
 
@@ -54,6 +55,7 @@ Json ToJson(const HandStageOptions& o) {
             {"temporal_rotation_weight_px_per_rad", f.temporal_rotation_weight_px_per_rad},
             {"temporal_translation_weight_px_per_mm", f.temporal_translation_weight_px_per_mm},
             {"max_iterations", f.max_iterations}}},
+          {"one_view_depth", {{"window_frames", o.one_view_depth.window_frames}}},
           {"chunk_frames", o.chunk_frames},
           {"num_threads", o.num_threads}};
 }
@@ -112,14 +114,19 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
   HandStageSummary summary;
   const hand::HandModel prior = hand::HandModel::Default(hand::HandSide::kLeft);
   hand::HandModel model = prior;
-  StatusOr<hand::BoneLengthEstimate> bones = hand::EstimateBoneLengths(left, prior, options.bones);
+  // One camera: the 3D points were lifted at an assumed depth (track/monocular_lift.h),
+  // their distances are no bone lengths: the model's own hand is used, and said.
+  const bool one_view = views == 1;
+  StatusOr<hand::BoneLengthEstimate> bones =
+      one_view ? StatusOr<hand::BoneLengthEstimate>(Status::Error("one camera"))
+               : hand::EstimateBoneLengths(left, prior, options.bones);
   if (bones.ok()) {
     StatusOr<hand::HandModel> sized = prior.WithBoneLengths(bones->lengths_mm);
     if (sized.ok()) model = *sized;
   } else {
     summary.warnings.push_back("hand: default bone lengths (" + bones.status().message() + ")");
   }
-  if (options.palm.enabled) {
+  if (options.palm.enabled && !one_view) {
     StatusOr<hand::PalmShapeEstimate> palm = hand::EstimatePalmShape(left, model, options.palm);
     StatusOr<hand::HandModel> palmed =
         palm.ok() ? model.WithBasePoints(palm->base_in_wrist_mm) : palm.status();
@@ -145,6 +152,10 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
   fitted.resize(static_cast<size_t>(frames));
   std::vector<double> residual_px(static_cast<size_t>(frames), kNaN);
   std::vector<double> median_residual_px(static_cast<size_t>(frames), kNaN);
+  // One camera: its view is all there is (the hand's depth starts on the string plane,
+  // track/monocular_lift.h, and the sound corrects it in the refinement).
+  hand::HandFitOptions fit_options = options.fit;
+  if (one_view) fit_options.min_views = 1;
   progress.SetTotal(frames);
   ParallelFor(
       num_chunks,
@@ -167,7 +178,7 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
           init.points_in_world_mm = left[static_cast<size_t>(f)];
           init.previous_pose = previous;
           const hand::HandFitResult r =
-              hand::FitHandMultiView(model, cameras, obs, init, options.fit);
+              hand::FitHandMultiView(model, cameras, obs, init, fit_options);
           if (r.ok) {
             fitted[static_cast<size_t>(f)] = r.pose;
             residual_px[static_cast<size_t>(f)] = r.rms_residual_px;
@@ -178,6 +189,25 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
         progress.Advance(end - ci * chunk);
       },
       1);
+  if (one_view) {
+    // The fingertips at the depth of the strings (the lifted hand's, one depth per frame).
+    std::vector<double> tip_depth(static_cast<size_t>(frames), kNaN);
+    for (int64_t f = 0; f < frames; ++f) {
+      for (const Eigen::Vector3d& p : left[static_cast<size_t>(f)]) {
+        if (p.allFinite()) {
+          tip_depth[static_cast<size_t>(f)] = cameras[0].PointInCamera(p).z();
+          break;
+        }
+      }
+    }
+    ARCO_ASSIGN_OR_RETURN(
+        const hand::OneViewDepthSummary moved,
+        hand::AlignHandDepth(model, cameras[0], tip_depth, options.one_view_depth, &fitted));
+    summary.warnings.push_back(
+        "hand: one camera: the hand's depth is the strings' (moved " +
+        std::to_string(static_cast<int>(std::lround(moved.median_shift_mm))) +
+        " mm along the rays, median of " + std::to_string(moved.frames_moved) + " frames)");
+  }
   int ok = 0;
   // Per frame: the RMS (dominated by the few outlier detections a robust fit
   // ignores) and the median residual; the summary gives the median over frames of both

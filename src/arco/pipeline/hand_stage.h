@@ -8,6 +8,7 @@
 
 #include "arco/hand/bone_lengths.h"
 #include "arco/hand/fit.h"
+#include "arco/hand/one_view_depth.h"
 #include "arco/hand/palm_shape.h"
 #include "arco/pipeline/capture_context.h"
 #include "arco/pipeline/result_folder.h"
@@ -23,6 +24,7 @@ struct HandStageOptions {
   hand::BoneLengthOptions bones;
   hand::PalmShapeOptions palm;  // the performer's palm (after the bone lengths)
   hand::HandFitOptions fit;
+  hand::OneViewDepthOptions one_view_depth;  // a one-camera capture's hand depth
   // The fit carries a temporal prior from frame to frame; the clip is cut into chunks of
   // this many frames that are fitted in parallel (each starts from its own 3D keypoints),
   // so results do not depend on the thread count.

@@ -3,6 +3,8 @@
 #include <limits>
 #include <vector>
 
+#include "arco/geometry/alignment.h"
+#include "arco/instrument/nominal_keypoints.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/registry/keypoint_layout.h"
 
@@ -96,10 +98,30 @@ StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& opti
     columns.push_back(capture.layout.Find(name));
   std::vector<Eigen::Matrix3Xd> keypoints(static_cast<size_t>(frames));
   std::vector<FrontHint> hints(static_cast<size_t>(frames));
+  // One camera: the instrument was placed by a PnP of its nominal points, which says where
+  // its front is; the performer's points were put at an assumed depth and say nothing.
+  const bool one_view = capture.view_to_camera.size() == 1;
+  const std::vector<Eigen::Vector3d> nominal = NominalKeypointsInInstrument(model);
   for (int64_t f = 0; f < frames; ++f) {
     Eigen::Matrix3Xd& m = keypoints[static_cast<size_t>(f)];
     m.resize(3, num_k);
     for (int k = 0; k < num_k; ++k) m.col(k) = PointAt(points, f, columns[static_cast<size_t>(k)]);
+    if (one_view) {
+      std::vector<Eigen::Vector3d> from, to;
+      for (int k = 0; k < num_k; ++k) {
+        from.push_back(nominal[static_cast<size_t>(k)]);
+        to.push_back(m.col(k));
+      }
+      AlignmentOptions similarity;
+      similarity.estimate_scale = true;
+      hints[static_cast<size_t>(f)].value.setConstant(std::numeric_limits<double>::quiet_NaN());
+      if (const auto a = AlignPoints(from, to, {}, similarity)) {
+        hints[static_cast<size_t>(f)].kind = FrontHint::Kind::kFrontDirection;
+        hints[static_cast<size_t>(f)].value =
+            a->target_from_source.rotation * Eigen::Vector3d::UnitZ();
+      }
+      continue;
+    }
     // The performer sits behind the instrument: the shoulders' midpoint says where the
     // back is (strings.h FrontHint).
     hints[static_cast<size_t>(f)].kind = FrontHint::Kind::kPerformerPoint;

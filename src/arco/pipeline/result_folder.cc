@@ -28,6 +28,7 @@ constexpr char kReprojectionRmsFile[] = "reprojection_rms_px.npy";
 constexpr char kInlierCountFile[] = "inlier_count.npy";
 constexpr char kViewCountFile[] = "view_count.npy";
 constexpr char kInlierMaskFile[] = "inlier_mask.npy";
+constexpr char kDepthSourceFile[] = "depth_source.npy";  // one camera only
 constexpr char kStringsFile[] = "strings.npy";
 constexpr char kKeypointsFile[] = "keypoints.npy";
 constexpr char kHandParamsFile[] = "hand_params.npy";
@@ -545,6 +546,8 @@ StatusOr<std::vector<std::string>> ResultFolder::WriteTriangulation(
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, kInlierCountFile), raw.num_inliers));
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, kViewCountFile), raw.num_views));
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, kInlierMaskFile), raw.inlier_mask));
+    if (!raw.depth_source.data.empty())
+      ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, kDepthSourceFile), raw.depth_source));
     return Status::Ok();
   };
   ARCO_RETURN_IF_ERROR(write_all(stage_tmp));
@@ -575,6 +578,18 @@ StatusOr<std::vector<std::string>> ResultFolder::WriteTriangulation(
                                              {"inlier_mask", kInlierMaskFile}}},
                                            {"options", record.options},
                                            {"summary", ToJson(record.summary)}};
+  if (!raw.depth_source.data.empty()) {
+    // One camera: the depths are not measured (track/monocular_lift.h LiftDepth).
+    Json& stage = result["stages"][kTriangulationStage];
+    stage["files"]["depth_source"] = kDepthSourceFile;
+    stage["depth"] = {
+        {"method", "one_view"},
+        {"codes",
+         {{"0", "not lifted"},
+          {"1", "instrument pose (PnP of its nominal points)"},
+          {"2", "the depth where the fingertips pass closest to the strings (left hand)"},
+          {"3", "assumed plane behind the instrument (body, right hand)"}}}};
+  }
   // A new capture header: the result is now what this triangulation was made from, and
   // `arco run`'s options no longer describe it.
   result.erase(kInputsKey);

@@ -11,6 +11,7 @@
 #include "arco/mocap/triangulate_sequence.h"
 #include "arco/pipeline/capture_context.h"
 #include "arco/pipeline/summaries.h"
+#include "arco/track/monocular_lift.h"
 #include "arco/util/json_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/progress.h"
@@ -24,6 +25,8 @@ struct TriangulateStageOptions {
   std::string capture_dir;
   std::string result_dir;
   SequenceTriangulationOptions triangulation;
+  // A capture of one camera is lifted from its view instead (track/monocular_lift.h).
+  track::MonocularLiftOptions one_view;
   // (group, filter) applied in order; later entries win for points in several groups.
   // Groups and filter rates are checked against the capture when the stage runs.
   std::vector<std::pair<std::string, TemporalFilterOptions>> filters;

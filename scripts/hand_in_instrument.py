@@ -1,0 +1,58 @@
+#!/usr/bin/python3
+"""The left hand in the instrument's frame, against SPD's (issue 26's one-camera measure).
+
+One camera places the instrument and the hand at a depth it cannot measure (the nominal
+instrument's size sets it), so the hand is compared where a player's hand is judged: in
+the instrument's own frame (origin the bridge's middle, x to the nut's, y across the
+strings), ours in the frame of our instrument, SPD's in the frame of SPD's.
+
+usage: hand_in_instrument.py RESULT_DIR TRUTH_POINTS3D [METHOD ...]
+Prints per method: the median over frames of the 21 joints' mean error (mm), the fraction
+of all frames within 15 mm, and the fraction of frames with a hand. As a module:
+left_hand_in_instrument(result_dir, truth_points3d, method) -> those three numbers.
+"""
+import json
+import sys
+
+import numpy as np
+
+
+def _frame(points, col):
+    nut_l, nut_r = points[:, col("nut_l")], points[:, col("nut_r")]
+    br_l, br_r = points[:, col("bridge_l")], points[:, col("bridge_r")]
+    nut, bridge = 0.5 * (nut_l + nut_r), 0.5 * (br_l + br_r)
+    x = nut - bridge
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    across = (nut_l - nut_r) + (br_l - br_r)
+    y = across - np.sum(across * x, 1, keepdims=True) * x
+    y /= np.linalg.norm(y, axis=1, keepdims=True)
+    return bridge, np.stack([x, y, np.cross(x, y)], 1)
+
+
+def _in_frame(points, bridge, rows):
+    return np.einsum("fij,fpj->fpi", rows, points - bridge[:, None])
+
+
+def left_hand_in_instrument(result_dir, truth_points3d, method):
+    names = json.load(open(result_dir + "/result.json"))["keypoint_names"]
+    col = names.index
+    hand = list(range(col("left_hand_wrist"), col("left_hand_wrist") + 21))
+    truth = np.load(truth_points3d)  # its first columns are the result's layout
+    ours = np.load("%s/%s/points3d.npy" % (result_dir, method))
+    want = _in_frame(truth[:, hand], *_frame(truth, col))
+    got = _in_frame(ours[:, hand], *_frame(ours, col))
+    distances = np.linalg.norm(got - want, axis=2)
+    counted = np.isfinite(distances).sum(1)
+    error = np.where(counted > 0, np.nansum(distances, 1) / np.maximum(counted, 1), np.nan)
+    fitted = np.isfinite(error)
+    if not fitted.any():
+        return float("nan"), 0.0, 0.0
+    return (float(np.median(error[fitted])), float(np.sum(error[fitted] <= 15) / len(error)),
+            float(fitted.mean()))
+
+
+if __name__ == "__main__":
+    for m in sys.argv[3:] or ["vision", "paper", "arco"]:
+        median, within, fitted = left_hand_in_instrument(sys.argv[1], sys.argv[2], m)
+        print("%-6s median %.1f mm, within 15 mm on %.3f of frames, a hand on %.3f"
+              % (m, median, within, fitted))

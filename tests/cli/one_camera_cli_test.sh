@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# One camera (issue 26 part 4): SPD's real cellist (cello01, first 11 s, real audio)
+# re-captured by `arco synth --motion` in ONE camera of the SPD rig, then `arco run` and
+# `arco eval`. One view fixes no depth: the instrument is placed by a PnP of its nominal
+# points, the left hand at the depth of the strings its fingertips pass closest to, the
+# body at an assumed depth, the bow not at all (track/monocular_lift.h). Checks that the run
+# completes, that every lifted point says where its depth came from
+# (triangulation/depth_source.npy, result.json), and the accuracy reached today in the
+# instrument's frame (regression bounds, not the issue's targets: docs/accuracy.md, "One
+# camera"). Also: a one-camera capture without the instrument is one line naming the file.
+# usage: one_camera_cli_test.sh ARCO_BINARY SHARED_DATA_DIR
+set -uo pipefail
+arco=$1
+spd=$2/spd
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
+take="$spd/cello01_first_half_results.npy"
+wav="$spd/cello01_first_half.wav"
+rig="$spd/cello_1113_scale_camera.xml"
+
+ok "re-capture" synth --motion "$take" --audio "$wav" --calibration "$rig" \
+  --error-model shared --cameras 1 --seed 1 -o "$tmp/cap"
+ok "run" run "$tmp/cap" -o "$tmp/res"
+check 'grep -q "one camera" "$tmp/err" "$tmp/out"' "the run says the hand's depth is the strings'"
+ok "eval" eval "$tmp/res" --truth "$tmp/cap/truth" -o "$tmp/eval.json"
+/usr/bin/python3 - "$tmp" "$(dirname "${BASH_SOURCE[0]}")/../../scripts" <<'PY' || fail=1
+import json, sys
+import numpy as np
+tmp = sys.argv[1]
+r = json.load(open(tmp + "/res/result.json"))
+bad = []
+tri = r["stages"]["triangulation"]
+if tri.get("depth", {}).get("method") != "one_view": bad.append("result.json has no one_view depth")
+names = r["keypoint_names"]
+d = np.load(tmp + "/res/triangulation/" + tri["files"]["depth_source"])
+p = np.load(tmp + "/res/triangulation/points3d.npy")
+col = lambda n: names.index(n)
+lh = list(range(col("left_hand_wrist"), col("left_hand_wrist") + 21))
+checks = [("instrument", [col("nut_l"), col("bridge_r")], 1), ("left hand", lh, 2),
+          ("shoulders", [col("left_shoulder"), col("right_shoulder")], 3)]
+for what, cols, code in checks:
+    got = d[:, cols]
+    lifted = got[got != 0]
+    if lifted.size == 0 or not np.all(lifted == code):
+        bad.append("%s: depth codes %s, expected %d" % (what, np.unique(got), code))
+for n in ("frog", "tip"):
+    if not (np.all(d[:, col(n)] == 0) and np.all(np.isnan(p[:, col(n)]))):
+        bad.append("the bow's %s was lifted (one view cannot place it)" % n)
+if not np.array_equal(np.isnan(p[..., 0]), d == 0): bad.append("a NaN point has a depth code")
+
+# The left hand in the instrument's frame (scripts/hand_in_instrument.py).
+sys.path.insert(0, sys.argv[2])
+from hand_in_instrument import left_hand_in_instrument
+res = {}
+for m in ("vision", "paper", "arco"):
+    res[m] = left_hand_in_instrument(tmp + "/res", tmp + "/cap/truth/points3d.npy", m)
+    print("%-6s left hand in the instrument's frame: median %.1f mm, within 15 mm on %.3f of "
+          "frames (a hand on %.3f)" % ((m,) + res[m]))
+j = json.load(open(tmp + "/eval.json"))["methods"]
+for m in ("paper", "arco"):
+    print("%-6s string %.3f finger %.3f contact %.1f mm" % (m, j[m]["string_accuracy"],
+          j[m]["finger_accuracy"], j[m]["contact_point_error_mm"]))
+# Today's figures with a margin (median 25 mm, paper's string agreement 0.90); before the
+# one-camera lift `arco run` stopped, and with the hand lifted to the strings' plane and
+# its bones measured from the lift the median was 680 mm.
+if not res["vision"][0] <= 35: bad.append("vision's left hand median %.1f mm > 35" % res["vision"][0])
+if not res["vision"][2] >= 0.9: bad.append("hand fitted on %.3f of frames" % res["vision"][2])
+if not j["paper"]["string_accuracy"] >= 0.8: bad.append("paper's strings %.3f" % j["paper"]["string_accuracy"])
+for b in bad: print("FAILED: " + b)
+sys.exit(1 if bad else 0)
+PY
+
+# A one-camera capture whose view never shows the instrument: one line naming the file.
+cp -r "$tmp/cap" "$tmp/blind"
+/usr/bin/python3 - "$tmp/blind/keypoints2d.npy" <<'PY'
+import numpy as np, sys
+k = np.load(sys.argv[1]); k[:, :, 133:140, 2] = 0; np.save(sys.argv[1], k)
+PY
+SNAPSHOT_DIR=$tmp
+bad_at "no instrument in the view" "$tmp/blind/keypoints2d.npy" run "$tmp/blind" -o "$tmp/res2"
+exit $fail
