@@ -242,6 +242,9 @@ FrameHandCheck CheckFrameHands(const HandConsistencyOptions& o,
                                float* data,
                                int views,
                                int64_t view_stride) {
+  if (const Status valid = o.Validate(); !valid.ok()) {
+    throw std::invalid_argument("CheckFrameHands: " + valid.message());
+  }
   const std::vector<Camera>& cameras = triangulator.rig().cameras;
   if (static_cast<int>(cameras.size()) != views) {
     throw std::invalid_argument("CheckFrameHands: " + std::to_string(views) + " views but " +

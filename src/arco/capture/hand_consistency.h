@@ -124,7 +124,9 @@ Json ToJson(const HandConsistencySummary& summary);
 // points (x, y, score), row v starting at data + v * view_stride floats; cameras[v] is
 // view v's calibration camera. Swaps hands (step 1) and down-weights single points
 // (step 3) in place; lists disagreeing views with their crops (step 2) but leaves them
-// as they are. `triangulator` must be built on a rig whose cameras are `cameras`, in order.
+// as they are. `triangulator` must be built on a rig whose cameras are the views', in
+// order. Throws std::invalid_argument on invalid options, a rig of another size or rows
+// shorter than WholeBody's (caller bugs).
 FrameHandCheck CheckFrameHands(const HandConsistencyOptions& options,
                                const Triangulator& triangulator,
                                float* data,

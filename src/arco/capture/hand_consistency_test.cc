@@ -251,6 +251,10 @@ TEST(CheckFrameHands, RejectsARigOfAnotherSize) {
   EXPECT_THROW(CheckFrameHands(o, triangulator, s.rows.data(), kViews - 1, s.stride),
                std::invalid_argument);
   EXPECT_THROW(CheckFrameHands(o, triangulator, s.rows.data(), kViews, 10), std::invalid_argument);
+  HandConsistencyOptions bad = o;
+  bad.low_score = 0.9;
+  EXPECT_THROW(CheckFrameHands(bad, triangulator, s.rows.data(), kViews, s.stride),
+               std::invalid_argument);
 }
 
 TEST(HandRoiFromPoints, FollowsTheHandsTurn) {
