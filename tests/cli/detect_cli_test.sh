@@ -33,6 +33,7 @@ JSON
 bad "frames syntax" '--frames "5" must look like FIRST:LAST' detect cap --frames 5
 bad "frames outside" "outside the capture's frames 1:1" detect cap --frames 1:4
 bad "threads range" "--threads: -1 is outside" detect cap --threads -1
+bad "hand gate range" "--hand-gate: 3 is outside" detect cap --hand-gate 3
 bad "score range" "--min-hand-presence: nan is not a finite number" detect cap --min-hand-presence nan
 bad "unknown model" "--model" detect cap --model tiny
 bad "no capture" "nowhere/capture.json" detect nowhere
@@ -50,6 +51,7 @@ check '[ $rc -eq 0 ]' "detect: exit $rc: $(tail -1 err.txt)"
 check 'grep -q "detected frames 1:1 in 2 cameras (layout coco_wholebody_133)" out.txt' "summary: $(cat out.txt)"
 check 'grep -Eq "front +1 frames  person 100.0%" out.txt' "front camera line: $(cat out.txt)"
 check 'grep -q "wrote cap/keypoints2d.npy, detect.json and capture.json" out.txt' "wrote line"
+check 'grep -q "hands across views: not checked (fewer cameras than hands.min_views)" out.txt' "hands line: $(cat out.txt)"
 /usr/bin/python3 - <<'PY' || { echo "FAILED: keypoints2d.npy"; fail=1; }
 import json
 import numpy as np

@@ -5,11 +5,13 @@
 // FFV1 videos). `capture new` -> `detect` -> `triangulate`: because the picture is flat,
 // every keypoint the detector finds must triangulate onto the plane and stay still on
 // it (in plane coordinates) while the plane moves. Figures are printed for
-// docs/accuracy.md; the bounds are the issue's (median 12 mm off the plane, 6 mm of
-// movement on it).
+// docs/accuracy.md; the bounds are issue 12's (median 12 mm off the plane, 6 mm of
+// movement on it) and issue 28's (the bowing hand within 30 mm of the plane at the 90th
+// percentile, with the hands checked across views: capture/hand_consistency.h).
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -67,6 +69,7 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
   ASSERT_TRUE(made.ok()) << made.status().message();
   DetectStageOptions d;
   d.capture_dir = c.output_dir;
+  d.hands.rerun = true;  // the re-run path too (the default down-weights at once)
   auto detected = RunDetectStage(d);
   ASSERT_TRUE(detected.ok()) << detected.status().message();
   const double detect_s = seconds() - render_s;
@@ -82,6 +85,24 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
       1e3 * total.preprocess_s / total.frames,
       1e3 * total.postprocess_s / total.frames,
       1e3 * detected->decode_s / total.frames);
+  const HandConsistencySummary& hands = detected->hands;
+  std::printf(
+      "hands across views: %lld hands judged, %lld views swapped, %lld disagreeing, %lld "
+      "re-run (%lld then agreed), %lld down-weighted whole, %lld points down-weighted; "
+      "%.2f s (%.1f ms per view-frame)\n",
+      static_cast<long long>(hands.hands_judged),
+      static_cast<long long>(hands.swapped),
+      static_cast<long long>(hands.disagreeing),
+      static_cast<long long>(hands.recropped),
+      static_cast<long long>(hands.fixed),
+      static_cast<long long>(hands.hands_down_weighted),
+      static_cast<long long>(hands.points_down_weighted),
+      hands.wall_s,
+      1e3 * hands.wall_s / total.frames);
+  EXPECT_TRUE(hands.ran) << hands.skipped;
+  EXPECT_GT(hands.disagreeing, 0);
+  EXPECT_EQ(hands.recropped, hands.disagreeing);
+  EXPECT_EQ(hands.fixed + hands.hands_down_weighted, hands.recropped);
   for (const auto& cam : detected->cameras) {
     EXPECT_EQ(cam.tracker.frames_with_person, frames) << cam.camera;
   }
@@ -97,6 +118,8 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
 
   // Every triangulated body and hand point in plane coordinates.
   std::vector<double> off_plane_mm;
+  // The same by part: the body (with the feet), the left hand, the right (bowing) hand.
+  std::array<std::vector<double>, 3> part_off_plane_mm;
   std::vector<double> body_moves_mm, hand_moves_mm;
   int hand_points_seen = 0;
   for (int64_t p = 0; p < std::min<int64_t>(num_points, wholebody::kNumPoints); ++p) {
@@ -107,6 +130,8 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
       const Eigen::Vector3d in_plane =
           scene.world_from_plane[f].Inverse() * Eigen::Vector3d(x[0], x[1], x[2]);
       off_plane_mm.push_back(std::abs(in_plane.z()));
+      const int part = p < wholebody::kLeftHandFirst ? 0 : p < wholebody::kRightHandFirst ? 1 : 2;
+      part_off_plane_mm[part].push_back(std::abs(in_plane.z()));
       on_plane.push_back(in_plane.head<2>());
     }
     if (on_plane.size() < static_cast<size_t>(frames) / 2) continue;
@@ -138,6 +163,23 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
       move_median,
       body_moves_mm.empty() ? NAN : Median(body_moves_mm),
       hand_moves_mm.empty() ? NAN : Median(hand_moves_mm));
+  const char* part_names[3] = {"body", "left hand", "right hand"};
+  std::array<double, 3> part_p90{};
+  for (int part = 0; part < 3; ++part) {
+    const std::vector<double>& d = part_off_plane_mm[part];
+    part_p90[part] = d.empty() ? NAN : InterpolatedQuantile(d, 0.9);
+    std::printf(
+        "plane test: %s off the plane median %.1f mm, 90th percentile %.1f mm (%zu points)\n",
+        part_names[part],
+        d.empty() ? NAN : Median(d),
+        part_p90[part],
+        d.size());
+  }
+  // Issue 28: the bowing hand within 30 mm of the plane at the 90th percentile (49 mm
+  // before the check across views), the body and the left hand no worse (23.5 and 2.6 mm).
+  EXPECT_LE(part_p90[2], 30.0);
+  EXPECT_LE(part_p90[0], 25.0);
+  EXPECT_LE(part_p90[1], 4.0);
   EXPECT_GE(body_moves_mm.size(), 12u);  // the body's points
   EXPECT_GE(hand_points_seen, 21);       // at least one whole hand
   EXPECT_LE(off_median, 12.0);

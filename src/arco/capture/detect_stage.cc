@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "arco/calibration/calibration_file.h"
+#include "arco/camera/rig.h"
 #include "arco/capture/capture_videos.h"
 #include "arco/media/video_reader.h"
 #include "arco/mocap/capture.h"
@@ -95,6 +96,7 @@ Status DetectStageOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(d.Validate().WithContext("detector"));
   ARCO_RETURN_IF_ERROR(CheckInRange("num_threads", num_threads, Closed(0, 1024)));
   ARCO_RETURN_IF_ERROR(CheckInRange("chunk_frames", chunk_frames, kDetectChunkFramesRange));
+  ARCO_RETURN_IF_ERROR(hands.Validate().WithContext("hands"));
   if (first_frame < -1) return Status::Error("first_frame must be -1 (the first) or >= 0");
   if (last_frame < -1) return Status::Error("last_frame must be -1 (the last) or >= 0");
   if (first_frame >= 0 && last_frame >= 0 && last_frame < first_frame) {
@@ -114,6 +116,7 @@ Json ToJson(const DetectStageOptions& o) {
               {"hand_recrop", o.detector.hand_recrop},
               {"detection_tile_levels", o.detector.detection_tile_levels},
               {"chunk_frames", o.chunk_frames},
+              {"hands", ToJson(o.hands)},
               {"first_frame", o.first_frame},
               {"last_frame", o.last_frame}};
 }
@@ -133,6 +136,7 @@ Json ToJson(const DetectStageSummary& s) {
               {"last_frame", s.last_frame},
               {"points", s.points},
               {"kept_other_points", s.kept_other_points},
+              {"hands", ToJson(s.hands)},
               {"total", SummaryJson(s.total)},
               {"cameras", cameras},
               {"decode_s", s.decode_s},
@@ -295,12 +299,148 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
   // The first failing item in item order (deterministic message).
   for (const Status& s : chunk_status) ARCO_RETURN_IF_ERROR(s);
 
+  // --- Hands checked across the views (hand_consistency.h) ---------------------------
+  HandConsistencySummary hands;
+  const bool synced_by_sound =
+      std::any_of(manifest.cameras.begin(), manifest.cameras.end(), [](const CaptureCamera& c) {
+        return !c.OnCaptureClock();
+      });
+  if (!options.hands.enabled) {
+    hands.skipped = "turned off";
+  } else if (views < options.hands.min_views) {
+    hands.skipped = "fewer cameras than hands.min_views";
+  } else if (synced_by_sound) {
+    hands.skipped = "cameras synced by sound: a row's views are not simultaneous";
+  } else {
+    const auto hands_start = std::chrono::steady_clock::now();
+    hands.ran = true;
+    Rig rig;
+    for (const CaptureVideo& in : inputs) rig.cameras.push_back(in.calibration);
+    const Triangulator triangulator(rig, ConsensusTriangulationOptions(options.hands));
+    const int64_t n = last - first + 1;
+    const auto frame_data = [&](int64_t g) { return &out.data[at(g - capture_first, 0, 0)]; };
+    // Frames are independent: any split gives the same result.
+    std::vector<FrameHandCheck> checks(static_cast<size_t>(n));
+    ParallelFor(n, threads, [&](int64_t i, int) {
+      checks[i] =
+          CheckFrameHands(options.hands, triangulator, frame_data(first + i), views, points * 3);
+    });
+    // Disagreeing hands, by (view, frame, hand): each worker reads its frames in order.
+    struct Rerun {
+      int view = 0;
+      int64_t frame = 0;
+      int hand = 0;
+      detect::Roi roi;
+      std::array<detect::ScoredPoint, kHandPoints> points;
+      double presence = 0;
+      Status status = Status::Ok();
+    };
+    std::vector<Rerun> reruns;
+    const auto hand_of = [&](int64_t g, int v, int h) {
+      return &out.data[at(
+          g - capture_first, v, h == 0 ? wholebody::kLeftHandFirst : wholebody::kRightHandFirst)];
+    };
+    for (int v = 0; v < views; ++v) {
+      for (int64_t i = 0; i < n; ++i) {
+        hands.swapped += checks[i].swapped[v];
+        for (int h = 0; h < 2; ++h) {
+          const HandViewCheck& c = checks[i].views[v][h];
+          hands.hands_judged += c.judged ? 1 : 0;
+          if (!c.disagrees) continue;
+          ++hands.disagreeing;
+          if (options.hands.rerun && c.recrop) {
+            Rerun r;
+            r.view = v;
+            r.frame = first + i;
+            r.hand = h;
+            r.roi = *c.recrop;
+            reruns.push_back(r);
+          } else {
+            const int64_t lowered = DownWeightHand(options.hands, hand_of(first + i, v, h));
+            hands.points_down_weighted += lowered;
+            ++hands.hands_down_weighted;
+          }
+        }
+      }
+    }
+    for (const FrameHandCheck& c : checks) hands.points_down_weighted += c.points_down_weighted;
+    // The re-runs: the hand landmarker alone, on each worker's tracker (its state is not
+    // touched), frames read again (the frame of the previous item reused).
+    struct Cached {
+      int view = -1;
+      int64_t frame = -1;
+      media::Image image;
+    };
+    std::vector<Cached> cached(pool.size());
+    ParallelFor(
+        static_cast<int64_t>(reruns.size()),
+        workers,
+        [&](int64_t k, int t) {
+          Worker& w = pool[t];
+          Rerun& r = reruns[k];
+          if (!w.tracker) {
+            auto tracker = detect::WholeBodyTracker::Create(detector);
+            if (!tracker.ok()) {
+              r.status = tracker.status();
+              return;
+            }
+            w.tracker.emplace(std::move(*tracker));
+          }
+          Cached& c = cached[t];
+          if (c.view != r.view || c.frame != r.frame) {
+            auto reader_it = w.readers.find(r.view);
+            if (reader_it == w.readers.end()) {
+              reader_it =
+                  w.readers.emplace(r.view, CaptureFrameReader(manifest, r.view, inputs[r.view]))
+                      .first;
+            }
+            c.view = -1;
+            StatusOr<bool> read = reader_it->second.Read(r.frame, &c.image);
+            if (!read.ok()) {
+              r.status = read.status();
+              return;
+            }
+            if (!*read) return;  // dropped: cannot happen for a detected hand
+            c.view = r.view;
+            c.frame = r.frame;
+          }
+          StatusOr<double> presence = w.tracker->LandmarkHand(c.image, r.roi, r.points.data());
+          if (!presence.ok()) {
+            r.status = presence.status();
+            return;
+          }
+          r.presence = *presence;
+        },
+        /*chunk=*/4);
+    for (Rerun& r : reruns) {
+      ARCO_RETURN_IF_ERROR(r.status);
+      ++hands.recropped;
+      const HandConsensus& consensus = checks[r.frame - first].consensus[r.hand];
+      const Camera& camera = inputs[r.view].calibration;
+      const HandViewCheck& c = checks[r.frame - first].views[r.view][r.hand];
+      float* hand = hand_of(r.frame, r.view, r.hand);
+      float* again = &r.points[0].x_px;
+      const double error = HandErrorPx(options.hands, consensus, camera, again);
+      if (r.presence >= detector.min_hand_presence && error <= c.gate_px) {
+        std::copy(again, again + 3 * kHandPoints, hand);
+        ++hands.fixed;
+        hands.points_down_weighted +=
+            DownWeightPointsOffConsensus(options.hands, consensus, camera, hand);
+      } else {
+        hands.points_down_weighted += DownWeightHand(options.hands, hand);
+        ++hands.hands_down_weighted;
+      }
+    }
+    hands.wall_s = SecondsSince(hands_start);
+  }
+
   DetectStageSummary summary;
   summary.layout = layout_name;
   summary.first_frame = first;
   summary.last_frame = last;
   summary.points = points;
   summary.kept_other_points = kept;
+  summary.hands = hands;
   summary.cameras.resize(views);
   for (int v = 0; v < views; ++v) {
     summary.cameras[v].camera = inputs[v].camera;
@@ -331,6 +471,7 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
   report_summary.erase("decode_s");
   report_summary.erase("decode_wait_s");
   report_summary.erase("wall_s");
+  report_summary["hands"].erase("wall_s");
   for (Json* j : {&report_summary["total"]}) {
     j->erase("models");
     j->erase("inference_s");

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "arco/capture/hand_consistency.h"
 #include "arco/detect/wholebody.h"
 #include "arco/util/json_io.h"
 #include "arco/util/number_range.h"
@@ -38,6 +39,11 @@ struct DetectStageOptions {
   // tracker runs on the current one (one extra thread per worker, mostly waiting). The
   // output is the same either way; false: decode and track in turn, as before issue 28.
   bool decode_ahead = true;
+  // Hands checked across the calibrated views after detection (hand_consistency.h):
+  // swapped hands exchanged, disagreeing hands re-run on a crop around the hand
+  // triangulated from the other views, kept when they then agree, else down-weighted.
+  // Skipped for cameras synced by sound (their rows are not simultaneous).
+  HandConsistencyOptions hands;
   Status Validate() const;
 };
 
@@ -63,6 +69,7 @@ struct DetectStageSummary {
   double decode_wait_s = 0;
   double wall_s = 0;
   bool kept_other_points = false;  // instrument/bow slots kept from the old keypoints2d.npy
+  HandConsistencySummary hands;    // the check across views
 };
 
 Json ToJson(const DetectStageSummary& summary);

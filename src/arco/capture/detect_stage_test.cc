@@ -148,6 +148,11 @@ TEST_F(DetectStageTest, FindsThePlayerInEveryCameraAfterRotation) {
   ASSERT_TRUE(report.ok()) << report.status().message();
   EXPECT_EQ((*report)["options"]["pose_model"], "full");
   EXPECT_EQ((*report)["summary"]["cameras"][1]["frames_with_person"], 3);
+  // The hands' check across views needs 3 cameras: skipped, and says so.
+  EXPECT_EQ((*report)["options"]["hands"]["max_error_hand_fraction"], 0.08);
+  EXPECT_EQ((*report)["summary"]["hands"]["ran"], false);
+  EXPECT_EQ((*report)["summary"]["hands"]["skipped"], "fewer cameras than hands.min_views");
+  EXPECT_FALSE((*report)["summary"]["hands"].contains("wall_s"));  // not deterministic
 }
 
 TEST_F(DetectStageTest, SameBytesForAnyThreadCount) {
@@ -355,6 +360,10 @@ TEST(DetectStageOptionsTest, RangesNameTheField) {
   o.last_frame = -1;
   o.detector.min_hand_presence = std::nan("");
   EXPECT_NE(o.Validate().message().find("min_hand_presence"), std::string::npos);
+  o.detector.min_hand_presence = 0.5;
+  o.hands.max_error_hand_fraction = -1;
+  EXPECT_NE(o.Validate().message().find("hands: max_error_hand_fraction"), std::string::npos)
+      << o.Validate().message();
 }
 
 }  // namespace

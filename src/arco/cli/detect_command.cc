@@ -20,7 +20,8 @@ inline constexpr FieldFlag kDetectFlags[] = {{"num_threads", "--threads"},
                                              {"chunk_frames", "--chunk-frames"},
                                              {"min_detection_score", "--min-detection-score"},
                                              {"min_pose_presence", "--min-pose-presence"},
-                                             {"min_hand_presence", "--min-hand-presence"}};
+                                             {"min_hand_presence", "--min-hand-presence"},
+                                             {"max_error_hand_fraction", "--hand-gate"}};
 
 struct DetectArgs {
   capture::DetectStageOptions o;
@@ -29,6 +30,8 @@ struct DetectArgs {
   std::string frames;  // FIRST:LAST
   bool no_hand_recrop = false;
   bool no_decode_ahead = false;
+  bool no_hand_check = false;
+  bool hand_rerun = false;
 };
 
 void ApplyAndValidate(DetectArgs& a) {
@@ -40,6 +43,8 @@ void ApplyAndValidate(DetectArgs& a) {
   a.o.detector.hand_model = *hands;
   a.o.detector.hand_recrop = !a.no_hand_recrop;
   a.o.decode_ahead = !a.no_decode_ahead;
+  a.o.hands.enabled = !a.no_hand_check;
+  a.o.hands.rerun = a.hand_rerun;
   ThrowIfInvalid(ParseFrameRange(a.frames, &a.o.first_frame, &a.o.last_frame));
   const Status valid = a.o.Validate();
   if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kDetectFlags)));
@@ -82,6 +87,23 @@ int RunDetect(const DetectArgs& a) {
       per_frame_ms(s.total.inference_s),
       per_frame_ms(s.decode_s),
       per_frame_ms(s.decode_wait_s));
+  const capture::HandConsistencySummary& h = s.hands;
+  if (h.ran) {
+    std::printf(
+        "hands across views: %lld checked, %lld views swapped, %lld disagreeing: %lld re-run "
+        "on the triangulated hand's crop (%lld then agreed), %lld down-weighted; %lld points "
+        "down-weighted in all (%.1f s)\n",
+        static_cast<long long>(h.hands_judged),
+        static_cast<long long>(h.swapped),
+        static_cast<long long>(h.disagreeing),
+        static_cast<long long>(h.recropped),
+        static_cast<long long>(h.fixed),
+        static_cast<long long>(h.hands_down_weighted),
+        static_cast<long long>(h.points_down_weighted),
+        h.wall_s);
+  } else {
+    std::printf("hands across views: not checked (%s)\n", h.skipped.c_str());
+  }
   if (s.kept_other_points) std::printf("kept the instrument and bow points already there\n");
   std::printf("wrote %s/keypoints2d.npy, detect.json and capture.json\n",
               NormalizeOutputPath(a.o.capture_dir).c_str());
@@ -147,6 +169,23 @@ std::function<int()> SetupDetect(CLI::App& app) {
   sub->add_flag("--no-hand-recrop",
                 a->no_hand_recrop,
                 "Hand crops straight from the pose, without hand_recrop's refinement");
+  AddNumber(sub,
+            "--hand-gate",
+            a->o.hands.max_error_hand_fraction,
+            "A view's hand disagrees with the hand triangulated from all views when its median "
+            "reprojection error exceeds this fraction of the hand's size in that view (and "
+            "4 px); its points are then down-weighted (score 0.05)",
+            capture::kHandGateFractionRange)
+      ->capture_default_str();
+  sub->add_flag("--no-hand-check",
+                a->no_hand_check,
+                "Leave each view's hands as detected: no check across the calibrated views "
+                "(swaps, re-runs, down-weighting)");
+  sub->add_flag("--hand-rerun",
+                a->hand_rerun,
+                "Before down-weighting a disagreeing hand, re-run the hand landmarker on a crop "
+                "around the hand triangulated from the other views and keep it if it then "
+                "agrees (decodes the frame again)");
   sub->add_flag("--no-decode-ahead",
                 a->no_decode_ahead,
                 "Decode each frame just before tracking it instead of on a thread beside "

@@ -300,6 +300,12 @@ struct WholeBodyTracker::Impl {
       }
       summary.postprocess_s += Seconds(decode);
     }
+    return HandInRoi(image, roi, first);
+  }
+
+  // The hand landmarker on `roi`: 21 points from `first` when the presence reaches
+  // min_hand_presence (left as they are otherwise); returns the presence.
+  StatusOr<double> HandInRoi(const cv::Mat& image, const Roi& roi, ScoredPoint* first) {
     CutCrop(image, roi, kHandSlot);
     ARCO_RETURN_IF_ERROR(Run(kHandSlot));
     const auto decode = Clock::now();
@@ -352,6 +358,23 @@ void WholeBodyTracker::Reset() {
   impl_->tracking = false;
   impl_->pose_roi = Roi();
   impl_->person_seen = false;
+}
+
+StatusOr<double> WholeBodyTracker::LandmarkHand(const media::Image& frame,
+                                                const Roi& roi,
+                                                ScoredPoint* first) {
+  if (frame.format != media::PixelFormat::kRgb8 || frame.width < 2 || frame.height < 2 ||
+      frame.pixels.size() != frame.row_bytes() * static_cast<size_t>(frame.height)) {
+    throw std::invalid_argument(
+        "WholeBodyTracker::LandmarkHand takes an RGB8 image of at least 2 x 2");
+  }
+  if (!roi.IsFinite() || !(roi.side_px > 0)) {
+    throw std::invalid_argument("WholeBodyTracker::LandmarkHand takes a finite, non-empty ROI");
+  }
+  const cv::Mat image(
+      frame.height, frame.width, CV_8UC3, const_cast<uint8_t*>(frame.pixels.data()));
+  for (int i = 0; i < kNumHandLandmarks; ++i) first[i] = ScoredPoint();
+  return impl_->HandInRoi(image, roi, first);
 }
 
 StatusOr<WholeBodyFrame> WholeBodyTracker::Track(const media::Image& frame) {

@@ -45,6 +45,7 @@
 #include <string>
 
 #include "arco/detect/model_registry.h"
+#include "arco/detect/roi.h"
 #include "arco/media/image.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/number_range.h"
@@ -164,6 +165,13 @@ class WholeBodyTracker {
   StatusOr<WholeBodyFrame> Track(const media::Image& frame);
   // Forgets the tracked person: the next frame starts with detection. Keeps summary().
   void Reset();
+  // The hand landmarker alone on `roi` of `frame` (a crop the caller chose, e.g. around a
+  // hand triangulated from other views: capture/hand_consistency.h): writes 21 points in
+  // hand_21 order from `first`, each scored with the presence (all NaN when the presence
+  // is below min_hand_presence), and returns the presence. Neither reads nor changes the
+  // tracking state; counted in summary() as a hand landmark run. Same frame checks as
+  // Track.
+  StatusOr<double> LandmarkHand(const media::Image& frame, const Roi& roi, ScoredPoint* first);
 
   const WholeBodyOptions& options() const;
   const WholeBodySummary& summary() const;

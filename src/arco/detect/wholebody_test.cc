@@ -212,6 +212,61 @@ TEST(WholeBodyTracker, CellistLeftHandOnTheFingerboard) {
 
 // Any one missing model stops Create with the line naming that file and scripts/setup
 // (here the hand model, the last one loaded).
+// The hand landmarker alone on a crop the caller chooses (capture/hand_consistency.h's
+// re-run): a crop around the tracked left hand finds it again where Track did; a crop of
+// the floor finds nothing; the tracking state is untouched (the next Track tracks).
+TEST(WholeBodyTracker, LandmarkHandOnACallersCrop) {
+  ARCO_REQUIRE_MODELS();
+  const media::Image image = ReadImage(ARCO_SHARED_DATA_DIR "/spd/example.jpg");
+  ASSERT_FALSE(image.empty());
+  StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(TestOptions());
+  ASSERT_TRUE(tracker.ok()) << tracker.status().message();
+  StatusOr<WholeBodyFrame> out = tracker->Track(image);
+  ASSERT_TRUE(out.ok()) << out.status().message();
+  ASSERT_TRUE(out->left_hand);
+  const ScoredPoint* hand = &out->points[wholebody::kLeftHandFirst];
+  double lo_x = 1e9, lo_y = 1e9, hi_x = -1e9, hi_y = -1e9;
+  for (int i = 0; i < 21; ++i) {
+    lo_x = std::min<double>(lo_x, hand[i].x_px);
+    hi_x = std::max<double>(hi_x, hand[i].x_px);
+    lo_y = std::min<double>(lo_y, hand[i].y_px);
+    hi_y = std::max<double>(hi_y, hand[i].y_px);
+  }
+  Roi roi;
+  roi.centre = {0.5 * (lo_x + hi_x), 0.5 * (lo_y + hi_y)};
+  roi.side_px = 2 * std::max(hi_x - lo_x, hi_y - lo_y);
+  roi.rotation_rad = AlignmentRotation(
+      {hand[0].x_px, hand[0].y_px}, {hand[9].x_px, hand[9].y_px}, 3.14159265358979 / 2);
+  std::array<ScoredPoint, 21> again;
+  StatusOr<double> presence = tracker->LandmarkHand(image, roi, again.data());
+  ASSERT_TRUE(presence.ok()) << presence.status().message();
+  EXPECT_GT(*presence, 0.9);
+  std::vector<double> moves;
+  for (int i = 0; i < 21; ++i) {
+    EXPECT_FLOAT_EQ(again[i].score, static_cast<float>(*presence));
+    moves.push_back(std::hypot(again[i].x_px - hand[i].x_px, again[i].y_px - hand[i].y_px));
+  }
+  std::sort(moves.begin(), moves.end());
+  std::printf(
+      "LandmarkHand: presence %.3f, median %.1f px from Track's hand\n", *presence, moves[10]);
+  EXPECT_LT(moves[10], 0.1 * roi.side_px);
+  // The carpet far from the player (network_test.cc's crop): no hand, every point NaN.
+  Roi floor;
+  floor.centre = {300, 2400};
+  floor.side_px = roi.side_px;
+  presence = tracker->LandmarkHand(image, floor, again.data());
+  ASSERT_TRUE(presence.ok());
+  EXPECT_LT(*presence, 0.5);
+  for (const ScoredPoint& p : again) EXPECT_TRUE(std::isnan(p.x_px));
+  Roi bad;
+  bad.side_px = NAN;
+  EXPECT_THROW((void)tracker->LandmarkHand(image, bad, again.data()), std::invalid_argument);
+  // The tracking state is the one Track left: no detector on the next frame.
+  out = tracker->Track(image);
+  ASSERT_TRUE(out.ok());
+  EXPECT_FALSE(out->detector_ran);
+}
+
 TEST(WholeBodyTracker, MissingHandModelNamesIt) {
   ARCO_REQUIRE_MODELS();
   const arco::testing::TempDir temp;
