@@ -416,9 +416,9 @@ TEST_F(TrackPlane, EveryInstrumentPointInEveryViewAndFrame) {
 
 // Two cameras that started later than the others (phones synced by sound: capture.json's
 // cameras[].offset_s), one of them labelled: their videos hold the scene from frame
-// 1 + k on, k = 12 (a labelled view) and 5. `arco track` must solve each frame's pose from
-// the pictures of one moment and leave every camera's points where it saw the instrument
-// at the capture's frames, as readers of keypoints2d.npy (and `arco triangulate`) sample
+// 1 + k on, k = 12 (a labelled view) and 5 (with a drift_ppm too). `arco track` must solve each
+// frame's pose from the pictures of one moment and leave every camera's points where it saw the
+// instrument at the capture's frames, as readers of keypoints2d.npy (and `arco triangulate`) sample
 // them. Before, it read frame g of every video as one moment: the labelled view's
 // labels were checked against its frame 21 (the scene's 33) and its points were 12
 // frames off in time.
@@ -454,6 +454,10 @@ TEST_F(TrackPlane, CamerasWithAnOffsetAreTrackedAtTheCapturesFrames) {
     cam["video"] = dir + "/videos/" + s.scene.rig.cameras[v].name + ".mkv";
     cam["offset_s"] = k / 30.0;
   }
+  // The second one's clock also runs 2000 ppm slow by capture.json (its frames rendered
+  // at whole frames: up to 0.06 frame off its stated moments), so that its rows are
+  // written between capture frames and read back between rows.
+  (*manifest)["cameras"][kShifted[1]]["drift_ppm"] = 2000;
   ASSERT_TRUE(AtomicWriteFile(capture + "/capture.json", manifest->dump(1)).ok());
 
   // Labels of the capture's frame 21 (the scene's): the late labelled camera's are of

@@ -592,7 +592,12 @@ Status WriteTrackOutputs(const TrackStageOptions& options,
     const double a = manifest.CameraFrameAt(v, 0.0), b = manifest.CameraFrameAt(v, 1.0) - a;
     for (int64_t f = 0; f < manifest.frame_count; ++f) {
       const bool recorded = manifest.VideoFrameNumber(v, first + f) >= 0;
-      const double row = (static_cast<double>(first + f) - a) / b - static_cast<double>(first);
+      double row = (static_cast<double>(first + f) - a) / b - static_cast<double>(first);
+      // Within half a frame past the first or last capture frame (a drifting clock): the
+      // points of that frame, as near as the tracker's pictures are to their moments.
+      const double end = static_cast<double>(manifest.frame_count - 1);
+      if (row < 0 && row >= -0.5) row = 0;
+      if (row > end && row <= end + 0.5) row = end;
       double lower = std::floor(row);
       double w = row - lower;
       if (w < 1e-9) w = 0;  // within a rounding error of a frame: that frame alone
