@@ -227,7 +227,16 @@ assert r["world"].startswith("the first camera") and r["rms_px"] < 3, r
 assert abs(r["string_length_mm"] - 695) < 1e-9 and r["cameras"][0]["pnp_frames"] > 0, r
 assert abs(r["string_length_measured"]["error_mm"]) < 3, r["string_length_measured"]
 PY' "from-instrument recovers the pair: $(tail -2 "$tmp/fi.out") $(cat "$tmp/err")"
-for bad in "--min-score 1:keypoints2d.npy: camera .* never shows 5 of the cello" \
+# --labels: labelme files of one frame (as `arco track --labels`); bad ones are one line
+# naming the file.
+cam0=$(/usr/bin/python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['cameras'][0]['name'])" "$tmp/two/capture.json")
+echo '{"shapes": [{"label": "fingerboard", "points": [[10, 10]], "shape_type": "point"}]}' >"$tmp/odd.json"
+for bad in "--labels nosuch=$tmp/odd.json:odd.json: camera nosuch is not in .*capture.json (cameras: " \
+           "--labels $cam0=$tmp/odd.json:odd.json: label .fingerboard. is not a point of the cello (scroll_top, " \
+           "--labels justtext:--labels .justtext. must look like CAMERA=LABELME.json" \
+           "--labels $cam0@3=$tmp/odd.json:must look like CAMERA=LABELME.json (the labels of --labels-frame)" \
+           "--labels $cam0=$tmp/odd.json --labels-frame -2:--labels-frame" \
+           "--min-score 1:keypoints2d.npy: camera .* never shows 5 of the cello" \
            ":capture.json: camera .* has no video to read its image size from" \
            "--image-size 12by4:--image-size: .12by4. is not WIDTHxHEIGHT" \
            "--focal-px 1000 --fov-deg 60:give one of them, not both"; do

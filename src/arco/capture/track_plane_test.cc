@@ -23,6 +23,7 @@
 #include "arco/capture/capture_new.h"
 #include "arco/capture/track_stage.h"
 #include "arco/media/video_reader.h"
+#include "arco/mocap/capture.h"
 #include "arco/mocap/labelme.h"
 #include "arco/mocap/triangulate_point.h"
 #include "arco/pipeline/triangulate_stage.h"
@@ -411,6 +412,144 @@ TEST_F(TrackPlane, EveryInstrumentPointInEveryViewAndFrame) {
               2 * kFrames);
   EXPECT_LE(Median(bow_mm), 8.0);
   EXPECT_GE(bow_mm.size(), static_cast<size_t>(2 * kFrames * 0.98));
+}
+
+// Two cameras that started later than the others (phones synced by sound: capture.json's
+// cameras[].offset_s), one of them labelled: their videos hold the scene from frame
+// 1 + k on, k = 12 (a labelled view) and 5 (with a drift_ppm too). `arco track` must solve each
+// frame's pose from the pictures of one moment and leave every camera's points where it saw the
+// instrument at the capture's frames, as readers of keypoints2d.npy (and `arco triangulate`) sample
+// them. Before, it read frame g of every video as one moment: the labelled view's
+// labels were checked against its frame 21 (the scene's 33) and its points were 12
+// frames off in time.
+TEST_F(TrackPlane, CamerasWithAnOffsetAreTrackedAtTheCapturesFrames) {
+  Scene& s = *g_scene;
+  constexpr int kShifted[2] = {kLabelViews[1], 0};
+  constexpr int kShift[2] = {12, 5};
+  constexpr int kCaptureFrames = kFrames - 12;
+  const std::string capture = s.dir / "capture_offset";
+  fs::remove_all(capture);
+  fs::create_directories(capture);
+  for (const auto& e : fs::directory_iterator(s.capture)) {
+    const std::string name = e.path().filename();
+    if (name == "capture.json" || name == "keypoints2d.npy" || name == "track.json") continue;
+    if (e.is_regular_file()) fs::copy_file(e.path(), capture + "/" + name);
+  }
+  auto manifest = ParseJsonLenient(s.fresh_manifest, "capture.json");
+  ASSERT_TRUE(manifest.ok());
+  (*manifest)["frames"]["count"] = kCaptureFrames;
+  // The shifted cameras' videos: the scene from frame 1 + k, one camera per scene folder.
+  for (int i = 0; i < 2; ++i) {
+    const int v = kShifted[i], k = kShift[i];
+    testing::PlaneScene late = s.scene;
+    late.rig.cameras = {s.scene.rig.cameras[v]};
+    late.world_from_plane.assign(s.scene.world_from_plane.begin() + k,
+                                 s.scene.world_from_plane.end());
+    testing::PlaneSceneWriteOptions write;
+    write.render.supersampling = 1;
+    const std::string dir = s.dir / ("scene_late_" + std::to_string(v));
+    ASSERT_TRUE(testing::WritePlaneScene(late, dir, write).ok());
+    Json& cam = (*manifest)["cameras"][v];
+    ASSERT_EQ(cam["name"], s.scene.rig.cameras[v].name);
+    cam["video"] = dir + "/videos/" + s.scene.rig.cameras[v].name + ".mkv";
+    cam["offset_s"] = k / 30.0;
+  }
+  // The second one's clock also runs 2000 ppm slow by capture.json (its frames rendered
+  // at whole frames: up to 0.06 frame off its stated moments), so that its rows are
+  // written between capture frames and read back between rows.
+  (*manifest)["cameras"][kShifted[1]]["drift_ppm"] = 2000;
+  ASSERT_TRUE(AtomicWriteFile(capture + "/capture.json", manifest->dump(1)).ok());
+
+  // Labels of the capture's frame 21 (the scene's): the late labelled camera's are of
+  // its own frame 9.
+  TrackStageOptions o;
+  o.capture_dir = capture;
+  for (int v : kLabelViews) {
+    const std::string cam = s.scene.rig.cameras[v].name;
+    o.labels.push_back({cam, -1, s.dir / LabelFile(cam, 20)});
+  }
+  o.labels_frame = 21;
+  o.num_threads = 2;
+  o.track_bow = false;
+  auto tracked = RunTrackStage(o);
+  ASSERT_TRUE(tracked.ok()) << tracked.status().message();
+  EXPECT_EQ(tracked->template_frame, 21);
+  EXPECT_EQ(tracked->frames_without_pose, 0);
+  EXPECT_LT(tracked->label_rms_px, 0.1);
+  // The late cameras saw 33 - k + 1 ... of the capture's frames: k frames without a picture.
+  EXPECT_EQ(tracked->cameras[kShifted[0]].frames, kCaptureFrames - kShift[0]);
+  EXPECT_EQ(tracked->cameras[kShifted[1]].frames, kCaptureFrames - kShift[1]);
+
+  // Every instrument point at the capture's frames (as every reader samples the rows)
+  // against its exact projection at that moment.
+  auto read_manifest = ReadCaptureManifest(capture);
+  ASSERT_TRUE(read_manifest.ok());
+  auto kp = ReadCaptureKeypoints2d(capture, *read_manifest);
+  ASSERT_TRUE(kp.ok()) << kp.status().message();
+  const std::vector<int>& slots = *FindKeypointLayout("spd_cello")->Group("instrument");
+  std::vector<double> errors_px, late_px;
+  int missing = 0, late_missing = 0;
+  for (int f = 0; f < kCaptureFrames; ++f)
+    for (int v = 0; v < kCameras; ++v) {
+      const int i = v == kShifted[0] ? 0 : v == kShifted[1] ? 1 : -1;
+      for (size_t p = 0; p < slots.size(); ++p) {
+        const double* x = &kp->at(f, v, slots[p], 0);
+        if (i >= 0 && f < kShift[i]) {
+          EXPECT_TRUE(std::isnan(x[0])) << "the camera had not started: frame " << f + 1;
+          continue;
+        }
+        const auto truth = testing::ProjectPlanePoint(
+            s.scene.rig.cameras[v], s.scene.world_from_plane[f], s.scene.texture, s.texture_px[p]);
+        if (!truth || !testing::InImage(s.scene.rig.cameras[v], *truth)) continue;
+        if (!std::isfinite(x[0])) {
+          ++(i >= 0 ? late_missing : missing);
+          continue;
+        }
+        const double e = (Eigen::Vector2d(x[0], x[1]) - *truth).norm();
+        (i >= 0 ? late_px : errors_px).push_back(e);
+      }
+    }
+  ASSERT_FALSE(errors_px.empty());
+  ASSERT_FALSE(late_px.empty());
+  std::printf(
+      "two cameras 12 and 5 frames late: 2D median %.2f px, 95th %.2f px (the late ones %.2f px, "
+      "%.2f px, max %.2f px)\n",
+      Median(errors_px),
+      InterpolatedQuantile(errors_px, 0.95),
+      Median(late_px),
+      InterpolatedQuantile(late_px, 0.95),
+      *std::max_element(late_px.begin(), late_px.end()));
+  EXPECT_LE(Median(errors_px), 2.0);
+  EXPECT_LE(InterpolatedQuantile(errors_px, 0.95), 6.0);
+  EXPECT_LE(Median(late_px), 2.0);
+  EXPECT_LE(InterpolatedQuantile(late_px, 0.95), 6.0);
+  EXPECT_EQ(missing, 0);
+  EXPECT_EQ(late_missing, 0);
+
+  // 3D from `arco triangulate` at the capture's frames.
+  pipeline::TriangulateStageOptions t;
+  t.capture_dir = capture;
+  t.result_dir = s.dir / "result_offset";
+  auto triangulated = pipeline::RunTriangulateStage(t);
+  ASSERT_TRUE(triangulated.ok()) << triangulated.status().message();
+  auto p3 = ReadNpy<double>(t.result_dir + "/triangulation/points3d_raw.npy");
+  ASSERT_TRUE(p3.ok()) << p3.status().message();
+  std::vector<double> errors_mm;
+  for (int f = 0; f < kCaptureFrames; ++f)
+    for (size_t p = 0; p < slots.size(); ++p) {
+      const double* x = &p3->data[static_cast<size_t>((f * p3->shape[1] + slots[p]) * 3)];
+      if (!std::isfinite(x[0])) continue;
+      const Eigen::Vector3d truth =
+          testing::PlaneToWorld(s.scene.world_from_plane[f],
+                                testing::TexturePixelToPlane(s.scene.texture, s.texture_px[p]));
+      errors_mm.push_back((Eigen::Vector3d(x[0], x[1], x[2]) - truth).norm());
+    }
+  ASSERT_GE(errors_mm.size(), static_cast<size_t>(0.98 * kCaptureFrames * slots.size()));
+  std::printf("  3D median %.2f mm, 95th %.2f mm\n",
+              Median(errors_mm),
+              InterpolatedQuantile(errors_mm, 0.95));
+  EXPECT_LE(Median(errors_mm), 4.0);
+  EXPECT_LE(InterpolatedQuantile(errors_mm, 0.95), 10.0);
 }
 
 TEST_F(TrackPlane, SameBytesForAnyThreadCount) {

@@ -45,9 +45,11 @@ class Frames {
     }
   }
 
-  // Reads global frame g of every view (in parallel over views); a null pointer for a
-  // view that dropped it.
-  StatusOr<std::vector<const media::Image*>> Read(int64_t g, int threads, double* decode_s) {
+  // Reads each view's own global frame `camera_frames[v]` (CameraFrameNear; in parallel
+  // over views); a null pointer for a view without one (-1) or that dropped it.
+  StatusOr<std::vector<const media::Image*>> Read(const std::vector<int64_t>& camera_frames,
+                                                  int threads,
+                                                  double* decode_s) {
     const auto start = std::chrono::steady_clock::now();
     const int n = static_cast<int>(readers_.size());
     std::vector<Status> status(n, Status::Ok());
@@ -56,7 +58,8 @@ class Frames {
         n,
         threads,
         [&](int64_t v, int) {
-          StatusOr<bool> read = readers_[v].Read(g, &images_[v]);
+          if (camera_frames[v] < 0) return;
+          StatusOr<bool> read = readers_[v].Read(camera_frames[v], &images_[v]);
           if (!read.ok()) {
             status[v] = read.status();
           } else if (*read) {
@@ -110,6 +113,21 @@ StatusOr<double> MmPerWorldUnit(const std::string& units,
   }
   ARCO_ASSIGN_OR_RETURN(const InstrumentModel model, InstrumentModel::Create(instrument));
   return model.string_length_mm() / (nut - bridge).norm();
+}
+
+// Each view's own global frame whose picture is nearest the capture's frame g
+// (cameras[].offset_s, drift_ppm: round(CameraFrameAt)), -1 when that is outside the
+// capture's rows (before the camera started, after the shortest recording ended). g
+// itself for a camera on the capture's clock.
+std::vector<int64_t> CameraFramesNear(const TrackCapture& capture, int64_t g) {
+  const CaptureManifest& manifest = capture.manifest;
+  std::vector<int64_t> out(capture.views(), g);
+  for (int v = 0; v < capture.views(); ++v) {
+    if (manifest.cameras[v].OnCaptureClock()) continue;
+    const int64_t own = std::llround(manifest.CameraFrameAt(v, static_cast<double>(g)));
+    out[v] = own >= capture.first && own <= capture.last ? own : -1;
+  }
+  return out;
 }
 
 // The index of point p of view v in frame f (from the first) of keypoints2d.npy.
@@ -179,9 +197,20 @@ StatusOr<TrackLabels> ReadTrackLabels(const TrackStageOptions& options,
                            " is outside the capture's frames " + std::to_string(first) + ":" +
                            std::to_string(last));
     }
-    if (manifest.VideoFrameNumber(v, frame) < 0) {
+    // The labelled frame is the capture's: the labels of a camera off the capture's
+    // clock are of its own frame nearest that moment (docs/track.md, "How to label").
+    const int64_t own = CameraFramesNear(capture, frame)[v];
+    if (own < 0) {
+      return Status::Error(
+          file.path + ": camera " + file.camera + " did not record frame " + std::to_string(frame) +
+          " of the capture (its offset_s " + FormatNumber(manifest.cameras[v].offset_s) +
+          " s puts it at its frame " +
+          std::to_string(std::llround(manifest.CameraFrameAt(v, static_cast<double>(frame)))) +
+          ", outside " + std::to_string(first) + ":" + std::to_string(last) + ")");
+    }
+    if (manifest.VideoFrameNumber(v, own) < 0) {
       return Status::Error(file.path + ": camera " + file.camera + " dropped frame " +
-                           std::to_string(frame));
+                           std::to_string(own));
     }
     ARCO_ASSIGN_OR_RETURN(const LabelmeAnnotation a, ReadLabelme(file.path));
     const Camera& cam = capture.cameras[v];
@@ -359,14 +388,18 @@ StatusOr<TrackRun> TrackCaptureFrames(const TrackStageOptions& options,
   const int64_t first = capture.first, last = capture.last;
   const int64_t template_frame = templates.template_frame;
   const std::vector<Camera>& cameras = templates.cameras;
-  // The right hand per view in frame f (capture index): the mean pixel of its points that
+  // The right hand per view in the pictures read (each view's row of its own frame
+  // `camera_frames[v]`, as `arco detect` wrote it): the mean pixel of its points that
   // `arco detect` scored at least bow_hand_min_score, when enough did; NaN otherwise.
   const std::vector<int>* hand_slots = capture.layout->Group("right_hand");
-  const auto right_hand = [&](int64_t f, int64_t* frames_with_hand) {
+  const auto right_hand = [&](const std::vector<int64_t>& camera_frames,
+                              int64_t* frames_with_hand) {
     std::vector<Eigen::Vector2d> px(views, Eigen::Vector2d::Constant(kNaN));
     if (!summary->kept_other_points || hand_slots == nullptr) return px;
     int seen = 0;
     for (int v = 0; v < views; ++v) {
+      if (camera_frames[v] < 0) continue;
+      const int64_t f = camera_frames[v] - first;
       Eigen::Vector2d sum = Eigen::Vector2d::Zero();
       int count = 0;
       for (int slot : *hand_slots) {
@@ -385,7 +418,15 @@ StatusOr<TrackRun> TrackCaptureFrames(const TrackStageOptions& options,
     return px;
   };
 
-  // Forwards from the labelled frame, then backwards.
+  // Forwards from the labelled frame, then backwards, over the capture's frames: the
+  // pose of frame g is solved from every view at once, so the pictures of one solve must
+  // be of one moment. A camera off the capture's clock (phones synced by sound) gives its
+  // own frame nearest g (CameraFramesNear): its tracks still move from one picture to the
+  // next of its video (a frame repeats or is skipped only once in 1 / drift frames), and
+  // the views of a solve are at most half a frame apart. Tracking each camera in its own
+  // frames and resampling the points afterwards, as `arco detect` may for a detector
+  // that sees one view, would solve each pose from pictures up to the offset apart.
+  // WriteTrackOutputs puts the points back on each camera's own rows.
   const int threads = ResolveThreadCount(options.num_threads);
   track::InstrumentTrackerOptions tracker_options = options.tracker;
   tracker_options.num_threads = threads;
@@ -409,8 +450,9 @@ StatusOr<TrackRun> TrackCaptureFrames(const TrackStageOptions& options,
     track::TrackFrame bow_r;
     Frames frames(manifest, capture.inputs);
     for (int64_t g = template_frame; g >= first && g <= last; g += step) {
+      const std::vector<int64_t> camera_frames = CameraFramesNear(capture, g);
       ARCO_ASSIGN_OR_RETURN(std::vector<const media::Image*> images,
-                            frames.Read(g, threads, &summary->decode_s));
+                            frames.Read(camera_frames, threads, &summary->decode_s));
       track::TrackFrame r;
       if (g == template_frame) {
         // A view that dropped the labelled frame starts from a blank picture.
@@ -425,7 +467,7 @@ StatusOr<TrackRun> TrackCaptureFrames(const TrackStageOptions& options,
         if (bow_tracker) {
           const auto bow_start = std::chrono::steady_clock::now();
           int64_t with_hand = 0;
-          const std::vector<Eigen::Vector2d> hand = right_hand(g - first, &with_hand);
+          const std::vector<Eigen::Vector2d> hand = right_hand(camera_frames, &with_hand);
           if (step > 0) summary->bow_hand_frames += with_hand;
           bow_r = bow_tracker->Start(images, &hand);
           summary->bow_s += SecondsSince(bow_start);
@@ -437,7 +479,7 @@ StatusOr<TrackRun> TrackCaptureFrames(const TrackStageOptions& options,
           const auto bow_start = std::chrono::steady_clock::now();
           const auto bow_it = labels.bow_labelled.find(g);
           int64_t with_hand = 0;
-          const std::vector<Eigen::Vector2d> hand = right_hand(g - first, &with_hand);
+          const std::vector<Eigen::Vector2d> hand = right_hand(camera_frames, &with_hand);
           bow_r = bow_tracker->Next(
               images, bow_it != labels.bow_labelled.end() ? &bow_it->second : nullptr, &hand);
           summary->bow_s += SecondsSince(bow_start);
@@ -484,13 +526,18 @@ Status WriteTrackOutputs(const TrackStageOptions& options,
     out.data[k + 1] = ok ? static_cast<float>(q.pixel.y()) : kNaNf;
     out.data[k + 2] = ok ? static_cast<float>(q.score) : kNaNf;
   };
+  // Whether view v had a picture for the capture's frame g (the tracker's frames).
+  const auto seen = [&](int v, int64_t g) {
+    const int64_t own = CameraFramesNear(capture, g)[v];
+    return own >= 0 && manifest.VideoFrameNumber(v, own) >= 0;
+  };
   Json frames_json = Json::array();
   for (int64_t f = 0; f < manifest.frame_count; ++f) {
     const track::TrackFrame& r = run.instrument[f];
     if (!r.pose_ok) ++summary->frames_without_pose;
     Json view_json = Json::array();
     for (int v = 0; v < views; ++v) {
-      const bool recorded = manifest.VideoFrameNumber(v, first + f) >= 0;
+      const bool recorded = seen(v, first + f);
       const track::ViewTrackReport& vr = r.views[v];
       view_json.push_back(ViewJson(vr));
       TrackCameraSummary& c = summary->cameras[v];
@@ -501,6 +548,8 @@ Status WriteTrackOutputs(const TrackStageOptions& options,
         c.mean_inliers += vr.inliers;
         c.mean_residual_px += vr.residual_px;
       }
+      // A camera off the capture's clock: its rows below.
+      if (!manifest.cameras[v].OnCaptureClock()) continue;
       for (size_t p = 0; p < names.size(); ++p) {
         put(f, v, (*capture.instrument_slots)[p], recorded, r.points[v][p]);
       }
@@ -515,7 +564,7 @@ Status WriteTrackOutputs(const TrackStageOptions& options,
       Json bow_views = Json::array();
       for (const auto& vr : b.views) bow_views.push_back(ViewJson(vr));
       for (int v = 0; v < views; ++v) {
-        if (manifest.VideoFrameNumber(v, first + f) < 0) continue;
+        if (!seen(v, first + f)) continue;
         summary->cameras[v].bow_lost_frames += b.views[v].lost;
       }
       bow_json = Json{{"pose_ok", b.pose_ok},
@@ -530,6 +579,52 @@ Status WriteTrackOutputs(const TrackStageOptions& options,
                            {"residual_px", r.residual_px},
                            {"views", view_json},
                            {"bow", bow_json}});
+  }
+  // keypoints2d.npy's rows of a camera off the capture's clock are its own frames
+  // (docs/formats.md, "Cameras synced by sound"): own frame n, exposed at the capture's
+  // (fractional) frame c, gets the points tracked at the capture's frames around c,
+  // linearly between the two (x and y; the lower score), as ResampleCameraKeypoints
+  // samples them, so that readers, which sample the rows back at the capture's frames,
+  // get the tracked points (exactly when the offset is a whole number of frames).
+  for (int v = 0; v < views; ++v) {
+    if (manifest.cameras[v].OnCaptureClock()) continue;
+    // CameraFrameAt is affine in the capture's frame: its inverse.
+    const double a = manifest.CameraFrameAt(v, 0.0), b = manifest.CameraFrameAt(v, 1.0) - a;
+    for (int64_t f = 0; f < manifest.frame_count; ++f) {
+      const bool recorded = manifest.VideoFrameNumber(v, first + f) >= 0;
+      double row = (static_cast<double>(first + f) - a) / b - static_cast<double>(first);
+      // Within half a frame past the first or last capture frame (a drifting clock): the
+      // points of that frame, as near as the tracker's pictures are to their moments.
+      const double end = static_cast<double>(manifest.frame_count - 1);
+      if (row < 0 && row >= -0.5) row = 0;
+      if (row > end && row <= end + 0.5) row = end;
+      double lower = std::floor(row);
+      double w = row - lower;
+      if (w < 1e-9) w = 0;  // within a rounding error of a frame: that frame alone
+      if (w > 1 - 1e-9) {
+        lower += 1;
+        w = 0;
+      }
+      const int64_t i0 = static_cast<int64_t>(lower), i1 = w == 0 ? i0 : i0 + 1;
+      const bool inside = lower >= 0 && i1 < manifest.frame_count;
+      const auto sample = [&](const std::vector<track::TrackFrame>& frames, size_t p) {
+        track::TrackedPoint q;
+        q.pixel = Eigen::Vector2d::Constant(kNaN);
+        if (!inside) return q;
+        const track::TrackedPoint& q0 = frames[i0].points[v][p];
+        const track::TrackedPoint& q1 = frames[i1].points[v][p];
+        q.pixel = (1 - w) * q0.pixel + w * q1.pixel;
+        q.score =
+            std::isnan(q0.score) || std::isnan(q1.score) ? kNaN : std::min(q0.score, q1.score);
+        return q;
+      };
+      for (size_t p = 0; p < names.size(); ++p) {
+        put(f, v, (*capture.instrument_slots)[p], recorded, sample(run.instrument, p));
+      }
+      for (size_t p = 0; bow_tracked && p < bow_names.size(); ++p) {
+        put(f, v, (*capture.bow_slots)[p], recorded, sample(run.bow, p));
+      }
+    }
   }
   if (bow_tracked && summary->bow_frames_without_pose > 0) {
     summary->warnings.push_back(

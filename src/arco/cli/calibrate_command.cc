@@ -4,6 +4,8 @@
 // `arco calibration show|convert`, which inspects and converts existing files.
 #include <cstdio>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "arco/calibration/calibrate.h"
 #include "arco/cli/command.h"
@@ -130,7 +132,9 @@ inline constexpr FieldFlag kFromInstrumentFlags[] = {{"focal_px", "--focal-px"},
                                                      {"min_points", "--min-points"},
                                                      {"pnp_gate_px", "--pnp-gate-px"},
                                                      {"max_frames", "--max-frames"},
-                                                     {"max_iterations", "--max-iterations"}};
+                                                     {"max_iterations", "--max-iterations"},
+                                                     {"labels_frame", "--labels-frame"},
+                                                     {"labels", "--labels"}};
 
 int RunFromInstrument(const pipeline::CalibrationFromInstrumentOptions& options) {
   ProgressBar bar("from-instrument");
@@ -495,6 +499,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
   auto fi = std::make_shared<pipeline::CalibrationFromInstrumentOptions>();
   auto image_size = std::make_shared<std::string>();
   auto fix_focal = std::make_shared<bool>(false);
+  auto labels = std::make_shared<std::vector<std::string>>();
   auto* from_instrument = cmd->add_subcommand(
       "from-instrument",
       "Calibrate two or more cameras without a board, from the take itself: each camera's "
@@ -560,8 +565,29 @@ CommandRun SetupCalibrate(CLI::App& app) {
             "Bundle adjustment iterations per pass at most",
             pipeline::kRefineIterationsRange)
       ->capture_default_str();
-  from_instrument->parse_complete_callback([fi, image_size, fix_focal] {
+  from_instrument->add_option(
+      "--labels",
+      *labels,
+      "CAMERA=LABELME.json: the instrument's points labelled in one frame (--labels-frame) of "
+      "each camera, as `arco track --labels` takes them, put in every frame in place of "
+      "keypoints2d's (a starting calibration; docs/phones.md); one per camera");
+  AddNumber(from_instrument,
+            "--labels-frame",
+            fi->labels_frame,
+            "Capture frame the labels are on (-1 = the capture's first frame), as `arco track`'s",
+            Closed(-1, 1e12))
+      ->capture_default_str();
+  from_instrument->parse_complete_callback([fi, image_size, fix_focal, labels] {
     fi->refine_focal = !*fix_focal;
+    fi->labels.clear();
+    for (const std::string& text : *labels) {
+      const size_t eq = text.find('=');
+      if (eq == std::string::npos || eq == 0 || eq + 1 == text.size() || text.find('@') < eq)
+        ThrowIfInvalid(Status::Error("--labels \"" + text +
+                                     "\" must look like CAMERA=LABELME.json (the labels of "
+                                     "--labels-frame)"));
+      fi->labels.push_back({text.substr(0, eq), text.substr(eq + 1)});
+    }
     if (!image_size->empty()) {
       int w = 0, h = 0;
       char x = 0, extra = 0;
@@ -584,6 +610,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
     PathRoles roles;
     if (from_instrument->parsed()) {
       AddCaptureInputs(&roles, "CAPTURE", fi->capture_dir);
+      for (const auto& l : fi->labels) roles.AddInput("--labels", l.path);
       roles.AddOutput("-o", fi->output);
       if (!fi->output.empty()) {
         roles.AddOutput("-o's report", calibration::ReportPath(fi->output));

@@ -113,7 +113,8 @@ std::function<int()> SetupTrack(CLI::App& app) {
   AddNumber(sub,
             "--labels-frame",
             a->labels_frame,
-            "Global frame the labels are on (-1 = the capture's first frame)",
+            "Capture frame the labels are on (-1 = the capture's first frame); a camera synced "
+            "by sound shows it in its own frame nearest that moment (docs/track.md)",
             Closed(-1, 1e12))
       ->capture_default_str();
   AddNumber(sub,

@@ -15,6 +15,7 @@
 #include "arco/instrument/nominal_keypoints.h"
 #include "arco/media/video_reader.h"
 #include "arco/mocap/capture.h"
+#include "arco/mocap/labelme.h"
 #include "arco/mocap/triangulate_point.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/output_set.h"
@@ -100,6 +101,105 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// The labelled instrument points of every camera (labelme files, mocap/labelme.h) into
+// every frame of `keypoints` (the capture's frames; score 1), in place of its instrument
+// points: a starting point before anything is tracked. Every check first, each error one
+// line naming the file.
+Status PutLabels(const CalibrationFromInstrumentOptions& options,
+                 const CaptureManifest& manifest,
+                 const std::string& manifest_file,
+                 const Rig& rig,
+                 const KeypointLayout& layout,
+                 NpyArray<double>* keypoints) {
+  const int64_t first = manifest.frame_first, last = first + manifest.frame_count - 1;
+  const int64_t frame = options.labels_frame >= 0 ? options.labels_frame : first;
+  if (frame < first || frame > last)
+    return Status::Error("labels_frame " + std::to_string(frame) +
+                         " is outside the capture's frames " + std::to_string(first) + ":" +
+                         std::to_string(last) + " (" + manifest_file + ")");
+  const std::vector<int>* instrument = layout.Group("instrument");
+  const std::vector<int>* bow = layout.Group("bow");
+  if (instrument == nullptr || instrument->empty())
+    return Status::Error(manifest_file + ": layout " + layout.name + " has no instrument points");
+  std::string expected;
+  for (int column : *instrument) expected += (expected.empty() ? "" : ", ") + layout.names[column];
+  const int views = static_cast<int>(manifest.cameras.size());
+  // Per view, the labelled pixel of each instrument column (NaN: not labelled).
+  std::vector<std::vector<Eigen::Vector2d>> labelled(views);
+  std::vector<std::string> file_of(views);
+  for (const InstrumentLabelsFile& file : options.labels) {
+    const int v = manifest.FindCamera(file.camera);
+    if (v < 0) {
+      std::string cameras;
+      for (const CaptureCamera& c : manifest.cameras)
+        cameras += (cameras.empty() ? "" : ", ") + c.name;
+      return Status::Error(file.path + ": camera " + file.camera + " is not in " + manifest_file +
+                           " (cameras: " + cameras + ")");
+    }
+    if (!file_of[v].empty())
+      return Status::Error(file.path + ": camera " + file.camera + " is labelled twice (also " +
+                           file_of[v] + ")");
+    file_of[v] = file.path;
+    // The labelled frame is the capture's, as `arco track`'s: a camera off the capture's
+    // clock shows it in its own frame nearest that moment.
+    const int64_t own = manifest.cameras[v].OnCaptureClock()
+                            ? frame
+                            : std::llround(manifest.CameraFrameAt(v, static_cast<double>(frame)));
+    if (own < first || own > last || manifest.VideoFrameNumber(v, own) < 0)
+      return Status::Error(file.path + ": camera " + file.camera + " did not record frame " +
+                           std::to_string(frame) + " of the capture (--labels-frame)");
+    ARCO_ASSIGN_OR_RETURN(const LabelmeAnnotation a, ReadLabelme(file.path));
+    const Camera& cam = rig.cameras[v];
+    if ((a.image_width > 0 && a.image_width != cam.width) ||
+        (a.image_height > 0 && a.image_height != cam.height))
+      return Status::Error(file.path + ": image is " + std::to_string(a.image_width) + "x" +
+                           std::to_string(a.image_height) + ", camera " + cam.name + " is " +
+                           std::to_string(cam.width) + "x" + std::to_string(cam.height) +
+                           " (label the frame as turned by rotate_deg)");
+    labelled[v].assign(instrument->size(), Eigen::Vector2d::Constant(NAN));
+    int count = 0;
+    for (const LabeledPoint& p : a.points) {
+      const int column = layout.Find(CanonicalKeypointName(p.label));
+      const auto it = std::find(instrument->begin(), instrument->end(), column);
+      if (it == instrument->end()) {
+        if (column >= 0 && bow != nullptr &&
+            std::find(bow->begin(), bow->end(), column) != bow->end())
+          continue;  // the bow's frog and tip, for `arco track`
+        return Status::Error(file.path + ": label \"" + p.label + "\" is not a point of the " +
+                             manifest.instrument + " (" + expected + ") or the bow");
+      }
+      if (!(p.pixel.x() >= -0.5 && p.pixel.y() >= -0.5 && p.pixel.x() < cam.width - 0.5 &&
+            p.pixel.y() < cam.height - 0.5))
+        return Status::Error(file.path + ": label " + p.label + " at (" + NumberText(p.pixel.x()) +
+                             ", " + NumberText(p.pixel.y()) + ") is outside the " +
+                             std::to_string(cam.width) + "x" + std::to_string(cam.height) +
+                             " image of camera " + cam.name);
+      labelled[v][it - instrument->begin()] = p.pixel;
+      ++count;
+    }
+    if (count < options.min_points)
+      return Status::Error(file.path + ": " + std::to_string(count) + " of the " +
+                           manifest.instrument + "'s points are labelled, a camera's pose needs " +
+                           std::to_string(options.min_points) + " (" + expected + ")");
+  }
+  for (int v = 0; v < views; ++v)
+    if (file_of[v].empty())
+      return Status::Error("labels: camera " + manifest.cameras[v].name +
+                           " has no labels (give --labels " + manifest.cameras[v].name +
+                           "=LABELS.json)");
+  NpyArray<double>& k = *keypoints;
+  for (int64_t f = 0; f < k.shape[0]; ++f)
+    for (int v = 0; v < views; ++v)
+      for (size_t i = 0; i < instrument->size(); ++i) {
+        const Eigen::Vector2d& x = labelled[v][i];
+        const bool ok = std::isfinite(x.x());
+        k.at(f, v, (*instrument)[i], 0) = ok ? x.x() : NAN;
+        k.at(f, v, (*instrument)[i], 1) = ok ? x.y() : NAN;
+        k.at(f, v, (*instrument)[i], 2) = ok ? 1.0 : NAN;
+      }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status CalibrationFromInstrumentOptions::Validate() const {
@@ -120,6 +220,10 @@ Status CalibrationFromInstrumentOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(CheckInRange("pnp_gate_px", pnp_gate_px, kFromInstrumentGateRangePx));
   ARCO_RETURN_IF_ERROR(CheckInRange("max_frames", max_frames, kRefineMaxFramesRange));
   ARCO_RETURN_IF_ERROR(CheckInRange("max_iterations", max_iterations, kRefineIterationsRange));
+  if (labels_frame < -1) return Status::Error("labels_frame must be -1 (the first) or >= 0");
+  for (const InstrumentLabelsFile& l : labels)
+    if (l.camera.empty() || l.path.empty())
+      return Status::Error("labels: a camera and a file each (CAMERA=LABELS.json)");
   return Status::Ok();
 }
 
@@ -236,14 +340,21 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
 
   // 2. PnP per view and frame.
   ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(options.capture_dir, manifest));
-  ARCO_ASSIGN_OR_RETURN(const NpyArray<double> keypoints,
+  ARCO_ASSIGN_OR_RETURN(NpyArray<double> keypoints,
                         ReadCaptureKeypoints2d(options.capture_dir, manifest));
-  const std::string keypoints_file = ResolveCapturePath(options.capture_dir, manifest.keypoints2d);
+  std::string keypoints_file = ResolveCapturePath(options.capture_dir, manifest.keypoints2d);
   const int64_t frames = keypoints.shape[0];
   if (keypoints.shape[2] != layout->size())
     return Status::Error(keypoints_file + ": " + std::to_string(keypoints.shape[2]) +
                          " keypoints per view, layout " + manifest.layout + " has " +
                          std::to_string(layout->size()));
+  if (!options.labels.empty()) {
+    ARCO_RETURN_IF_ERROR(PutLabels(options, manifest, manifest_file, rig, *layout, &keypoints));
+    // Messages about the instrument's points name the labels.
+    keypoints_file.clear();
+    for (const InstrumentLabelsFile& l : options.labels)
+      keypoints_file += (keypoints_file.empty() ? "" : ", ") + l.path;
+  }
   const std::vector<Eigen::Vector3d> nominal = NominalKeypointsInInstrument(model);
   std::vector<std::pair<int, cv::Point3d>> rigid;  // layout column, nominal point
   for (int k : model.rigid_keypoints()) {
@@ -352,6 +463,7 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
   refine.capture_dir = options.capture_dir;
   refine.calibration = "the rig from the instrument's PnP poses";
   refine.input_rig = rig;
+  refine.input_keypoints = &keypoints;
   refine.write = false;
   refine.reference_camera = rig.cameras[0].name;
   refine.refine_focal = options.refine_focal;

@@ -7,6 +7,11 @@
 //    phone's main camera by default (kPhoneFovDeg: a 26 mm-equivalent lens on a 4:3
 //    sensor, whose width a video keeps); principal point at the image centre, no
 //    distortion. The summary says which.
+//    With labels (`--labels CAMERA=LABELS.json`, labelme files of one frame as `arco
+//    track` takes them, read by mocap/labelme.h), the instrument's points come from them:
+//    the labelled points are put in every frame of their camera (score 1), as if the
+//    instrument stood still for the whole take, in place of keypoints2d's instrument
+//    points (a starting calibration for `arco track`; docs/phones.md).
 // 2. Per camera and frame, cam_from_instrument by PnP of the instrument's rigid keypoints
 //    against their nominal places (instrument/nominal_keypoints.h: the model's real
 //    dimensions give the metric scale): EPnP (Lepetit, Moreno-Noguer, Fua, IJCV 2009)
@@ -25,6 +30,7 @@
 // identity), millimetres.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -44,6 +50,12 @@ inline constexpr NumberRange kFromInstrumentPointsRange = Closed(4, 64);
 inline constexpr NumberRange kFromInstrumentGateRangePx = AboveZero(1000);
 inline constexpr NumberRange kFromInstrumentImageSideRange = Closed(0, 100000);
 
+// One labelme file: the instrument's points labelled in `camera` (name or serial).
+struct InstrumentLabelsFile {
+  std::string camera;
+  std::string path;
+};
+
 struct CalibrationFromInstrumentOptions {
   std::string capture_dir;
   std::string output;        // calibration to write (.json, .yaml/.yml, .xml)
@@ -60,7 +72,11 @@ struct CalibrationFromInstrumentOptions {
   // views constrain each point less (docs/calibration.md's figures).
   int max_frames = 300;
   int max_iterations = 100;  // per bundle adjustment pass
-  Status Validate() const;   // messages name the fields
+  // Labels of every camera (none: keypoints2d's instrument points) of the capture's frame
+  // labels_frame (-1: the first; on the capture's clock, as `arco track --labels-frame`).
+  std::vector<InstrumentLabelsFile> labels;
+  int64_t labels_frame = -1;
+  Status Validate() const;  // messages name the fields
 };
 
 struct FromInstrumentCamera {
@@ -101,7 +117,11 @@ struct CalibrationFromInstrumentSummary {
 // written on an error. Errors (one line naming the file): an unreadable capture, no
 // instrument, an image size that cannot be read, a camera that never sees min_points
 // instrument points, no frame where every camera has a pose, fewer than two cameras, and
-// RefineCalibration's.
+// RefineCalibration's; with labels, before any work: an unreadable or malformed file, an
+// unknown camera, a camera labelled twice or not at all, a labelled frame the camera did
+// not record, an image size that is not the camera's, a label outside the image, a label
+// that is neither a point of the instrument nor the bow's, fewer than min_points of the
+// instrument's points in a file.
 StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
     const CalibrationFromInstrumentOptions& options, Progress& progress = NoProgress());
 

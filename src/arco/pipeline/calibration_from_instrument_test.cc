@@ -16,10 +16,13 @@
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/run_capture.h"
 #include "arco/pipeline/run_with_rig_test_support.h"
+#include "arco/registry/keypoint_layout.h"
 #include "arco/synth/capture_writer.h"
 #include "arco/synth/synth.h"
 #include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
+#include "arco/util/json_io.h"
+#include "arco/util/npy.h"
 
 namespace arco::pipeline {
 namespace {
@@ -265,6 +268,127 @@ TEST(CalibrateFromInstrument, BadInputIsOneErrorAndNothingWritten) {
   std::printf("%s\n", single.status().message().c_str());
   EXPECT_NE(single.status().message().find("at least two cameras"), std::string::npos);
   nothing_written();
+}
+
+// `--labels CAMERA=LABELS.json` (labelme, as `arco track` takes them): the instrument's
+// points of one frame, put in every frame in place of keypoints2d's (here made NaN, as
+// before `arco track`), with the performer from keypoints2d. Then bad labels: one line
+// naming the file, nothing written.
+TEST(CalibrateFromInstrument, ReadsLabelsInsteadOfTrackedPoints) {
+  TempDir dir;
+  const std::string capture = dir / "capture";
+  WriteTwoCameraCapture(capture);
+  auto truth = LoadCalibration(capture + "/calibration.json");
+  ASSERT_TRUE(truth.ok());
+  auto manifest = ReadCaptureManifest(capture);
+  ASSERT_TRUE(manifest.ok());
+  auto keypoints = ReadCaptureKeypoints2d(capture, *manifest);
+  ASSERT_TRUE(keypoints.ok()) << keypoints.status().message();
+  const KeypointLayout* layout = FindKeypointLayout(manifest->layout);
+  ASSERT_NE(layout, nullptr);
+  const std::vector<int>& instrument = *layout->Group("instrument");
+  // The labels: frame 11's instrument points as detected (labelme's corner origin), the
+  // bow's frog too (ignored); then no instrument points left in keypoints2d.
+  constexpr int64_t kLabelsFrame = 11;
+  const int64_t row = kLabelsFrame - manifest->frame_first;
+  const auto labelme = [&](int v, const std::vector<std::string>& names, int count) {
+    Json shapes = Json::array();
+    for (int i = 0; i < count; ++i) {
+      const int column = layout->Find(names[i]);
+      shapes.push_back({{"label", names[i]},
+                        {"points",
+                         Json::array({Json::array({keypoints->at(row, v, column, 0) + 0.5,
+                                                   keypoints->at(row, v, column, 1) + 0.5})})},
+                        {"shape_type", "point"}});
+    }
+    return Json{{"version", "5.3.1"},
+                {"shapes", shapes},
+                {"imageWidth", kImageWidth},
+                {"imageHeight", kImageHeight}}
+        .dump(1);
+  };
+  std::vector<std::string> names;
+  for (int column : instrument) names.push_back(layout->names[column]);
+  std::vector<std::string> with_bow = names;
+  with_bow.push_back("frog");
+  std::vector<InstrumentLabelsFile> labels;
+  for (int v = 0; v < 2; ++v) {
+    const std::string path = dir / (manifest->cameras[v].name + ".json");
+    ASSERT_TRUE(
+        AtomicWriteFile(path, labelme(v, with_bow, static_cast<int>(with_bow.size()))).ok());
+    labels.push_back({manifest->cameras[v].name, path});
+  }
+  NpyArray<double> without = *keypoints;
+  for (int64_t f = 0; f < without.shape[0]; ++f)
+    for (int v = 0; v < 2; ++v)
+      for (int column : instrument)
+        for (int c = 0; c < 3; ++c) without.at(f, v, column, c) = NAN;
+  ASSERT_TRUE(WriteNpy(ResolveCapturePath(capture, manifest->keypoints2d), without).ok());
+
+  CalibrationFromInstrumentOptions options = Options(capture, dir / "rig.json");
+  options.focal_px = truth->rig.cameras[0].fx;
+  options.refine_focal = false;
+  auto none = CalibrateFromInstrument(options);  // nothing to take a pose from
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.status().message().find(" never shows 5 "), std::string::npos);
+  options.labels = labels;
+  options.labels_frame = kLabelsFrame;
+  auto result = CalibrateFromInstrument(options);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  const RelativeError e = CompareRelative(truth->rig, result->rig);
+  std::printf(
+      "[ from-instrument --labels ] frame %lld's labels in every frame: PnP in %d frames; "
+      "relative pose error %.3f deg, %.2f mm (baseline %+.3f %%); string triangulated %.1f mm\n",
+      static_cast<long long>(kLabelsFrame),
+      result->shared_frames,
+      e.rotation_deg,
+      e.position_mm,
+      100 * e.baseline_rel,
+      result->string_length_measured_mm);
+  EXPECT_LE(e.rotation_deg, 2.0);
+  EXPECT_LE(std::abs(e.baseline_rel), 0.05);
+  EXPECT_NEAR(result->string_length_measured_mm, result->string_length_mm, 35);
+
+  // Bad labels.
+  const std::string output = dir / "bad.json";
+  const auto fails = [&](const std::vector<InstrumentLabelsFile>& bad,
+                         const std::string& file,
+                         const std::string& what) {
+    CalibrationFromInstrumentOptions o = options;
+    o.output = output;
+    o.labels = bad;
+    auto r = CalibrateFromInstrument(o);
+    ASSERT_FALSE(r.ok()) << what;
+    const std::string& m = r.status().message();
+    std::printf("%s\n", m.c_str());
+    EXPECT_EQ(m.find('\n'), std::string::npos);
+    EXPECT_NE(m.find(file), std::string::npos) << m;
+    EXPECT_NE(m.find(what), std::string::npos) << m;
+    EXPECT_FALSE(fs::exists(output));
+    EXPECT_FALSE(fs::exists(dir / "bad.report.json"));
+  };
+  const std::string cam0 = manifest->cameras[0].name;
+  fails({labels[0], {"nosuch", labels[1].path}}, labels[1].path, "camera nosuch is not in");
+  fails({labels[0], {cam0, labels[1].path}}, labels[1].path, "is labelled twice");
+  fails({labels[0]}, "--labels " + manifest->cameras[1].name, "has no labels");
+  const std::string strange = dir / "strange.json";
+  {
+    // A label name that is no point of the cello.
+    auto text = ParseJsonLenient(labelme(1, names, static_cast<int>(names.size())), strange);
+    ASSERT_TRUE(text.ok());
+    (*text)["shapes"][2]["label"] = "fingerboard";
+    ASSERT_TRUE(AtomicWriteFile(strange, text->dump()).ok());
+  }
+  fails({labels[0], {manifest->cameras[1].name, strange}},
+        strange,
+        "label \"fingerboard\" is not a point of the cello");
+  const std::string few = dir / "few.json";
+  ASSERT_TRUE(AtomicWriteFile(few, labelme(1, names, 3)).ok());
+  fails({labels[0], {manifest->cameras[1].name, few}}, few, "3 of the cello's points are labelled");
+  const std::string missing = dir / "missing.json";
+  fails({labels[0], {manifest->cameras[1].name, missing}}, missing, "missing.json");
+  options.labels_frame = 100000;
+  fails(labels, "labels_frame 100000", "is outside the capture's frames");
 }
 
 }  // namespace

@@ -180,9 +180,13 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
     fit_options.world_units_per_mm = units_per_mm = 1e-3;
   }
 
-  ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(options.capture_dir, manifest));
-  ARCO_ASSIGN_OR_RETURN(const NpyArray<double> keypoints,
-                        ReadCaptureKeypoints2d(options.capture_dir, manifest));
+  NpyArray<double> read_keypoints;
+  if (options.input_keypoints == nullptr) {
+    ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(options.capture_dir, manifest));
+    ARCO_ASSIGN_OR_RETURN(read_keypoints, ReadCaptureKeypoints2d(options.capture_dir, manifest));
+  }
+  const NpyArray<double>& keypoints =
+      options.input_keypoints != nullptr ? *options.input_keypoints : read_keypoints;
   const int64_t frames = keypoints.shape[0], views = keypoints.shape[1],
                 points = keypoints.shape[2];
   if (points != layout->size())

@@ -30,6 +30,7 @@
 #include "arco/camera/calibration_io.h"
 #include "arco/camera/rig.h"
 #include "arco/util/json_io.h"
+#include "arco/util/npy.h"
 #include "arco/util/number_range.h"
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
@@ -47,6 +48,10 @@ struct CalibrationRefineOptions {
   // Set: this rig is refined (calibration, if set, only names it in messages), as
   // `arco calibrate from-instrument` does with the rig it made.
   std::optional<Rig> input_rig;
+  // Set: these 2D keypoints (the capture's frames and layout, as ReadCaptureKeypoints2d
+  // gives them) instead of the capture's keypoints2d file, as `arco calibrate
+  // from-instrument --labels` does with the labelled instrument points put in.
+  const NpyArray<double>* input_keypoints = nullptr;
   std::string output;            // calibration to write (.json, .yaml/.yml, .xml)
   bool write = true;             // false: nothing is written, the summary only (output unused)
   bool overwrite = false;        // replace an existing output file

@@ -147,7 +147,9 @@ struct InstrumentTracker::State {
   // a small correction from Lucas-Kanade.
   void Flow(int v, const cv::Mat& image, const Rigid3d& prediction) {
     View& view = views[v];
-    if (view.features.empty()) return;
+    // No picture (a dropped frame, a camera not started yet): the features wait for the
+    // next one.
+    if (view.features.empty() || image.empty()) return;
     std::vector<cv::Point2f> from, to, back;
     for (const Feature& f : view.features) {
       from.emplace_back(static_cast<float>(f.pixel.x()), static_cast<float>(f.pixel.y()));
@@ -575,6 +577,12 @@ TrackFrame InstrumentTracker::Next(const std::vector<const media::Image*>& frame
       s.options.num_threads,
       [&](int64_t v, int) {
         View& view = s.views[v];
+        if (images[v].empty()) {
+          // No picture: the features and the last picture are kept as they were for the
+          // view's next picture (Lucas-Kanade from it, the anchors when it is lost).
+          view.report.tracked = 0;
+          return;
+        }
         const Camera& cam = view.camera;
         const double gate = s.options.pose.inlier_px;
         const auto error = [&](const Feature& f) {
