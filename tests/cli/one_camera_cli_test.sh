@@ -32,6 +32,7 @@ r = json.load(open(tmp + "/res/result.json"))
 bad = []
 tri = r["stages"]["triangulation"]
 if tri.get("depth", {}).get("method") != "one_view": bad.append("result.json has no one_view depth")
+if len(tri["depth"].get("camera_centre_in_world", [])) != 3: bad.append("no camera centre in result.json")
 names = r["keypoint_names"]
 d = np.load(tmp + "/res/triangulation/" + tri["files"]["depth_source"])
 p = np.load(tmp + "/res/triangulation/points3d.npy")
@@ -70,6 +71,14 @@ if not j["paper"]["string_accuracy"] >= 0.8: bad.append("paper's strings %.3f" %
 for b in bad: print("FAILED: " + b)
 sys.exit(1 if bad else 0)
 PY
+
+# `arco refine` refines from the folder what `arco run` refined (the camera's centre is in
+# result.json): the same bytes.
+cp "$tmp/res/arco/points3d.npy" "$tmp/arco_run.npy"
+cp "$tmp/res/arco/contacts.csv" "$tmp/arco_run.csv"
+ok "refine" refine "$tmp/res" --mode arco
+check 'cmp -s "$tmp/arco_run.npy" "$tmp/res/arco/points3d.npy" && cmp -s "$tmp/arco_run.csv" "$tmp/res/arco/contacts.csv"' \
+  "arco refine differs from arco run on a one-camera result"
 
 # A one-camera capture whose view never shows the instrument: one line naming the file.
 cp -r "$tmp/cap" "$tmp/blind"

@@ -1,18 +1,20 @@
 // The depth of a hand fitted in ONE view (issue 26 part 4, track/monocular_lift.h).
 //
 // One view fixes a fitted hand's depth only through its size in the image, which a few
-// pixels of detector noise move by centimetres. Where the hand's fingertips are known to
-// lie (at the depth of the strings they play, from the instrument's pose), the fitted hand
-// is moved along its wrist's ray so that its four fingertips' median depth is that depth.
-// The shift is a median over the frames around (the hand's depth changes slowly; the
-// fingertips do not all touch the strings in every frame). The wrist's image stays; the
-// rest of the hand's image scales by about shift / depth (1-5 % here).
+// pixels of detector noise move by centimetres. Where something else says how far from
+// the camera a fingertip is (the strings its fingertips play, from the instrument's pose;
+// the contact point of the note the sound says it presses), the fitted hand is moved
+// along its wrist's ray from the camera by that difference: every keypoint moves by the
+// same vector, so a fingertip's distance from the camera changes by the shift (to the
+// cosine of the small angle between its ray and the wrist's), and the wrist's image stays
+// where it was. Each frame's shift is the median over the frames around (a hand's depth
+// changes slowly; single frames are wrong).
 #pragma once
 
+#include <Eigen/Core>
 #include <optional>
 #include <vector>
 
-#include "arco/camera/camera.h"
 #include "arco/hand/hand_model.h"
 #include "arco/hand/kinematics.h"
 #include "arco/util/status.h"
@@ -29,12 +31,20 @@ struct OneViewDepthSummary {
   double median_shift_mm = 0;  // signed, along the rays (+: away from the camera); NaN: none
 };
 
-// `tip_depth_mm[f]`: the camera depth (z in its frame, mm) the fingertips should have in
-// frame f; NaN when unknown. `hands` (world mm) are moved in place; frames without a hand
-// stay empty. Errors: invalid options, sizes that differ.
+// Moves each frame's hand (world mm) along its wrist's ray from `camera_centre_mm` by the
+// median of `shift_mm` (NaN: unknown) over the frames around; frames without a hand stay
+// empty, frames with no known shift around stay where they are. Errors: invalid options,
+// sizes that differ.
+StatusOr<OneViewDepthSummary> MoveHandsAlongRays(const Eigen::Vector3d& camera_centre_mm,
+                                                 const std::vector<double>& shift_mm,
+                                                 const OneViewDepthOptions& options,
+                                                 std::vector<std::optional<HandPose>>* hands);
+
+// The shifts that put each frame's four fingertips' median distance from the camera at
+// `tip_distance_mm[f]` (NaN: unknown), then MoveHandsAlongRays.
 StatusOr<OneViewDepthSummary> AlignHandDepth(const HandModel& model,
-                                             const Camera& camera_mm,
-                                             const std::vector<double>& tip_depth_mm,
+                                             const Eigen::Vector3d& camera_centre_mm,
+                                             const std::vector<double>& tip_distance_mm,
                                              const OneViewDepthOptions& options,
                                              std::vector<std::optional<HandPose>>* hands);
 

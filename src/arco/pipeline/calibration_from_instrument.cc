@@ -18,6 +18,7 @@
 #include "arco/mocap/labelme.h"
 #include "arco/mocap/triangulate_point.h"
 #include "arco/registry/keypoint_layout.h"
+#include "arco/track/one_view_pnp.h"
 #include "arco/util/output_set.h"
 
 namespace arco::pipeline {
@@ -40,22 +41,21 @@ ViewPose SolveView(const std::vector<cv::Point3d>& object,
                    const cv::Matx33d& K,
                    double gate_px) {
   ViewPose pose;
-  cv::Mat rvec, tvec;
-  std::vector<int> inliers;
-  if (!cv::solvePnPRansac(object,
-                          image,
-                          K,
-                          cv::noArray(),
-                          rvec,
-                          tvec,
-                          false,
-                          100,
-                          static_cast<float>(gate_px),
-                          0.999,
-                          inliers,
-                          cv::SOLVEPNP_EPNP) ||
-      inliers.size() < 4)
-    return pose;
+  std::vector<Eigen::Vector3d> object_points;
+  std::vector<Eigen::Vector2d> pixels;
+  for (const cv::Point3d& p : object) object_points.emplace_back(p.x, p.y, p.z);
+  for (const cv::Point2d& p : image) pixels.emplace_back(p.x, p.y);
+  Eigen::Matrix3d k;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) k(r, c) = K(r, c);
+  const std::optional<track::OneViewPnp> pnp =
+      track::EpnpInRansac(object_points, pixels, k, gate_px, 4);
+  if (!pnp) return pose;
+  const std::vector<int>& inliers = pnp->inliers;
+  cv::Mat rvec =
+      (cv::Mat_<double>(3, 1) << pnp->angle_axis.x(), pnp->angle_axis.y(), pnp->angle_axis.z());
+  cv::Mat tvec =
+      (cv::Mat_<double>(3, 1) << pnp->translation.x(), pnp->translation.y(), pnp->translation.z());
   std::vector<cv::Point3d> in_object;
   std::vector<cv::Point2d> in_image;
   for (int i : inliers) in_object.push_back(object[i]), in_image.push_back(image[i]);

@@ -190,19 +190,26 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
       },
       1);
   if (one_view) {
-    // The fingertips at the depth of the strings (the lifted hand's, one depth per frame).
-    std::vector<double> tip_depth(static_cast<size_t>(frames), kNaN);
+    // The fingertips at the depth of the strings: the lifted fingertips' median distance
+    // from the camera (the lift put the hand at one depth per frame).
+    const Eigen::Vector3d centre = cameras[0].CenterInWorld();
+    std::vector<double> tip_distance(static_cast<size_t>(frames), kNaN);
     for (int64_t f = 0; f < frames; ++f) {
-      for (const Eigen::Vector3d& p : left[static_cast<size_t>(f)]) {
-        if (p.allFinite()) {
-          tip_depth[static_cast<size_t>(f)] = cameras[0].PointInCamera(p).z();
-          break;
-        }
+      std::vector<double> d;
+      for (hand::Finger finger : {hand::Finger::kIndex,
+                                  hand::Finger::kMiddle,
+                                  hand::Finger::kRing,
+                                  hand::Finger::kLittle}) {
+        const Eigen::Vector3d& p = left[static_cast<size_t>(f)][hand::TipKeypoint(finger)];
+        if (p.allFinite()) d.push_back((p - centre).norm());
       }
+      if (d.empty()) continue;
+      std::sort(d.begin(), d.end());
+      tip_distance[static_cast<size_t>(f)] = d[d.size() / 2];
     }
     ARCO_ASSIGN_OR_RETURN(
         const hand::OneViewDepthSummary moved,
-        hand::AlignHandDepth(model, cameras[0], tip_depth, options.one_view_depth, &fitted));
+        hand::AlignHandDepth(model, centre, tip_distance, options.one_view_depth, &fitted));
     summary.warnings.push_back(
         "hand: one camera: the hand's depth is the strings' (moved " +
         std::to_string(static_cast<int>(std::lround(moved.median_shift_mm))) +

@@ -105,6 +105,21 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
     // have none: frames are then assigned by their own pitch).
     ARCO_ASSIGN_OR_RETURN(records.notes, result.ReadNotes());
   }
+  // One camera: its centre, recorded by the triangulation stage.
+  ARCO_ASSIGN_OR_RETURN(const Json manifest, result.ReadManifest());
+  const Json* centre = nullptr;
+  if (manifest.contains("stages") && manifest["stages"].contains(kTriangulationStage) &&
+      manifest["stages"][kTriangulationStage].contains("depth") &&
+      manifest["stages"][kTriangulationStage]["depth"].contains("camera_centre_in_world"))
+    centre = &manifest["stages"][kTriangulationStage]["depth"]["camera_centre_in_world"];
+  if (centre != nullptr) {
+    if (!centre->is_array() || centre->size() != 3 || !(*centre)[0].is_number() ||
+        !(*centre)[1].is_number() || !(*centre)[2].is_number())
+      return Status::Error(result.ManifestPath() +
+                           ": stages.triangulation.depth.camera_centre_in_world must be 3 numbers");
+    records.one_view_camera_centre_in_world = Eigen::Vector3d(
+        (*centre)[0].get<double>(), (*centre)[1].get<double>(), (*centre)[2].get<double>());
+  }
   ARCO_ASSIGN_OR_RETURN(RefineInputs inputs, MakeRefineInputs(result_dir, records));
   // double_stops.csv (`arco run --double-stops`): the two voices the run refined.
   if (has_pitch) {
@@ -211,6 +226,8 @@ StatusOr<RefineInputs> MakeRefineInputs(const std::string& result_dir,
   out.input.strings_in_world_mm = seg;
   out.input.fps = fps > 0 ? fps : 30.0;
   out.input.a4_hz = instrument.a4_hz;
+  if (records.one_view_camera_centre_in_world)
+    out.input.one_view_camera_centre_mm = *records.one_view_camera_centre_in_world / s;
   out.input.pitch.assign(static_cast<size_t>(frames), refine::FramePitch{});
   out.has_pitch = records.pitch != nullptr;
   if (out.has_pitch) {

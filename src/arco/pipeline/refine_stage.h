@@ -56,6 +56,8 @@ struct StageRecords {
   const HandRecord* hand = nullptr;
   const std::vector<audio::PitchFrame>* pitch = nullptr;  // null: no pitch stage
   std::vector<audio::Note> notes;                         // notes.csv's notes
+  // One camera: its centre (world units; TriangulationRecord::one_view_camera_centre).
+  std::optional<Eigen::Vector3d> one_view_camera_centre_in_world;
   // The instrument's model when already built (the run's CaptureContext); null: built
   // from the instrument record (its name and A4).
   std::shared_ptr<const InstrumentModel> model;

@@ -589,6 +589,11 @@ StatusOr<std::vector<std::string>> ResultFolder::WriteTriangulation(
           {"1", "instrument pose (PnP of its nominal points)"},
           {"2", "the depth where the fingertips pass closest to the strings (left hand)"},
           {"3", "assumed plane behind the instrument (body, right hand)"}}}};
+    if (record.one_view_camera_centre) {
+      Json centre = Json::array();
+      for (int c = 0; c < 3; ++c) centre.push_back((*record.one_view_camera_centre)[c]);
+      stage["depth"]["camera_centre_in_world"] = centre;
+    }
   }
   // A new capture header: the result is now what this triangulation was made from, and
   // `arco run`'s options no longer describe it.

@@ -95,6 +95,9 @@ struct TriangulationRecord {
   Json options;       // triangulation and filter options as run
   SequenceTriangulationSummary summary;
   CaptureInputs inputs;  // the capture files read (manifest, calibration, keypoints2d)
+  // One camera: its centre (world units), which `arco refine` needs to move the hand along
+  // its rays (result.json's triangulation "depth" entry).
+  std::optional<Eigen::Vector3d> one_view_camera_centre;
 };
 
 // instrument/ and its entry.

@@ -154,6 +154,11 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
   records.instrument = &instrument;
   records.hand = &hand;
   records.model = capture.instrument;
+  if (capture.view_to_camera.size() == 1) {
+    records.one_view_camera_centre_in_world =
+        capture.calibration.rig.cameras.at(static_cast<size_t>(capture.view_to_camera[0]))
+            .CenterInWorld();
+  }
   std::vector<audio::PitchFrame> pitch_as_written;
   if (summary.pitch.ran) {
     ARCO_ASSIGN_OR_RETURN(pitch_as_written,

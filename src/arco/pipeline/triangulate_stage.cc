@@ -205,6 +205,11 @@ StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptio
   // The result names the capture as the options do (the run's capture_dir is the
   // capture's).
   record.capture_dir = o.capture_dir;
+  if (one_view) {
+    record.one_view_camera_centre =
+        capture.calibration.rig.cameras.at(static_cast<size_t>(capture.view_to_camera.at(0)))
+            .CenterInWorld();
+  }
   record.units = capture.calibration.rig.units;
   record.summary = Summarize(raw);
   record.options = ToJson(o);

@@ -105,6 +105,8 @@ Status RefineInput::Validate() const {
                            std::to_string(instrument->num_strings()));
     }
   }
+  if (one_view_camera_centre_mm && !one_view_camera_centre_mm->allFinite())
+    return Status::Error("refine input: the one camera's centre is not finite");
   if (!detected_left_hand.empty() && detected_left_hand.size() != n) {
     return Status::Error("refine input: " + std::to_string(detected_left_hand.size()) +
                          " detected hand frames for " + std::to_string(n) + " frames");
@@ -210,6 +212,7 @@ Status RefineOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(paper.Validate());
   ARCO_RETURN_IF_ERROR(decode.Validate());
   ARCO_RETURN_IF_ERROR(ik.Validate());
+  ARCO_RETURN_IF_ERROR(one_view_depth.Validate().WithContext("refine options: one_view_depth"));
   if (num_threads < 0) return Status::Error("refine options: num_threads must be >= 0");
   return Status::Ok();
 }
@@ -244,7 +247,36 @@ RefineResult Refine(const RefineInput& input, const RefineOptions& options) {
                                  options.pitch,
                                  LiftMaxMm(input.hand_model, options.ik),
                                  options.num_threads);
-    result.hand = SolveArcoIk(context,
+    // One camera: the hand's depth from the sound, then the decoding again.
+    RefineInput moved;
+    DecodeContext moved_context;
+    const DecodeContext* ik_context = &context;
+    if (input.one_view_camera_centre_mm) {
+      const Eigen::Vector3d& centre = *input.one_view_camera_centre_mm;
+      std::vector<double> shift(input.pitch.size(), kNaN);
+      for (size_t f = 0; f < shift.size(); ++f) {
+        const FrameContact& c = result.contacts[f];
+        const auto& tips = context.vision_points[f];
+        if (!c.pressed() || c.finger < 1 || c.finger > 4 || !tips ||
+            !c.point_in_world_mm.allFinite())
+          continue;
+        const Eigen::Vector3d& tip =
+            (*tips)[hand::TipKeypoint(static_cast<hand::Finger>(c.finger))];
+        shift[f] = (c.point_in_world_mm - centre).norm() - (tip - centre).norm();
+      }
+      moved = input;
+      ThrowIfError(
+          hand::MoveHandsAlongRays(centre, shift, options.one_view_depth, &moved.vision_hand)
+              .status());
+      moved_context = MakeDecodeContext(moved, result.analysis, options.num_threads);
+      result.contacts = DecodeArco(moved_context,
+                                   options.decode,
+                                   options.pitch,
+                                   LiftMaxMm(input.hand_model, options.ik),
+                                   options.num_threads);
+      ik_context = &moved_context;
+    }
+    result.hand = SolveArcoIk(*ik_context,
                               options.ik,
                               options.pitch,
                               options.decode.onset_lead_frames,
@@ -268,6 +300,7 @@ Json ToJson(const RefineOptions& o) {
           {"max_residual_mm", o.ik.max_residual_mm},
           {"audio_onsets", o.mode == RefineMode::kArco && o.decode.audio_onsets},
           {"num_threads", o.num_threads},
+          {"one_view_depth", {{"window_frames", o.one_view_depth.window_frames}}},
           {"pitch",
            {{"min_confidence", o.pitch.min_confidence},
             {"min_confidence_in_note", o.pitch.min_confidence_in_note},

@@ -23,6 +23,7 @@
 #include "arco/hand/hand_model.h"
 #include "arco/hand/ik.h"
 #include "arco/hand/kinematics.h"
+#include "arco/hand/one_view_depth.h"
 #include "arco/instrument/instrument_model.h"
 #include "arco/instrument/strings.h"
 #include "arco/refine/contact_annotation.h"
@@ -56,6 +57,12 @@ struct RefineInput {
   // hand toward a contact its joints cannot reach only as far as this detected hand says
   // the fitted one may be off (ArcoIkOptions::contact_sigma_mm). Empty: unknown.
   std::vector<std::optional<hand::HandPointsMm>> detected_left_hand;
+  // One camera (track/monocular_lift.h): its centre (world mm). arco then takes the hand's
+  // depth from the sound: after a first decoding, the fitted hand is moved along its rays
+  // so that the pressing fingertip is as far from the camera as its note's contact
+  // (hand/one_view_depth.h, a median over the frames around), and decoded again. Empty:
+  // several cameras, whose hand stays where they put it.
+  std::optional<Eigen::Vector3d> one_view_camera_centre_mm;
 
   // Errors: no instrument, a right-hand model, sizes that differ, fps <= 0, a strings entry
   // with a wrong string count or non-finite ends.
@@ -209,6 +216,7 @@ struct RefineOptions {
   PaperOptions paper;
   ArcoDecodeOptions decode;
   ArcoIkOptions ik;
+  hand::OneViewDepthOptions one_view_depth;  // RefineInput::one_view_camera_centre_mm
   int num_threads = 0;  // 0 = all cores; results do not depend on it
   Status Validate() const;
 };

@@ -3,9 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <opencv2/calib3d.hpp>
-#include <opencv2/core.hpp>
 
+#include "arco/track/one_view_pnp.h"
 #include "arco/track/pose_solver.h"
 #include "arco/util/number_range.h"
 
@@ -20,47 +19,27 @@ double Median(std::vector<double> v) {
   return *mid;
 }
 
-// EPnP in RANSAC on undistorted pixels: the start of the refinement on the full camera
-// model. Empty when RANSAC finds no pose of >= min_points inliers.
+// EPnP in RANSAC on undistorted pixels (one_view_pnp.h): the start of the refinement on
+// the full camera model. Empty when RANSAC finds no pose in front of the camera.
 std::optional<Rigid3d> InitialPose(const Camera& camera,
                                    const std::vector<PoseCorrespondence>& c,
                                    const MonocularLiftOptions& o) {
-  std::vector<cv::Point3d> object;
-  std::vector<cv::Point2d> image;
+  std::vector<Eigen::Vector3d> object;
+  std::vector<Eigen::Vector2d> image;
   for (const PoseCorrespondence& x : c) {
-    const Eigen::Vector2d u = camera.UndistortPixel(x.pixel);
-    object.emplace_back(x.point_in_template.x(), x.point_in_template.y(), x.point_in_template.z());
-    image.emplace_back(u.x(), u.y());
+    object.push_back(x.point_in_template);
+    image.push_back(camera.UndistortPixel(x.pixel));
   }
-  const cv::Matx33d K(camera.fx, camera.skew, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
-  cv::Mat rvec, tvec;
-  std::vector<int> inliers;
-  // cv::RNG is seeded by solvePnPRansac itself, so the result is repeatable.
-  if (!cv::solvePnPRansac(object,
-                          image,
-                          K,
-                          cv::noArray(),
-                          rvec,
-                          tvec,
-                          false,
-                          100,
-                          static_cast<float>(o.pnp_gate_px),
-                          0.999,
-                          inliers,
-                          cv::SOLVEPNP_EPNP) ||
-      static_cast<int>(inliers.size()) < o.min_instrument_points)
-    return std::nullopt;
-  cv::Matx33d R;
-  cv::Rodrigues(rvec, R);
-  Eigen::Matrix3d cam_from_template;
-  for (int r = 0; r < 3; ++r)
-    for (int k = 0; k < 3; ++k) cam_from_template(r, k) = R(r, k);
-  const Eigen::Vector3d t(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
-  if (!(t.z() > 0)) return std::nullopt;
+  Eigen::Matrix3d K;
+  K << camera.fx, camera.skew, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1;
+  const std::optional<OneViewPnp> pnp =
+      EpnpInRansac(object, image, K, o.pnp_gate_px, o.min_instrument_points);
+  if (!pnp || !(pnp->translation.z() > 0)) return std::nullopt;
   // world_from_template = world_from_cam * cam_from_template.
   const Eigen::Matrix3d& Rc = camera.cam_from_world.rotation;
   const Eigen::Vector3d& tc = camera.cam_from_world.translation;
-  return Rigid3d(Eigen::Matrix3d(Rc.transpose() * cam_from_template), Rc.transpose() * (t - tc));
+  return Rigid3d(Eigen::Matrix3d(Rc.transpose() * pnp->cam_from_object.rotation),
+                 Rc.transpose() * (pnp->translation - tc));
 }
 
 // The point of the ray through `pixel` at which it cuts the plane (point, normal); empty
