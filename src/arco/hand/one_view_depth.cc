@@ -5,18 +5,12 @@
 #include <limits>
 
 #include "arco/util/number_range.h"
+#include "arco/util/stats.h"
 
 namespace arco::hand {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return kNaN;
-  const auto mid = v.begin() + static_cast<long>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
 
 }  // namespace
 
@@ -46,7 +40,7 @@ StatusOr<OneViewDepthSummary> MoveHandsAlongRays(const Eigen::Vector3d& centre,
         around.push_back(shift_mm[static_cast<size_t>(g)]);
     }
     if (around.empty()) continue;
-    const double s = Median(around);
+    const double s = UpperMedian(around);
     Eigen::Vector3d& wrist = pose->world_from_wrist.translation;
     const double range = (wrist - centre).norm();
     if (!(range > 0) || !(range + s > 0)) continue;
@@ -54,7 +48,7 @@ StatusOr<OneViewDepthSummary> MoveHandsAlongRays(const Eigen::Vector3d& centre,
     applied.push_back(s);
     ++summary.frames_moved;
   }
-  summary.median_shift_mm = Median(applied);
+  summary.median_shift_mm = UpperMedian(applied);
   return summary;
 }
 
@@ -75,7 +69,7 @@ StatusOr<OneViewDepthSummary> AlignHandDepth(const HandModel& model,
     std::vector<double> tips;
     for (Finger finger : {Finger::kIndex, Finger::kMiddle, Finger::kRing, Finger::kLittle})
       tips.push_back((points[TipKeypoint(finger)] - centre).norm());
-    shift[f] = tip_distance_mm[f] - Median(tips);
+    shift[f] = tip_distance_mm[f] - UpperMedian(tips);
   }
   return MoveHandsAlongRays(centre, shift, options, hands);
 }

@@ -203,9 +203,7 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
         const Eigen::Vector3d& p = left[static_cast<size_t>(f)][hand::TipKeypoint(finger)];
         if (p.allFinite()) d.push_back((p - centre).norm());
       }
-      if (d.empty()) continue;
-      std::sort(d.begin(), d.end());
-      tip_distance[static_cast<size_t>(f)] = d[d.size() / 2];
+      if (!d.empty()) tip_distance[static_cast<size_t>(f)] = UpperMedian(d);
     }
     ARCO_ASSIGN_OR_RETURN(
         const hand::OneViewDepthSummary moved,

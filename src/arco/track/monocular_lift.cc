@@ -7,17 +7,12 @@
 #include "arco/track/one_view_pnp.h"
 #include "arco/track/pose_solver.h"
 #include "arco/util/number_range.h"
+#include "arco/util/stats.h"
 
 namespace arco::track {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-double Median(std::vector<double> v) {
-  const auto mid = v.begin() + static_cast<long>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
 
 // EPnP in RANSAC on undistorted pixels (one_view_pnp.h): the start of the refinement on
 // the full camera model. Empty when RANSAC finds no pose in front of the camera.
@@ -192,7 +187,7 @@ StatusOr<MonocularLift> LiftOneView(const Camera& camera,
       if (std::isfinite(depth[static_cast<size_t>(g)]))
         around.push_back(depth[static_cast<size_t>(g)]);
     }
-    const double scale = Median(around) / depth[static_cast<size_t>(f)];
+    const double scale = UpperMedian(around) / depth[static_cast<size_t>(f)];
     const Eigen::Vector3d centre = *pose * centre_mm;
     pose->translation += (scale - 1) * (centre - camera_centre);
   }
@@ -235,7 +230,7 @@ StatusOr<MonocularLift> LiftOneView(const Camera& camera,
       if (best) depths.push_back(camera.PointInCamera(best->on_ray).z());
     }
     if (!depths.empty()) {
-      const double depth = Median(depths);
+      const double depth = UpperMedian(depths);
       for (int p : scene.string_line_columns) {
         if (!valid(p)) continue;
         const Eigen::Vector2d n = camera.PixelToNormalized(pixel(p));
@@ -245,7 +240,7 @@ StatusOr<MonocularLift> LiftOneView(const Camera& camera,
       }
     }
   }
-  out.summary.median_pnp_rms_px = rms.empty() ? kNaN : Median(rms);
+  out.summary.median_pnp_rms_px = UpperMedian(rms);  // NaN when none
   return out;
 }
 
