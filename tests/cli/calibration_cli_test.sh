@@ -232,7 +232,7 @@ PY' "from-instrument recovers the pair: $(tail -2 "$tmp/fi.out") $(cat "$tmp/err
 cam0=$(/usr/bin/python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['cameras'][0]['name'])" "$tmp/two/capture.json")
 echo '{"shapes": [{"label": "fingerboard", "points": [[10, 10]], "shape_type": "point"}]}' >"$tmp/odd.json"
 for bad in "--labels nosuch=$tmp/odd.json:odd.json: camera nosuch is not in .*capture.json (cameras: " \
-           "--labels $cam0=$tmp/odd.json:odd.json: label .fingerboard. is not a point of the cello (scroll_top, " \
+           "--labels $cam0=$tmp/odd.json:odd.json: 0 of the cello's points are labelled (not its points: fingerboard), a camera's pose needs 5 (scroll_top, " \
            "--labels justtext:--labels .justtext. must look like CAMERA=LABELME.json" \
            "--labels $cam0@3=$tmp/odd.json:must look like CAMERA=LABELME.json (the labels of --labels-frame)" \
            "--labels $cam0=$tmp/odd.json --labels-frame -2:--labels-frame" \

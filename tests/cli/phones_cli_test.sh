@@ -124,7 +124,7 @@ check '[ ! -e rig.json ] && [ ! -e rig.report.json ]' "a failed calibration wrot
 check 'grep -q "^arco calibrate from-instrument capture --labels left=left.json --labels right=right.json" "$src/docs/phones.md"' \
   "the guide's from-instrument line with --labels was not found"
 echo '{"shapes": [{"label": "bridge", "points": [[10, 10]], "shape_type": "point"}]}' >bad_labels.json
-bad "a label that is not a point" "bad_labels.json: label \"bridge\" is not a point of the cello (scroll_top, nut_l, nut_r, bridge_l, bridge_r, tail_gut, end_pin) or the bow" \
+bad "a label that is not a point" "bad_labels.json: 0 of the cello's points are labelled (not its points: bridge), a camera's pose needs 5 (scroll_top, nut_l, nut_r, bridge_l, bridge_r, tail_gut, end_pin)" \
   calibrate from-instrument capture --labels left=left.json --labels right=bad_labels.json --labels-frame 31 -o rig.json
 bad "labels of a frame the right phone did not record" "right.json: camera right did not record frame 3 of the capture (--labels-frame)" \
   calibrate from-instrument capture --labels left=left.json --labels right=right.json --labels-frame 3 -o rig.json

@@ -20,6 +20,7 @@
 #include "arco/registry/keypoint_layout.h"
 #include "arco/track/one_view_pnp.h"
 #include "arco/util/output_set.h"
+#include "arco/util/stats.h"
 
 namespace arco::pipeline {
 namespace {
@@ -95,12 +96,6 @@ Relative RelativePose(const RigidMatrix3d& c_from_instrument,
   return r;
 }
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
 // The labelled instrument points of every camera (labelme files, mocap/labelme.h) into
 // every frame of `keypoints` (the capture's frames; score 1), in place of its instrument
 // points: a starting point before anything is tracked. Every check first, each error one
@@ -110,7 +105,8 @@ Status PutLabels(const CalibrationFromInstrumentOptions& options,
                  const std::string& manifest_file,
                  const Rig& rig,
                  const KeypointLayout& layout,
-                 NpyArray<double>* keypoints) {
+                 NpyArray<double>* keypoints,
+                 std::vector<std::string>* warnings) {
   const int64_t first = manifest.frame_first, last = first + manifest.frame_count - 1;
   const int64_t frame = options.labels_frame >= 0 ? options.labels_frame : first;
   if (frame < first || frame > last)
@@ -158,6 +154,7 @@ Status PutLabels(const CalibrationFromInstrumentOptions& options,
                            " (label the frame as turned by rotate_deg)");
     labelled[v].assign(instrument->size(), Eigen::Vector2d::Constant(NAN));
     int count = 0;
+    std::string ignored;  // labels that are no point of the instrument or the bow
     for (const LabeledPoint& p : a.points) {
       const int column = layout.Find(CanonicalKeypointName(p.label));
       const auto it = std::find(instrument->begin(), instrument->end(), column);
@@ -165,8 +162,13 @@ Status PutLabels(const CalibrationFromInstrumentOptions& options,
         if (column >= 0 && bow != nullptr &&
             std::find(bow->begin(), bow->end(), column) != bow->end())
           continue;  // the bow's frog and tip, for `arco track`
-        return Status::Error(file.path + ": label \"" + p.label + "\" is not a point of the " +
-                             manifest.instrument + " (" + expected + ") or the bow");
+        // Ignored with a warning, as `arco track --labels` does: other tools' label sets
+        // (SPD's neck_bottom_l/r) hold points arco's model does not have. Too few known
+        // points left is still an error (below).
+        warnings->push_back(file.path + ": label \"" + p.label + "\" is not a point of the " +
+                            manifest.instrument + " or the bow (ignored)");
+        ignored += (ignored.empty() ? "" : ", ") + p.label;
+        continue;
       }
       if (!(p.pixel.x() >= -0.5 && p.pixel.y() >= -0.5 && p.pixel.x() < cam.width - 0.5 &&
             p.pixel.y() < cam.height - 0.5))
@@ -178,9 +180,10 @@ Status PutLabels(const CalibrationFromInstrumentOptions& options,
       ++count;
     }
     if (count < options.min_points)
-      return Status::Error(file.path + ": " + std::to_string(count) + " of the " +
-                           manifest.instrument + "'s points are labelled, a camera's pose needs " +
-                           std::to_string(options.min_points) + " (" + expected + ")");
+      return Status::Error(
+          file.path + ": " + std::to_string(count) + " of the " + manifest.instrument +
+          "'s points are labelled" + (ignored.empty() ? "" : " (not its points: " + ignored + ")") +
+          ", a camera's pose needs " + std::to_string(options.min_points) + " (" + expected + ")");
   }
   for (int v = 0; v < views; ++v)
     if (file_of[v].empty())
@@ -348,8 +351,10 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
     return Status::Error(keypoints_file + ": " + std::to_string(keypoints.shape[2]) +
                          " keypoints per view, layout " + manifest.layout + " has " +
                          std::to_string(layout->size()));
+  std::vector<std::string> label_warnings;
   if (!options.labels.empty()) {
-    ARCO_RETURN_IF_ERROR(PutLabels(options, manifest, manifest_file, rig, *layout, &keypoints));
+    ARCO_RETURN_IF_ERROR(
+        PutLabels(options, manifest, manifest_file, rig, *layout, &keypoints, &label_warnings));
     // Messages about the instrument's points name the labels.
     keypoints_file.clear();
     for (const InstrumentLabelsFile& l : options.labels)
@@ -387,7 +392,7 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
       if (poses[v][f].valid) rms.push_back(poses[v][f].rms_px);
     }
     summary.cameras[v].pnp_frames = static_cast<int>(rms.size());
-    summary.cameras[v].pnp_rms_px = Median(rms);
+    summary.cameras[v].pnp_rms_px = UpperMedian(rms);
     if (rms.empty())
       return Status::Error(keypoints_file + ": camera " + cam.name + " never shows " +
                            std::to_string(options.min_points) + " of the " + manifest.instrument +
@@ -440,7 +445,7 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
   std::vector<double> d(n);
   for (int i = 0; i < n; ++i) {
     for (int j = 0; j < n; ++j) d[j] = distance(i, j);
-    const double cost = Median(d);
+    const double cost = UpperMedian(d);
     if (cost < best_cost) best_cost = cost, best = i;
   }
   summary.reference_frame = manifest.frame_first + shared[best];
@@ -454,8 +459,8 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
       deg.push_back(RotationAngleBetween(relative[v][i].rotation, r.rotation) * 180 / M_PI);
       mm.push_back((relative[v][i].centre_mm - r.centre_mm).norm());
     }
-    summary.cameras[v].relative_spread_deg = Median(deg);
-    summary.cameras[v].relative_spread_mm = Median(mm);
+    summary.cameras[v].relative_spread_deg = UpperMedian(deg);
+    summary.cameras[v].relative_spread_mm = UpperMedian(mm);
   }
 
   // 4. Bundle adjustment with the performer and the instrument (calibration_refine.h).
@@ -506,11 +511,18 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
       if (all) lengths.push_back((0.5 * (p[0] + p[1]) - 0.5 * (p[2] + p[3])).norm());
     }
     summary.string_length_frames = static_cast<int>(lengths.size());
-    summary.string_length_measured_mm = Median(lengths);
+    summary.string_length_measured_mm = UpperMedian(lengths);
     for (double& l : lengths) l = std::abs(l - summary.string_length_measured_mm);
-    summary.string_length_spread_mm = 1.4826 * Median(lengths);
+    summary.string_length_spread_mm = kMadToSigma * UpperMedian(lengths);
   }
-  summary.warnings = summary.refinement.warnings;
+  summary.warnings = label_warnings;
+  summary.warnings.insert(summary.warnings.end(),
+                          summary.refinement.warnings.begin(),
+                          summary.refinement.warnings.end());
+  if (summary.string_length_frames == 0)
+    summary.warnings.push_back(
+        "no frame shows the nut and the bridge in two views with the result: the string length "
+        "is not measured, so nothing checks the scale");
   for (const FromInstrumentCamera& c : summary.cameras)
     if (std::abs(c.focal_px / c.initial_focal_px - 1) > 0.03)
       summary.warnings.push_back(

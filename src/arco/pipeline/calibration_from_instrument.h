@@ -103,7 +103,8 @@ struct CalibrationFromInstrumentSummary {
   double string_length_initial_mm = 0;
   // The nut-centre to bridge-centre distance triangulated with the refined rig in every
   // frame where both cameras see all four points: median, robust spread (1.4826 MAD) and
-  // frames. An independent check of the scale (the template is held at the model's).
+  // frames. An independent check of the scale (the template is held at the model's). NaN
+  // (null in the report, with a warning) when no frame shows the four points in two views.
   double string_length_measured_mm = 0, string_length_spread_mm = 0;
   int string_length_frames = 0;
   double rms_initial_px = 0, rms_px = 0;  // reprojection RMS, initial rig and refined
@@ -119,9 +120,9 @@ struct CalibrationFromInstrumentSummary {
 // instrument points, no frame where every camera has a pose, fewer than two cameras, and
 // RefineCalibration's; with labels, before any work: an unreadable or malformed file, an
 // unknown camera, a camera labelled twice or not at all, a labelled frame the camera did
-// not record, an image size that is not the camera's, a label outside the image, a label
-// that is neither a point of the instrument nor the bow's, fewer than min_points of the
-// instrument's points in a file.
+// not record, an image size that is not the camera's, a label outside the image, fewer
+// than min_points of the instrument's points in a file. A label that is neither a point
+// of the instrument nor the bow's is a warning and is ignored, as in `arco track`.
 StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
     const CalibrationFromInstrumentOptions& options, Progress& progress = NoProgress());
 

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "arco/calibration/calibration_file.h"
@@ -314,8 +315,15 @@ TEST(CalibrateFromInstrument, ReadsLabelsInsteadOfTrackedPoints) {
   std::vector<InstrumentLabelsFile> labels;
   for (int v = 0; v < 2; ++v) {
     const std::string path = dir / (manifest->cameras[v].name + ".json");
-    ASSERT_TRUE(
-        AtomicWriteFile(path, labelme(v, with_bow, static_cast<int>(with_bow.size()))).ok());
+    auto file = ParseJsonLenient(labelme(v, with_bow, static_cast<int>(with_bow.size())), path);
+    ASSERT_TRUE(file.ok());
+    // Camera 1's file also holds a point arco's cello does not have (as SPD's label files
+    // hold neck_bottom_l/r): ignored with a warning, as `arco track --labels` does.
+    if (v == 1)
+      (*file)["shapes"].push_back({{"label", "fingerboard"},
+                                   {"points", Json::array({Json::array({10.0, 10.0})})},
+                                   {"shape_type", "point"}});
+    ASSERT_TRUE(AtomicWriteFile(path, file->dump(1)).ok());
     labels.push_back({manifest->cameras[v].name, path});
   }
   NpyArray<double> without = *keypoints;
@@ -348,6 +356,10 @@ TEST(CalibrateFromInstrument, ReadsLabelsInsteadOfTrackedPoints) {
   EXPECT_LE(e.rotation_deg, 2.0);
   EXPECT_LE(std::abs(e.baseline_rel), 0.05);
   EXPECT_NEAR(result->string_length_measured_mm, result->string_length_mm, 35);
+  const std::string ignored =
+      labels[1].path + ": label \"fingerboard\" is not a point of the cello or the bow (ignored)";
+  EXPECT_NE(std::find(result->warnings.begin(), result->warnings.end(), ignored),
+            result->warnings.end());
 
   // Bad labels.
   const std::string output = dir / "bad.json";
@@ -373,15 +385,17 @@ TEST(CalibrateFromInstrument, ReadsLabelsInsteadOfTrackedPoints) {
   fails({labels[0]}, "--labels " + manifest->cameras[1].name, "has no labels");
   const std::string strange = dir / "strange.json";
   {
-    // A label name that is no point of the cello.
+    // Label names that are no points of the cello: too few points left is an error naming
+    // them.
     auto text = ParseJsonLenient(labelme(1, names, static_cast<int>(names.size())), strange);
     ASSERT_TRUE(text.ok());
-    (*text)["shapes"][2]["label"] = "fingerboard";
+    for (int i = 0; i + 4 < static_cast<int>(names.size()); ++i)
+      (*text)["shapes"][i]["label"] = "fingerboard" + std::to_string(i);
     ASSERT_TRUE(AtomicWriteFile(strange, text->dump()).ok());
   }
   fails({labels[0], {manifest->cameras[1].name, strange}},
         strange,
-        "label \"fingerboard\" is not a point of the cello");
+        "4 of the cello's points are labelled (not its points: fingerboard0, fingerboard1");
   const std::string few = dir / "few.json";
   ASSERT_TRUE(AtomicWriteFile(few, labelme(1, names, 3)).ok());
   fails({labels[0], {manifest->cameras[1].name, few}}, few, "3 of the cello's points are labelled");
