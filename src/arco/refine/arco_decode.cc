@@ -13,6 +13,36 @@
 namespace arco::refine {
 namespace {
 
+// One camera (RefineInput::one_view_camera_centre_mm): the lifted hand's depth is what the
+// view lacks, so a candidate is compared with the hand scaled about the camera's centre
+// until finger k's tip is as far from the camera as the candidate. Every point stays on
+// its ray (the image is unchanged); the depth is the candidate's own, and what is left of
+// tip - contact is the image's evidence, in mm at the contact's distance.
+hand::HandPointsMm AtCandidateDistance(const hand::HandPointsMm& points,
+                                       const Eigen::Vector3d& centre,
+                                       const Eigen::Vector3d& contact,
+                                       int finger) {
+  const Eigen::Vector3d& tip = points[hand::TipKeypoint(static_cast<hand::Finger>(finger))];
+  const double tip_distance = (tip - centre).norm();
+  if (!(tip_distance > 0)) return points;
+  const double scale = (contact - centre).norm() / tip_distance;
+  hand::HandPointsMm scaled;
+  for (size_t j = 0; j < points.size(); ++j) scaled[j] = centre + scale * (points[j] - centre);
+  return scaled;
+}
+
+// The vision hand as a candidate of finger k at `contact` sees it: as fitted, or with one
+// camera and options.one_view_along_rays, at the candidate's distance (above).
+hand::HandPointsMm CandidateHand(const DecodeContext& context,
+                                 const hand::HandPointsMm& points,
+                                 const Eigen::Vector3d& contact,
+                                 int finger,
+                                 const ArcoDecodeOptions& options) {
+  const auto& centre = context.input->one_view_camera_centre_mm;
+  if (!centre || !options.one_view_along_rays) return points;
+  return AtCandidateDistance(points, *centre, contact, finger);
+}
+
 struct State {
   int string = 0;
   int finger = 0;                 // 0 = open string
@@ -58,13 +88,14 @@ std::vector<State> NoteStates(const DecodeContext& context,
           continue;
         }
         double d = 0, o = 0;
-        FrameCosts(*context.vision_points[i],
-                   StringFrameOf(context.strings(static_cast<int>(f)), s),
-                   cand.point_in_world,
-                   k,
-                   options,
-                   &d,
-                   &o);
+        FrameCosts(
+            CandidateHand(context, *context.vision_points[i], cand.point_in_world, k, options),
+            StringFrameOf(context.strings(static_cast<int>(f)), s),
+            cand.point_in_world,
+            k,
+            options,
+            &d,
+            &o);
         distances.push_back(d);
         orders.push_back(o);
       }
@@ -105,6 +136,7 @@ double TransitionCost(const NoteSpan& from_note,
 
 // The contact of one frame of a decoded note (state, string, finger) at pitch f0_hz.
 void AssignFrame(const DecodeContext& context,
+                 const ArcoDecodeOptions& options,
                  int string,
                  int finger,
                  double f0_hz,
@@ -140,7 +172,10 @@ void AssignFrame(const DecodeContext& context,
     return;
   }
   const int tip = hand::TipKeypoint(static_cast<hand::Finger>(finger));
-  fc->tip_distance_vision_mm = ((*points)[tip] - cand.point_in_world).norm();
+  fc->tip_distance_vision_mm =
+      (CandidateHand(context, *points, cand.point_in_world, finger, options)[tip] -
+       cand.point_in_world)
+          .norm();
   if (fc->tip_distance_vision_mm > lift_max_mm[static_cast<size_t>(finger)]) {
     fc->state = ContactState::kUncertain;  // lift test: string and finger kept as info
     fc->reason = ContactReason::kOutOfReach;
@@ -252,12 +287,26 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
       const size_t i = static_cast<size_t>(f);
       const FrameAudioState a = context.analysis->frame_state[i];
       if (a == FrameAudioState::kNote) {
-        AssignFrame(
-            context, st.string, st.finger, out[i].f0_hz, pitch_options, lift_max_mm, f, &out[i]);
+        AssignFrame(context,
+                    options,
+                    st.string,
+                    st.finger,
+                    out[i].f0_hz,
+                    pitch_options,
+                    lift_max_mm,
+                    f,
+                    &out[i]);
       } else if (a == FrameAudioState::kBoundary) {
         // The frame's own pitch straddles the change: the note's pitch instead.
-        AssignFrame(
-            context, st.string, st.finger, note.f0_hz, pitch_options, lift_max_mm, f, &out[i]);
+        AssignFrame(context,
+                    options,
+                    st.string,
+                    st.finger,
+                    note.f0_hz,
+                    pitch_options,
+                    lift_max_mm,
+                    f,
+                    &out[i]);
         if (out[i].reason == ContactReason::kNone) out[i].reason = ContactReason::kNoteBoundary;
       }
     }
@@ -302,7 +351,8 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
       if (!untrusted && !handover) break;
       FrameContact lead = out[i];
       lead.note = note_index;
-      AssignFrame(context, st.string, st.finger, onset_hz, pitch_options, lift_max_mm, f, &lead);
+      AssignFrame(
+          context, options, st.string, st.finger, onset_hz, pitch_options, lift_max_mm, f, &lead);
       // Only where the fitted finger is already near its contact (not still on its way),
       // and nearer than to the previous note's contact.
       if (!lead.pressed() || !(lead.tip_distance_vision_mm <= lead_max_mm)) break;
@@ -353,7 +403,8 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
       if (!(own.f0_hz >= lo && own.f0_hz <= hi && own.confidence >= pitch_options.min_confidence))
         continue;
       FrameContact glide = c;
-      AssignFrame(context, c.string, c.finger, own.f0_hz, pitch_options, lift_max_mm, f, &glide);
+      AssignFrame(
+          context, options, c.string, c.finger, own.f0_hz, pitch_options, lift_max_mm, f, &glide);
       if (!glide.pressed()) continue;  // the lift test: keep the note's contact
       glide.reason = c.reason;
       out[static_cast<size_t>(f)] = glide;

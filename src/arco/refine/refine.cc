@@ -341,6 +341,7 @@ Json ToJson(const RefineOptions& o) {
             {"handover_margin_mm", JsonFromDouble(o.decode.handover_margin_mm)},  // inf: off
             {"glide_frames", o.decode.glide_frames},
             {"audio_onsets", o.decode.audio_onsets},
+            {"one_view_along_rays", o.decode.one_view_along_rays},
             {"boundaries",
              {{"onset_tolerance_s", o.decode.boundaries.onset_tolerance_s},
               {"match_cents", o.decode.boundaries.match_cents},

@@ -132,6 +132,12 @@ struct ArcoDecodeOptions {
   // between the two notes' pitches (a glide heard; arco_decode.h). 0: always the note's
   // pitch, the former rule.
   int glide_frames = 3;
+  // One camera (RefineInput::one_view_camera_centre_mm): each candidate is compared with
+  // the vision hand scaled about the camera's centre until the candidate finger's tip is
+  // as far from the camera as the candidate contact (the image unchanged, the depth the
+  // candidate's): one view tells where a fingertip is across its ray, not along it.
+  // false: the lifted hand as it is (the former rule). No effect with several cameras.
+  bool one_view_along_rays = true;
   // Note boundaries from the audio's onsets (note_boundaries.h), when the input has them.
   bool audio_onsets = true;
   NoteBoundaryOptions boundaries;

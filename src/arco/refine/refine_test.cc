@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "arco/hand/kinematics.h"
+#include "arco/hand/one_view_depth.h"
 #include "arco/refine/test_scene.h"
 
 namespace arco::refine {
@@ -382,6 +383,46 @@ TEST(Refine, LiftTestRejectsContactsTheFingerCannotReach) {
   }
   EXPECT_TRUE(r.contacts[10].pressed());
   EXPECT_EQ(r.summary.rejected_out_of_reach, 20);
+}
+
+// One camera: depth is what one view lacks. The vision hand moved 70 mm along the rays of a
+// camera in front of the player and to the scroll's side (as a one-view lift misplaces it;
+// every point on its own ray, the image unchanged) lies off along the strings, across
+// them and above them, beyond the lift test's reach. Compared with the hand scaled to each
+// candidate's distance from the camera (ArcoDecodeOptions::one_view_along_rays) the
+// decoding finds the strings and fingers; the lifted hand as it is finds none (at 40 mm
+// it still found 0.986 of them: the decoding's own margin).
+TEST(Refine, OneCameraComparesCandidatesAlongTheCameraRays) {
+  testing::Scene scene = Cello(Piece());
+  // 1.35 m from the bridge along the strings, 1 m to the side and 1.2 m in front of them.
+  const Eigen::Vector3d centre = scene.pose[0].ToWorld(Eigen::Vector3d(1350, 1000, 1200));
+  hand::OneViewDepthOptions move;
+  move.window_frames = 0;
+  const std::vector<double> shift_mm(scene.input.vision_hand.size(), 70.0);
+  ASSERT_TRUE(hand::MoveHandsAlongRays(centre, shift_mm, move, &scene.input.vision_hand).ok());
+  scene.input.one_view_camera_centre_mm = centre;
+  const auto right_fraction = [&](bool along_rays) {
+    RefineOptions o = Options(RefineMode::kArco);
+    o.decode.one_view_along_rays = along_rays;
+    const RefineResult r = Refine(scene.input, o);
+    int pressed = 0, right = 0;
+    for (size_t f = 0; f < r.contacts.size(); ++f) {
+      if (scene.truth_finger[f] == 0) continue;
+      ++pressed;
+      const FrameContact& c = r.contacts[f];
+      right +=
+          c.pressed() && c.string == scene.truth_string[f] && c.finger == scene.truth_finger[f];
+    }
+    return static_cast<double>(right) / pressed;
+  };
+  const double along = right_fraction(true), lifted = right_fraction(false);
+  std::printf(
+      "[ one camera ] string and finger right on %.3f of pressed frames along the "
+      "rays, %.3f with the lifted hand\n",
+      along,
+      lifted);
+  EXPECT_GE(along, 0.95);
+  EXPECT_LT(lifted, along - 0.2);
 }
 
 TEST(Refine, FingeringTranscription) {
