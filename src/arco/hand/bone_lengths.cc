@@ -18,6 +18,7 @@ Status BoneLengthOptions::Validate() const {
   if (!(min_ratio > 0 && min_ratio <= 1 && max_ratio >= 1 && std::isfinite(max_ratio))) {
     return bad("need 0 < min_ratio <= 1 <= max_ratio");
   }
+  if (!(quantile >= 0.5 && quantile < 1)) return bad("quantile must be in [0.5, 1)");
   return Status::Ok();
 }
 
@@ -49,7 +50,8 @@ StatusOr<BoneLengthEstimate> EstimateBoneLengths(const std::vector<HandPointsMm>
       if (std::abs(d - median) <= options.mad_gate * sigma) inliers.push_back(d);
     }
     out.inliers[k] = static_cast<int>(inliers.size());
-    const double m = Median(inliers);
+    const double m =
+        options.quantile == 0.5 ? Median(inliers) : InterpolatedQuantile(inliers, options.quantile);
     out.lengths_mm[k] = m;
     if (options.correct_noise_bias) {
       const double tau = kMadToSigma * MedianAbsDeviation(inliers, m);

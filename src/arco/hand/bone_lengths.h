@@ -36,6 +36,12 @@ struct BoneLengthOptions {
   // arco's contact deviation on its synthetic captures rose by 0.16-0.79 mm
   // (docs/accuracy.md), past the bar run_capture_test checks.
   bool correct_noise_bias = false;
+  // [0.5, 1): each length is this quantile of its inliers (numpy's linear interpolation);
+  // 0.5 is the median. One camera's lifted points (track/monocular_lift.h) lie at one
+  // depth per frame, so their distances are the bones' projections on a plane parallel
+  // to the image, whole only when a bone lies parallel to it: the hand stage takes a
+  // higher quantile there (HandStageOptions::one_view_bone_quantile).
+  double quantile = 0.5;
   Status Validate() const;
 };
 

@@ -94,6 +94,36 @@ TEST(EstimateBoneLengths, RemovesTheUpwardBiasOfNoisyDistances) {
   EXPECT_LT(corrected.second, 0.6 * plain.second);
 }
 
+// One camera: the lifted hand lies at one depth per frame, so each distance is the bone's
+// projection on a plane parallel to the image. A higher quantile of the projections comes
+// nearer the bones than their median (HandStageOptions::one_view_bone_quantile).
+TEST(EstimateBoneLengths, AHigherQuantileOfProjectedDistancesNearsTheBones) {
+  std::mt19937 rng(5);
+  Capture c = MakeCapture(300, 1.0, rng);
+  for (HandPointsMm& p : c.frames)
+    for (auto& q : p) q.z() = 0;  // every point onto one plane (the camera looks along z)
+  const HandModel prior = HandModel::Default(HandSide::kLeft);
+  const auto mean_error = [&](double quantile) {
+    BoneLengthOptions o;
+    o.quantile = quantile;
+    const StatusOr<BoneLengthEstimate> est = EstimateBoneLengths(c.frames, prior, o);
+    EXPECT_TRUE(est.ok()) << est.status().message();
+    double sum = 0;
+    for (int k = 1; k < kNumHandKeypoints; ++k)
+      sum += std::abs(est->lengths_mm[k] - c.truth.bone_length_mm(k));
+    return sum / (kNumHandKeypoints - 1);
+  };
+  const double median = mean_error(0.5), upper = mean_error(0.75);
+  std::printf(
+      "[ bones ] projections: mean bone error %.2f mm (median), %.2f mm (0.75)\n", median, upper);
+  EXPECT_LT(upper, 0.7 * median);
+  BoneLengthOptions bad;
+  bad.quantile = 1.0;
+  EXPECT_FALSE(bad.Validate().ok());
+  bad.quantile = 0.4;
+  EXPECT_FALSE(bad.Validate().ok());
+}
+
 TEST(EstimateBoneLengths, FillsUnseenBonesFromScaleAndClampsToAnatomy) {
   std::mt19937 rng(3);
   Capture c = MakeCapture(50, 1.0, rng);

@@ -25,6 +25,9 @@ struct HandStageOptions {
   hand::PalmShapeOptions palm;  // the performer's palm (after the bone lengths)
   hand::HandFitOptions fit;
   hand::OneViewDepthOptions one_view_depth;  // a one-camera capture's hand depth
+  // [0.5, 1): one camera: the bone lengths are this quantile of the lifted hand's
+  // distances (bones.quantile; the lift's points are projections at the strings' depth).
+  double one_view_bone_quantile = 0.75;
   // The fit carries a temporal prior from frame to frame; the clip is cut into chunks of
   // this many frames that are fitted in parallel (each starts from its own 3D keypoints),
   // so results do not depend on the thread count.
