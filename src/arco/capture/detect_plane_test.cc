@@ -85,6 +85,13 @@ TEST(DetectPlane, KeypointsTriangulateOntoTheMovingPlaneAndStayOnIt) {
       1e3 * total.preprocess_s / total.frames,
       1e3 * total.postprocess_s / total.frames,
       1e3 * detected->decode_s / total.frames);
+  std::printf(
+      "hand crops from the previous frame's hand: %lld; hands re-used: %lld; "
+      "hand_recrop runs: %lld; hand landmarker runs: %lld\n",
+      static_cast<long long>(total.hands_tracked),
+      static_cast<long long>(total.hands_reused),
+      static_cast<long long>(total.models[2].runs),
+      static_cast<long long>(total.models[3].runs));
   const HandConsistencySummary& hands = detected->hands;
   std::printf(
       "hands across views: %lld hands judged, %lld views swapped, %lld disagreeing, %lld "
