@@ -172,12 +172,12 @@ std::function<int()> SetupDetect(CLI::App& app) {
   sub->add_flag("--no-hand-recrop",
                 a->no_hand_recrop,
                 "Hand crops straight from the pose, without hand_recrop's refinement");
-  sub->add_flag("--hand-tracking,!--no-hand-tracking",
+  sub->add_flag("--hand-tracking",
                 d.hand_tracking,
                 "A hand found on the previous frame gets its crop from its own landmarks "
                 "(MediaPipe's hand tracking) instead of the pose and hand_recrop, while that "
-                "crop lies on the pose's hand")
-      ->capture_default_str();
+                "crop lies on the pose's hand (off: it cost the bow hand accuracy on the "
+                "plane test, docs/detect.md)");
   AddNumber(sub,
             "--min-hand-tracking-presence",
             d.min_hand_tracking_presence,
