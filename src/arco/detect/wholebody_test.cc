@@ -15,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "arco/detect/models_for_test.h"
@@ -298,6 +299,19 @@ TEST(WholeBodyTracker, HandsTrackedFromTheirLandmarksAndStillHandsReused) {
   const double left = HandMedianMove(*first, *after, wholebody::kLeftHandFirst);
   EXPECT_GT(left, 8.0);
   EXPECT_LT(left, 30.0);
+
+  // The same three frames on 1 thread: the same bits.
+  options.num_threads = 1;
+  StatusOr<WholeBodyTracker> one = WholeBodyTracker::Create(options);
+  ASSERT_TRUE(one.ok()) << one.status().message();
+  const std::vector<std::pair<const media::Image*, const WholeBodyFrame*>> runs = {
+      {&image, &*first}, {&image, &*again}, {&moved, &*after}};
+  for (const auto& [frame, expected] : runs) {
+    StatusOr<WholeBodyFrame> out = one->Track(*frame);
+    ASSERT_TRUE(out.ok());
+    EXPECT_TRUE(SameBits(*out, *expected));
+  }
+  EXPECT_EQ(one->summary().hands_reused, 2);
 }
 
 // Any one missing model stops Create with the line naming that file and scripts/setup
