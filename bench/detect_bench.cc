@@ -13,9 +13,13 @@
 // - BM_DecodeFrame: reading frames with media::VideoReader (decoding is not part of
 //   the tracker's time): opencv-doc's vtest.avi (768 x 576 MPEG-4) and the cellist JPEG;
 // - BM_DetectStagePlane: `arco detect` (capture::RunDetectStage, default models) on
-//   capture_detect_plane_test's scene (8 views x 12 frames of 1152 x 1328 FFV1, rendered
-//   once, untimed), wall time per view-frame with decoding, for --threads 1 and 2 and
-//   with frames decoded ahead on a thread beside each worker or in turn (issue 28).
+//   capture_detect_plane_test's scene (8 views x 12 frames of 1152 x 1328, rendered
+//   once per codec, untimed), wall time per view-frame with decoding, for --threads 1
+//   and 2, with frames decoded ahead on a thread beside each worker or in turn (issue
+//   28), and with the videos as lossless FFV1 RGB (the tests' codec) or as H.264 at
+//   high quality (libx264 crf 16, yuv420p: what phones and cameras deliver). With
+//   ARCO_DETECT_BENCH_DIR set the captures are made there and kept (FOLDER/ffv1/capture,
+//   FOLDER/h264/capture), e.g. to run `arco detect` of two builds on the same videos.
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
@@ -30,6 +34,7 @@
 #include "arco/detect/network.h"
 #include "arco/detect/wholebody.h"
 #include "arco/media/video_reader.h"
+#include "arco/media/video_writer.h"
 #include "arco/testing/plane_scene.h"
 
 namespace arco::detect {
@@ -160,19 +165,33 @@ BENCHMARK(BM_DecodeFrame)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMilli
 struct PlaneCapture {
   std::string dir, error;
   int64_t view_frames = 0;
+  bool keep = false;
   ~PlaneCapture() {
-    if (!dir.empty()) std::filesystem::remove_all(dir);
+    if (!dir.empty() && !keep) std::filesystem::remove_all(dir);
   }
 };
-const PlaneCapture& GetPlaneCapture() {
-  static PlaneCapture capture = [] {
-    PlaneCapture c;
-    char pattern[] = "/tmp/arco_detect_bench_XXXXXX";
-    if (mkdtemp(pattern) == nullptr) {
-      c.error = "cannot make a temporary folder";
-      return c;
+// codec 0: FFV1 (lossless RGB), 1: libx264 (crf 16, yuv420p).
+const PlaneCapture& GetPlaneCapture(int codec) {
+  static PlaneCapture captures[2];
+  static bool tried[2] = {false, false};
+  PlaneCapture& c = captures[codec];
+  if (tried[codec]) return c;
+  tried[codec] = true;
+  {
+    const char* keep_dir = std::getenv("ARCO_DETECT_BENCH_DIR");
+    if (keep_dir != nullptr && *keep_dir != '\0') {
+      c.dir = std::string(keep_dir) + (codec == 0 ? "/ffv1" : "/h264");
+      c.keep = true;
+      std::filesystem::remove_all(c.dir);
+      std::filesystem::create_directories(c.dir);
+    } else {
+      char pattern[] = "/tmp/arco_detect_bench_XXXXXX";
+      if (mkdtemp(pattern) == nullptr) {
+        c.error = "cannot make a temporary folder";
+        return c;
+      }
+      c.dir = pattern;
     }
-    c.dir = pattern;
     StatusOr<media::VideoReader> reader = media::VideoReader::Open(kCellist);
     if (!reader.ok()) {
       c.error = reader.status().message();
@@ -186,6 +205,13 @@ const PlaneCapture& GetPlaneCapture() {
     const testing::PlaneScene scene = testing::DetectPlaneScene(*image);
     testing::PlaneSceneWriteOptions write;
     write.render.supersampling = 1;
+    if (codec == 1) {
+      if (!media::HasVideoEncoder("libx264")) {
+        c.error = "this FFmpeg has no libx264 encoder";
+        return c;
+      }
+      write.codec = "libx264";
+    }
     const std::string scene_dir = c.dir + "/scene";
     const Status written = testing::WritePlaneScene(scene, scene_dir, write);
     if (!written.ok()) {
@@ -205,14 +231,14 @@ const PlaneCapture& GetPlaneCapture() {
     }
     c.view_frames =
         static_cast<int64_t>(scene.rig.cameras.size() * scene.world_from_plane.size());
-    return c;
-  }();
-  return capture;
+  }
+  return c;
 }
 
-// range(0): --threads; range(1): 1 decode ahead, 0 decode and track in turn.
+// range(0): --threads; range(1): 1 decode ahead, 0 decode and track in turn; range(2):
+// 0 FFV1 videos, 1 H.264.
 void BM_DetectStagePlane(benchmark::State& state) {
-  const PlaneCapture& capture = GetPlaneCapture();
+  const PlaneCapture& capture = GetPlaneCapture(static_cast<int>(state.range(2)));
   if (!capture.error.empty()) {
     state.SkipWithError(capture.error.c_str());
     return;
@@ -221,7 +247,8 @@ void BM_DetectStagePlane(benchmark::State& state) {
   o.capture_dir = capture.dir + "/capture";
   o.num_threads = static_cast<int>(state.range(0));
   o.decode_ahead = state.range(1) != 0;
-  state.SetLabel(std::string(o.decode_ahead ? "decode ahead" : "decode in turn") + ", " +
+  state.SetLabel(std::string(state.range(2) == 0 ? "FFV1, " : "H.264, ") +
+                 (o.decode_ahead ? "decode ahead" : "decode in turn") + ", " +
                  std::to_string(o.num_threads) + " threads");
   double decode_s = 0, wait_s = 0, inference_s = 0;
   int64_t runs = 0;
@@ -245,7 +272,7 @@ void BM_DetectStagePlane(benchmark::State& state) {
   state.counters["inference_ms"] = inference_s * per_view_frame;
 }
 BENCHMARK(BM_DetectStagePlane)
-    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgsProduct({{1, 2}, {0, 1}, {0, 1}})
     ->Iterations(1)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);

@@ -61,6 +61,8 @@ Json SummaryJson(const detect::WholeBodySummary& s) {
               {"frames_with_right_hand", s.frames_with_right_hand},
               {"detector_runs", s.detector_runs},
               {"redetections", s.redetections},
+              {"hands_tracked", s.hands_tracked},
+              {"hands_reused", s.hands_reused},
               {"models", models},
               {"inference_s", s.inference_s},
               {"preprocess_s", s.preprocess_s},
@@ -77,6 +79,8 @@ detect::WholeBodySummary Difference(const detect::WholeBodySummary& after,
   d.frames_with_right_hand -= before.frames_with_right_hand;
   d.detector_runs -= before.detector_runs;
   d.redetections -= before.redetections;
+  d.hands_tracked -= before.hands_tracked;
+  d.hands_reused -= before.hands_reused;
   for (size_t k = 0; k < d.models.size(); ++k) {
     d.models[k].runs -= before.models[k].runs;
     d.models[k].inference_s -= before.models[k].inference_s;
@@ -114,6 +118,9 @@ Json ToJson(const DetectStageOptions& o) {
               {"min_pose_presence", o.detector.min_pose_presence},
               {"min_hand_presence", o.detector.min_hand_presence},
               {"hand_recrop", o.detector.hand_recrop},
+              {"hand_tracking", o.detector.hand_tracking},
+              {"min_hand_tracking_presence", o.detector.min_hand_tracking_presence},
+              {"hand_reuse_max_change", o.detector.hand_reuse_max_change},
               {"detection_tile_levels", o.detector.detection_tile_levels},
               {"chunk_frames", o.chunk_frames},
               {"hands", ToJson(o.hands)},

@@ -11,12 +11,6 @@
 namespace arco::capture {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-// hand_21: the wrist, and the bases (MCP joints) of the index, middle, ring fingers.
-constexpr int kWrist = 0, kIndexBase = 5, kMiddleBase = 9, kRingBase = 13;
-// MediaPipe's HandLandmarksToRectCalculator and the hand landmark graph's ROI rule.
-constexpr double kRoiScale = 2.0;
-constexpr double kRoiShiftY = -0.1;
 // A hand is compared when at least this many of its points can be (a third of them).
 constexpr int kMinComparedPoints = 7;
 
@@ -179,31 +173,9 @@ double HandErrorPx(const HandConsistencyOptions& options,
 
 std::optional<detect::Roi> HandRoiFromPoints(const std::array<Eigen::Vector2d, kHandPoints>& px,
                                              const std::array<bool, kHandPoints>& valid) {
-  if (!valid[kWrist] || !valid[kIndexBase] || !valid[kMiddleBase] || !valid[kRingBase]) {
-    return std::nullopt;
-  }
-  const Eigen::Vector2d bases = 0.5 * (0.5 * (px[kIndexBase] + px[kRingBase]) + px[kMiddleBase]);
-  const double rotation =
-      detect::AlignmentRotation({px[kWrist].x(), px[kWrist].y()}, {bases.x(), bases.y()}, kPi / 2);
-  // The crop's axes in the image (roi.h): x along (cos r, sin r), y along (-sin r, cos r).
-  const Eigen::Vector2d ax(std::cos(rotation), std::sin(rotation));
-  const Eigen::Vector2d ay(-std::sin(rotation), std::cos(rotation));
-  Eigen::Vector2d lo(INFINITY, INFINITY), hi(-INFINITY, -INFINITY);
-  for (int i = 0; i < kHandPoints; ++i) {
-    if (!valid[i]) continue;
-    const Eigen::Vector2d q(px[i].dot(ax), px[i].dot(ay));
-    lo = lo.cwiseMin(q);
-    hi = hi.cwiseMax(q);
-  }
-  const Eigen::Vector2d mid = 0.5 * (lo + hi);
-  const double side = kRoiScale * (hi - lo).maxCoeff();
-  if (!(side > 0) || !std::isfinite(side)) return std::nullopt;
-  const Eigen::Vector2d centre = mid.x() * ax + mid.y() * ay + kRoiShiftY * side * ay;
-  detect::Roi roi;
-  roi.centre = {centre.x(), centre.y()};
-  roi.side_px = side;
-  roi.rotation_rad = rotation;
-  return roi;
+  std::array<detect::Point2, kHandPoints> points;
+  for (int i = 0; i < kHandPoints; ++i) points[i] = {px[i].x(), px[i].y()};
+  return detect::HandRoiFromLandmarks(points.data(), valid.data());
 }
 
 int64_t DownWeightPointsOffConsensus(const HandConsistencyOptions& o,

@@ -16,12 +16,15 @@ namespace arco::cli {
 namespace {
 
 // Detection options as set by `arco detect` (the library names the fields).
-inline constexpr FieldFlag kDetectFlags[] = {{"num_threads", "--threads"},
-                                             {"chunk_frames", "--chunk-frames"},
-                                             {"min_detection_score", "--min-detection-score"},
-                                             {"min_pose_presence", "--min-pose-presence"},
-                                             {"min_hand_presence", "--min-hand-presence"},
-                                             {"max_error_hand_fraction", "--hand-gate"}};
+inline constexpr FieldFlag kDetectFlags[] = {
+    {"num_threads", "--threads"},
+    {"chunk_frames", "--chunk-frames"},
+    {"min_detection_score", "--min-detection-score"},
+    {"min_pose_presence", "--min-pose-presence"},
+    {"min_hand_presence", "--min-hand-presence"},
+    {"min_hand_tracking_presence", "--min-hand-tracking-presence"},
+    {"hand_reuse_max_change", "--hand-reuse-max-change"},
+    {"max_error_hand_fraction", "--hand-gate"}};
 
 struct DetectArgs {
   capture::DetectStageOptions o;
@@ -169,6 +172,28 @@ std::function<int()> SetupDetect(CLI::App& app) {
   sub->add_flag("--no-hand-recrop",
                 a->no_hand_recrop,
                 "Hand crops straight from the pose, without hand_recrop's refinement");
+  sub->add_flag("--hand-tracking",
+                d.hand_tracking,
+                "A hand found on the previous frame gets its crop from its own landmarks "
+                "(MediaPipe's hand tracking) instead of the pose and hand_recrop, while that "
+                "crop lies on the pose's hand (off: it cost the bow hand accuracy on the "
+                "plane test, docs/detect.md)");
+  AddNumber(sub,
+            "--min-hand-tracking-presence",
+            d.min_hand_tracking_presence,
+            "Hand tracking starts from a hand whose presence reached this",
+            detect::kWholeBodyScoreRange)
+      ->capture_default_str();
+  AddNumber(sub,
+            "--hand-reuse-max-change",
+            d.hand_reuse_max_change,
+            "Skip the hand landmarker and keep the hand it last found while no " +
+                std::to_string(detect::kHandReuseBlockPx) + " x " +
+                std::to_string(detect::kHandReuseBlockPx) +
+                " px block of that crop has changed by more than this mean absolute "
+                "difference (8-bit levels); 0 = always run it",
+            detect::kWholeBodyHandReuseChangeRange)
+      ->capture_default_str();
   AddNumber(sub,
             "--hand-gate",
             a->o.hands.max_error_hand_fraction,

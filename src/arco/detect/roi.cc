@@ -1,5 +1,6 @@
 #include "arco/detect/roi.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace arco::detect {
@@ -59,6 +60,43 @@ Roi WholeImageRoi(int width, int height) {
 Roi HandRoiFromPose(Point2 wrist, Point2 index, Point2 pinky, double scale, double shift_y) {
   const Point2 middle = (1.0 / 3.0) * (2.0 * index + pinky);
   return RoiFromAlignmentPoints(middle, middle + (middle - wrist), kPi / 2, scale, shift_y);
+}
+
+// hand_landmark_landmarks_to_roi.pbtxt's SplitNormalizedLandmarkListCalculator ranges
+// [0, 4), [5, 7), [9, 11), [13, 15), [17, 19).
+const bool kHandTrackingRoiPoints[21] = {true,  true,  true,  true, false, true,  true,
+                                         false, false, true,  true, false, false, true,
+                                         true,  false, false, true, true,  false, false};
+
+std::optional<Roi> HandRoiFromLandmarks(const Point2* points, const bool* use) {
+  constexpr int kWrist = 0, kIndexBase = 5, kMiddleBase = 9, kRingBase = 13;
+  const auto used = [&](int i) { return use == nullptr || use[i]; };
+  if (!used(kWrist) || !used(kIndexBase) || !used(kMiddleBase) || !used(kRingBase)) {
+    return std::nullopt;
+  }
+  const Point2 bases = 0.5 * (0.5 * (points[kIndexBase] + points[kRingBase]) + points[kMiddleBase]);
+  const double rotation = AlignmentRotation(points[kWrist], bases, kPi / 2);
+  // The crop's axes in the image: x along (cos r, sin r), y along (-sin r, cos r).
+  const double c = std::cos(rotation), s = std::sin(rotation);
+  double lo_x = INFINITY, lo_y = INFINITY, hi_x = -INFINITY, hi_y = -INFINITY;
+  for (int i = 0; i < 21; ++i) {
+    if (!used(i)) continue;
+    const double qx = points[i].x * c + points[i].y * s;
+    const double qy = points[i].x * -s + points[i].y * c;
+    lo_x = std::min(lo_x, qx);
+    lo_y = std::min(lo_y, qy);
+    hi_x = std::max(hi_x, qx);
+    hi_y = std::max(hi_y, qy);
+  }
+  const double mid_x = 0.5 * (lo_x + hi_x), mid_y = 0.5 * (lo_y + hi_y);
+  const double side = kHandLandmarksRoiScale * std::max(hi_x - lo_x, hi_y - lo_y);
+  if (!(side > 0) || !std::isfinite(side)) return std::nullopt;
+  Roi roi;
+  const double shift = kHandLandmarksRoiShiftY * side;
+  roi.centre = {mid_x * c + mid_y * -s + shift * -s, mid_x * s + mid_y * c + shift * c};
+  roi.side_px = side;
+  roi.rotation_rad = rotation;
+  return roi;
 }
 
 }  // namespace arco::detect

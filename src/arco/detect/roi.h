@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cmath>
+#include <optional>
 
 namespace arco::detect {
 
@@ -64,5 +65,22 @@ Roi WholeImageRoi(int width, int height);
 // (2 index + pinky) / 3, a square of side 2 |middle - wrist| centred on it, turned so
 // wrist -> middle points up; then shifted by shift_y * side and scaled by `scale`.
 Roi HandRoiFromPose(Point2 wrist, Point2 index, Point2 pinky, double scale, double shift_y);
+
+// MediaPipe's crop around a hand from its own landmarks (hand_landmark_landmarks_to_roi:
+// HandLandmarksToRectCalculator, then RectTransformationCalculator with scale 2, shift_y
+// -0.1, square_long): turned so the wrist -> the finger bases' centre
+// ((index + ring) / 2 + middle) / 2 points up, the bounding box of the points in that
+// frame, its longer side x kHandLandmarksRoiScale, moved kHandLandmarksRoiShiftY x side
+// along the crop's y axis (towards the fingers). `points` holds the 21 points in hand_21
+// order; points whose `use` is false are left out of the box (nullptr: all are used).
+// Empty when the wrist or the index, middle or ring base is left out, or the box is empty.
+inline constexpr double kHandLandmarksRoiScale = 2.0;
+inline constexpr double kHandLandmarksRoiShiftY = -0.1;
+std::optional<Roi> HandRoiFromLandmarks(const Point2* points, const bool* use = nullptr);
+
+// The hand_21 points MediaPipe's hand tracking graph takes for the next frame's crop:
+// the wrist, the thumb's first three and every finger's base and next joint (the
+// fingertips and the last joints are left out: they move the most between frames).
+extern const bool kHandTrackingRoiPoints[21];
 
 }  // namespace arco::detect

@@ -4,8 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 #include <set>
 #include <string>
@@ -93,6 +96,63 @@ TEST(HandRoiFromPose, CentredOnTheMiddleFingerBaseTurnedFingersUp) {
   EXPECT_NEAR(roi.side_px, 2 * Norm(middle - wrist), 1e-9);
   // The crop's top is further left, away from the wrist.
   EXPECT_LT(roi.ToImage(0.5, 0).x, middle.x - 50);
+}
+
+// MediaPipe's next-frame hand crop from the hand's own points: an upright hand (wrist
+// below the finger bases) gives an upright square of twice the points' extent, moved up
+// (towards the fingers) by 0.1 of its side; the same hand turned by any angle gives the
+// same square turned with it; points left out do not count; without the wrist or a
+// finger base there is no crop.
+TEST(HandRoiFromLandmarks, TwiceTheBoxShiftedTowardsTheFingersTurnedWithTheHand) {
+  std::array<Point2, 21> upright;
+  // A hand 40 px wide: the wrist at (0, 60); finger bases at y = 0; joints above them.
+  for (int i = 0; i < 21; ++i) upright[i] = {0, 60};
+  const double base_x[4] = {-15, -5, 5, 15};  // index, middle, ring, little bases
+  for (int f = 0; f < 4; ++f) {
+    for (int j = 0; j < 4; ++j) upright[5 + 4 * f + j] = {base_x[f], -15.0 * j};
+  }
+  for (int j = 1; j < 5; ++j) upright[j] = {-20.0 - 2 * j, 50.0 - 12 * j};  // the thumb
+  // The middle of the bases ((index + ring) / 2 + middle) / 2 is (-5, 0): move the wrist
+  // under it so the hand points straight up.
+  upright[0] = {-5, 60};
+  std::optional<Roi> roi = HandRoiFromLandmarks(upright.data());
+  ASSERT_TRUE(roi.has_value());
+  EXPECT_NEAR(roi->rotation_rad, 0, 1e-12);
+  // Box: x from -28 to 15 (43), y from -45 to 60 (105): side 210, centre (-6.5, 7.5)
+  // moved up by 21.
+  EXPECT_NEAR(roi->side_px, 210, 1e-9);
+  EXPECT_NEAR(roi->centre.x, -6.5, 1e-9);
+  EXPECT_NEAR(roi->centre.y, 7.5 - 21, 1e-9);
+  for (double angle : {0.3, -1.2, 2.5}) {
+    const Point2 pivot = {100, 200};
+    std::array<Point2, 21> turned;
+    // Turning the image points by +angle (x right, y down: clockwise on screen) turns
+    // the crop by +angle in MediaPipe's convention.
+    const auto turn = [&](Point2 p) {
+      const double c = std::cos(angle), s = std::sin(angle);
+      return Point2{pivot.x + c * p.x - s * p.y, pivot.y + s * p.x + c * p.y};
+    };
+    for (int i = 0; i < 21; ++i) turned[i] = turn(upright[i]);
+    std::optional<Roi> r = HandRoiFromLandmarks(turned.data());
+    ASSERT_TRUE(r.has_value());
+    EXPECT_NEAR(r->rotation_rad, angle, 1e-9);
+    EXPECT_NEAR(r->side_px, 210, 1e-9);
+    const Point2 centre = turn(roi->centre);
+    EXPECT_NEAR(r->centre.x, centre.x, 1e-9);
+    EXPECT_NEAR(r->centre.y, centre.y, 1e-9);
+  }
+  // The tracking subset keeps each finger's base and next joint only (and the thumb
+  // without its tip): the box is y -15 .. 60, side 2 x 75.
+  std::optional<Roi> subset = HandRoiFromLandmarks(upright.data(), kHandTrackingRoiPoints);
+  ASSERT_TRUE(subset.has_value());
+  EXPECT_NEAR(subset->side_px, 150, 1e-9);
+  bool no_wrist[21];
+  std::fill(no_wrist, no_wrist + 21, true);
+  no_wrist[0] = false;
+  EXPECT_FALSE(HandRoiFromLandmarks(upright.data(), no_wrist).has_value());
+  std::array<Point2, 21> collapsed;
+  collapsed.fill({3, 4});
+  EXPECT_FALSE(HandRoiFromLandmarks(collapsed.data()).has_value());
 }
 
 TEST(SsdAnchors, PoseDetectionGrid) {
@@ -204,10 +264,12 @@ TEST(WholeBodyOptions, ValidateNamesTheField) {
     const char* field;
     double WholeBodyOptions::*member;
   };
-  for (const Case& c : {Case{"min_detection_score", &WholeBodyOptions::min_detection_score},
-                        Case{"nms_min_iou", &WholeBodyOptions::nms_min_iou},
-                        Case{"min_pose_presence", &WholeBodyOptions::min_pose_presence},
-                        Case{"min_hand_presence", &WholeBodyOptions::min_hand_presence}}) {
+  for (const Case& c :
+       {Case{"min_detection_score", &WholeBodyOptions::min_detection_score},
+        Case{"nms_min_iou", &WholeBodyOptions::nms_min_iou},
+        Case{"min_pose_presence", &WholeBodyOptions::min_pose_presence},
+        Case{"min_hand_presence", &WholeBodyOptions::min_hand_presence},
+        Case{"min_hand_tracking_presence", &WholeBodyOptions::min_hand_tracking_presence}}) {
     for (double bad : {-0.01, 1.01, nan, std::numeric_limits<double>::infinity()}) {
       WholeBodyOptions options;
       options.*c.member = bad;
@@ -225,6 +287,18 @@ TEST(WholeBodyOptions, ValidateNamesTheField) {
     WholeBodyOptions options;
     options.num_threads = threads;
     EXPECT_NE(options.Validate().message().find("WholeBodyOptions.num_threads"), std::string::npos);
+  }
+  for (double bad : {-0.5, 16.5, nan}) {
+    WholeBodyOptions options;
+    options.hand_reuse_max_change = bad;
+    EXPECT_NE(options.Validate().message().find("WholeBodyOptions.hand_reuse_max_change"),
+              std::string::npos)
+        << bad;
+  }
+  for (double edge : {0.0, 16.0}) {
+    WholeBodyOptions options;
+    options.hand_reuse_max_change = edge;
+    EXPECT_TRUE(options.Validate().ok()) << edge;
   }
   for (int levels : {-1, 3}) {
     WholeBodyOptions options;

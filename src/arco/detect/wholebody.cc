@@ -118,6 +118,12 @@ Status WholeBodyOptions::Validate() const {
       CheckInRange("WholeBodyOptions.num_threads", num_threads, kWholeBodyThreadsRange));
   ARCO_RETURN_IF_ERROR(CheckInRange(
       "WholeBodyOptions.detection_tile_levels", detection_tile_levels, kWholeBodyTileLevelsRange));
+  ARCO_RETURN_IF_ERROR(CheckInRange("WholeBodyOptions.min_hand_tracking_presence",
+                                    min_hand_tracking_presence,
+                                    kWholeBodyScoreRange));
+  ARCO_RETURN_IF_ERROR(CheckInRange("WholeBodyOptions.hand_reuse_max_change",
+                                    hand_reuse_max_change,
+                                    kWholeBodyHandReuseChangeRange));
   return Status::Ok();
 }
 
@@ -128,6 +134,8 @@ void WholeBodySummary::Merge(const WholeBodySummary& other) {
   frames_with_right_hand += other.frames_with_right_hand;
   detector_runs += other.detector_runs;
   redetections += other.redetections;
+  hands_tracked += other.hands_tracked;
+  hands_reused += other.hands_reused;
   for (size_t k = 0; k < models.size(); ++k) {
     models[k].runs += other.models[k].runs;
     models[k].inference_s += other.models[k].inference_s;
@@ -151,36 +159,66 @@ struct WholeBodyTracker::Impl {
   std::vector<SsdDetection> detections;
   std::array<Point2, mediapipe_pose::kNumWithAuxiliary> pose_points{};
   std::array<double, mediapipe_pose::kNumWithAuxiliary> pose_scores{};
+  std::array<Point2, kNumHandLandmarks> hand_points{};  // HandInRoi's, image pixels
+  cv::Mat reuse_crop;  // the crop cut again to compare (hand_reuse_max_change)
+  // Per hand (0: the person's left, 1: right), what the last frame found: hand tracking
+  // and re-use start from it. Cleared by Reset and whenever the hand is not found.
+  struct HandState {
+    bool found = false;  // the last frame's hand reached min_hand_presence
+    double presence = 0;
+    std::array<ScoredPoint, kNumHandLandmarks> points{};  // as written to the frame
+    std::array<Point2, kNumHandLandmarks> landmarks{};    // the same, in double
+    // The crop the landmarker last saw and its 8-bit pixels (hand_reuse_max_change > 0).
+    Roi landmarked_roi;
+    cv::Mat landmarked_crop;
+  };
+  std::array<HandState, 2> hand_state;
 
-  // Cuts `roi` from `image` into slot's input (its size and value range).
-  void CutCrop(const cv::Mat& image, const Roi& roi, ModelSlot slot) {
-    const auto start = Clock::now();
-    const ModelInfo& info = networks[slot]->info();
-    const int size = info.input_width;
+  // Cuts `roi` of `image` as a size x size 8-bit crop into `out` (bilinear, black outside).
+  static void WarpCrop(const cv::Mat& image, const Roi& roi, int size, cv::Mat* out) {
     double m[6];
     roi.CropPixelToImageAffine(size, m);
     const cv::Mat to_image(2, 3, CV_64F, m);
     cv::warpAffine(image,
-                   crop,
+                   *out,
                    to_image,
                    cv::Size(size, size),
                    cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
                    cv::BORDER_CONSTANT,
                    cv::Scalar::all(0));
+  }
+
+  // Cuts `roi` from `image` into slot's input (its size and value range), straight into
+  // the network's planar layout (NCHW): the values are those of the interleaved input
+  // Network::Run would otherwise reorder, without that extra pass.
+  void CutCrop(const cv::Mat& image, const Roi& roi, ModelSlot slot) {
+    const auto start = Clock::now();
+    const ModelInfo& info = networks[slot]->info();
+    const int size = info.input_width;
+    WarpCrop(image, roi, size, &crop);
     std::vector<float>& input = inputs[slot];
     const float scale = info.range == ValueRange::kZeroToOne ? 1.0f / 255.0f : 1.0f / 127.5f;
     const float offset = info.range == ValueRange::kZeroToOne ? 0.0f : -1.0f;
+    const size_t plane = static_cast<size_t>(size) * size;
+    float* r = input.data();
+    float* g = r + plane;
+    float* b = g + plane;
     for (int y = 0; y < size; ++y) {
       const uint8_t* row = crop.ptr<uint8_t>(y);
-      float* out = input.data() + static_cast<size_t>(y) * size * 3;
-      for (int i = 0; i < size * 3; ++i) out[i] = row[i] * scale + offset;
+      const size_t at = static_cast<size_t>(y) * size;
+      for (int x = 0; x < size; ++x) {
+        r[at + x] = row[3 * x] * scale + offset;
+        g[at + x] = row[3 * x + 1] * scale + offset;
+        b[at + x] = row[3 * x + 2] * scale + offset;
+      }
     }
     summary.preprocess_s += Seconds(start);
   }
 
   Status Run(ModelSlot slot) {
     const auto start = Clock::now();
-    ARCO_RETURN_IF_ERROR(networks[slot]->Run(inputs[slot].data(), inputs[slot].size()));
+    ARCO_RETURN_IF_ERROR(
+        networks[slot]->Run(inputs[slot].data(), inputs[slot].size(), TensorLayout::kNchw));
     const double s = Seconds(start);
     summary.models[slot].runs += 1;
     summary.models[slot].inference_s += s;
@@ -267,17 +305,97 @@ struct WholeBodyTracker::Impl {
 
   // One hand from the pose's wrist, index and little-finger points: writes 21 points
   // from `first` and returns the presence (NaN when the hand was not looked for).
-  StatusOr<double> Hand(
-      const cv::Mat& image, int wrist_index, int index_index, int pinky_index, ScoredPoint* first) {
+  // `side` 0 is the person's left hand, 1 the right (hand_state).
+  StatusOr<double> Hand(const cv::Mat& image,
+                        int side,
+                        int wrist_index,
+                        int index_index,
+                        int pinky_index,
+                        ScoredPoint* first) {
     const auto start = Clock::now();
+    HandState& state = hand_state[side];
     const Point2 wrist = pose_points[wrist_index];
     const Point2 index = pose_points[index_index], pinky = pose_points[pinky_index];
     const Point2 middle = (1.0 / 3.0) * (2.0 * index + pinky);
     const double length = Norm(middle - wrist);
     summary.postprocess_s += Seconds(start);
     if (!(length * 4 >= kMinRoiSidePx) || !InsideImage(middle, image.cols, image.rows)) {
+      state.found = false;
       return std::numeric_limits<double>::quiet_NaN();
     }
+    // A crop for this hand is kept only when it lies on the pose's hand.
+    const auto on_pose_hand = [&](const Roi& r) {
+      return r.IsFinite() && Norm(r.centre - middle) < 2 * length && r.side_px > length &&
+             r.side_px < 8 * length;
+    };
+    if (options.hand_reuse_max_change > 0 && state.found && !state.landmarked_crop.empty() &&
+        StillSince(image, state)) {
+      std::copy(state.points.begin(), state.points.end(), first);
+      summary.hands_reused += 1;
+      return state.presence;
+    }
+    Roi roi;
+    bool tracked = false;
+    if (options.hand_tracking && state.found &&
+        state.presence >= options.min_hand_tracking_presence) {
+      const auto from_landmarks = Clock::now();
+      const std::optional<Roi> next =
+          HandRoiFromLandmarks(state.landmarks.data(), kHandTrackingRoiPoints);
+      if (next && on_pose_hand(*next)) {
+        roi = *next;
+        tracked = true;
+        summary.hands_tracked += 1;
+      }
+      summary.postprocess_s += Seconds(from_landmarks);
+    }
+    if (!tracked) {
+      ARCO_ASSIGN_OR_RETURN(roi, RoiFromPose(image, wrist, index, pinky, on_pose_hand));
+    }
+    ARCO_ASSIGN_OR_RETURN(const double presence, HandInRoi(image, roi, first));
+    state.found = presence >= options.min_hand_presence;
+    if (state.found) {
+      state.presence = presence;
+      std::copy(first, first + kNumHandLandmarks, state.points.begin());
+      state.landmarks = hand_points;
+      if (options.hand_reuse_max_change > 0) {
+        state.landmarked_roi = roi;
+        crop.copyTo(state.landmarked_crop);  // HandInRoi's crop
+      }
+    }
+    return presence;
+  }
+
+  // Whether the pixels under the crop the landmarker last saw for this hand are still
+  // what it saw (hand_reuse_max_change, kHandReuseBlockPx).
+  bool StillSince(const cv::Mat& image, const HandState& state) {
+    const auto start = Clock::now();
+    const int size = state.landmarked_crop.rows;
+    WarpCrop(image, state.landmarked_roi, size, &reuse_crop);
+    const double max_sum = options.hand_reuse_max_change;
+    bool still = true;
+    for (int by = 0; by < size && still; by += kHandReuseBlockPx) {
+      for (int bx = 0; bx < size && still; bx += kHandReuseBlockPx) {
+        const int y_end = std::min(size, by + kHandReuseBlockPx);
+        const int x_end = std::min(size, bx + kHandReuseBlockPx);
+        int64_t sum = 0;
+        for (int y = by; y < y_end; ++y) {
+          const uint8_t* a = state.landmarked_crop.ptr<uint8_t>(y) + 3 * bx;
+          const uint8_t* b = reuse_crop.ptr<uint8_t>(y) + 3 * bx;
+          for (int i = 0; i < 3 * (x_end - bx); ++i) sum += std::abs(int{a[i]} - int{b[i]});
+        }
+        const int64_t values = 3 * static_cast<int64_t>(y_end - by) * (x_end - bx);
+        still = static_cast<double>(sum) <= max_sum * static_cast<double>(values);
+      }
+    }
+    summary.preprocess_s += Seconds(start);
+    return still;
+  }
+
+  // The hand's crop from the pose alone: the pose's square, refined by hand_recrop when
+  // that is on and its answer lies on the pose's hand.
+  template <typename OnPoseHand>
+  StatusOr<Roi> RoiFromPose(
+      const cv::Mat& image, Point2 wrist, Point2 index, Point2 pinky, OnPoseHand on_pose_hand) {
     Roi roi = HandRoiFromPose(wrist, index, pinky, kHandRoiFallbackScale, 0.0);
     if (options.hand_recrop) {
       const Roi recrop_roi =
@@ -294,13 +412,10 @@ struct WholeBodyTracker::Impl {
           RoiFromAlignmentPoints(centre, edge, -kPi / 2, 1.0, kHandRoiFromRecropShiftY);
       // Keep the refinement only when it is plausible: on this hand, and between 1 and
       // 8 wrist-to-middle lengths wide (else the pose-derived crop).
-      if (refined.IsFinite() && Norm(refined.centre - middle) < 2 * length &&
-          refined.side_px > length && refined.side_px < 8 * length) {
-        roi = refined;
-      }
+      if (on_pose_hand(refined)) roi = refined;
       summary.postprocess_s += Seconds(decode);
     }
-    return HandInRoi(image, roi, first);
+    return roi;
   }
 
   // The hand landmarker on `roi`: 21 points from `first` when the presence reaches
@@ -315,7 +430,8 @@ struct WholeBodyTracker::Impl {
       const int size = net.info().input_width;
       const std::vector<float>& raw = net.output("landmarks").data;
       for (int i = 0; i < kNumHandLandmarks; ++i) {
-        SetPoint(first + i, roi.CropPixelToImage(raw[3 * i], raw[3 * i + 1], size), presence);
+        hand_points[i] = roi.CropPixelToImage(raw[3 * i], raw[3 * i + 1], size);
+        SetPoint(first + i, hand_points[i], presence);
       }
     }
     summary.postprocess_s += Seconds(decode);
@@ -358,6 +474,7 @@ void WholeBodyTracker::Reset() {
   impl_->tracking = false;
   impl_->pose_roi = Roi();
   impl_->person_seen = false;
+  for (Impl::HandState& hand : impl_->hand_state) hand.found = false;
 }
 
 StatusOr<double> WholeBodyTracker::LandmarkHand(const media::Image& frame,
@@ -408,7 +525,10 @@ StatusOr<WholeBodyFrame> WholeBodyTracker::Track(const media::Image& frame) {
     }
   }
   out.pose_presence = static_cast<float>(presence);
-  if (!have_pose) return out;
+  if (!have_pose) {
+    for (Impl::HandState& hand : s.hand_state) hand.found = false;
+    return out;
+  }
 
   // The body points, and the next frame's ROI from the auxiliary alignment points.
   const auto start = Clock::now();
@@ -436,12 +556,14 @@ StatusOr<WholeBodyFrame> WholeBodyTracker::Track(const media::Image& frame) {
   // The person's left hand is MediaPipe's left (15, 17, 19) and COCO's left.
   ARCO_ASSIGN_OR_RETURN(const double left,
                         s.Hand(image,
+                               0,
                                mediapipe_pose::kLeftWrist,
                                mediapipe_pose::kLeftIndex,
                                mediapipe_pose::kLeftPinky,
                                &out.points[wholebody::kLeftHandFirst]));
   ARCO_ASSIGN_OR_RETURN(const double right,
                         s.Hand(image,
+                               1,
                                mediapipe_pose::kRightWrist,
                                mediapipe_pose::kRightIndex,
                                mediapipe_pose::kRightPinky,

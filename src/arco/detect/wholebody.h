@@ -72,6 +72,11 @@ ModelId HandLandmarkModel(HandModel model);
 inline constexpr NumberRange kWholeBodyScoreRange = Closed(0, 1);  // thresholds on scores
 inline constexpr NumberRange kWholeBodyThreadsRange = Closed(1, 1024);
 inline constexpr NumberRange kWholeBodyTileLevelsRange = Closed(0, 2);
+// hand_reuse_max_change: 8-bit levels (mean absolute difference of a block of the crop).
+inline constexpr NumberRange kWholeBodyHandReuseChangeRange = Closed(0, 16);
+// The side of the square blocks of the hand crop compared for hand_reuse_max_change
+// (crop pixels; 224 / 16 = 14 x 14 blocks, a finger is about one block wide).
+inline constexpr int kHandReuseBlockPx = 16;
 
 struct WholeBodyOptions {
   PoseModel pose_model = PoseModel::kFull;
@@ -96,6 +101,22 @@ struct WholeBodyOptions {
   // the hand landmarker sees a square of 4 wrist-to-middle-finger lengths around the
   // pose's estimate of the middle finger's base.
   bool hand_recrop = true;
+  // Hand tracking (MediaPipe's hand tracking graph, hand_landmark_landmarks_to_roi): a
+  // hand found on the previous frame with presence >= this gets its crop from its own
+  // landmarks (roi.h HandRoiFromLandmarks) instead of from the pose and hand_recrop, as
+  // long as that crop lies on this frame's pose hand (centre within 2 wrist-to-middle
+  // lengths of the pose's middle-finger base, side between 1 and 8 of them; else the
+  // pose's crop, as without tracking). Left and right still come from the pose.
+  bool hand_tracking = false;
+  double min_hand_tracking_presence = 0.5;
+  // A still hand: when the crop the hand landmarker saw on an earlier frame, cut again
+  // from this frame at the same place, differs from it by at most this (the largest mean
+  // absolute difference, in 8-bit levels, over blocks of kHandReuseBlockPx x
+  // kHandReuseBlockPx crop pixels), the hand landmarker is skipped and that frame's hand
+  // (points and presence) is used again. Blocks, not the whole crop, so that one finger
+  // moving is seen. The reference crop stays the one last landmarked, so slow drift
+  // adds up until it is run again. 0: always run the landmarker.
+  double hand_reuse_max_change = 0;
   int num_threads = 1;  // cv::dnn threads (network.h)
   // Every number inside its declared range; messages name the field.
   Status Validate() const;
@@ -133,6 +154,10 @@ struct WholeBodySummary {
   // Of those, the ones after a person had been found since creation or the last
   // Reset: tracking was lost.
   int64_t redetections = 0;
+  // Hands whose crop came from their previous landmarks (hand_tracking), and hands taken
+  // again from an earlier frame without running the landmarker (hand_reuse_max_change).
+  int64_t hands_tracked = 0;
+  int64_t hands_reused = 0;
   // Wall time of the forward passes (Network::Run) per model kind, and of the rest:
   // cutting and converting crops (preprocess), decoding outputs and ROI geometry
   // (postprocess). Not deterministic; never part of the output.

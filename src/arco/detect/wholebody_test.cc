@@ -15,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "arco/detect/models_for_test.h"
@@ -118,7 +119,11 @@ TEST(WholeBodyTracker, CellistLeftHandOnTheFingerboard) {
   ARCO_REQUIRE_MODELS();
   const media::Image image = ReadImage(ARCO_SHARED_DATA_DIR "/spd/example.jpg");
   ASSERT_FALSE(image.empty());
-  StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(TestOptions());
+  // Every frame's hands from the pose and hand_recrop (Holistic's way; the hands tracked
+  // from their own landmarks, the default: HandsTrackedFromTheirLandmarks... below).
+  WholeBodyOptions options = TestOptions();
+  options.hand_tracking = false;
+  StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(options);
   ASSERT_TRUE(tracker.ok()) << tracker.status().message();
   StatusOr<WholeBodyFrame> out = tracker->Track(image);
   ASSERT_TRUE(out.ok()) << out.status().message();
@@ -208,6 +213,105 @@ TEST(WholeBodyTracker, CellistLeftHandOnTheFingerboard) {
   EXPECT_EQ(summary.models[3].runs, 6);
   EXPECT_GT(summary.inference_s, 0.0);
   EXPECT_GT(summary.preprocess_s, 0.0);
+}
+
+// The median distance between two frames' points of one hand (21 points from `first`).
+double HandMedianMove(const WholeBodyFrame& a, const WholeBodyFrame& b, int first) {
+  std::vector<double> moves;
+  for (int i = 0; i < wholebody::kNumHandPoints; ++i) {
+    const ScoredPoint& pa = a.points[first + i];
+    const ScoredPoint& pb = b.points[first + i];
+    moves.push_back(std::hypot(pa.x_px - pb.x_px, pa.y_px - pb.y_px));
+  }
+  std::sort(moves.begin(), moves.end());
+  return moves[moves.size() / 2];
+}
+
+// Hand tracking (MediaPipe's hand tracking graph, issue 28): the cellist three times
+// with hand_tracking on runs hand_recrop on the first frame only; the next frames' hands
+// take their crops from their own landmarks and stay within a few pixels of the first
+// frame's. With hand_reuse_max_change on as well, the same picture once more re-uses
+// both hands bit for bit without the landmarker, and the picture moved by 12 px runs it
+// again.
+TEST(WholeBodyTracker, HandsTrackedFromTheirLandmarksAndStillHandsReused) {
+  ARCO_REQUIRE_MODELS();
+  const media::Image image = ReadImage(ARCO_SHARED_DATA_DIR "/spd/example.jpg");
+  ASSERT_FALSE(image.empty());
+  WholeBodyOptions options = TestOptions();
+  options.hand_tracking = true;
+  options.hand_reuse_max_change = 0;
+  StatusOr<WholeBodyTracker> tracker = WholeBodyTracker::Create(options);
+  ASSERT_TRUE(tracker.ok()) << tracker.status().message();
+  std::vector<WholeBodyFrame> frames;
+  for (int k = 0; k < 3; ++k) {
+    StatusOr<WholeBodyFrame> out = tracker->Track(image);
+    ASSERT_TRUE(out.ok()) << out.status().message();
+    ASSERT_TRUE(out->left_hand && out->right_hand) << k;
+    EXPECT_GT(out->left_hand_presence, 0.9) << k;
+    EXPECT_GT(out->right_hand_presence, 0.9) << k;
+    frames.push_back(*out);
+  }
+  for (int k = 1; k < 3; ++k) {
+    const double left = HandMedianMove(frames[0], frames[k], wholebody::kLeftHandFirst);
+    const double right = HandMedianMove(frames[0], frames[k], wholebody::kRightHandFirst);
+    std::printf(
+        "hands tracked from their landmarks, frame %d: left %.1f px, right %.1f px "
+        "(median) from frame 0's\n",
+        k,
+        left,
+        right);
+    EXPECT_LT(left, 6.0);
+    EXPECT_LT(right, 6.0);
+  }
+  const WholeBodySummary& summary = tracker->summary();
+  EXPECT_EQ(summary.models[2].runs, 2);  // hand_recrop: the first frame only
+  EXPECT_EQ(summary.models[3].runs, 6);
+  EXPECT_EQ(summary.hands_tracked, 4);
+  EXPECT_EQ(summary.hands_reused, 0);
+
+  // Still hands re-used: the same picture again runs no hand landmarker.
+  options.hand_reuse_max_change = 2;
+  tracker = WholeBodyTracker::Create(options);
+  ASSERT_TRUE(tracker.ok()) << tracker.status().message();
+  StatusOr<WholeBodyFrame> first = tracker->Track(image);
+  StatusOr<WholeBodyFrame> again = tracker->Track(image);
+  ASSERT_TRUE(first.ok() && again.ok());
+  ASSERT_TRUE(again->left_hand && again->right_hand);
+  EXPECT_EQ(tracker->summary().hands_reused, 2);
+  EXPECT_EQ(tracker->summary().models[3].runs, 2);
+  EXPECT_EQ(std::memcmp(&first->points[wholebody::kLeftHandFirst],
+                        &again->points[wholebody::kLeftHandFirst],
+                        2 * wholebody::kNumHandPoints * sizeof(ScoredPoint)),
+            0);
+  EXPECT_EQ(again->left_hand_presence, first->left_hand_presence);
+  // The picture moved 12 px right and down: the pixels under the last crops changed.
+  media::Image moved = media::MakeImage(image.width, image.height, media::PixelFormat::kRgb8);
+  const cv::Mat from(image.height, image.width, CV_8UC3, const_cast<uint8_t*>(image.pixels.data()));
+  cv::Mat to(moved.height, moved.width, CV_8UC3, moved.pixels.data());
+  from(cv::Rect(0, 0, image.width - 12, image.height - 12))
+      .copyTo(to(cv::Rect(12, 12, image.width - 12, image.height - 12)));
+  StatusOr<WholeBodyFrame> after = tracker->Track(moved);
+  ASSERT_TRUE(after.ok());
+  ASSERT_TRUE(after->left_hand && after->right_hand);
+  EXPECT_EQ(tracker->summary().hands_reused, 2);
+  EXPECT_EQ(tracker->summary().models[3].runs, 4);
+  // The hands follow the picture.
+  const double left = HandMedianMove(*first, *after, wholebody::kLeftHandFirst);
+  EXPECT_GT(left, 8.0);
+  EXPECT_LT(left, 30.0);
+
+  // The same three frames on 1 thread: the same bits.
+  options.num_threads = 1;
+  StatusOr<WholeBodyTracker> one = WholeBodyTracker::Create(options);
+  ASSERT_TRUE(one.ok()) << one.status().message();
+  const std::vector<std::pair<const media::Image*, const WholeBodyFrame*>> runs = {
+      {&image, &*first}, {&image, &*again}, {&moved, &*after}};
+  for (const auto& [frame, expected] : runs) {
+    StatusOr<WholeBodyFrame> out = one->Track(*frame);
+    ASSERT_TRUE(out.ok());
+    EXPECT_TRUE(SameBits(*out, *expected));
+  }
+  EXPECT_EQ(one->summary().hands_reused, 2);
 }
 
 // Any one missing model stops Create with the line naming that file and scripts/setup
