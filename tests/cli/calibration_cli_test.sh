@@ -100,8 +100,9 @@ same=1
 for i in 1 2 3 4; do
   "$arco" "${K[@]}" $([ $i -gt 2 ] && echo --threads 1) -o "$tmp/again$i.json" >/dev/null 2>&1
   cmp -s "$tmp/rig.json" "$tmp/again$i.json" || same=0
+  cmp -s "$tmp/rig.report.json" "$tmp/again$i.report.json" || same=0
 done
-check '[ $same -eq 1 ]' "calibrate: four repeat runs (two with --threads 1) write the same file"
+check '[ $same -eq 1 ]' "calibrate: four repeat runs (two with --threads 1) write the same file and report"
 # The first camera given is the world, whichever flag gives it.
 "$arco" calibrate --board chessboard:9x6:25 --images right="$tmp/R" --video left="$tmp/L" \
   -o "$tmp/order.json" >"$tmp/order.out" 2>"$tmp/err"

@@ -295,8 +295,9 @@ nlohmann::ordered_json RigCalibrationReport::ToJson() const {
                             {"initial_cost", bundle_adjustment.initial_cost},
                             {"final_cost", bundle_adjustment.final_cost},
                             {"residual_blocks", bundle_adjustment.residual_blocks},
-                            {"board_poses", bundle_adjustment.board_poses},
-                            {"time_s", bundle_adjustment.time_s}};
+                            {"board_poses", bundle_adjustment.board_poses}};
+  // No solve time here: the report of the same inputs is the same bytes (the command
+  // prints the time).
   j["warnings"] = nlohmann::ordered_json::array();
   for (const CalibrationWarning& w : warnings)
     j["warnings"].push_back({{"code", w.code}, {"camera", w.camera}, {"message", w.message}});

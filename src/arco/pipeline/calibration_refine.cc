@@ -91,8 +91,7 @@ Json CalibrationRefineSummary::ToJson() const {
                            {"iterations", p.iterations},
                            {"initial_cost", p.initial_cost},
                            {"final_cost", p.final_cost},
-                           {"residual_blocks", p.residual_blocks},
-                           {"time_s", p.time_s}});
+                           {"residual_blocks", p.residual_blocks}});  // no time: same bytes
   j["warnings"] = warnings;
   return j;
 }
