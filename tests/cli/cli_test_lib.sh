@@ -52,3 +52,27 @@ bad_at() {
   local name=$1 path; path=$(glob_literal "$2"); shift 2
   expect_error "$name" "$path: *" "$@"
 }
+
+# require_browser SRC [COMMAND...]: the browser tests' prerequisites. Debian's chromium
+# (and each COMMAND) absent: the test is skipped (exit 77); node or the npm playwright-core
+# that drives chromium (scripts/fetch_view_tools) absent: it fails (exit 1). Sets
+# `playwright` to playwright-core's folder.
+require_browser() {
+  local src=$1 c
+  shift
+  if [ ! -x /usr/bin/chromium ]; then
+    echo "SKIPPED: /usr/bin/chromium is not installed (scripts/setup)"
+    exit 77
+  fi
+  for c in "$@"; do
+    if ! command -v "$c" >/dev/null; then
+      echo "SKIPPED: $c is not installed (scripts/setup)"
+      exit 77
+    fi
+  done
+  playwright=$src/tools/view/node_modules/playwright-core
+  if ! command -v node >/dev/null || [ ! -f "$playwright/package.json" ]; then
+    echo "FAILED: node or $playwright missing (run scripts/fetch_view_tools)"
+    exit 1
+  fi
+}

@@ -106,15 +106,7 @@ rm "$tmp/res_no_fingering/arco/fingering.csv"
 expect_error "no fingering" "*fingering.csv*" report "$tmp/res_no_fingering" -o "$tmp/r.html"
 [ $fail -eq 0 ] || exit 1
 
-if [ ! -x /usr/bin/chromium ]; then
-  echo "SKIPPED: /usr/bin/chromium is not installed (apt-get install chromium)"
-  exit 77
-fi
-playwright=$src/tools/view/node_modules/playwright-core
-if ! command -v node >/dev/null || [ ! -f "$playwright/package.json" ]; then
-  echo "FAILED: node or $playwright missing (run scripts/fetch_view_tools)"
-  exit 1
-fi
+require_browser "$src"
 node "$src/tests/cli/report_browser_check.js" "$playwright" "$tmp/report.html" \
   "$tmp/res/arco/fingering.csv" "$tmp" || fail=1
 [ $fail -eq 0 ] && echo "report_cli_test: passed"

@@ -21,15 +21,7 @@ expect_error "-o without --no-serve" "*-o is for --no-serve*" view "$work/not_a_
 expect_error "port out of range" "*--port*" view "$work/not_a_result" --port 70000
 [ $fail -eq 0 ] || exit 1
 
-if [ ! -x /usr/bin/chromium ]; then
-  echo "SKIPPED: /usr/bin/chromium is not installed (apt-get install chromium)"
-  exit 77
-fi
-playwright=$src/tools/view/node_modules/playwright-core
-if ! command -v node >/dev/null || [ ! -f "$playwright/package.json" ]; then
-  echo "FAILED: node or $playwright missing (run scripts/fetch_view_tools)"
-  exit 1
-fi
+require_browser "$src"
 "$arco" synth -o "$work/cap" --duration-s 3 >/dev/null 2>&1 &&
   "$arco" run "$work/cap" -o "$work/res" >/dev/null 2>&1 ||
   { echo "FAILED: synth + run"; exit 1; }

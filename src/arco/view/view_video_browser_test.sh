@@ -16,15 +16,8 @@ rm -rf "$work"
 mkdir -p "$work"
 # The video cache (docs/view.md, "Video cache") in the work folder, not the user's.
 export XDG_CACHE_HOME=$work/cache
-if [ ! -x /usr/bin/chromium ] || ! command -v ffmpeg >/dev/null || ! command -v ffprobe >/dev/null; then
-  echo "SKIPPED: /usr/bin/chromium or ffmpeg/ffprobe is not installed (scripts/setup)"
-  exit 77
-fi
-playwright=$src/tools/view/node_modules/playwright-core
-if ! command -v node >/dev/null || [ ! -f "$playwright/package.json" ]; then
-  echo "FAILED: node or $playwright missing (run scripts/fetch_view_tools)"
-  exit 1
-fi
+source "$src/tests/cli/cli_test_lib.sh"
+require_browser "$src" ffmpeg ffprobe
 "$arco" synth -o "$work/cap" --duration-s 3 >/dev/null 2>&1 &&
   "$arco" run "$work/cap" -o "$work/res" >/dev/null 2>&1 ||
   { echo "FAILED: synth + run"; exit 1; }
