@@ -7,8 +7,9 @@
 // along its wrist's ray from the camera by that difference: every keypoint moves by the
 // same vector, so a fingertip's distance from the camera changes by the shift (to the
 // cosine of the small angle between its ray and the wrist's), and the wrist's image stays
-// where it was. Each frame's shift is the median over the frames around (a hand's depth
-// changes slowly; single frames are wrong).
+// where it was. Each frame's wrist goes to the median over the frames around of the
+// wanted wrist distances (its distance plus its shift): a hand's depth changes slowly,
+// single frames are wrong, and the fit's own depth jitters from frame to frame.
 #pragma once
 
 #include <Eigen/Core>
@@ -22,7 +23,7 @@
 namespace arco::hand {
 
 struct OneViewDepthOptions {
-  int window_frames = 15;  // [0, 300]: the shift is the median over this many frames each side
+  int window_frames = 15;  // [0, 300]: the wanted distance's median over this many frames each side
   Status Validate() const;
 };
 
@@ -31,10 +32,10 @@ struct OneViewDepthSummary {
   double median_shift_mm = 0;  // signed, along the rays (+: away from the camera); NaN: none
 };
 
-// Moves each frame's hand (world mm) along its wrist's ray from `camera_centre_mm` by the
-// median of `shift_mm` (NaN: unknown) over the frames around; frames without a hand stay
-// empty, frames with no known shift around stay where they are. Errors: invalid options,
-// sizes that differ.
+// Moves each frame's hand (world mm) along its wrist's ray from `camera_centre_mm` to the
+// median over the frames around of the wanted wrist distances (each frame's distance plus
+// its `shift_mm`; NaN: unknown); frames without a hand stay empty, frames with no known
+// shift around stay where they are. Errors: invalid options, sizes that differ.
 StatusOr<OneViewDepthSummary> MoveHandsAlongRays(const Eigen::Vector3d& camera_centre_mm,
                                                  const std::vector<double>& shift_mm,
                                                  const OneViewDepthOptions& options,

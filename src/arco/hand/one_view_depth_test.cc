@@ -41,11 +41,13 @@ TEST(AlignHandDepth, MovesTheHandAlongItsRaysToTheFingertipsDepth) {
   const StatusOr<OneViewDepthSummary> s = AlignHandDepth(model, kCentre, wanted, {2}, &hands);
   ASSERT_TRUE(s.ok()) << s.status().message();
   EXPECT_EQ(s->frames_moved, 8);
-  EXPECT_NEAR(s->median_shift_mm, -40, 1e-9);
+  // The frames' own distances differ by up to 2 mm (the hand moves across the image), and
+  // each frame takes the median of the wanted distances around it.
+  EXPECT_NEAR(s->median_shift_mm, -40, 2.0);
   EXPECT_FALSE(hands[7].has_value());
   for (size_t f : {0u, 3u, 4u, 8u}) {
     const double moved = TipsDistance(model, *hands[f]) - TipsDistance(model, *before[f]);
-    EXPECT_NEAR(moved, -40, 1.0) << "frame " << f;
+    EXPECT_NEAR(moved, -40, 2.0) << "frame " << f;
     // Along the ray: the wrist's image is where it was.
     EXPECT_NEAR((Image(hands[f]->world_from_wrist.translation) -
                  Image(before[f]->world_from_wrist.translation))
@@ -53,6 +55,26 @@ TEST(AlignHandDepth, MovesTheHandAlongItsRaysToTheFingertipsDepth) {
                 0,
                 1e-12);
   }
+}
+
+// A one-view fit's depth jitters from frame to frame (a few pixels of the hand's size in
+// the image); where the wanted distance is steady, every frame's hand goes to it, the
+// jitter gone to under a millimetre (a median of the shifts instead would keep it).
+TEST(AlignHandDepth, TheFitsOwnDepthJitterIsRemoved) {
+  const HandModel model = HandModel::Default(HandSide::kLeft);
+  std::vector<std::optional<HandPose>> hands(31);
+  std::vector<double> wanted(hands.size());
+  for (size_t f = 0; f < hands.size(); ++f) {
+    HandPose pose;
+    const double jitter_mm = (f % 2 ? 25.0 : -25.0) * std::sin(0.7 * f);
+    pose.world_from_wrist.translation = Eigen::Vector3d(0, -50, 30 + jitter_mm);
+    hands[f] = pose;
+    wanted[f] = 1950;
+  }
+  ASSERT_TRUE(AlignHandDepth(model, kCentre, wanted, {15}, &hands).ok());
+  double worst = 0;
+  for (const auto& h : hands) worst = std::max(worst, std::abs(TipsDistance(model, *h) - 1950));
+  EXPECT_LT(worst, 1.0);  // +-25 mm of jitter; the tips move by the cosine of the rays' angle
 }
 
 TEST(AlignHandDepth, LeavesHandsWithoutADepthAroundAndRejectsBadInput) {
