@@ -303,8 +303,8 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
         const InstrumentFramePose& pose = fit->frames[f];
         if (pose.status != FrameFitStatus::kOk) continue;
         body.valid[f] = 1;
-        body.rotation[f] = pose.pose.rotation;
-        body.translation[f] = pose.pose.translation;
+        body.rotation[f] = pose.world_from_instrument.rotation;
+        body.translation[f] = pose.world_from_instrument.translation;
       }
       for (int k : {nut_l, nut_r, bridge_l, bridge_r})
         if (k < 0 || !body.points[k].allFinite())
