@@ -241,7 +241,7 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
   replace.marker = kCaptureManifestName;  // only an arco capture is replaced
   replace.kind = "capture";
   ARCO_RETURN_IF_ERROR(CheckOutputFolder(o.output_dir, replace));  // before the work
-  ARCO_ASSIGN_OR_RETURN(const Calibration calibration, LoadCalibration(o.calibration));
+  ARCO_ASSIGN_OR_RETURN(const Calibration calibration, calibration::LoadCalibration(o.calibration));
   const Rig& rig = calibration.rig;
 
   // Cameras first (cheap), then the videos.

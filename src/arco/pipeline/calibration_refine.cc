@@ -126,7 +126,7 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
   } else {
     if (options.calibration.empty())
       ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(options.capture_dir, manifest));
-    ARCO_ASSIGN_OR_RETURN(calibration, LoadCalibration(summary.calibration));
+    ARCO_ASSIGN_OR_RETURN(calibration, calibration::LoadCalibration(summary.calibration));
   }
   const Rig& input = calibration.rig;
   summary.units = input.units;
@@ -425,7 +425,7 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
   OutputSet outputs;
   ARCO_ASSIGN_OR_RETURN(const std::string calibration_tmp, outputs.AddFile(options.output));
   ARCO_ASSIGN_OR_RETURN(const std::string report_tmp, outputs.AddFile(report_file));
-  ARCO_RETURN_IF_ERROR(SaveCalibration(calibration_tmp, rig, format));
+  ARCO_RETURN_IF_ERROR(calibration::SaveCalibration(calibration_tmp, rig, format));
   {
     std::ofstream out(report_tmp);
     out << summary.ToJson().dump(2) << "\n";
