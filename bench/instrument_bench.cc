@@ -46,21 +46,24 @@ const Clip& MakeClip() {
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
     Clip c;
     for (int f = 0; f < kFrames; ++f) {
-      InstrumentPose pose;
+      SimMatrix3d world_from_instrument;
       const double t = 0.05 * f;
-      pose.rotation = (Eigen::AngleAxisd(1.2 + 0.08 * std::sin(t), Eigen::Vector3d::UnitZ()) *
-                       Eigen::AngleAxisd(0.3 + 0.05 * std::cos(0.7 * t), Eigen::Vector3d::UnitX()))
-                          .toRotationMatrix();
-      pose.translation = Eigen::Vector3d(0.1 + 0.01 * std::sin(0.3 * t), -0.2, 1.9);
-      pose.world_units_per_mm = 1.0 / 2020.0;
+      world_from_instrument.rotation =
+          (Eigen::AngleAxisd(1.2 + 0.08 * std::sin(t), Eigen::Vector3d::UnitZ()) *
+           Eigen::AngleAxisd(0.3 + 0.05 * std::cos(0.7 * t), Eigen::Vector3d::UnitX()))
+              .toRotationMatrix();
+      world_from_instrument.translation =
+          Eigen::Vector3d(0.1 + 0.01 * std::sin(0.3 * t), -0.2, 1.9);
+      world_from_instrument.scale = 1.0 / 2020.0;  // world units per mm
       Eigen::Matrix3Xd kp = Eigen::Matrix3Xd::Constant(3, 9, kNaN);
       for (int k = 0; k < 7; ++k) {
         Eigen::Vector3d p = shape[k] + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
         if (uniform(rng) < 0.06) p += Eigen::Vector3d(120, -60, 40);
-        if (uniform(rng) >= 0.1) kp.col(k) = pose.ToWorld(p);
+        if (uniform(rng) >= 0.1) kp.col(k) = world_from_instrument * p;
       }
       c.keypoints.push_back(kp);
-      c.hints.push_back({FrontHint::Kind::kPerformerPoint, pose.ToWorld({450, 50, -300})});
+      c.hints.push_back({FrontHint::Kind::kPerformerPoint,
+                         world_from_instrument * Eigen::Vector3d(450, 50, -300)});
     }
     return c;
   }();
@@ -77,7 +80,8 @@ void BM_FitInstrumentAndStrings(benchmark::State& state) {
     size_t with_strings = 0;
     for (const InstrumentFramePose& frame : fit->frames) {
       if (!frame.has_pose()) continue;
-      const std::vector<StringSegment> strings = StringsAt(fit->instrument, frame.pose);
+      const std::vector<StringSegment> strings =
+          StringsAt(fit->instrument, frame.world_from_instrument);
       benchmark::DoNotOptimize(strings.data());
       ++with_strings;
     }
@@ -119,7 +123,8 @@ void BM_SmoothPosesAndStrings(benchmark::State& state) {
   for (auto _ : state) {
     const std::vector<InstrumentFramePose> smooth = SmoothFramePoses(fit->frames);
     for (const InstrumentFramePose& frame : smooth) {
-      if (frame.has_pose()) benchmark::DoNotOptimize(StringsAt(fit->instrument, frame.pose));
+      if (frame.has_pose())
+        benchmark::DoNotOptimize(StringsAt(fit->instrument, frame.world_from_instrument));
     }
   }
   state.counters["s_per_frame"] =

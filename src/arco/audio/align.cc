@@ -1,9 +1,5 @@
 #include "arco/audio/align.h"
 
-extern "C" {
-#include <libavformat/avformat.h>
-#include <libavutil/log.h>
-}
 #include <fftw3.h>
 
 #include <algorithm>
@@ -360,26 +356,6 @@ StatusOr<AlignResult> AlignTracks(const AudioTrack& ref,
     return Status::Error(pair + ": clock drift of " + Fixed(result.drift_ppm, 0) + " ppm, beyond " +
                          Fixed(o.max_drift_ppm, 0) + " ppm");
   }
-  return result;
-}
-
-StatusOr<double> VideoStartOnAudioClock(const std::string& path) {
-  av_log_set_level(AV_LOG_QUIET);
-  AVFormatContext* format = nullptr;
-  if (avformat_open_input(&format, path.c_str(), nullptr, nullptr) < 0) {
-    return Status::Error(path + ": cannot open");
-  }
-  double result = 0;
-  if (avformat_find_stream_info(format, nullptr) >= 0) {
-    const int a = av_find_best_stream(format, AVMEDIA_TYPE_AUDIO, -1, -1, nullptr, 0);
-    const int v = av_find_best_stream(format, AVMEDIA_TYPE_VIDEO, -1, -1, nullptr, 0);
-    const auto start = [&](int index) {
-      const AVStream* s = format->streams[index];
-      return s->start_time == AV_NOPTS_VALUE ? 0.0 : double(s->start_time) * av_q2d(s->time_base);
-    };
-    if (a >= 0 && v >= 0) result = start(v) - std::max(0.0, start(a));
-  }
-  avformat_close_input(&format);
   return result;
 }
 

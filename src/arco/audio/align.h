@@ -83,10 +83,4 @@ StatusOr<AlignResult> AlignTracks(const AudioTrack& reference,
                                   const AudioTrack& other,
                                   const AlignOptions& options);
 
-// For a video file: the time (s) of its first video frame on the clock whose zero is
-// the first decoded sample of its audio track (the stream start times of the container;
-// an audio start before 0, an encoder's priming that the decoder drops, counts as 0).
-// 0 for files without both streams.
-StatusOr<double> VideoStartOnAudioClock(const std::string& path);
-
 }  // namespace arco::audio

@@ -66,7 +66,7 @@ StatusOr<std::unique_ptr<AudioReader>> OpenAudio(const std::string& path);
 
 // libsndfile only (also used directly by tests).
 StatusOr<std::unique_ptr<AudioReader>> OpenAudioWithSndfile(const std::string& path);
-// FFmpeg libavformat/libavcodec only: the best audio stream of any container.
+// FFmpeg only (through media/audio_decoder.h): the best audio stream of any container.
 StatusOr<std::unique_ptr<AudioReader>> OpenAudioWithFfmpeg(const std::string& path);
 // Decodes an in-memory file image with libsndfile's virtual IO (fuzzing and
 // tests). `bytes` must outlive the reader.

@@ -1,31 +1,19 @@
-// Writes small test videos with FFmpeg's libraries (tests only): a Matroska
-// file with an FFV1 (lossless) grayscale video whose frame brightness is given
-// per frame, and optionally a PCM audio track.
+// Test scenes for sync (tests only): a clap filmed and heard, as a TestVideo that
+// media/test_audio_video.h writes (an FFV1 grayscale video and an audio track).
 #pragma once
 
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "arco/media/test_audio_video.h"
 #include "arco/util/status.h"
 
 namespace arco::audio::testing {
 
-struct TestVideo {
-  int width = 160, height = 120;
-  int fps = 30;
-  int frames = 90;
-  // Grey level (0..255) of frame k; pixels get this value plus a fixed texture.
-  std::function<double(int frame)> brightness = [](int) { return 64.0; };
-  // When set, draws frame k itself (row-major grey levels, width x height) and
-  // `brightness` is ignored.
-  std::function<void(int frame, std::vector<double>* grey)> draw;
-  std::vector<float> audio;  // mono samples at audio_rate_hz; empty: no audio track
-  int audio_rate_hz = 48000;
-  std::string audio_codec = "pcm_s16le";  // or "flac", "aac"
-};
-
-Status WriteTestVideo(const std::string& path, const TestVideo& video);
+// The videos themselves are written by media/'s test support, the one owner of FFmpeg.
+using media::testing::TestVideo;
+using media::testing::WriteTestVideo;
 
 // Two bright hands (uniform rectangles, both edges anti-aliased) on a dark textured
 // background close horizontally and stop when they meet at contact_s. Each frame

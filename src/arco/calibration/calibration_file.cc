@@ -6,7 +6,7 @@
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
 
-namespace arco {
+namespace arco::calibration {
 namespace {
 
 std::string LowerExtension(const std::string& path) {
@@ -120,4 +120,4 @@ Status SaveCalibration(const std::string& path, const Rig& rig, CalibrationForma
   return AtomicWriteFile(path, *text);
 }
 
-}  // namespace arco
+}  // namespace arco::calibration

@@ -12,7 +12,7 @@
 #include "arco/camera/calibration_io.h"
 #include "arco/util/status.h"
 
-namespace arco {
+namespace arco::calibration {
 
 StatusOr<Calibration> LoadCalibration(const std::string& path);
 
@@ -38,4 +38,4 @@ StatusOr<CalibrationFormat> CalibrationFormatFromFlag(const std::string& flag);
 StatusOr<Calibration> ParseOpenCvCalibration(const std::string& text, const std::string& source);
 StatusOr<std::string> WriteOpenCvCalibration(const Rig& rig, bool yaml);
 
-}  // namespace arco
+}  // namespace arco::calibration

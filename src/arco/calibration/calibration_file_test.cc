@@ -11,7 +11,7 @@
 #include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
 
-namespace arco {
+namespace arco::calibration {
 namespace {
 
 namespace fs = std::filesystem;
@@ -193,4 +193,4 @@ TEST(LoadCalibration, MalformedFilesGiveOneLineErrors) {
 }
 
 }  // namespace
-}  // namespace arco
+}  // namespace arco::calibration

@@ -4,7 +4,7 @@
 
 #include "arco/calibration/calibration_file.h"
 
-namespace arco {
+namespace arco::calibration {
 namespace {
 
 std::string OneLine(std::string s) {
@@ -162,4 +162,4 @@ StatusOr<std::string> WriteOpenCvCalibration(const Rig& rig, bool yaml) {
   }
 }
 
-}  // namespace arco
+}  // namespace arco::calibration

@@ -12,7 +12,7 @@
 
 #include "arco/camera/camera.h"
 
-namespace arco {
+namespace arco::calibration {
 
 // out = R(pose[0..2]) * point + pose[3..5].
 template <typename T>
@@ -38,4 +38,4 @@ bool ReprojectionResidual(const T* cam_from_world,
   return true;
 }
 
-}  // namespace arco
+}  // namespace arco::calibration

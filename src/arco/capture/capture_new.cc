@@ -9,6 +9,7 @@
 #include "arco/audio/align.h"
 #include "arco/audio/audio_reader.h"
 #include "arco/calibration/calibration_file.h"
+#include "arco/media/audio_decoder.h"
 #include "arco/media/frame_times.h"
 #include "arco/media/video_reader.h"
 #include "arco/mocap/capture.h"
@@ -113,7 +114,7 @@ StatusOr<AudioSync> SyncByAudio(const std::vector<OpenedInput>& opened,
                     audio::kAlignSilentDbfs);
       return Status::Error(input.path + text);
     }
-    ARCO_ASSIGN_OR_RETURN(video_start_s[i], audio::VideoStartOnAudioClock(input.path));
+    ARCO_ASSIGN_OR_RETURN(video_start_s[i], media::VideoStartOnAudioClock(input.path));
   }
   // Each camera's alignment to the reference: t_ref = offset + (1 + drift) t_camera_audio.
   std::vector<audio::AlignResult> to_ref(n);
@@ -240,7 +241,7 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
   replace.marker = kCaptureManifestName;  // only an arco capture is replaced
   replace.kind = "capture";
   ARCO_RETURN_IF_ERROR(CheckOutputFolder(o.output_dir, replace));  // before the work
-  ARCO_ASSIGN_OR_RETURN(const Calibration calibration, LoadCalibration(o.calibration));
+  ARCO_ASSIGN_OR_RETURN(const Calibration calibration, calibration::LoadCalibration(o.calibration));
   const Rig& rig = calibration.rig;
 
   // Cameras first (cheap), then the videos.

@@ -40,7 +40,7 @@ std::string WriteCalibration(const TempDir& dir) {
   rig.units = "m";
   rig.cameras = {MakeCamera("cam0", "111", 128, 96), MakeCamera("cam1", "222", 96, 128)};
   const std::string path = dir / "rig.json";
-  EXPECT_TRUE(SaveCalibration(path, rig).ok());
+  EXPECT_TRUE(calibration::SaveCalibration(path, rig).ok());
   return path;
 }
 
@@ -99,7 +99,7 @@ TEST(CreateCapture, ReferencesTheVideosAndReadsBack) {
   EXPECT_EQ(m->cameras[0].video, o.inputs[0].path);
   EXPECT_TRUE(m->keypoints2d.empty());
   EXPECT_TRUE(fs::exists(ResolveCapturePath(o.output_dir, m->calibration)));
-  EXPECT_TRUE(LoadCalibration(ResolveCapturePath(o.output_dir, m->calibration)).ok());
+  EXPECT_TRUE(calibration::LoadCalibration(ResolveCapturePath(o.output_dir, m->calibration)).ok());
   // No keypoints yet: the readers say what to run.
   const Status none = CheckCaptureKeypoints2d(o.output_dir, *m);
   ASSERT_FALSE(none.ok());

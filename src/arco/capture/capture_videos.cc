@@ -13,7 +13,7 @@ StatusOr<std::vector<CaptureVideo>> OpenCaptureVideos(const std::string& dir,
                                                       int64_t last) {
   const std::string manifest_path = CaptureManifestPath(dir);
   const std::string calibration_path = ResolveCapturePath(dir, manifest.calibration);
-  StatusOr<Calibration> calibration = LoadCalibration(calibration_path);
+  StatusOr<Calibration> calibration = calibration::LoadCalibration(calibration_path);
   if (!calibration.ok()) return calibration.status().WithContext(manifest_path + ": calibration");
   ARCO_ASSIGN_OR_RETURN(const std::vector<int> rig_index,
                         MatchCaptureCameras(dir, manifest, calibration->rig, calibration_path));

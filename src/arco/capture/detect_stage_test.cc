@@ -79,7 +79,7 @@ class DetectStageTest : public ::testing::Test {
     rig.units = "mm";
     rig.cameras = {MakeCamera("cam0", photo_.width, photo_.height),
                    MakeCamera("cam1", photo_.width, photo_.height)};
-    ASSERT_TRUE(SaveCalibration(dir_ / "cal.json", rig).ok());
+    ASSERT_TRUE(calibration::SaveCalibration(dir_ / "cal.json", rig).ok());
     CaptureNewOptions o;
     o.calibration = dir_ / "cal.json";
     o.inputs = {{"cam0", dir_ / "cam0", true}, {"cam1", dir_ / "cam1", true}};
@@ -195,7 +195,7 @@ TEST_F(DetectStageTest, DecodingAheadGivesTheTrackerEveryFrameInOrder) {
   Rig rig;
   rig.units = "mm";
   rig.cameras = {MakeCamera("cam0", photo_.width, photo_.height)};
-  ASSERT_TRUE(SaveCalibration(dir_ / "cal1.json", rig).ok());
+  ASSERT_TRUE(calibration::SaveCalibration(dir_ / "cal1.json", rig).ok());
   CaptureNewOptions c;
   c.calibration = dir_ / "cal1.json";
   c.inputs = {{"cam0", dir_ / "moving", true}};
@@ -328,7 +328,7 @@ TEST_F(DetectStageTest, BadInputChangesNothing) {
                  MakeCamera("cam1", photo_.height, photo_.width)};
   const std::string calibration = capture + "/calibration.json";
   const std::string calibration_before = ReadBytes(calibration);
-  ASSERT_TRUE(SaveCalibration(calibration, rig).ok());
+  ASSERT_TRUE(calibration::SaveCalibration(calibration, rig).ok());
   auto size = RunDetectStage(o);
   ASSERT_FALSE(size.ok());
   EXPECT_NE(size.status().message().find("after rotate_deg 90"), std::string::npos)

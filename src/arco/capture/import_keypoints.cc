@@ -112,7 +112,7 @@ StatusOr<ImportKeypointsSummary> ImportKeypoints(const ImportKeypointsOptions& o
   }
   if (rotated && o.pixels == "decoded") {
     const std::string calibration_path = ResolveCapturePath(o.capture_dir, m.calibration);
-    StatusOr<Calibration> calibration = LoadCalibration(calibration_path);
+    StatusOr<Calibration> calibration = calibration::LoadCalibration(calibration_path);
     if (!calibration.ok()) return calibration.status().WithContext(manifest_path + ": calibration");
     ARCO_ASSIGN_OR_RETURN(
         const std::vector<int> cameras,

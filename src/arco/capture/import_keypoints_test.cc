@@ -36,7 +36,7 @@ std::string MakeCapture(const TempDir& dir, const std::string& instrument = "non
     c.fx = c.fy = 100;
     rig.cameras.push_back(c);
   }
-  EXPECT_TRUE(SaveCalibration(dir / "rig.json", rig).ok());
+  EXPECT_TRUE(calibration::SaveCalibration(dir / "rig.json", rig).ok());
   CaptureNewOptions o;
   o.calibration = dir / "rig.json";
   for (int v = 0; v < 2; ++v) {
@@ -242,7 +242,7 @@ TEST(ImportKeypoints, VideosToCaptureToTriangulation) {
     c.cx = c.cx * s;
     c.cy = c.cy * s;
   }
-  ASSERT_TRUE(SaveCalibration(dir / "rig.json", rig).ok());
+  ASSERT_TRUE(calibration::SaveCalibration(dir / "rig.json", rig).ok());
   constexpr int kFrames = 5;
   const NpyArray<double> truth = testing::MakeSyntheticPoints(kFrames, 133, 3);
   testing::SyntheticDetectionOptions d;

@@ -22,7 +22,7 @@ StatusOr<ImportSpdSummary> ImportSpdCapture(const ImportSpdOptions& o) {
   replace.kind = "capture";
   ARCO_RETURN_IF_ERROR(CheckOutputFolder(o.output_dir, replace));  // before the work
   std::error_code ec;
-  ARCO_ASSIGN_OR_RETURN(Calibration calibration, LoadCalibration(o.calibration));
+  ARCO_ASSIGN_OR_RETURN(Calibration calibration, calibration::LoadCalibration(o.calibration));
   SpdImportOptions spd;
   spd.instrument = o.instrument;
   spd.human_dir = o.human_dir;

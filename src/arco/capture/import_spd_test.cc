@@ -25,7 +25,7 @@ const std::string kCalibration =
 // that drops one frame of one camera; imported, then triangulated end to end.
 TEST(ImportSpdCapture, SpdFoldersToCaptureToTriangulation) {
   TempDir dir;
-  auto calibration = LoadCalibration(kCalibration);
+  auto calibration = calibration::LoadCalibration(kCalibration);
   ASSERT_TRUE(calibration.ok()) << calibration.status().message();
   Rig rig = calibration->rig;
   rig.cameras.resize(6);

@@ -26,7 +26,7 @@ StatusOr<Json> TriangulateLabelViews(const LabelViewsOptions& o) {
     return Status::Error("views: need at least two (camera, labelme file) views (got " +
                          std::to_string(o.views.size()) + ")");
   }
-  ARCO_ASSIGN_OR_RETURN(Calibration calibration, LoadCalibration(o.calibration));
+  ARCO_ASSIGN_OR_RETURN(Calibration calibration, calibration::LoadCalibration(o.calibration));
   Rig rig = calibration.rig;
   if (o.ignore_distortion) {
     for (Camera& c : rig.cameras) c.distortion = Distortion();

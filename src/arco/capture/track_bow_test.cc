@@ -114,7 +114,7 @@ void MovingBow(bool plain_stick, bool with_hand_too) {
   const Rig rig = testing::MakePlaneRig(rig_options);
   const std::string scene = dir / "scene";
   ASSERT_TRUE(MakeDirectories(scene).ok());
-  ASSERT_TRUE(SaveCalibration(scene + "/calibration.json", rig).ok());
+  ASSERT_TRUE(calibration::SaveCalibration(scene + "/calibration.json", rig).ok());
   testing::PlaneRenderOptions render;
   render.supersampling = 1;
   render.threads = 2;

@@ -301,7 +301,8 @@ StatusOr<TrackTemplates> MakeTrackTemplates(const TrackStageOptions& options,
   // (t and X both times the scale). Outputs are pixels; track.json's 3D points are put
   // back into the calibration's units.
   const std::string calibration_path = ResolveCapturePath(capture.dir, manifest.calibration);
-  ARCO_ASSIGN_OR_RETURN(const Calibration calibration, LoadCalibration(calibration_path));
+  ARCO_ASSIGN_OR_RETURN(const Calibration calibration,
+                        calibration::LoadCalibration(calibration_path));
   ARCO_ASSIGN_OR_RETURN(t.mm_per_unit,
                         MmPerWorldUnit(calibration.rig.units,
                                        calibration_path,

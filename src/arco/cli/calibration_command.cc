@@ -28,7 +28,7 @@ void PrintWarnings(const Calibration& calibration) {
 }
 
 int RunCalibrationShow(const CalibrationShowOptions& o) {
-  auto calibration = LoadCalibration(o.input);
+  auto calibration = calibration::LoadCalibration(o.input);
   if (!calibration.ok()) return PrintError(calibration.status().message());
   PrintWarnings(*calibration);
   const Rig& rig = calibration->rig;
@@ -86,18 +86,18 @@ int RunCalibrationShow(const CalibrationShowOptions& o) {
 int RunCalibrationConvert(const CalibrationConvertOptions& o) {
   CalibrationFormat format = CalibrationFormat::kUnknown;
   if (!o.format.empty()) {
-    auto parsed = CalibrationFormatFromFlag(o.format);
+    auto parsed = calibration::CalibrationFormatFromFlag(o.format);
     if (!parsed.ok()) return PrintError(parsed.status().message());
     format = *parsed;
   }
   const Status writable = CheckOutputFile(o.output);  // before the work
   if (!writable.ok()) return PrintError(writable.message());
-  auto calibration = LoadCalibration(o.input);
+  auto calibration = calibration::LoadCalibration(o.input);
   if (!calibration.ok()) return PrintError(calibration.status().message());
   PrintWarnings(*calibration);
-  Status saved = SaveCalibration(o.output, calibration->rig, format);
+  Status saved = calibration::SaveCalibration(o.output, calibration->rig, format);
   if (!saved.ok()) return PrintError(saved.message());
-  auto written = LoadCalibration(o.output);  // what a user will read back
+  auto written = calibration::LoadCalibration(o.output);  // what a user will read back
   if (!written.ok()) return PrintError(written.status().message());
   std::printf("wrote %s (%s, %zu cameras, units %s) from %s (%s)\n",
               o.output.c_str(),

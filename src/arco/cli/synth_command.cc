@@ -105,7 +105,7 @@ int RunMotion(Args& a) {
   const Status writable = synth::CheckCaptureOutput(a.output, a.w);
   if (!writable.ok()) return PrintError(writable.message());
   const auto start = std::chrono::steady_clock::now();
-  auto calibration = LoadCalibration(a.calibration);
+  auto calibration = calibration::LoadCalibration(a.calibration);
   if (!calibration.ok()) return PrintError(calibration.status().message());
   auto capture = synth::GenerateFromMotion(calibration->rig, m);
   if (!capture.ok()) {
@@ -174,7 +174,7 @@ int Run(Args& a) {
   const Status writable = synth::CheckCaptureOutput(a.output, a.w);
   if (!writable.ok()) return PrintError(writable.message());
   const auto start = std::chrono::steady_clock::now();
-  auto calibration = LoadCalibration(a.calibration);
+  auto calibration = calibration::LoadCalibration(a.calibration);
   if (!calibration.ok()) return PrintError(calibration.status().message());
   auto capture = synth::Generate(calibration->rig, a.o);
   if (!capture.ok()) {

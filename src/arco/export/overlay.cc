@@ -312,7 +312,7 @@ StatusOr<OverlaySummary> WriteOverlay(const OverlayOptions& options,
                          options.camera + "' (cameras: " + names + ")");
   }
   const std::string calibration_path = ResolveCapturePath(header.capture_dir, manifest.calibration);
-  StatusOr<Calibration> calibration = LoadCalibration(calibration_path);
+  StatusOr<Calibration> calibration = calibration::LoadCalibration(calibration_path);
   if (!calibration.ok()) {
     return calibration.status().WithContext(CaptureManifestPath(header.capture_dir) +
                                             ": calibration");

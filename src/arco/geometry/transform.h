@@ -84,6 +84,34 @@ struct Sim3d {
   Sim3d operator*(const Sim3d& other) const;
 };
 
+// x -> s R x + t with R held as a 3x3 matrix: Sim3d's map for code whose numbers are
+// matrix products (the instrument's world_from_instrument, whose scale is world units per
+// mm), as RigidMatrix3d is Rigid3d's. Each operation is the plain matrix expression.
+struct SimMatrix3d {
+  double scale = 1.0;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  SimMatrix3d() = default;
+  // Takes the values as given (no check): callers build them from a rotation and a scale.
+  SimMatrix3d(double scale, const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation)
+      : scale(scale), rotation(rotation), translation(translation) {}
+  explicit SimMatrix3d(const Sim3d& sim)
+      : scale(sim.scale), rotation(sim.RotationMatrix()), translation(sim.translation) {}
+
+  // Throws std::invalid_argument unless `rotation` is a proper rotation matrix and the
+  // scale positive.
+  Sim3d ToSim3d() const { return Sim3d(scale, rotation, translation); }
+  Eigen::Vector3d operator*(const Eigen::Vector3d& point) const {
+    return scale * (rotation * point) + translation;
+  }
+  // The inverse map of one point, R^T (y - t) / s, without forming Inverse(): the
+  // expression its callers have always computed, so their bits stay as they were.
+  Eigen::Vector3d InverseMap(const Eigen::Vector3d& point) const {
+    return rotation.transpose() * (point - translation) / scale;
+  }
+};
+
 // Throws std::invalid_argument unless `rotation` is a proper rotation matrix.
 void CheckRotationMatrix(const Eigen::Matrix3d& rotation, const char* what);
 

@@ -73,6 +73,30 @@ TEST(RigidMatrix3d, IsTheSameMapAsRigid3dAndItsOperationsAreThePlainMatrixOnes) 
                std::invalid_argument);
 }
 
+TEST(SimMatrix3d, IsTheSameMapAsSim3dAndItsOperationsAreThePlainMatrixOnes) {
+  std::mt19937 rng(14);
+  for (int i = 0; i < 100; ++i) {
+    const Sim3d a = RandomSim(&rng);
+    const SimMatrix3d ma(a);
+    const Eigen::Vector3d p = RandomVector(&rng, 5);
+    EXPECT_LT((ma * p - a * p).norm(), 1e-12);
+    EXPECT_LT((ma.InverseMap(ma * p) - p).norm(), 1e-12);
+    EXPECT_LT((ma.InverseMap(p) - a.Inverse() * p).norm(), 1e-12);
+    EXPECT_LT((ma.ToSim3d() * p - a * p).norm(), 1e-12);
+    EXPECT_EQ(ma.ToSim3d().scale, a.scale);
+    // Bit for bit the expressions of the hand-written pose it replaces (InstrumentPose's
+    // ToWorld and ToInstrument), so the instrument's outputs stay byte-identical.
+    const Eigen::Vector3d to_world = ma.scale * (ma.rotation * p) + ma.translation;
+    const Eigen::Vector3d to_local = ma.rotation.transpose() * (p - ma.translation) / ma.scale;
+    EXPECT_EQ(ma * p, to_world);
+    EXPECT_EQ(ma.InverseMap(p), to_local);
+  }
+  EXPECT_THROW(SimMatrix3d(0.0, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()).ToSim3d(),
+               std::invalid_argument);
+  EXPECT_THROW(SimMatrix3d(1.0, Eigen::Matrix3d::Identity() * 2, Eigen::Vector3d::Zero()).ToSim3d(),
+               std::invalid_argument);
+}
+
 TEST(Sim3d, GroupLawsHoldAndScaleComposes) {
   std::mt19937 rng(12);
   for (int i = 0; i < 100; ++i) {

@@ -105,18 +105,18 @@ TEST(InstrumentOnRealLabels, ScaleDistancesAndStringOrder) {
   // SPD labels put nut_l / bridge_l on the lowest string (DOMAIN.md section 5).
   EXPECT_TRUE(g->order.labels_agree) << g->order.warning;
   // README: the nut-bridge distance measures about 0.344 Metashape units (695 mm).
-  EXPECT_NEAR(g->pose.world_units_per_mm * 695.0, 0.344, 0.004);
+  EXPECT_NEAR(g->world_from_instrument.scale * 695.0, 0.344, 0.004);
   // DOMAIN.md section 5 distances at that scale.
   auto mm = [&](const char* a, const char* b) {
-    return (f.points.at(a) - f.points.at(b)).norm() / g->pose.world_units_per_mm;
+    return (f.points.at(a) - f.points.at(b)).norm() / g->world_from_instrument.scale;
   };
   EXPECT_NEAR(mm("nut_l", "nut_r"), 23.9, 1.5);
   EXPECT_NEAR(mm("bridge_l", "bridge_r"), 48.2, 1.5);
   EXPECT_NEAR(mm("bridge_l", "tail_gut"), 377, 8);
   EXPECT_NEAR(mm("tail_gut", "end_pin"), 314, 8);
   // Instrument frame: the end pin is below the bridge (toward -x), the scroll beyond the nut.
-  EXPECT_LT(g->pose.ToInstrument(f.points.at("end_pin")).x(), -600);
-  EXPECT_GT(g->pose.ToInstrument(f.points.at("scroll_top")).x(), 695 + 100);
+  EXPECT_LT(g->world_from_instrument.InverseMap(f.points.at("end_pin")).x(), -600);
+  EXPECT_GT(g->world_from_instrument.InverseMap(f.points.at("scroll_top")).x(), 695 + 100);
   // The other frontal-ish views agree on the side; the performer's side would flip it.
   FrontHint behind = FrontCamera(f);
   behind.kind = FrontHint::Kind::kPerformerPoint;
@@ -135,7 +135,7 @@ TEST(InstrumentOnRealLabels, OctaveIsHalfWayAlongTheRealString) {
     const StringSegment& seg = g->strings[s - 1];
     const Eigen::Vector3d p = seg.PointAtFraction(c.fraction_from_bridge);
     EXPECT_NEAR((p - seg.nut).norm(), (p - seg.bridge).norm(), 1e-12);
-    EXPECT_NEAR(g->pose.ToInstrument(p).x(), 347.5, 0.5);
+    EXPECT_NEAR(g->world_from_instrument.InverseMap(p).x(), 347.5, 0.5);
   }
   // The C string runs next to the labelled nut_l / bridge_l.
   EXPECT_LT((g->strings[3].nut - f.points.at("nut_l")).norm(),

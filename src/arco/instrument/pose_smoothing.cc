@@ -36,7 +36,7 @@ std::vector<InstrumentFramePose> SmoothFramePoses(const std::vector<InstrumentFr
   std::vector<int> prev_ok(n, -1), next_ok(n, -1);
   for (int f = 0, last = -1; f < n; ++f) {
     if (frames[f].status == FrameFitStatus::kOk) {
-      quats[f] = Eigen::Quaterniond(frames[f].pose.rotation).normalized();
+      quats[f] = Eigen::Quaterniond(frames[f].world_from_instrument.rotation).normalized();
       last = f;
     }
     prev_ok[f] = last;
@@ -68,8 +68,8 @@ std::vector<InstrumentFramePose> SmoothFramePoses(const std::vector<InstrumentFr
       const double w = kernel[std::abs(g - f)];
       window.push_back(quats[g]);
       weights.push_back(w);
-      translation += w * frames[g].pose.translation;
-      units = frames[g].pose.world_units_per_mm;
+      translation += w * frames[g].world_from_instrument.translation;
+      units = frames[g].world_from_instrument.scale;
       weight_sum += w;
     }
     if (weight_sum <= 0) continue;
@@ -77,9 +77,8 @@ std::vector<InstrumentFramePose> SmoothFramePoses(const std::vector<InstrumentFr
     if (!mean) continue;
     out[f].filled = in.status != FrameFitStatus::kOk;
     out[f].status = FrameFitStatus::kOk;
-    out[f].pose.rotation = mean->normalized().toRotationMatrix();
-    out[f].pose.translation = translation / weight_sum;
-    out[f].pose.world_units_per_mm = units;
+    out[f].world_from_instrument =
+        SimMatrix3d(units, mean->normalized().toRotationMatrix(), translation / weight_sum);
   }
   return out;
 }

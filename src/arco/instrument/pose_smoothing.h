@@ -5,7 +5,7 @@
 //   InstrumentFit fit = *FitInstrument(model, keypoints, hints);
 //   std::vector<InstrumentFramePose> smooth = SmoothFramePoses(fit.frames, {});
 //   for (frame f with smooth[f].has_pose())
-//     strings = StringsAt(fit.instrument, smooth[f].pose);          // template_fit.h
+//     strings = StringsAt(fit.instrument, smooth[f].world_from_instrument);  // template_fit.h
 //     point   = strings[s - 1].PointAtFraction(contact.fraction_from_bridge);
 //
 // Method: a Gaussian kernel over time (sigma_frames, truncated at radius_frames) over the

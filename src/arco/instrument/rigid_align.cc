@@ -16,8 +16,7 @@ bool FitRigidSubset(const Eigen::Matrix3Xd& source,
                     const Eigen::Matrix3Xd& target,
                     const std::vector<int>& indices,
                     double min_spread,
-                    Eigen::Matrix3d* rotation,
-                    Eigen::Vector3d* translation) {
+                    RigidMatrix3d* target_from_source) {
   const int n = static_cast<int>(indices.size());
   if (n < 3) return false;
   Eigen::Vector3d s_mean = Eigen::Vector3d::Zero();
@@ -37,16 +36,16 @@ bool FitRigidSubset(const Eigen::Matrix3Xd& source,
   // Closed-form Kabsch/Umeyama solve (arco_geometry).
   const std::optional<AlignmentResult> fit = AlignPoints(from, to, {}, AlignmentOptions());
   if (!fit) return false;
-  *rotation = fit->target_from_source.RotationMatrix();
-  *translation = fit->target_from_source.translation;
-  return rotation->allFinite() && translation->allFinite();
+  // Without scale, AlignPoints' similarity is this rigid map (scale 1).
+  *target_from_source =
+      RigidMatrix3d(fit->target_from_source.RotationMatrix(), fit->target_from_source.translation);
+  return target_from_source->rotation.allFinite() && target_from_source->translation.allFinite();
 }
 
 namespace {
 
 struct Hypothesis {
-  Eigen::Matrix3d rotation;
-  Eigen::Vector3d translation;
+  RigidMatrix3d target_from_source;
   std::vector<int> inliers;
   double residual_sum = 0;
 };
@@ -59,7 +58,7 @@ void Score(const Eigen::Matrix3Xd& source,
   h->inliers.clear();
   h->residual_sum = 0;
   for (int i : common) {
-    const double r = (target.col(i) - (h->rotation * source.col(i) + h->translation)).norm();
+    const double r = (target.col(i) - (h->target_from_source * source.col(i))).norm();
     if (r <= gate) {
       h->inliers.push_back(i);
       h->residual_sum += r;
@@ -93,7 +92,7 @@ RigidAlignment AlignRigidRobust(const Eigen::Matrix3Xd& source,
 
   Hypothesis best;
   bool have_best = false;
-  if (FitRigidSubset(source, target, common, min_spread, &best.rotation, &best.translation)) {
+  if (FitRigidSubset(source, target, common, min_spread, &best.target_from_source)) {
     Score(source, target, common, gate, &best);
     have_best = true;
   }
@@ -106,7 +105,7 @@ RigidAlignment AlignRigidRobust(const Eigen::Matrix3Xd& source,
       for (int b = a + 1; b < n; ++b) {
         for (int c = b + 1; c < n; ++c) {
           sample = {common[a], common[b], common[c]};
-          if (!FitRigidSubset(source, target, sample, min_spread, &h.rotation, &h.translation)) {
+          if (!FitRigidSubset(source, target, sample, min_spread, &h.target_from_source)) {
             continue;
           }
           Score(source, target, common, gate, &h);
@@ -122,8 +121,7 @@ RigidAlignment AlignRigidRobust(const Eigen::Matrix3Xd& source,
   // Refit on the inliers, then re-select once with the refined pose.
   for (int round = 0; round < 2; ++round) {
     Hypothesis refit;
-    if (!FitRigidSubset(
-            source, target, best.inliers, min_spread, &refit.rotation, &refit.translation)) {
+    if (!FitRigidSubset(source, target, best.inliers, min_spread, &refit.target_from_source)) {
       break;
     }
     Score(source, target, common, gate, &refit);
@@ -133,14 +131,14 @@ RigidAlignment AlignRigidRobust(const Eigen::Matrix3Xd& source,
     if (same) break;
   }
   // Final least squares on the final inlier set (also checks it is not collinear).
-  if (!FitRigidSubset(source, target, best.inliers, min_spread, &out.rotation, &out.translation)) {
+  if (!FitRigidSubset(source, target, best.inliers, min_spread, &out.target_from_source)) {
     return out;
   }
   out.ok = true;
   double sum_sq = 0;
   for (int i : best.inliers) {
     out.inlier_mask |= (1u << i);
-    sum_sq += (target.col(i) - (out.rotation * source.col(i) + out.translation)).squaredNorm();
+    sum_sq += (target.col(i) - out.target_from_source * source.col(i)).squaredNorm();
   }
   out.num_inliers = static_cast<int>(best.inliers.size());
   out.rms_residual = std::sqrt(sum_sq / out.num_inliers);

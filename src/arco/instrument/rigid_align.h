@@ -10,12 +10,13 @@
 #include <cstdint>
 #include <vector>
 
+#include "arco/geometry/transform.h"
+
 namespace arco {
 
 struct RigidAlignment {
   bool ok = false;  // false: fewer than 3 usable, non-collinear inlier points
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // target = R * source + t
-  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  RigidMatrix3d target_from_source;  // target = R * source + t
   uint32_t inlier_mask = 0;  // bit k: point k used in the final fit
   int num_common = 0;        // points finite in both source and target
   int num_inliers = 0;
@@ -37,7 +38,6 @@ bool FitRigidSubset(const Eigen::Matrix3Xd& source,
                     const Eigen::Matrix3Xd& target,
                     const std::vector<int>& indices,
                     double min_spread,
-                    Eigen::Matrix3d* rotation,
-                    Eigen::Vector3d* translation);
+                    RigidMatrix3d* target_from_source);
 
 }  // namespace arco

@@ -154,11 +154,11 @@ StatusOr<InstrumentGeometry> GeometryFromEdges(const InstrumentModel& model,
     AppendWarning(&report, "geometry puts the lowest string on the labels' r side");
   }
 
-  g.pose.rotation.col(0) = x;
-  g.pose.rotation.col(1) = y;
-  g.pose.rotation.col(2) = z;
-  g.pose.translation = bridge_c;
-  g.pose.world_units_per_mm = units_per_mm;
+  g.world_from_instrument.rotation.col(0) = x;
+  g.world_from_instrument.rotation.col(1) = y;
+  g.world_from_instrument.rotation.col(2) = z;
+  g.world_from_instrument.translation = bridge_c;
+  g.world_from_instrument.scale = units_per_mm;
 
   // Unit vectors from the high to the low side along each labelled edge; a degenerate
   // edge borrows the in-plane lateral direction.
@@ -185,19 +185,19 @@ StatusOr<InstrumentGeometry> GeometryFromEdges(const InstrumentModel& model,
   g.strings_in_instrument.resize(n);
   for (int s = 0; s < n; ++s) {
     g.strings_in_instrument[s].string = g.strings[s].string;
-    g.strings_in_instrument[s].nut = g.pose.ToInstrument(g.strings[s].nut);
-    g.strings_in_instrument[s].bridge = g.pose.ToInstrument(g.strings[s].bridge);
+    g.strings_in_instrument[s].nut = g.world_from_instrument.InverseMap(g.strings[s].nut);
+    g.strings_in_instrument[s].bridge = g.world_from_instrument.InverseMap(g.strings[s].bridge);
   }
   return g;
 }
 
 std::vector<StringSegment> StringsInWorld(const std::vector<StringSegment>& strings_in_instrument,
-                                          const InstrumentPose& pose) {
+                                          const SimMatrix3d& world_from_instrument) {
   std::vector<StringSegment> out(strings_in_instrument.size());
   for (size_t i = 0; i < out.size(); ++i) {
     out[i].string = strings_in_instrument[i].string;
-    out[i].nut = pose.ToWorld(strings_in_instrument[i].nut);
-    out[i].bridge = pose.ToWorld(strings_in_instrument[i].bridge);
+    out[i].nut = world_from_instrument * strings_in_instrument[i].nut;
+    out[i].bridge = world_from_instrument * strings_in_instrument[i].bridge;
   }
   return out;
 }

@@ -8,7 +8,7 @@
 //           the lowest string is on the viewer's left (DOMAIN.md section 5), and a viewer
 //           looking along -z with x up has +y on the left.
 // World points are in the calibration's units (arbitrary for Metashape rigs, hence
-// InstrumentPose::world_units_per_mm).
+// world_from_instrument.scale, below).
 //
 // String order comes from geometry, never from label names: the two edge points at each
 // end (SPD nut_l/nut_r, bridge_l/bridge_r) span the string plane with the string axis;
@@ -33,30 +33,11 @@
 
 namespace arco {
 
-// point_in_world = world_units_per_mm * (rotation * point_in_instrument_mm) + translation.
-// rotation's columns are the instrument x, y, z axes in the world; translation is the
-// bridge centre in world units.
-struct InstrumentPose {
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
-  double world_units_per_mm = 1.0;
-
-  Eigen::Vector3d ToWorld(const Eigen::Vector3d& point_in_instrument_mm) const {
-    return world_units_per_mm * (rotation * point_in_instrument_mm) + translation;
-  }
-  Eigen::Vector3d ToInstrument(const Eigen::Vector3d& point_in_world) const {
-    return rotation.transpose() * (point_in_world - translation) / world_units_per_mm;
-  }
-  // The same map as arco_geometry's similarity transform.
-  Sim3d world_from_instrument() const { return Sim3d(world_units_per_mm, rotation, translation); }
-  static InstrumentPose FromSim3d(const Sim3d& world_from_instrument) {
-    InstrumentPose pose;
-    pose.rotation = world_from_instrument.RotationMatrix();
-    pose.translation = world_from_instrument.translation;
-    pose.world_units_per_mm = world_from_instrument.scale;
-    return pose;
-  }
-};
+// The instrument's pose is geometry's SimMatrix3d `world_from_instrument`:
+// point_in_world = scale * (rotation * point_in_instrument_mm) + translation, its scale
+// the world units per mm; rotation's columns are the instrument x, y, z axes in the
+// world; translation is the bridge centre in world units. A matrix rotation, not Sim3d's
+// quaternion: the instrument's numbers are matrix products (docs/architecture.md).
 
 // One string from the nut to the bridge (in whichever frame its container says).
 struct StringSegment {
@@ -117,7 +98,7 @@ struct StringEdges {
 };
 
 struct InstrumentGeometry {
-  InstrumentPose pose;                 // world_from_instrument, see header comment
+  SimMatrix3d world_from_instrument;   // see above; scale = world units per mm
   std::vector<StringSegment> strings;  // in the world; index = string - 1
   StringOrderReport order;
   // The same strings in the instrument frame (mm).
@@ -132,8 +113,8 @@ StatusOr<InstrumentGeometry> GeometryFromEdges(const InstrumentModel& model,
                                                const FrontHint& hint,
                                                const StringGeometryOptions& options = {});
 
-// The strings of `strings_in_instrument` placed in the world by `pose` (index = string - 1).
+// The strings of `strings_in_instrument` placed in the world (index = string - 1).
 std::vector<StringSegment> StringsInWorld(const std::vector<StringSegment>& strings_in_instrument,
-                                          const InstrumentPose& pose);
+                                          const SimMatrix3d& world_from_instrument);
 
 }  // namespace arco

@@ -19,7 +19,7 @@ const InstrumentModel& Cello() {
 // A cello in a known pose: instrument-frame edge points (mm) mapped into a Metashape-like
 // world (1 unit = 2020 mm). Labels follow SPD: nut_l / bridge_l on the low side (+y).
 struct Scene {
-  InstrumentPose truth;
+  SimMatrix3d truth;  // world_from_instrument
   StringEdges edges;
   Eigen::Vector3d performer;  // behind the top plate (z < 0 in the instrument frame)
 };
@@ -30,12 +30,12 @@ Scene MakeScene(double label_nut_mm = 23.9, double label_bridge_mm = 48.2) {
                       Eigen::AngleAxisd(-0.3, Eigen::Vector3d::UnitX()))
                          .toRotationMatrix();
   s.truth.translation = Eigen::Vector3d(0.12, -0.4, 2.3);
-  s.truth.world_units_per_mm = 1.0 / 2020.0;
-  s.edges.nut_l = s.truth.ToWorld({695, label_nut_mm / 2, 0});
-  s.edges.nut_r = s.truth.ToWorld({695, -label_nut_mm / 2, 0});
-  s.edges.bridge_l = s.truth.ToWorld({0, label_bridge_mm / 2, 0});
-  s.edges.bridge_r = s.truth.ToWorld({0, -label_bridge_mm / 2, 0});
-  s.performer = s.truth.ToWorld({350, 20, -250});
+  s.truth.scale = 1.0 / 2020.0;
+  s.edges.nut_l = s.truth * Eigen::Vector3d(695, label_nut_mm / 2, 0);
+  s.edges.nut_r = s.truth * Eigen::Vector3d(695, -label_nut_mm / 2, 0);
+  s.edges.bridge_l = s.truth * Eigen::Vector3d(0, label_bridge_mm / 2, 0);
+  s.edges.bridge_r = s.truth * Eigen::Vector3d(0, -label_bridge_mm / 2, 0);
+  s.performer = s.truth * Eigen::Vector3d(350, 20, -250);
   return s;
 }
 
@@ -48,9 +48,9 @@ TEST(GeometryFromEdges, RecoversFrameScaleAndRealSpacing) {
   EXPECT_FALSE(g->order.ambiguous) << g->order.warning;
   EXPECT_TRUE(g->order.labels_agree);
   EXPECT_NEAR(g->order.front_margin_mm, 250.0, 1e-6);
-  EXPECT_NEAR(g->pose.world_units_per_mm, scene.truth.world_units_per_mm, 1e-15);
-  EXPECT_LT((g->pose.rotation - scene.truth.rotation).norm(), 1e-12);
-  EXPECT_LT((g->pose.translation - scene.truth.translation).norm(), 1e-12);
+  EXPECT_NEAR(g->world_from_instrument.scale, scene.truth.scale, 1e-15);
+  EXPECT_LT((g->world_from_instrument.rotation - scene.truth.rotation).norm(), 1e-12);
+  EXPECT_LT((g->world_from_instrument.translation - scene.truth.translation).norm(), 1e-12);
   ASSERT_EQ(g->strings.size(), 4u);
   for (int s = 1; s <= 4; ++s) {
     const StringSegment& in = g->strings_in_instrument[s - 1];
@@ -59,13 +59,14 @@ TEST(GeometryFromEdges, RecoversFrameScaleAndRealSpacing) {
     EXPECT_NEAR(in.bridge.y(), Cello().LateralOffsetAtBridgeMm(s), 1e-9);
     EXPECT_NEAR(in.nut.x(), 695.0, 1e-9);
     EXPECT_NEAR(in.bridge.x(), 0.0, 1e-9);
-    EXPECT_LT((g->strings[s - 1].nut - scene.truth.ToWorld(in.nut)).norm(), 1e-12);
+    EXPECT_LT((g->strings[s - 1].nut - scene.truth * in.nut).norm(), 1e-12);
   }
   // The C string (4) is on the +y (low) side, i.e. next to nut_l.
   EXPECT_LT((g->strings[3].nut - scene.edges.nut_l).norm(),
             (g->strings[0].nut - scene.edges.nut_l).norm());
   // Outer strings 23 mm apart at the nut, not the 23.9 mm label width.
-  const double nut_mm = (g->strings[3].nut - g->strings[0].nut).norm() / g->pose.world_units_per_mm;
+  const double nut_mm =
+      (g->strings[3].nut - g->strings[0].nut).norm() / g->world_from_instrument.scale;
   EXPECT_NEAR(nut_mm, Cello().nut_spacing_mm(), 1e-9);
 }
 
@@ -77,7 +78,7 @@ TEST(GeometryFromEdges, OctaveContactIsHalfWayInThreeD) {
   const StringSegment& d = g->strings[1];
   const Eigen::Vector3d p = d.PointAtFraction(c.fraction_from_bridge);
   EXPECT_NEAR((p - d.nut).norm(), (p - d.bridge).norm(), 1e-12);
-  EXPECT_NEAR(g->pose.ToInstrument(p).x(), 347.5, 1e-6);
+  EXPECT_NEAR(g->world_from_instrument.InverseMap(p).x(), 347.5, 1e-6);
 }
 
 TEST(GeometryFromEdges, SwappedLabelsGiveTheSameStrings) {
@@ -119,12 +120,12 @@ TEST(GeometryFromEdges, MirroredSceneReversesOrderAgainstLabels) {
   EXPECT_FALSE(g->order.labels_agree);
   EXPECT_LT((g->strings[3].nut - scene.edges.nut_r).norm(),
             (g->strings[3].nut - scene.edges.nut_l).norm());
-  EXPECT_NEAR(g->pose.rotation.determinant(), 1.0, 1e-12);
+  EXPECT_NEAR(g->world_from_instrument.rotation.determinant(), 1.0, 1e-12);
 }
 
 TEST(GeometryFromEdges, HintSideDecidesTheOrder) {
   const Scene scene = MakeScene();
-  const Eigen::Vector3d front = scene.truth.ToWorld({350, 0, 400});
+  const Eigen::Vector3d front = scene.truth * Eigen::Vector3d(350, 0, 400);
   auto by_performer = GeometryFromEdges(Cello(), scene.edges, Performer(scene.performer));
   auto by_front = GeometryFromEdges(Cello(), scene.edges, {FrontHint::Kind::kFrontPoint, front});
   auto by_dir = GeometryFromEdges(
@@ -140,7 +141,8 @@ TEST(GeometryFromEdges, HintSideDecidesTheOrder) {
 
 TEST(GeometryFromEdges, HintInThePlaneIsAmbiguous) {
   const Scene scene = MakeScene();
-  auto g = GeometryFromEdges(Cello(), scene.edges, Performer(scene.truth.ToWorld({350, 300, 5})));
+  auto g = GeometryFromEdges(
+      Cello(), scene.edges, Performer(scene.truth * Eigen::Vector3d(350, 300, 5)));
   ASSERT_TRUE(g.ok());
   EXPECT_TRUE(g->order.ambiguous);
   EXPECT_NE(g->order.warning.find("ambiguous"), std::string::npos);
@@ -193,21 +195,21 @@ TEST(GeometryFromEdges, DegenerateInputIsAnError) {
   EXPECT_FALSE(GeometryFromEdges(Cello(), scene.edges, hint, bad).ok());
 }
 
-TEST(InstrumentPose, MatchesSim3d) {
+TEST(WorldFromInstrument, MatchesSim3d) {
   const Scene scene = MakeScene();
-  const Sim3d sim = scene.truth.world_from_instrument();
+  const Sim3d sim = scene.truth.ToSim3d();
   const Eigen::Vector3d p(100, -5, 20);
-  EXPECT_LT((sim * p - scene.truth.ToWorld(p)).norm(), 1e-12);
-  const InstrumentPose back = InstrumentPose::FromSim3d(sim);
-  EXPECT_LT((back.ToWorld(p) - scene.truth.ToWorld(p)).norm(), 1e-12);
-  EXPECT_LT((back.ToInstrument(scene.truth.ToWorld(p)) - p).norm(), 1e-9);
+  EXPECT_LT((sim * p - scene.truth * p).norm(), 1e-12);
+  const SimMatrix3d back(sim);
+  EXPECT_LT((back * p - scene.truth * p).norm(), 1e-12);
+  EXPECT_LT((back.InverseMap(scene.truth * p) - p).norm(), 1e-9);
 }
 
 TEST(StringsInWorld, MatchesTheGeometry) {
   const Scene scene = MakeScene();
   auto g = GeometryFromEdges(Cello(), scene.edges, Performer(scene.performer));
   ASSERT_TRUE(g.ok());
-  const auto strings = StringsInWorld(g->strings_in_instrument, g->pose);
+  const auto strings = StringsInWorld(g->strings_in_instrument, g->world_from_instrument);
   for (int s = 0; s < 4; ++s) {
     EXPECT_LT((strings[s].nut - g->strings[s].nut).norm(), 1e-12);
     EXPECT_LT((strings[s].bridge - g->strings[s].bridge).norm(), 1e-12);

@@ -89,8 +89,8 @@ Eigen::Matrix3Xd UpdateTemplate(const std::vector<Eigen::Matrix3Xd>& pts,
     for (auto& c : coords) c.clear();
     for (size_t f = 0; f < pts.size(); ++f) {
       if (!used[f] || !(align[f].inlier_mask & (1u << k))) continue;
-      const Eigen::Vector3d p =
-          align[f].rotation.transpose() * (pts[f].col(k) - align[f].translation);
+      const Eigen::Vector3d p = align[f].target_from_source.rotation.transpose() *
+                                (pts[f].col(k) - align[f].target_from_source.translation);
       for (int a = 0; a < 3; ++a) coords[a].push_back(p(a));
     }
     if (static_cast<int>(coords[0].size()) < min_observations) continue;
@@ -197,7 +197,7 @@ StatusOr<InstrumentFit> FitInstrument(const InstrumentModel& model,
       for (int k : rigid) {
         if (!(align[f].inlier_mask & (1u << k))) continue;
         point_residuals.push_back(
-            (pts[f].col(k) - (align[f].rotation * shape.col(k) + align[f].translation)).norm());
+            (pts[f].col(k) - align[f].target_from_source * shape.col(k)).norm());
       }
     }
     Eigen::Matrix3Xd updated =
@@ -209,10 +209,9 @@ StatusOr<InstrumentFit> FitInstrument(const InstrumentModel& model,
     for (int k : rigid) {
       if (shape.col(k).allFinite() && updated.col(k).allFinite()) common.push_back(k);
     }
-    Eigen::Matrix3d gauge_r;
-    Eigen::Vector3d gauge_t;
-    if (FitRigidSubset(updated, shape, common, options.min_spread_mm, &gauge_r, &gauge_t)) {
-      updated = (gauge_r * updated).colwise() + gauge_t;
+    RigidMatrix3d shape_from_updated;
+    if (FitRigidSubset(updated, shape, common, options.min_spread_mm, &shape_from_updated)) {
+      updated = (shape_from_updated.rotation * updated).colwise() + shape_from_updated.translation;
     }
     const double change = MaxChange(shape, updated);
     shape = updated;
@@ -242,8 +241,8 @@ StatusOr<InstrumentFit> FitInstrument(const InstrumentModel& model,
       InstrumentGeometry first,
       GeometryFromEdges(
           model, edges, {FrontHint::Kind::kFrontDirection, {1, 2, 3}}, geometry_options));
-  const Eigen::Vector3d z_first = first.pose.rotation.col(2);
-  const Eigen::Vector3d mid = first.pose.ToWorld({0.5 * length_mm, 0, 0});
+  const Eigen::Vector3d z_first = first.world_from_instrument.rotation.col(2);
+  const Eigen::Vector3d mid = first.world_from_instrument * Eigen::Vector3d(0.5 * length_mm, 0, 0);
   int votes_for = 0, votes_against = 0;
   std::vector<double> margins;
   const bool direction_hints = hints.front().kind == FrontHint::Kind::kFrontDirection;
@@ -253,11 +252,11 @@ StatusOr<InstrumentFit> FitInstrument(const InstrumentModel& model,
     double s = 0;
     if (h.kind == FrontHint::Kind::kFrontDirection) {
       if (!(h.value.norm() > 0)) continue;
-      s = z_first.dot(align[f].rotation.transpose() * h.value.normalized());
+      s = z_first.dot(align[f].target_from_source.rotation.transpose() * h.value.normalized());
       margins.push_back(std::asin(std::min(1.0, std::abs(s))) * 180.0 / 3.14159265358979323846);
     } else {
-      const Eigen::Vector3d p =
-          align[f].rotation.transpose() * (h.value / u - align[f].translation);
+      const Eigen::Vector3d p = align[f].target_from_source.rotation.transpose() *
+                                (h.value / u - align[f].target_from_source.translation);
       s = z_first.dot(p - mid);
       if (h.kind == FrontHint::Kind::kPerformerPoint) s = -s;
       margins.push_back(std::abs(s));
@@ -325,7 +324,8 @@ StatusOr<InstrumentFit> FitInstrument(const InstrumentModel& model,
   instrument.keypoints_in_instrument.assign(num_keypoints, Eigen::Vector3d::Constant(kNaN));
   for (int k : rigid) {
     if (shape.col(k).allFinite()) {
-      instrument.keypoints_in_instrument[k] = geometry.pose.ToInstrument(shape.col(k));
+      instrument.keypoints_in_instrument[k] =
+          geometry.world_from_instrument.InverseMap(shape.col(k));
     }
   }
 

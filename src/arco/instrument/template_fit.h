@@ -73,7 +73,7 @@ const char* FrameFitStatusName(FrameFitStatus status);
 struct InstrumentFramePose {
   FrameFitStatus status = FrameFitStatus::kTooFewPoints;
   bool has_pose() const { return status != FrameFitStatus::kTooFewPoints; }
-  InstrumentPose pose;         // world_from_instrument (valid when has_pose())
+  SimMatrix3d world_from_instrument;  // valid when has_pose(); scale = world units per mm
   double rms_residual_mm = 0;  // over the inlier keypoints; NaN without a pose
   int num_observed = 0;        // rigid keypoints finite in this frame and in the template
   int num_inliers = 0;
@@ -131,17 +131,17 @@ InstrumentFramePose FitFramePose(const InstrumentTemplate& instrument,
                                  double point_gate_mm,
                                  double min_spread_mm = 3.0);
 
-// RMS distance (mm) between the template placed by `pose` and the keypoints in
+// RMS distance (mm) between the template placed by `world_from_instrument` and the keypoints in
 // `inlier_mask` (e.g. after smoothing the pose); NaN when none is finite.
 double PoseResidualMm(const InstrumentTemplate& instrument,
-                      const InstrumentPose& pose,
+                      const SimMatrix3d& world_from_instrument,
                       const Eigen::Matrix3Xd& keypoints_in_world,
                       uint32_t inlier_mask);
 
 // The strings in the world for one pose (index = string - 1).
 inline std::vector<StringSegment> StringsAt(const InstrumentTemplate& instrument,
-                                            const InstrumentPose& pose) {
-  return StringsInWorld(instrument.strings_in_instrument, pose);
+                                            const SimMatrix3d& world_from_instrument) {
+  return StringsInWorld(instrument.strings_in_instrument, world_from_instrument);
 }
 
 }  // namespace arco

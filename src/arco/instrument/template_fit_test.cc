@@ -36,14 +36,14 @@ std::vector<Eigen::Vector3d> TruthCello() {
           {kNaN, kNaN, kNaN}};
 }
 
-InstrumentPose TruthPose(int f) {
-  InstrumentPose p;
+SimMatrix3d TruthPose(int f) {
+  SimMatrix3d p;
   const double t = 0.05 * f;
   p.rotation = (Eigen::AngleAxisd(1.2 + 0.08 * std::sin(t), Eigen::Vector3d::UnitZ()) *
                 Eigen::AngleAxisd(0.3 + 0.05 * std::cos(0.7 * t), Eigen::Vector3d::UnitX()) *
                 Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitY()))
                    .toRotationMatrix();
-  p.world_units_per_mm = 1.0 / 2020.0;  // Metashape-like units
+  p.scale = 1.0 / 2020.0;  // world units per mm: Metashape-like units
   p.translation = Eigen::Vector3d(0.1 + 0.01 * std::sin(0.3 * t), -0.2, 1.9 + 0.005 * t);
   return p;
 }
@@ -65,7 +65,7 @@ Clip MakeClip(int num_frames, double noise_mm, uint32_t seed, bool mirror = fals
       mirror ? Eigen::Vector3d(-1, 1, 1).asDiagonal().toDenseMatrix() : Eigen::Matrix3d::Identity();
   Clip clip;
   for (int f = 0; f < num_frames; ++f) {
-    const InstrumentPose pose = TruthPose(f);
+    const SimMatrix3d pose = TruthPose(f);
     Eigen::Matrix3Xd kp = Eigen::Matrix3Xd::Constant(3, 9, kNaN);
     std::vector<bool> displaced(9, false);
     const bool garbage = f % 37 == 5;
@@ -78,13 +78,15 @@ Clip MakeClip(int num_frames, double noise_mm, uint32_t seed, bool mirror = fals
              (80 + 120 * uniform(rng));
         displaced[k] = true;
       }
-      kp.col(k) = m * pose.ToWorld(p);
+      kp.col(k) = m * (pose * p);
       if (uniform(rng) < 0.1 || (sparse && k >= 2)) kp.col(k).setConstant(kNaN);
     }
-    kp.col(7) = m * pose.ToWorld({300 + 50 * std::sin(0.1 * f), 100, 60});  // bow: not rigid
-    kp.col(8) = m * pose.ToWorld({-100.0, -400.0 + (30 * f) % 200, 90.0});
+    kp.col(7) =
+        m * (pose * Eigen::Vector3d(300 + 50 * std::sin(0.1 * f), 100, 60));  // bow: not rigid
+    kp.col(8) = m * (pose * Eigen::Vector3d(-100.0, -400.0 + (30 * f) % 200, 90.0));
     clip.keypoints.push_back(kp);
-    clip.hints.push_back({FrontHint::Kind::kPerformerPoint, m * pose.ToWorld({450, 50, -300})});
+    clip.hints.push_back(
+        {FrontHint::Kind::kPerformerPoint, m * (pose * Eigen::Vector3d(450, 50, -300))});
     clip.displaced.push_back(displaced);
     clip.garbage.push_back(garbage);
     clip.sparse.push_back(sparse);
@@ -139,11 +141,11 @@ TEST(FitInstrument, RecoversTemplateScaleAndPosesDespiteOutliers) {
     ASSERT_TRUE(p.has_pose()) << f;
     if (p.status != FrameFitStatus::kOk) continue;
     ++good;
-    const InstrumentPose truth_pose = TruthPose(static_cast<int>(f));
+    const SimMatrix3d truth_pose = TruthPose(static_cast<int>(f));
     // Where the pose puts the instrument (its keypoints and the string ends), in mm.
     double worst_mm = 0;
     for (const Eigen::Vector3d& q : TruthStrings()) {
-      worst_mm = std::max(worst_mm, (p.pose.ToWorld(q) - truth_pose.ToWorld(q)).norm() * 2020.0);
+      worst_mm = std::max(worst_mm, (p.world_from_instrument * q - truth_pose * q).norm() * 2020.0);
     }
     placement_mm.push_back(worst_mm);
     EXPECT_LT(p.rms_residual_mm, 8.0);
@@ -179,11 +181,11 @@ TEST(FitInstrument, StringsFromPoseMatchTruthAndOctaveIsHalfWay) {
   const Contact octave = ContactPoint(Cello(), 3, 2 * Cello().open_hz(3));
   for (int f : {0, 10, 99, 150}) {
     ASSERT_EQ(fit->frames[f].status, FrameFitStatus::kOk) << f;
-    const InstrumentPose& pose = fit->frames[f].pose;
+    const SimMatrix3d& pose = fit->frames[f].world_from_instrument;
     const std::vector<StringSegment> strings = StringsAt(fit->instrument, pose);
-    const InstrumentPose truth = TruthPose(f);
+    const SimMatrix3d truth = TruthPose(f);
     const double nut_y = Cello().LateralOffsetAtNutMm(3);
-    const Eigen::Vector3d truth_nut = truth.ToWorld({695, nut_y, 0});
+    const Eigen::Vector3d truth_nut = truth * Eigen::Vector3d(695, nut_y, 0);
     EXPECT_LT((strings[2].nut - truth_nut).norm() * 2020.0, 3.0);
     const Eigen::Vector3d p = strings[2].PointAtFraction(octave.fraction_from_bridge);
     EXPECT_NEAR((p - strings[2].bridge).norm(), (p - strings[2].nut).norm(), 1e-9);
@@ -229,8 +231,10 @@ TEST(FitInstrument, ResultsDoNotDependOnThreadCount) {
   ASSERT_TRUE(a.ok() && b.ok());
   for (size_t f = 0; f < a->frames.size(); ++f) {
     EXPECT_EQ(a->frames[f].status, b->frames[f].status);
-    EXPECT_EQ(a->frames[f].pose.rotation, b->frames[f].pose.rotation);
-    EXPECT_EQ(a->frames[f].pose.translation, b->frames[f].pose.translation);
+    EXPECT_EQ(a->frames[f].world_from_instrument.rotation,
+              b->frames[f].world_from_instrument.rotation);
+    EXPECT_EQ(a->frames[f].world_from_instrument.translation,
+              b->frames[f].world_from_instrument.translation);
     EXPECT_EQ(a->frames[f].inlier_mask, b->frames[f].inlier_mask);
   }
   EXPECT_EQ(a->instrument.world_units_per_mm, b->instrument.world_units_per_mm);
@@ -281,20 +285,25 @@ TEST(SmoothFramePoses, ReducesJitterFillsGapsAndKeepsScale) {
       EXPECT_TRUE(smooth[f].filled);
     }
     if (fit->frames[f].status != FrameFitStatus::kOk) continue;
-    const InstrumentPose truth = TruthPose(static_cast<int>(f));
+    const SimMatrix3d truth = TruthPose(static_cast<int>(f));
     // Compare where the pose puts the nut centre (mm).
-    const Eigen::Vector3d nut_truth = truth.ToWorld({695, 0, 0});
-    raw_error += (fit->frames[f].pose.ToWorld({695, 0, 0}) - nut_truth).norm() * 2020.0;
-    smooth_error += (smooth[f].pose.ToWorld({695, 0, 0}) - nut_truth).norm() * 2020.0;
-    EXPECT_EQ(smooth[f].pose.world_units_per_mm, fit->frames[f].pose.world_units_per_mm);
-    EXPECT_NEAR(smooth[f].pose.rotation.determinant(), 1.0, 1e-9);
+    const Eigen::Vector3d nut_truth = truth * Eigen::Vector3d(695, 0, 0);
+    raw_error +=
+        (fit->frames[f].world_from_instrument * Eigen::Vector3d(695, 0, 0) - nut_truth).norm() *
+        2020.0;
+    smooth_error +=
+        (smooth[f].world_from_instrument * Eigen::Vector3d(695, 0, 0) - nut_truth).norm() * 2020.0;
+    EXPECT_EQ(smooth[f].world_from_instrument.scale, fit->frames[f].world_from_instrument.scale);
+    EXPECT_NEAR(smooth[f].world_from_instrument.rotation.determinant(), 1.0, 1e-9);
     ++n;
   }
   ASSERT_GT(n, 200);
   EXPECT_LT(smooth_error, 0.7 * raw_error);
   // Strings from the smoothed pose; residual recomputed against the keypoints.
-  const double r = PoseResidualMm(
-      fit->instrument, smooth[50].pose, clip.keypoints[50], fit->frames[50].inlier_mask);
+  const double r = PoseResidualMm(fit->instrument,
+                                  smooth[50].world_from_instrument,
+                                  clip.keypoints[50],
+                                  fit->frames[50].inlier_mask);
   EXPECT_TRUE(std::isfinite(r));
   EXPECT_LT(r, 15.0);
   PoseSmoothingOptions bad;

@@ -67,9 +67,8 @@ InstrumentFramePose FitFramePose(const InstrumentTemplate& instrument,
   out.rms_residual_mm = kNaN;
   if (!a.ok) return out;
   out.status = FrameFitStatus::kOk;
-  out.pose.rotation = a.rotation;
-  out.pose.translation = u * a.translation;
-  out.pose.world_units_per_mm = u;
+  out.world_from_instrument =
+      SimMatrix3d(u, a.target_from_source.rotation, u * a.target_from_source.translation);
   out.rms_residual_mm = a.rms_residual;
   out.num_inliers = a.num_inliers;
   out.inlier_mask = a.inlier_mask;
@@ -77,7 +76,7 @@ InstrumentFramePose FitFramePose(const InstrumentTemplate& instrument,
 }
 
 double PoseResidualMm(const InstrumentTemplate& instrument,
-                      const InstrumentPose& pose,
+                      const SimMatrix3d& world_from_instrument,
                       const Eigen::Matrix3Xd& keypoints_in_world,
                       uint32_t inlier_mask) {
   double sum_sq = 0;
@@ -89,7 +88,7 @@ double PoseResidualMm(const InstrumentTemplate& instrument,
     const Eigen::Vector3d& p = instrument.keypoints_in_instrument[k];
     const Eigen::Vector3d x = keypoints_in_world.col(k);
     if (!p.allFinite() || !x.allFinite()) continue;
-    sum_sq += ((pose.ToWorld(p) - x) / pose.world_units_per_mm).squaredNorm();
+    sum_sq += ((world_from_instrument * p - x) / world_from_instrument.scale).squaredNorm();
     ++n;
   }
   return n > 0 ? std::sqrt(sum_sq / n) : kNaN;

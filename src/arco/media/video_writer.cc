@@ -333,6 +333,8 @@ bool HasVideoEncoder(const std::string& name) {
   return codec != nullptr && codec->type == AVMEDIA_TYPE_VIDEO;
 }
 
+unsigned CodecLibraryVersion() { return avcodec_version(); }
+
 Status WriteImageFile(const std::string& path, const Image& image) {
   if (image.empty()) return Status::Error(path + ": empty image");
   VideoWriterOptions options;

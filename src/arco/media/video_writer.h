@@ -94,6 +94,10 @@ class VideoWriter {
 // Whether this FFmpeg build has the encoder (libx264 is optional).
 bool HasVideoEncoder(const std::string& name);
 
+// libavcodec's version (LIBAVCODEC_VERSION_INT): what the encoders' bytes depend on, for
+// caches of encoded videos (arco view's).
+unsigned CodecLibraryVersion();
+
 // Writes one RGB8 or Gray8 image as a lossless PNG file (through VideoWriter:
 // libavformat's image2 muxer). Errors name the file.
 Status WriteImageFile(const std::string& path, const Image& image);

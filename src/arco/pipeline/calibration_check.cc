@@ -135,7 +135,8 @@ StatusOr<CalibrationCheckSummary> CheckCalibration(const CalibrationCheckOptions
   // capture.json's field); another one by its path.
   if (options.calibration.empty())
     ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(capture_dir, manifest));
-  ARCO_ASSIGN_OR_RETURN(const Calibration calibration, LoadCalibration(summary.calibration));
+  ARCO_ASSIGN_OR_RETURN(const Calibration calibration,
+                        calibration::LoadCalibration(summary.calibration));
   const Rig& rig = calibration.rig;
   if (result_points && header.units != rig.units)
     return Status::Error(options.capture_dir + "/result.json: points in '" + header.units +

@@ -27,7 +27,7 @@ void WriteCapture(const std::string& dir, Rig* rig) {
   d.missing_fraction = 0.1;
   const NpyArray<double> k = testing::MakeSyntheticDetections(*rig, truth, d);
   ASSERT_TRUE(MakeDirectories(dir).ok());
-  ASSERT_TRUE(SaveCalibration(dir + "/rig.json", *rig).ok());
+  ASSERT_TRUE(calibration::SaveCalibration(dir + "/rig.json", *rig).ok());
   NpyArray<float> kf;
   kf.shape = k.shape;
   kf.data.assign(k.data.begin(), k.data.end());
@@ -66,7 +66,7 @@ TEST(CheckCalibration, FlagsOnlyACameraTurnedByOneDegree) {
   turned.cam_from_world.rotation =
       RotationFromAxisAngle(Eigen::Vector3d(0, M_PI / 180, 0)) * turned.cam_from_world.rotation;
   turned.cam_from_world.translation = -turned.cam_from_world.rotation * centre;
-  ASSERT_TRUE(SaveCalibration(dir / "moved.json", moved).ok());
+  ASSERT_TRUE(calibration::SaveCalibration(dir / "moved.json", moved).ok());
   options.calibration = dir / "moved.json";
   auto bad = CheckCalibration(options);
   ASSERT_TRUE(bad.ok()) << bad.status().message();
@@ -110,7 +110,7 @@ TEST(CheckCalibration, ResultFolderUsesItsPointsAndItsCapture) {
   turned.cam_from_world.rotation =
       RotationFromAxisAngle(Eigen::Vector3d(0, M_PI / 180, 0)) * turned.cam_from_world.rotation;
   turned.cam_from_world.translation = -turned.cam_from_world.rotation * centre;
-  ASSERT_TRUE(SaveCalibration(dir / "moved.json", moved).ok());
+  ASSERT_TRUE(calibration::SaveCalibration(dir / "moved.json", moved).ok());
   options.calibration = dir / "moved.json";
   auto bad = CheckCalibration(options);
   ASSERT_TRUE(bad.ok()) << bad.status().message();
@@ -139,7 +139,7 @@ TEST(CheckCalibration, RealSpdLabelledViews) {
   EXPECT_TRUE(good->flagged.empty()) << good->ToJson().dump();
   for (const CameraCheck& c : good->cameras) EXPECT_GE(c.residuals, 5) << c.name;
 
-  auto loaded = LoadCalibration(calibration);
+  auto loaded = calibration::LoadCalibration(calibration);
   ASSERT_TRUE(loaded.ok());
   Rig moved = loaded->rig;
   Camera& turned = moved.cameras[moved.FindCamera("21334211")];
@@ -147,7 +147,7 @@ TEST(CheckCalibration, RealSpdLabelledViews) {
   turned.cam_from_world.rotation =
       RotationFromAxisAngle(Eigen::Vector3d(M_PI / 180, 0, 0)) * turned.cam_from_world.rotation;
   turned.cam_from_world.translation = -turned.cam_from_world.rotation * centre;
-  ASSERT_TRUE(SaveCalibration(dir / "moved.json", moved).ok());
+  ASSERT_TRUE(calibration::SaveCalibration(dir / "moved.json", moved).ok());
   options.calibration = dir / "moved.json";
   auto bad = CheckCalibration(options);
   ASSERT_TRUE(bad.ok()) << bad.status().message();

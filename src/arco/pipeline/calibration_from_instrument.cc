@@ -538,7 +538,7 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
   OutputSet outputs;
   ARCO_ASSIGN_OR_RETURN(const std::string calibration_tmp, outputs.AddFile(options.output));
   ARCO_ASSIGN_OR_RETURN(const std::string report_tmp, outputs.AddFile(report_file));
-  ARCO_RETURN_IF_ERROR(SaveCalibration(calibration_tmp, summary.rig, format));
+  ARCO_RETURN_IF_ERROR(calibration::SaveCalibration(calibration_tmp, summary.rig, format));
   {
     std::ofstream out(report_tmp);
     out << summary.ToJson().dump(2) << "\n";

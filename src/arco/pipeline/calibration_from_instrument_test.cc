@@ -36,8 +36,8 @@ constexpr int kImageWidth = 2300, kImageHeight = 2656;  // the SPD cameras'
 
 // A 4-second cello scale seen by two of the SPD rig's cameras, about 1.8 m apart.
 void WriteTwoCameraCapture(const std::string& path) {
-  auto calibration =
-      LoadCalibration(std::string(ARCO_SHARED_DATA_DIR) + "/spd/cello_1113_scale_camera.xml");
+  auto calibration = calibration::LoadCalibration(std::string(ARCO_SHARED_DATA_DIR) +
+                                                  "/spd/cello_1113_scale_camera.xml");
   ASSERT_TRUE(calibration.ok()) << calibration.status().message();
   Rig rig;
   rig.units = calibration->rig.units;
@@ -92,7 +92,7 @@ TEST(CalibrateFromInstrument, RecoversTwoCamerasWithTheTrueAndAWrongFocal) {
   TempDir dir;
   const std::string capture = dir / "capture";
   WriteTwoCameraCapture(capture);
-  auto truth = LoadCalibration(capture + "/calibration.json");
+  auto truth = calibration::LoadCalibration(capture + "/calibration.json");
   ASSERT_TRUE(truth.ok());
   const double true_focal = truth->rig.cameras[0].fx;
   Rig wrong_focal_rig;
@@ -107,7 +107,7 @@ TEST(CalibrateFromInstrument, RecoversTwoCamerasWithTheTrueAndAWrongFocal) {
     ASSERT_TRUE(result.ok()) << result.status().message();
     ASSERT_TRUE(FileExists(output));
     ASSERT_TRUE(FileExists(RefineReportPath(output)));
-    auto written = LoadCalibration(output);
+    auto written = calibration::LoadCalibration(output);
     ASSERT_TRUE(written.ok());
     EXPECT_EQ(written->rig.units, "mm");
     ASSERT_EQ(written->rig.cameras.size(), 2u);
@@ -279,7 +279,7 @@ TEST(CalibrateFromInstrument, ReadsLabelsInsteadOfTrackedPoints) {
   TempDir dir;
   const std::string capture = dir / "capture";
   WriteTwoCameraCapture(capture);
-  auto truth = LoadCalibration(capture + "/calibration.json");
+  auto truth = calibration::LoadCalibration(capture + "/calibration.json");
   ASSERT_TRUE(truth.ok());
   auto manifest = ReadCaptureManifest(capture);
   ASSERT_TRUE(manifest.ok());

@@ -125,7 +125,7 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
   } else {
     if (options.calibration.empty())
       ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(options.capture_dir, manifest));
-    ARCO_ASSIGN_OR_RETURN(calibration, LoadCalibration(summary.calibration));
+    ARCO_ASSIGN_OR_RETURN(calibration, calibration::LoadCalibration(summary.calibration));
   }
   const Rig& input = calibration.rig;
   summary.units = input.units;
@@ -302,8 +302,8 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
         const InstrumentFramePose& pose = fit->frames[f];
         if (pose.status != FrameFitStatus::kOk) continue;
         body.valid[f] = 1;
-        body.rotation[f] = pose.pose.rotation;
-        body.translation[f] = pose.pose.translation;
+        body.rotation[f] = pose.world_from_instrument.rotation;
+        body.translation[f] = pose.world_from_instrument.translation;
       }
       for (int k : {nut_l, nut_r, bridge_l, bridge_r})
         if (k < 0 || !body.points[k].allFinite())
@@ -424,7 +424,7 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
   OutputSet outputs;
   ARCO_ASSIGN_OR_RETURN(const std::string calibration_tmp, outputs.AddFile(options.output));
   ARCO_ASSIGN_OR_RETURN(const std::string report_tmp, outputs.AddFile(report_file));
-  ARCO_RETURN_IF_ERROR(SaveCalibration(calibration_tmp, rig, format));
+  ARCO_RETURN_IF_ERROR(calibration::SaveCalibration(calibration_tmp, rig, format));
   {
     std::ofstream out(report_tmp);
     out << summary.ToJson().dump(2) << "\n";

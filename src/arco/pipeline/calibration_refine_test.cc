@@ -32,8 +32,8 @@ using arco::testing::TempDir;
 
 // A 4-second cello scale (no audio rendering needed by refine; run's pitch stage reads it).
 void WriteSyntheticCapture(const std::string& path) {
-  auto calibration =
-      LoadCalibration(std::string(ARCO_SHARED_DATA_DIR) + "/spd/cello_1113_scale_camera.xml");
+  auto calibration = calibration::LoadCalibration(std::string(ARCO_SHARED_DATA_DIR) +
+                                                  "/spd/cello_1113_scale_camera.xml");
   ASSERT_TRUE(calibration.ok()) << calibration.status().message();
   synth::SynthOptions o;
   o.max_duration_s = 4.0;
@@ -88,10 +88,10 @@ TEST(RefineCalibration, RecoversAPerturbedRigAndTheRunsAccuracy) {
   TempDir dir;
   const std::string capture = dir / "capture";
   WriteSyntheticCapture(capture);
-  auto truth = LoadCalibration(capture + "/calibration.json");
+  auto truth = calibration::LoadCalibration(capture + "/calibration.json");
   ASSERT_TRUE(truth.ok());
   const Rig perturbed = Perturb(truth->rig, 7);
-  ASSERT_TRUE(SaveCalibration(dir / "perturbed.json", perturbed).ok());
+  ASSERT_TRUE(calibration::SaveCalibration(dir / "perturbed.json", perturbed).ok());
   const RigError before = Compare(truth->rig, perturbed);
 
   CalibrationRefineOptions options;
@@ -102,7 +102,7 @@ TEST(RefineCalibration, RecoversAPerturbedRigAndTheRunsAccuracy) {
   ASSERT_TRUE(refined.ok()) << refined.status().message();
   ASSERT_TRUE(FileExists(dir / "refined.json"));
   ASSERT_TRUE(FileExists(dir / "refined.report.json"));
-  auto written = LoadCalibration(dir / "refined.json");
+  auto written = calibration::LoadCalibration(dir / "refined.json");
   ASSERT_TRUE(written.ok());
   const RigError after = Compare(truth->rig, written->rig);
   std::printf(
@@ -177,7 +177,7 @@ TEST(RefineCalibration, RefinesFocalLengthsToo) {
   TempDir dir;
   const std::string capture = dir / "capture";
   WriteSyntheticCapture(capture);
-  auto truth = LoadCalibration(capture + "/calibration.json");
+  auto truth = calibration::LoadCalibration(capture + "/calibration.json");
   ASSERT_TRUE(truth.ok());
   Rig perturbed = Perturb(truth->rig, 11);
   std::mt19937 rng(12);
@@ -187,7 +187,7 @@ TEST(RefineCalibration, RefinesFocalLengthsToo) {
     perturbed.cameras[c].fx *= f;
     perturbed.cameras[c].fy *= f;
   }
-  ASSERT_TRUE(SaveCalibration(dir / "perturbed.json", perturbed).ok());
+  ASSERT_TRUE(calibration::SaveCalibration(dir / "perturbed.json", perturbed).ok());
   CalibrationRefineOptions options;
   options.capture_dir = capture;
   options.calibration = dir / "perturbed.json";

@@ -39,7 +39,7 @@ Status LoadCaptureCalibration(CaptureContext* capture) {
   // Read once: parsed here, and its fingerprint taken of the same bytes.
   StatusOr<std::string> text = ReadFileToString(path);
   StatusOr<Calibration> calibration =
-      text.ok() ? ParseCalibration(*text, path) : StatusOr<Calibration>(text.status());
+      text.ok() ? calibration::ParseCalibration(*text, path) : StatusOr<Calibration>(text.status());
   if (!calibration.ok()) {
     return calibration.status().WithContext(CaptureManifestPath(capture_dir) + ": calibration");
   }

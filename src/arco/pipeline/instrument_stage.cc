@@ -157,7 +157,7 @@ StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& opti
     const InstrumentFramePose& p = poses[static_cast<size_t>(f)];
     if (!p.has_pose()) continue;
     ++with_pose;
-    const std::vector<StringSegment> seg = StringsAt(fit->instrument, p.pose);
+    const std::vector<StringSegment> seg = StringsAt(fit->instrument, p.world_from_instrument);
     for (int i = 0; i < model.num_strings(); ++i) {
       for (int c = 0; c < 3; ++c) {
         strings.at(f, i, 0, c) = seg[static_cast<size_t>(i)].nut[c] / s;
@@ -167,7 +167,7 @@ StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& opti
     for (int k = 0; k < num_k; ++k) {
       const Eigen::Vector3d& t = fit->instrument.keypoints_in_instrument[static_cast<size_t>(k)];
       if (!t.allFinite()) continue;
-      const Eigen::Vector3d w = p.pose.ToWorld(t) / s;
+      const Eigen::Vector3d w = (p.world_from_instrument * t) / s;
       for (int c = 0; c < 3; ++c) placed.at(f, k, c) = w[c];
     }
   }

@@ -43,8 +43,8 @@ const std::string& SyntheticCapture() {
   static const arco::testing::TempDir dir("RunCaptureShared");
   static const std::string capture = [] {
     const std::string path = dir / "capture";
-    auto calibration =
-        LoadCalibration(std::string(ARCO_SHARED_DATA_DIR) + "/spd/cello_1113_scale_camera.xml");
+    auto calibration = calibration::LoadCalibration(std::string(ARCO_SHARED_DATA_DIR) +
+                                                    "/spd/cello_1113_scale_camera.xml");
     EXPECT_TRUE(calibration.ok()) << calibration.status().message();
     synth::SynthOptions o;
     o.max_duration_s = 4.0;
@@ -212,8 +212,8 @@ TEST(RunCapture, ThePerformersPalmIsFittedStoredAndReadBack) {
 TEST(RunCapture, DoubleStopsGiveArcoASecondVoiceThatEvalScores) {
   arco::testing::TempDir out;
   const std::string capture = out / "capture";
-  auto calibration =
-      LoadCalibration(std::string(ARCO_SHARED_DATA_DIR) + "/spd/cello_1113_scale_camera.xml");
+  auto calibration = calibration::LoadCalibration(std::string(ARCO_SHARED_DATA_DIR) +
+                                                  "/spd/cello_1113_scale_camera.xml");
   ASSERT_TRUE(calibration.ok());
   synth::SynthOptions so;
   so.instrument = "violin";

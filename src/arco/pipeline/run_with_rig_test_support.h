@@ -21,7 +21,7 @@ inline eval::MethodMetrics RunWithRig(const std::string& capture,
                                       const std::string& dir) {
   const std::string copy = dir + "/capture";
   std::filesystem::copy(capture, copy, std::filesystem::copy_options::recursive);
-  EXPECT_TRUE(SaveCalibration(copy + "/calibration.json", rig).ok());
+  EXPECT_TRUE(calibration::SaveCalibration(copy + "/calibration.json", rig).ok());
   RunOptions o;
   o.capture_dir = copy;
   o.result_dir = dir + "/result";

@@ -55,7 +55,7 @@ StatusOr<CaptureContext> OpenForTriangulation(const TriangulateStageOptions& o) 
   // Filters refer to groups of the layout; checked before any work (pipeline/capture_checks.h).
   ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(o, capture.layout, manifest.fps, manifest_path));
   const std::string calibration_path = ResolveCapturePath(o.capture_dir, manifest.calibration);
-  StatusOr<Calibration> calibration = LoadCalibration(calibration_path);
+  StatusOr<Calibration> calibration = calibration::LoadCalibration(calibration_path);
   if (!calibration.ok()) return calibration.status().WithContext(manifest_path + ": calibration");
   ARCO_ASSIGN_OR_RETURN(
       capture.view_to_camera,

@@ -189,7 +189,7 @@ SyntheticCapture WriteSyntheticCapture(const std::string& dir, int frames) {
   d.missing_fraction = 0.1;
   NpyArray<double> k = testing::MakeSyntheticDetections(c.rig, c.truth, d);
   EXPECT_TRUE(MakeDirectories(dir).ok());
-  EXPECT_TRUE(SaveCalibration(dir + "/rig.json", c.rig).ok());
+  EXPECT_TRUE(calibration::SaveCalibration(dir + "/rig.json", c.rig).ok());
   NpyArray<float> kf;
   kf.shape = k.shape;
   kf.data.assign(k.data.begin(), k.data.end());
@@ -346,7 +346,7 @@ TEST(TriangulateCapture, CamerasSyncedBySoundAreTriangulatedAtOneInstant) {
   TempDir dir;
   const std::string capture = dir / "capture";
   ASSERT_TRUE(MakeDirectories(capture).ok());
-  ASSERT_TRUE(SaveCalibration(capture + "/rig.json", rig).ok());
+  ASSERT_TRUE(calibration::SaveCalibration(capture + "/rig.json", rig).ok());
   ASSERT_TRUE(WriteNpy(capture + "/keypoints2d.npy", k).ok());
   CaptureManifest m;
   m.name = "synced_by_sound";

@@ -14,7 +14,7 @@ namespace arco::python {
 // ---- calibration --------------------------------------------------------------------
 
 PyCalibration LoadCalibrationOrRaise(const std::string& path) {
-  StatusOr<Calibration> calibration = LoadCalibration(path);
+  StatusOr<Calibration> calibration = calibration::LoadCalibration(path);
   if (!calibration.ok()) RaiseStatus(calibration.status(), path);
   return PyCalibration{std::move(*calibration)};
 }
@@ -181,11 +181,11 @@ void BindCalibration(py::module_& m) {
           [](const PyCalibration& c, const std::filesystem::path& path, const std::string& format) {
             CalibrationFormat f = CalibrationFormat::kUnknown;
             if (!format.empty()) {
-              StatusOr<CalibrationFormat> parsed = CalibrationFormatFromFlag(format);
+              StatusOr<CalibrationFormat> parsed = calibration::CalibrationFormatFromFlag(format);
               CheckValid(parsed.status());
               f = *parsed;
             }
-            const Status saved = SaveCalibration(path.string(), c.calibration.rig, f);
+            const Status saved = calibration::SaveCalibration(path.string(), c.calibration.rig, f);
             if (!saved.ok()) throw std::runtime_error(saved.message());
           },
           "path"_a,

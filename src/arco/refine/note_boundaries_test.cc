@@ -290,7 +290,8 @@ TEST(ArcoIk, ARejectedFrameStartsFromItsNeighboursHandShift) {
   const std::vector<SceneNote> notes = {{2, 1, 2, 20}, {2, 1, 5, 20}, {2, 3, 7, 20}};
   testing::Scene scene = testing::MakeScene(InstrumentKind::kCello, notes);
   for (int f = 20; f < 40; ++f) {
-    const Eigen::Vector3d toward_nut = scene.pose[static_cast<size_t>(f)].rotation.col(0);
+    const Eigen::Vector3d toward_nut =
+        scene.world_from_instrument[static_cast<size_t>(f)].rotation.col(0);
     scene.input.vision_hand[static_cast<size_t>(f)]->world_from_wrist.translation -=
         (f == 30 ? 22.0 : 12.0) * toward_nut;
   }

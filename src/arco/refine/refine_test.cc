@@ -371,7 +371,7 @@ TEST(Refine, LiftTestRejectsContactsTheFingerCannotReach) {
   for (int f = 20; f < 40; ++f) {
     hand::HandPose& h = *scene.input.vision_hand[static_cast<size_t>(f)];
     h.world_from_wrist.translation +=
-        scene.pose[static_cast<size_t>(f)].rotation * Eigen::Vector3d(0, 0, 70);
+        scene.world_from_instrument[static_cast<size_t>(f)].rotation * Eigen::Vector3d(0, 0, 70);
   }
   const RefineResult r = Refine(scene.input, Options(RefineMode::kArco));
   for (int f = 20; f < 40; ++f) {

@@ -48,7 +48,7 @@ struct Scene {
   std::vector<hand::HandPose> truth_hand;
   std::vector<int> truth_string, truth_finger;  // 0 = none
   std::vector<Eigen::Vector3d> truth_contact;   // NaN when none
-  std::vector<InstrumentPose> pose;
+  std::vector<SimMatrix3d> world_from_instrument;  // per frame, mm
 };
 
 inline std::vector<StringSegment> StringsInInstrument(const InstrumentModel& model) {
@@ -114,10 +114,10 @@ inline hand::HandPose PlayingPose(const hand::HandModel& hand_model,
   return pose;
 }
 
-inline hand::HandPose ToWorld(const hand::HandPose& in_instrument, const InstrumentPose& p) {
+inline hand::HandPose ToWorld(const hand::HandPose& in_instrument, const SimMatrix3d& p) {
   hand::HandPose out = in_instrument;
   out.world_from_wrist.rotation = p.rotation * in_instrument.world_from_wrist.rotation;
-  out.world_from_wrist.translation = p.ToWorld(in_instrument.world_from_wrist.translation);
+  out.world_from_wrist.translation = p * in_instrument.world_from_wrist.translation;
   return out;
 }
 
@@ -149,13 +149,13 @@ inline Scene MakeScene(InstrumentKind kind,
     }
     for (int i = 0; i < note.frames; ++i, ++frame) {
       const double t = frame / fps;
-      InstrumentPose p;
+      SimMatrix3d p;
       const double a = options.sway ? 0.05 * std::sin(2 * M_PI * 0.3 * t) : 0.0;
       p.rotation = (Eigen::AngleAxisd(0.3 + a, Eigen::Vector3d::UnitZ()) *
                     Eigen::AngleAxisd(-1.2, Eigen::Vector3d::UnitX()))
                        .toRotationMatrix();
       p.translation = Eigen::Vector3d(100, 200 + (options.sway ? 15 * std::sin(t) : 0), 900);
-      scene.pose.push_back(p);
+      scene.world_from_instrument.push_back(p);
       scene.input.strings_in_world_mm.push_back(StringsInWorld(strings, p));
       double f0 = centre_hz;
       if (stopped && note.vibrato_cents > 0) {
@@ -172,7 +172,7 @@ inline Scene MakeScene(InstrumentKind kind,
       scene.truth_hand.push_back(truth);
       scene.truth_string.push_back(stopped ? note.string : 0);
       scene.truth_finger.push_back(stopped ? note.finger : 0);
-      scene.truth_contact.push_back(stopped ? p.ToWorld(contact) : contact);
+      scene.truth_contact.push_back(stopped ? p * contact : contact);
       hand::HandPose vision = truth;
       if (stopped && (options.lift_mm > 0 || options.lift_across_mm != 0)) {
         hand::FingerIkOptions lift;

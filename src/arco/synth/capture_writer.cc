@@ -39,7 +39,7 @@ TruthFolder MakeTruthFolder(const SyntheticCapture& c,
   m.calibration_source = w.calibration_source;
   m.mm_per_unit = c.stage.mm_per_unit;
   m.median_camera_distance_mm = c.stage.median_camera_distance_mm;
-  m.performer_origin_in_world_mm = c.stage.performer_origin_in_world_mm;
+  m.performer_origin_in_world_mm = c.stage.world_from_performer.translation;
   m.hand_model = "arco default (hand/hand_model.h), left and right";
   m.noise_px = o.detection.noise_px;
   m.outlier_rate = o.detection.outlier_rate;

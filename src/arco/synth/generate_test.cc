@@ -288,7 +288,7 @@ TEST(PlaceStage, SpdRigGetsItsMetricScale) {
   // 695 mm nut-bridge / 0.344 Metashape units (../shared/data/spd/README.md).
   EXPECT_NEAR(stage->mm_per_unit, 695.0 / 0.344, 0.01 * 695.0 / 0.344);
   // Up is opposite to the cameras' image rows.
-  EXPECT_GT(stage->world_from_performer_rotation.col(1).dot(
+  EXPECT_GT(stage->world_from_performer.rotation.col(1).dot(
                 -SpdRig().cameras[0].cam_from_world.rotation.row(1).transpose()),
             0.5);
 }

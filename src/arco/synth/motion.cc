@@ -235,8 +235,7 @@ StatusOr<SyntheticCapture> GenerateFromMotion(const Rig& rig, const MotionOption
   // keypoints onto the template at its rest pose on the stage.
   ARCO_ASSIGN_OR_RETURN(cap.stage, PlaceStage(rig, options.stage));
   cap.rig_mm = ScaleRigToMm(rig, cap.stage.mm_per_unit);
-  const RigidMatrix3d world_from_performer{cap.stage.world_from_performer_rotation,
-                                           cap.stage.performer_origin_in_world_mm};
+  const RigidMatrix3d& world_from_performer = cap.stage.world_from_performer;
   const RigidMatrix3d world_from_rest = world_from_performer * InstrumentRestPose(kind, tmpl.scale);
   std::vector<int> rigid_points;  // instrument keypoints of the template (not frog, tip)
   for (int i = 0; i < cap.num_instrument_points; ++i)

@@ -103,11 +103,12 @@ StatusOr<Stage> PlaceStage(const Rig& rig, const StageOptions& options) {
   if (!(forward.norm() > 1e-9)) return Status::Error("cannot tell the performer's front");
   forward.normalize();
   const Eigen::Vector3d left = up.cross(forward);  // x = y cross z
-  stage.world_from_performer_rotation.col(0) = left;
-  stage.world_from_performer_rotation.col(1) = up;
-  stage.world_from_performer_rotation.col(2) = forward;
-  stage.performer_origin_in_world_mm =
-      stage.focus_in_world_mm - stage.world_from_performer_rotation * options.focus_in_performer_mm;
+  Eigen::Matrix3d& rotation = stage.world_from_performer.rotation;
+  rotation.col(0) = left;
+  rotation.col(1) = up;
+  rotation.col(2) = forward;
+  stage.world_from_performer.translation =
+      stage.focus_in_world_mm - rotation * options.focus_in_performer_mm;
   return stage;
 }
 

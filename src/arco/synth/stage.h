@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "arco/camera/rig.h"
+#include "arco/geometry/transform.h"
 #include "arco/util/status.h"
 
 namespace arco::synth {
@@ -38,14 +39,11 @@ extern const double kSpdCameraDistanceMm;
 struct Stage {
   double mm_per_unit = 1;
   Eigen::Vector3d focus_in_world_mm = Eigen::Vector3d::Zero();
-  // Columns: performer x (left), y (up), z (forward) in the world.
-  Eigen::Matrix3d world_from_performer_rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d performer_origin_in_world_mm = Eigen::Vector3d::Zero();
+  // The performer frame in the world (mm): the rotation's columns are performer x
+  // (left), y (up), z (forward) in the world, the translation the performer's origin. A
+  // matrix rotation: synth's numbers are matrix products (docs/architecture.md).
+  RigidMatrix3d world_from_performer;
   double median_camera_distance_mm = 0;
-
-  Eigen::Vector3d ToWorld(const Eigen::Vector3d& point_in_performer_mm) const {
-    return world_from_performer_rotation * point_in_performer_mm + performer_origin_in_world_mm;
-  }
 };
 
 // Copy of the rig with world units scaled to mm (translations times mm_per_unit).

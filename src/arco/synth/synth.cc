@@ -92,8 +92,7 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
   // Stage and rig in mm.
   ARCO_ASSIGN_OR_RETURN(cap.stage, PlaceStage(rig, options.stage));
   cap.rig_mm = ScaleRigToMm(rig, cap.stage.mm_per_unit);
-  const RigidMatrix3d world_from_performer{cap.stage.world_from_performer_rotation,
-                                           cap.stage.performer_origin_in_world_mm};
+  const RigidMatrix3d& world_from_performer = cap.stage.world_from_performer;
 
   // Layout: the SPD layout of the instrument, plus the 13 contact-stage extras in truth.
   const bool violin_like = kind == InstrumentKind::kViolin || kind == InstrumentKind::kViola;

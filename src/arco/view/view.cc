@@ -1,5 +1,7 @@
 #include "arco/view/view.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,6 +13,7 @@
 
 #include "arco/export/export.h"
 #include "arco/export/overlay.h"
+#include "arco/media/video_writer.h"
 #include "arco/mocap/capture.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/refine/contacts_csv.h"
@@ -21,11 +24,6 @@
 #include "arco/util/file_io.h"
 #include "arco/util/json_io.h"
 #include "arco/view/video_cache.h"
-
-extern "C" {
-#include <libavcodec/avcodec.h>
-}
-#include <unistd.h>
 
 #ifndef ARCO_VIEW_WEB_DIR
 #define ARCO_VIEW_WEB_DIR ""
@@ -202,7 +200,7 @@ StatusOr<std::string> VideoKey(const ViewOptions& options,
                                const std::string& method) {
   Sha256 hash;
   hash.AddField("arco-view-video", std::to_string(kVideoCacheVersion));
-  hash.AddField("libavcodec", std::to_string(avcodec_version()));
+  hash.AddField("libavcodec", std::to_string(media::CodecLibraryVersion()));
   hash.AddField("codec", "webm-vp8");
   hash.AddField("method", method);
   hash.AddField("camera", std::to_string(v) + "/" + capture.cameras[v].name);
