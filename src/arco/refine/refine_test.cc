@@ -395,7 +395,7 @@ TEST(Refine, LiftTestRejectsContactsTheFingerCannotReach) {
 TEST(Refine, OneCameraComparesCandidatesAlongTheCameraRays) {
   testing::Scene scene = Cello(Piece());
   // 1.35 m from the bridge along the strings, 1 m to the side and 1.2 m in front of them.
-  const Eigen::Vector3d centre = scene.pose[0].ToWorld(Eigen::Vector3d(1350, 1000, 1200));
+  const Eigen::Vector3d centre = scene.world_from_instrument[0] * Eigen::Vector3d(1350, 1000, 1200);
   hand::OneViewDepthOptions move;
   move.window_frames = 0;
   const std::vector<double> shift_mm(scene.input.vision_hand.size(), 70.0);
