@@ -10,16 +10,9 @@ extern "C" {
 
 #include <algorithm>
 
+#include "arco/media/av_error.h"
+
 namespace arco::media {
-namespace {
-
-std::string AvError(int code) {
-  char buffer[AV_ERROR_MAX_STRING_SIZE] = {0};
-  av_strerror(code, buffer, sizeof(buffer));
-  return buffer;
-}
-
-}  // namespace
 
 struct AudioDecoder::State {
   ~State() {

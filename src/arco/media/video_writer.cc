@@ -16,16 +16,9 @@ extern "C" {
 #include <utility>
 #include <vector>
 
+#include "arco/media/av_error.h"
+
 namespace arco::media {
-namespace {
-
-std::string AvError(int code) {
-  char text[AV_ERROR_MAX_STRING_SIZE] = {0};
-  av_strerror(code, text, sizeof(text));
-  return text;
-}
-
-}  // namespace
 
 Status VideoWriterOptions::Validate() const {
   if (width < 1 || height < 1 || width > 16384 || height > 16384) {
