@@ -133,6 +133,10 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
   } else {
     summary.warnings.push_back("hand: default bone lengths (" + bones.status().message() + ")");
   }
+  if (one_view && bones.ok())
+    summary.warnings.push_back(
+        "hand: one camera: bone lengths from the hand's image at the strings' depth (a high "
+        "quantile of their projections), the average palm (its shape needs two views)");
   if (options.palm.enabled && !one_view) {
     StatusOr<hand::PalmShapeEstimate> palm = hand::EstimatePalmShape(left, model, options.palm);
     StatusOr<hand::HandModel> palmed =
