@@ -31,6 +31,7 @@ Json ToJson(const TriangulateStageOptions& o) {
                    {"pnp_gate_px", v.pnp_gate_px},
                    {"body_behind_mm", v.body_behind_mm},
                    {"depth_window_frames", v.depth_window_frames},
+                   {"rotation_window_frames", v.rotation_window_frames},
                    {"min_ray_plane_cos", v.min_ray_plane_cos}};
   return j;
 }

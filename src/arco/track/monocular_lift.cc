@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "arco/geometry/rotation.h"
 #include "arco/track/one_view_pnp.h"
 #include "arco/track/pose_solver.h"
 #include "arco/util/number_range.h"
@@ -89,6 +90,8 @@ Status MonocularLiftOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(CheckInRange("pnp_gate_px", pnp_gate_px, AboveZero(200)));
   ARCO_RETURN_IF_ERROR(CheckInRange("body_behind_mm", body_behind_mm, Closed(0, 2000)));
   ARCO_RETURN_IF_ERROR(CheckInRange("depth_window_frames", depth_window_frames, Closed(0, 300)));
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("rotation_window_frames", rotation_window_frames, Closed(0, 300)));
   return CheckInRange("min_ray_plane_cos", min_ray_plane_cos, AboveZero(1));
 }
 
@@ -177,6 +180,30 @@ StatusOr<MonocularLift> LiftOneView(const Camera& camera,
   // instrument is held nearly still. The pose moves along the ray through its centre
   // (the image of the centre is kept).
   const Eigen::Vector3d camera_centre = camera.CenterInWorld();
+  // Its orientation likewise: one view fixes the roll about the strings from the nut's
+  // and the bridge's widths alone (24 and 48 mm on a cello), a few degrees of jitter per
+  // frame where the held instrument turns by tenths. The Markley average over the frames
+  // around (geometry/rotation.h), turned about the strings' middle (its image is kept).
+  std::vector<Eigen::Quaterniond> rotations(static_cast<size_t>(frames));
+  for (int64_t f = 0; f < frames; ++f) {
+    if (out.world_from_instrument[static_cast<size_t>(f)])
+      rotations[static_cast<size_t>(f)] =
+          out.world_from_instrument[static_cast<size_t>(f)]->rotation;
+  }
+  for (int64_t f = 0; f < frames && o.rotation_window_frames > 0; ++f) {
+    std::optional<Rigid3d>& pose = out.world_from_instrument[static_cast<size_t>(f)];
+    if (!pose) continue;
+    std::vector<Eigen::Quaterniond> around;
+    for (int64_t g = std::max<int64_t>(0, f - o.rotation_window_frames);
+         g <= std::min(frames - 1, f + o.rotation_window_frames);
+         ++g) {
+      if (out.world_from_instrument[static_cast<size_t>(g)])
+        around.push_back(rotations[static_cast<size_t>(g)]);
+    }
+    const Eigen::Vector3d centre = *pose * centre_mm;
+    pose->rotation = *AverageQuaternions(around);
+    pose->translation = centre - pose->rotation * centre_mm;
+  }
   for (int64_t f = 0; f < frames; ++f) {
     std::optional<Rigid3d>& pose = out.world_from_instrument[static_cast<size_t>(f)];
     if (!pose) continue;

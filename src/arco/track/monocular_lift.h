@@ -52,6 +52,9 @@ struct MonocularLiftOptions {
   // [0, 300]: the instrument's depth is the median over this many frames on each side
   // (0: each frame's own PnP).
   int depth_window_frames = 15;
+  // [0, 300]: its orientation is the average over this many frames on each side (0: each
+  // frame's own).
+  int rotation_window_frames = 15;
   double min_ray_plane_cos = 0.2;  // (0, 1]: a flatter ray misses the assumed plane
   Status Validate() const;
 };
