@@ -7,6 +7,7 @@
 #include <string>
 
 #include "arco/geometry/triangulation.h"
+#include "arco/mocap/refine_point_pixels.h"
 
 namespace arco {
 namespace {
@@ -18,6 +19,7 @@ struct Linearization {
   double cost = kInf;  // sum |r_i'|^2, px^2
   Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
   Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
+  Eigen::Vector2d* pixels = nullptr;  // each view's pixel at the point, when not null
 };
 
 // Robustified residual r' = s(|r|^2) r with s = sqrt(rho(|r|^2) / |r|^2)
@@ -41,6 +43,7 @@ bool Linearize(const RefinementView* views,
     Eigen::Vector2d pixel;
     Eigen::Matrix<double, 2, 3> d_pixel;
     if (!v.camera->ProjectWithJacobian(x, &pixel, &d_pixel)) return false;
+    if (out->pixels != nullptr) out->pixels[i] = pixel;
     const double w = v.sqrt_weight;
     const double rx = w * (pixel.x() - v.pixel.x()), ry = w * (pixel.y() - v.pixel.y());
     const double q = std::sqrt(1 + (rx * rx + ry * ry) * inv_b2);
@@ -81,18 +84,26 @@ Status PointRefinementOptions::Validate() const {
   return Status::Ok();
 }
 
-PointRefinementSummary RefinePointRobust(const RefinementView* views,
-                                         int count,
-                                         const PointRefinementOptions& options,
-                                         Eigen::Vector3d* point_in_world) {
+namespace internal {
+
+bool RefinePointRobustWithPixels(const RefinementView* views,
+                                 int count,
+                                 const PointRefinementOptions& options,
+                                 Eigen::Vector3d* point_in_world,
+                                 Eigen::Vector2d* pixels,
+                                 PointRefinementSummary* summary_out) {
   const double inv_b2 = 1.0 / (options.loss_scale_px * options.loss_scale_px);
-  PointRefinementSummary summary;
+  PointRefinementSummary& summary = *summary_out;
+  summary = PointRefinementSummary();
   Eigen::Vector3d& x = *point_in_world;
   Linearization at_x, trial;
+  // Two halves of the scratch, swapped with the linearisations: at_x's pixels are always
+  // those at x.
+  if (pixels != nullptr) at_x.pixels = pixels, trial.pixels = pixels + count;
   ++summary.evaluations;
   if (!Linearize(views, count, inv_b2, x, &at_x)) {
     summary.initial_cost = summary.final_cost = kInf;
-    return summary;
+    return false;
   }
   summary.initial_cost = summary.final_cost = at_x.cost;
   // Levenberg-Marquardt with Marquardt's scaling, (J^T J + mu diag(J^T J)) dx = -J^T r,
@@ -131,6 +142,19 @@ PointRefinementSummary RefinePointRobust(const RefinementView* views,
     }
   }
   summary.final_cost = at_x.cost;
+  if (pixels != nullptr && at_x.pixels != pixels)
+    std::copy(at_x.pixels, at_x.pixels + count, pixels);
+  return true;
+}
+
+}  // namespace internal
+
+PointRefinementSummary RefinePointRobust(const RefinementView* views,
+                                         int count,
+                                         const PointRefinementOptions& options,
+                                         Eigen::Vector3d* point_in_world) {
+  PointRefinementSummary summary;
+  internal::RefinePointRobustWithPixels(views, count, options, point_in_world, nullptr, &summary);
   return summary;
 }
 

@@ -5,6 +5,7 @@
 #include <random>
 #include <vector>
 
+#include "arco/mocap/refine_point_pixels.h"
 #include "arco/testing/synthetic_views.h"
 
 namespace arco {
@@ -83,6 +84,32 @@ TEST(RefinePointRobust, EndsAtAMinimumOfTheRobustCost) {
       const Eigen::Vector3d y = x + Eigen::Vector3d(d(rng), d(rng), d(rng));
       EXPECT_GE(RobustCost(views, b, y), summary.final_cost - 1e-9);
     }
+  }
+}
+
+// The pixels handed back are Camera::Project's at the returned point, bit for bit, and
+// the point and summary are RefinePointRobust's (the triangulation's final classification
+// uses them instead of projecting again).
+TEST(RefinePointRobustWithPixels, PixelsAreTheProjectionsAtTheReturnedPoint) {
+  testing::SyntheticRigOptions o;
+  o.num_cameras = 12;
+  const Rig rig = testing::MakeSyntheticRig(o);
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Vector3d truth(0.1 * trial - 1.0, 0.05 * trial - 0.5, 1.2);
+    const auto views = Observe(rig, truth, 2.0, &rng);
+    const int count = static_cast<int>(views.size());
+    const Eigen::Vector3d start = truth + Eigen::Vector3d(0.02, -0.03, 0.05);
+    Eigen::Vector3d x = start, y = start;
+    const auto expected = RefinePointRobust(views.data(), count, PointRefinementOptions(), &x);
+    std::vector<Eigen::Vector2d> pixels(2 * static_cast<size_t>(count));
+    PointRefinementSummary summary;
+    ASSERT_TRUE(internal::RefinePointRobustWithPixels(
+        views.data(), count, PointRefinementOptions(), &y, pixels.data(), &summary));
+    EXPECT_EQ(x, y);
+    EXPECT_EQ(summary.final_cost, expected.final_cost);
+    EXPECT_EQ(summary.evaluations, expected.evaluations);
+    for (int i = 0; i < count; ++i) EXPECT_EQ(pixels[i], *views[i].camera->Project(y)) << i;
   }
 }
 

@@ -1,6 +1,7 @@
 #include "arco/mocap/triangulate_point.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -9,6 +10,7 @@
 #include "arco/camera/undistort.h"
 #include "arco/geometry/robust.h"
 #include "arco/mocap/refine_point.h"
+#include "arco/mocap/refine_point_pixels.h"
 
 namespace arco {
 namespace {
@@ -183,6 +185,12 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
   // 4. Robust Levenberg-Marquardt on the distorted reprojection error of the inliers
   //    (refine_point.h: 3 parameters, normal equations accumulated view by view).
   TriangulatedPoint result;
+  // The refined views' pixels at the refined point, from the refinement's last pass
+  // (refine_point_pixels.h); up to kCachedViews views, on the stack (a rig with more
+  // projects them again below).
+  constexpr int kCachedViews = 64;
+  std::array<Eigen::Vector2d, 2 * kCachedViews> pixels;
+  bool have_pixels = false;
   if (options_.refine) {
     s.refine.clear();
     for (int k = 0; k < n; ++k) {
@@ -195,11 +203,19 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
     refine.loss_scale_px = options_.robust_loss_scale_px;
     refine.max_iterations = options_.max_refine_iterations;  // both checked by Validate()
     Eigen::Vector3d x = x_world;
-    const PointRefinementSummary summary =
-        RefinePointRobust(s.refine.data(), static_cast<int>(s.refine.size()), refine, &x);
+    const int count = static_cast<int>(s.refine.size());
+    PointRefinementSummary summary;
+    const bool projected =
+        internal::RefinePointRobustWithPixels(s.refine.data(),
+                                              count,
+                                              refine,
+                                              &x,
+                                              count <= kCachedViews ? pixels.data() : nullptr,
+                                              &summary);
     if (x.allFinite() && summary.final_cost <= summary.initial_cost) {
       x_world = x;
       result.refined = true;
+      have_pixels = projected && count <= kCachedViews;
     }
   }
 
@@ -207,9 +223,13 @@ std::optional<TriangulatedPoint> Triangulator::Triangulate(
   result.point_in_world = x_world;
   result.num_views = n;
   double sum_sq = 0;
+  result.inlier_cameras.reserve(static_cast<size_t>(n));
+  int refined_view = 0;  // index in s.refine (the best inliers, in k order)
   for (int k = 0; k < n; ++k) {
     const double e =
-        ReprojectionErrorPx(rig_.cameras[s.views[k].camera], x_world, s.views[k].pixel);
+        have_pixels && s.best_inlier[k]
+            ? (pixels[static_cast<size_t>(refined_view++)] - s.views[k].pixel).norm()
+            : ReprojectionErrorPx(rig_.cameras[s.views[k].camera], x_world, s.views[k].pixel);
     if (e < gate) {
       result.inlier_cameras.push_back(s.views[k].camera);
       sum_sq += e * e;
