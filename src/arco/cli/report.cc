@@ -56,6 +56,9 @@ std::string FormatStageLine(const pipeline::RunSummary& summary,
                   static_cast<long long>(t.points),
                   t.median_rms_reprojection_px,
                   summary.triangulate.units.c_str());
+    if (t.one_view)  // one camera: the depth is placed, not measured
+      return std::string(line) +
+             Format(", instrument depth +-%.0f mm (median over frames)", t.median_depth_sigma_mm);
     return line;
   }
   if (timing.name == "instrument") {

@@ -121,15 +121,22 @@ SequenceTriangulationSummary Summarize(const SequenceTriangulation& result) {
     s.median_rms_reprojection_px = MedianInPlace(rms.begin(), rms.end());
     s.mean_inliers = static_cast<double>(inliers) / static_cast<double>(rms.size());
   }
+  s.one_view = !result.depth_source.data.empty();
+  std::vector<float> sigma;
+  for (float x : result.depth_sigma_mm.data)
+    if (std::isfinite(x)) sigma.push_back(x);
+  if (!sigma.empty()) s.median_depth_sigma_mm = MedianInPlace(sigma.begin(), sigma.end());
   return s;
 }
 
 Json ToJson(const SequenceTriangulationSummary& s) {
-  return {{"frames", s.frames},
-          {"points", s.points},
-          {"triangulated", s.triangulated},
-          {"median_rms_reprojection_px", JsonFromDouble(s.median_rms_reprojection_px)},
-          {"mean_inliers", s.mean_inliers}};
+  Json j = {{"frames", s.frames},
+            {"points", s.points},
+            {"triangulated", s.triangulated},
+            {"median_rms_reprojection_px", JsonFromDouble(s.median_rms_reprojection_px)},
+            {"mean_inliers", s.mean_inliers}};
+  if (s.one_view) j["median_depth_sigma_mm"] = JsonFromDouble(s.median_depth_sigma_mm);
+  return j;
 }
 
 }  // namespace arco

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "arco/camera/rig.h"
@@ -35,6 +36,9 @@ struct SequenceTriangulation {
   // (track/monocular_lift.h LiftDepth; triangulation/depth_source.npy); empty when the
   // points were triangulated from several views.
   NpyArray<uint8_t> depth_source;
+  // (F) one camera only: how far the instrument's depth may be off, mm
+  // (track/monocular_lift.h; triangulation/depth_sigma_mm.npy).
+  NpyArray<float> depth_sigma_mm;
 };
 
 struct SequenceTriangulationSummary {
@@ -43,6 +47,10 @@ struct SequenceTriangulationSummary {
   int64_t triangulated = 0;               // points with a 3D position
   double median_rms_reprojection_px = 0;  // over triangulated points (NaN when none)
   double mean_inliers = 0;                // mean inlier views per triangulated point
+  // One camera only (a lift, not a triangulation): the median over frames of the
+  // instrument's depth uncertainty (SequenceTriangulation::depth_sigma_mm), NaN when none.
+  bool one_view = false;
+  double median_depth_sigma_mm = std::numeric_limits<double>::quiet_NaN();
 };
 
 // `keypoints2d` is (F, V, P, 3); `view_to_camera[v]` is the rig camera of view v.

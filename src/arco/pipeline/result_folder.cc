@@ -29,6 +29,7 @@ constexpr char kInlierCountFile[] = "inlier_count.npy";
 constexpr char kViewCountFile[] = "view_count.npy";
 constexpr char kInlierMaskFile[] = "inlier_mask.npy";
 constexpr char kDepthSourceFile[] = "depth_source.npy";  // one camera only
+constexpr char kDepthSigmaFile[] = "depth_sigma_mm.npy";  // one camera only
 constexpr char kStringsFile[] = "strings.npy";
 constexpr char kKeypointsFile[] = "keypoints.npy";
 constexpr char kHandParamsFile[] = "hand_params.npy";
@@ -548,6 +549,8 @@ StatusOr<std::vector<std::string>> ResultFolder::WriteTriangulation(
     ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, kInlierMaskFile), raw.inlier_mask));
     if (!raw.depth_source.data.empty())
       ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, kDepthSourceFile), raw.depth_source));
+    if (!raw.depth_sigma_mm.data.empty())
+      ARCO_RETURN_IF_ERROR(WriteNpy(JoinPath(tmp_dir, kDepthSigmaFile), raw.depth_sigma_mm));
     return Status::Ok();
   };
   ARCO_RETURN_IF_ERROR(write_all(stage_tmp));
@@ -582,6 +585,7 @@ StatusOr<std::vector<std::string>> ResultFolder::WriteTriangulation(
     // One camera: the depths are not measured (track/monocular_lift.h LiftDepth).
     Json& stage = result["stages"][kTriangulationStage];
     stage["files"]["depth_source"] = kDepthSourceFile;
+    if (!raw.depth_sigma_mm.data.empty()) stage["files"]["depth_sigma_mm"] = kDepthSigmaFile;
     stage["depth"] = {
         {"method", "one_view"},
         {"codes",

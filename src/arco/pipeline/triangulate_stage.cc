@@ -136,6 +136,7 @@ StatusOr<SequenceTriangulation> LiftOneViewCapture(const CaptureContext& capture
   out.num_inliers.shape = out.num_views.shape = {frames, points};
   out.inlier_mask.shape = {frames, points, 1};
   out.depth_source = std::move(lift->depth_source);
+  out.depth_sigma_mm = std::move(lift->depth_sigma_mm);
   for (int64_t f = 0; f < frames; ++f) {
     for (int64_t p = 0; p < points; ++p) {
       const bool lifted = out.depth_source.at(f, p) != 0;

@@ -133,6 +133,9 @@ StatusOr<MonocularLift> LiftOneView(const Camera& camera,
   out.depth_source.data.assign(static_cast<size_t>(frames * points), 0);
   out.pnp_rms_px.shape = {frames};
   out.pnp_rms_px.data.assign(static_cast<size_t>(frames), std::numeric_limits<float>::quiet_NaN());
+  out.depth_sigma_mm.shape = {frames};
+  out.depth_sigma_mm.data.assign(static_cast<size_t>(frames),
+                                 std::numeric_limits<float>::quiet_NaN());
   out.world_from_instrument.assign(static_cast<size_t>(frames), std::nullopt);
   out.summary.frames = frames;
 
@@ -214,7 +217,10 @@ StatusOr<MonocularLift> LiftOneView(const Camera& camera,
       if (std::isfinite(depth[static_cast<size_t>(g)]))
         around.push_back(depth[static_cast<size_t>(g)]);
     }
-    const double scale = UpperMedian(around) / depth[static_cast<size_t>(f)];
+    const double wanted = UpperMedian(around);
+    out.depth_sigma_mm.data[static_cast<size_t>(f)] =
+        static_cast<float>(kMadToSigma * MedianAbsDeviation(around, wanted));
+    const double scale = wanted / depth[static_cast<size_t>(f)];
     const Eigen::Vector3d centre = *pose * centre_mm;
     pose->translation += (scale - 1) * (centre - camera_centre);
   }

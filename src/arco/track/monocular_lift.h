@@ -82,6 +82,11 @@ struct MonocularLift {
   NpyArray<double> points3d_mm;    // (F, P, 3) world mm, NaN when not lifted
   NpyArray<uint8_t> depth_source;  // (F, P) LiftDepth
   NpyArray<float> pnp_rms_px;      // (F) the instrument's PnP RMS (NaN: no pose)
+  // (F) how far the instrument's depth may be off, mm: the spread (1.4826 MAD) of the
+  // frames' own PnP depths over the depth window, NaN without a pose. Not divided by the
+  // frames' number: their errors hold for seconds (the template's misfit, the detector's
+  // slow drift), so the window's median is as uncertain as one frame.
+  NpyArray<float> depth_sigma_mm;
   std::vector<std::optional<Rigid3d>> world_from_instrument;  // per frame
   MonocularLiftSummary summary;
 };

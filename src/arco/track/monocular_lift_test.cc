@@ -155,6 +155,38 @@ TEST(LiftOneView, SmoothsTheInstrumentsDepthOverTheFramesAround) {
   EXPECT_LT(depth_error(5), 5.0);
 }
 
+TEST(LiftOneView, SaysHowFarTheInstrumentsDepthMayBeOff) {
+  // Exact pixels: the frames' own depths agree, nothing is uncertain. Two pixels of
+  // noise: the frames' depths spread by centimetres and the spread is reported; the
+  // actual error of the window's median lies within two of it in most frames.
+  const World exact = MakeWorld(31, /*sway=*/false);
+  const StatusOr<MonocularLift> a = LiftOneView(exact.camera, exact.keypoints, exact.scene, {});
+  ASSERT_TRUE(a.ok());
+  ASSERT_EQ(a->depth_sigma_mm.shape, std::vector<int64_t>{31});
+  for (float sigma : a->depth_sigma_mm.data) EXPECT_LT(sigma, 0.1);
+  World noisy = MakeWorld(31, /*sway=*/false);
+  std::mt19937 random(3);
+  std::normal_distribution<double> noise(0.0, 2.0);
+  for (int f = 0; f < 31; ++f) {
+    for (int p = 0; p < 7; ++p) {
+      for (int c = 0; c < 2; ++c) noisy.keypoints.at(f, 0, p, c) += noise(random);
+    }
+  }
+  const StatusOr<MonocularLift> b = LiftOneView(noisy.camera, noisy.keypoints, noisy.scene, {});
+  ASSERT_TRUE(b.ok());
+  int within = 0;
+  for (int f = 0; f < 31; ++f) {
+    const float sigma = b->depth_sigma_mm.data[f];
+    EXPECT_GT(sigma, 5.0) << "frame " << f;
+    const Eigen::Vector3d bridge(
+        b->points3d_mm.at(f, 3, 0), b->points3d_mm.at(f, 3, 1), b->points3d_mm.at(f, 3, 2));
+    const double error = std::abs(noisy.camera.PointInCamera(bridge).z() -
+                                  noisy.camera.PointInCamera(noisy.truth[f][3]).z());
+    if (error <= 2 * sigma) ++within;
+  }
+  EXPECT_GE(within, 28);
+}
+
 TEST(LiftOneView, AveragesTheInstrumentsOrientationOverTheFramesAround) {
   // Two pixels of noise on every instrument point: each frame's own PnP turns the
   // strings' plane about the strings by a degree or more (the nut and the bridge are 24
