@@ -153,15 +153,17 @@ StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& opti
     ++with_pose;
     const std::vector<StringSegment> seg = StringsAt(fit->instrument, p.world_from_instrument);
     for (int i = 0; i < model.num_strings(); ++i) {
+      const Eigen::Vector3d nut_mm = PointInMm(seg[static_cast<size_t>(i)].nut, s);
+      const Eigen::Vector3d bridge_mm = PointInMm(seg[static_cast<size_t>(i)].bridge, s);
       for (int c = 0; c < 3; ++c) {
-        strings.at(f, i, 0, c) = seg[static_cast<size_t>(i)].nut[c] / s;
-        strings.at(f, i, 1, c) = seg[static_cast<size_t>(i)].bridge[c] / s;
+        strings.at(f, i, 0, c) = nut_mm[c];
+        strings.at(f, i, 1, c) = bridge_mm[c];
       }
     }
     for (int k = 0; k < num_k; ++k) {
       const Eigen::Vector3d& t = fit->instrument.keypoints_in_instrument[static_cast<size_t>(k)];
       if (!t.allFinite()) continue;
-      const Eigen::Vector3d w = (p.world_from_instrument * t) / s;
+      const Eigen::Vector3d w = PointInMm(p.world_from_instrument * t, s);
       for (int c = 0; c < 3; ++c) placed.at(f, k, c) = w[c];
     }
   }

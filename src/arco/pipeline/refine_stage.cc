@@ -227,7 +227,7 @@ StatusOr<RefineInputs> MakeRefineInputs(const std::string& result_dir,
   out.input.fps = fps > 0 ? fps : 30.0;
   out.input.a4_hz = instrument.a4_hz;
   if (records.one_view_camera_centre_in_world)
-    out.input.one_view_camera_centre_mm = *records.one_view_camera_centre_in_world / s;
+    out.input.one_view_camera_centre_mm = PointInMm(*records.one_view_camera_centre_in_world, s);
   out.input.pitch.assign(static_cast<size_t>(frames), refine::FramePitch{});
   out.has_pitch = records.pitch != nullptr;
   if (out.has_pitch) {
