@@ -4,7 +4,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 
 #include "arco/calibration/bundle_adjustment.h"
 #include "arco/calibration/calibration_file.h"
@@ -15,13 +14,13 @@
 #include "arco/mocap/capture.h"
 #include "arco/mocap/triangulate_point.h"
 #include "arco/pipeline/capture_checks.h"
+#include "arco/pipeline/result_folder.h"  // pipeline::kNaN
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/output_set.h"
 
 namespace arco::pipeline {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Every camera must keep this many detections, or its pose is left to a handful of points.
 constexpr int64_t kMinCameraObservations = 30;
 constexpr int64_t kMinPoints = 30;

@@ -5,6 +5,7 @@
 // through it, so no capture file is opened twice (docs/architecture.md, "The pipeline").
 #pragma once
 
+#include <Eigen/Core>
 #include <memory>
 #include <string>
 #include <vector>
@@ -48,6 +49,11 @@ struct CaptureContext {
 // scale, world units per mm): every coordinate divided by it. Cameras keep their
 // projection (cam_from_world translation / s: the same pixels for points / s).
 NpyArray<double> PointsInMm(const NpyArray<double>& points_in_world, double world_units_per_mm);
+// The same for one point (each coordinate divided, as PointsInMm does, so that both give
+// the same bits).
+inline Eigen::Vector3d PointInMm(const Eigen::Vector3d& point_in_world, double world_units_per_mm) {
+  return point_in_world / world_units_per_mm;
+}
 // The cameras of the capture's views (view_to_camera) with the world in mm.
 std::vector<Camera> ViewCamerasInMm(const CaptureContext& capture, double world_units_per_mm);
 

@@ -74,9 +74,9 @@ StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
   ARCO_ASSIGN_OR_RETURN(instrument.world_units_per_mm, result.ReadWorldUnitsPerMm());
   TriangulateStageResult triangulation;
   ARCO_ASSIGN_OR_RETURN(triangulation.points3d, result.ReadPoints3d(kTriangulationStage));
-  ARCO_ASSIGN_OR_RETURN(
-      HandRecord record,
-      RunHandStage(options, capture, result, triangulation, instrument, progress));
+  ARCO_ASSIGN_OR_RETURN(HandRecord record,
+                        RunHandStage(options, capture, triangulation, instrument, progress));
+  ARCO_RETURN_IF_ERROR(result.WriteHand(record));
   return std::move(record.summary);
 }
 
@@ -85,18 +85,7 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
                                   const TriangulateStageResult& triangulation,
                                   const InstrumentRecord& instrument,
                                   Progress& progress) {
-  return RunHandStage(
-      options, capture, ResultFolder(options.result_dir), triangulation, instrument, progress);
-}
-
-StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
-                                  const CaptureContext& capture,
-                                  const ResultFolder& result,
-                                  const TriangulateStageResult& triangulation,
-                                  const InstrumentRecord& instrument,
-                                  Progress& progress) {
   ARCO_RETURN_IF_ERROR(options.Validate());
-  result.RequireDir(options.result_dir);
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   const double s = instrument.world_units_per_mm;
   if (!(s > 0)) return Status::Error("hand stage: the instrument has no world_units_per_mm");
@@ -247,7 +236,6 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
   record.summary = summary;
   record.inputs =
       SelectInputs(capture.inputs, {kManifestInput, kCalibrationInput, kKeypoints2dInput});
-  ARCO_RETURN_IF_ERROR(result.WriteHand(record));
   return record;
 }
 

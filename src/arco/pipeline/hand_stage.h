@@ -42,21 +42,15 @@ Json ToJson(const HandStageOptions& options);
 
 // Fits the hand of every frame to the triangulation and the instrument's scale made from
 // `capture` (as `arco run` holds them, not read back), with the capture's 2D keypoints
-// and calibration (capture_context.h), and writes hand/; returns what it wrote
-// (record.summary: the stage's summary).
+// and calibration (capture_context.h); writes nothing: the record is what
+// ResultFolder::WriteHand writes into hand/ (record.summary: the stage's summary).
 StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
                                   const CaptureContext& capture,
                                   const TriangulateStageResult& triangulation,
                                   const InstrumentRecord& instrument,
                                   Progress& progress = NoProgress());
-// The same into `result` (options.result_dir's folder: `arco run`'s one ResultFolder).
-StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
-                                  const CaptureContext& capture,
-                                  const ResultFolder& result,
-                                  const TriangulateStageResult& triangulation,
-                                  const InstrumentRecord& instrument,
-                                  Progress& progress = NoProgress());
-// The same on the stages in options.result_dir, which must come from `capture`.
+// The same on the stages in options.result_dir, which must come from `capture`, written
+// into it.
 StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
                                         const CaptureContext& capture,
                                         Progress& progress = NoProgress());

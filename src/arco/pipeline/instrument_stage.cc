@@ -70,25 +70,16 @@ StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions
   triangulation.summary.units = manifest.value("units", "unknown");
   ARCO_ASSIGN_OR_RETURN(triangulation.points3d, result.ReadPoints3d(kTriangulationStage));
   ARCO_ASSIGN_OR_RETURN(InstrumentRecord record,
-                        RunInstrumentStage(options, capture, result, triangulation, progress));
+                        RunInstrumentStage(options, capture, triangulation, progress));
+  ARCO_RETURN_IF_ERROR(result.WriteInstrument(record));
   return std::move(record.summary);
 }
 
 StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& options,
                                               const CaptureContext& capture,
                                               const TriangulateStageResult& triangulation,
-                                              Progress& progress) {
-  return RunInstrumentStage(
-      options, capture, ResultFolder(options.result_dir), triangulation, progress);
-}
-
-StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& options,
-                                              const CaptureContext& capture,
-                                              const ResultFolder& result,
-                                              const TriangulateStageResult& triangulation,
                                               Progress& /*progress*/) {
   ARCO_RETURN_IF_ERROR(options.Validate());
-  result.RequireDir(options.result_dir);
   const NpyArray<double>& points = triangulation.points3d;
   const InstrumentModel& model = *capture.instrument;
   const int64_t frames = points.shape[0];
@@ -134,7 +125,10 @@ StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& opti
   fit_options.num_threads = options.num_threads;
   StatusOr<InstrumentFit> fit = FitInstrument(model, keypoints, hints, fit_options);
   // FitInstrument's messages start "instrument fit: "; the context is the file it fitted.
-  if (!fit.ok()) return fit.status().WithContext(result.Points3dPath(kTriangulationStage));
+  if (!fit.ok()) {
+    return fit.status().WithContext(
+        ResultFolder(options.result_dir).Points3dPath(kTriangulationStage));
+  }
   const std::vector<InstrumentFramePose> poses = SmoothFramePoses(fit->frames, options.smoothing);
   InstrumentStageSummary summary;
   for (const std::string& w : fit->summary.warnings) summary.warnings.push_back("instrument: " + w);
@@ -159,15 +153,17 @@ StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& opti
     ++with_pose;
     const std::vector<StringSegment> seg = StringsAt(fit->instrument, p.world_from_instrument);
     for (int i = 0; i < model.num_strings(); ++i) {
+      const Eigen::Vector3d nut_mm = PointInMm(seg[static_cast<size_t>(i)].nut, s);
+      const Eigen::Vector3d bridge_mm = PointInMm(seg[static_cast<size_t>(i)].bridge, s);
       for (int c = 0; c < 3; ++c) {
-        strings.at(f, i, 0, c) = seg[static_cast<size_t>(i)].nut[c] / s;
-        strings.at(f, i, 1, c) = seg[static_cast<size_t>(i)].bridge[c] / s;
+        strings.at(f, i, 0, c) = nut_mm[c];
+        strings.at(f, i, 1, c) = bridge_mm[c];
       }
     }
     for (int k = 0; k < num_k; ++k) {
       const Eigen::Vector3d& t = fit->instrument.keypoints_in_instrument[static_cast<size_t>(k)];
       if (!t.allFinite()) continue;
-      const Eigen::Vector3d w = (p.world_from_instrument * t) / s;
+      const Eigen::Vector3d w = PointInMm(p.world_from_instrument * t, s);
       for (int c = 0; c < 3; ++c) placed.at(f, k, c) = w[c];
     }
   }
@@ -187,7 +183,6 @@ StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& opti
   record.keypoint_names = model.keypoint_names();
   record.summary = summary;
   record.inputs = SelectInputs(capture.inputs, {kManifestInput});
-  ARCO_RETURN_IF_ERROR(result.WriteInstrument(record));
   return record;
 }
 

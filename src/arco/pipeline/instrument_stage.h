@@ -36,19 +36,14 @@ struct InstrumentStageOptions {
 Json ToJson(const InstrumentStageOptions& options);
 
 // Fits the instrument to the triangulation made from `capture` (as `arco run` holds it,
-// not read back) and writes instrument/; returns what it wrote (record.summary: the
-// stage's summary).
+// not read back); writes nothing: the record is what ResultFolder::WriteInstrument writes
+// into instrument/ (record.summary: the stage's summary).
 StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& options,
                                               const CaptureContext& capture,
                                               const TriangulateStageResult& triangulation,
                                               Progress& progress = NoProgress());
-// The same into `result` (options.result_dir's folder: `arco run`'s one ResultFolder).
-StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& options,
-                                              const CaptureContext& capture,
-                                              const ResultFolder& result,
-                                              const TriangulateStageResult& triangulation,
-                                              Progress& progress = NoProgress());
-// The same on the triangulation in options.result_dir, which must come from `capture`.
+// The same on the triangulation in options.result_dir, which must come from `capture`,
+// written into it.
 StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions& options,
                                                     const CaptureContext& capture,
                                                     Progress& progress = NoProgress());

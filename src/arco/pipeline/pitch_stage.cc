@@ -7,29 +7,15 @@
 #include "arco/audio/notes.h"
 #include "arco/audio/pitch_tracker.h"
 #include "arco/capture/pitch_sync.h"
-#include "arco/pipeline/result_folder.h"
 
 namespace arco::pipeline {
 
-Status PitchStageOptions::Validate() const {
-  if (result_dir.empty()) return Status::Error("result_dir is empty");
-  return Status::Ok();
-}
+Status PitchStageOptions::Validate() const { return Status::Ok(); }
 
 StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
                                     const CaptureContext& capture,
-                                    Progress& progress) {
-  return RunPitchStage(options, capture, ResultFolder(options.result_dir), progress);
-}
-
-StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
-                                    const CaptureContext& capture,
-                                    const ResultFolder& result,
                                     Progress& progress) {
   ARCO_RETURN_IF_ERROR(options.Validate());
-  result.RequireDir(options.result_dir);
-  // The result it joins must come from the capture given.
-  ARCO_RETURN_IF_ERROR(result.CheckInputsMatch(capture.inputs));
   const CaptureManifest& m = capture.manifest;
   PitchRecord record;
   PitchStageSummary& summary = record.summary;
@@ -92,7 +78,6 @@ StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
     }
   }
   record.inputs = SelectInputs(capture.inputs, {kManifestInput, kAudioInput});
-  ARCO_RETURN_IF_ERROR(result.WritePitch(record));
   return record;
 }
 

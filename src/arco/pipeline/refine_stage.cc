@@ -227,7 +227,7 @@ StatusOr<RefineInputs> MakeRefineInputs(const std::string& result_dir,
   out.input.fps = fps > 0 ? fps : 30.0;
   out.input.a4_hz = instrument.a4_hz;
   if (records.one_view_camera_centre_in_world)
-    out.input.one_view_camera_centre_mm = *records.one_view_camera_centre_in_world / s;
+    out.input.one_view_camera_centre_mm = PointInMm(*records.one_view_camera_centre_in_world, s);
   out.input.pitch.assign(static_cast<size_t>(frames), refine::FramePitch{});
   out.has_pitch = records.pitch != nullptr;
   if (out.has_pitch) {
@@ -269,16 +269,23 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
                                                const RefineInputs& inputs,
                                                const refine::RefineOptions& options,
                                                const refine::BowingOptions& bowing) {
-  return RefineAndWrite(ResultFolder(result_dir), inputs, options, bowing);
-}
-
-StatusOr<refine::RefineSummary> RefineAndWrite(const ResultFolder& result,
-                                               const RefineInputs& inputs,
-                                               const refine::RefineOptions& options,
-                                               const refine::BowingOptions& bowing) {
+  const ResultFolder result(result_dir);
   if (options.mode != refine::RefineMode::kVision && !inputs.has_pitch) {
     return Status::Error(result.ManifestPath() +
                          ": no pitch stage (the capture has no audio); only vision can be written");
+  }
+  ARCO_ASSIGN_OR_RETURN(const MethodRecord record, RefineMethod(inputs, options, bowing));
+  ARCO_RETURN_IF_ERROR(result.WriteMethod(record));
+  return record.summary;
+}
+
+StatusOr<MethodRecord> RefineMethod(const RefineInputs& inputs,
+                                    const refine::RefineOptions& options,
+                                    const refine::BowingOptions& bowing) {
+  if (options.mode != refine::RefineMode::kVision && !inputs.has_pitch) {
+    throw std::invalid_argument(std::string("RefineMethod: ") +
+                                refine::RefineModeName(options.mode) +
+                                " needs the pitch stage's inputs");
   }
   refine::RefineResult r = refine::Refine(inputs.input, options);
   // arco with double stops: the upper notes' strings, fingers and the second finger's IK.
@@ -334,8 +341,7 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const ResultFolder& result,
     out.bowing = std::move(bow);
     out.bowing_options = bowing;
   }
-  ARCO_RETURN_IF_ERROR(result.WriteMethod(out));
-  return r.summary;
+  return out;
 }
 
 StatusOr<refine::RefineSummary> RunRefineStage(const RefineStageOptions& options) {

@@ -65,15 +65,17 @@ struct StageRecords {
 // `result_dir` names the files in messages (shapes that disagree).
 StatusOr<RefineInputs> MakeRefineInputs(const std::string& result_dir, const StageRecords& records);
 
-// Refines one method (options.mode) and writes its folder; arco's also gets the bow arm
-// (refine/bowing.h: bowing.csv, bowing_notes.csv). Errors: a method that needs audio on a
-// result without a pitch stage.
+// Refines one method (options.mode); arco's also gets the bow arm (refine/bowing.h:
+// bowing.csv, bowing_notes.csv). Writes nothing: the record is what
+// ResultFolder::WriteMethod writes into RESULT_DIR/<method>/ (record.summary: the method's
+// summary). A method that needs audio on inputs without pitch is a caller bug
+// (std::invalid_argument): RefineAndWrite checks it first.
+StatusOr<MethodRecord> RefineMethod(const RefineInputs& inputs,
+                                    const refine::RefineOptions& options,
+                                    const refine::BowingOptions& bowing = {});
+// RefineMethod into the result folder `result_dir`. Errors: a method that needs audio on
+// a result without a pitch stage.
 StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
-                                               const RefineInputs& inputs,
-                                               const refine::RefineOptions& options,
-                                               const refine::BowingOptions& bowing = {});
-// The same into `result` (`arco run`'s one ResultFolder).
-StatusOr<refine::RefineSummary> RefineAndWrite(const ResultFolder& result,
                                                const RefineInputs& inputs,
                                                const refine::RefineOptions& options,
                                                const refine::BowingOptions& bowing = {});

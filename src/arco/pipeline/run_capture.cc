@@ -52,7 +52,6 @@ HandStageOptions RunOptions::ForHands() const {
 
 PitchStageOptions RunOptions::ForPitch() const {
   PitchStageOptions o = pitch;
-  o.result_dir = result_dir;
   o.double_stops = double_stops;
   return o;
 }
@@ -109,17 +108,21 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
   };
 
   // Each stage takes the records of the stages before it as made, not read back from
-  // the result folder (the files hold the same values).
+  // the result folder (the files hold the same values), and returns its own, which the
+  // run writes through its one ResultFolder.
   auto start = stage(1, "triangulate");
-  ARCO_ASSIGN_OR_RETURN(const TriangulateStageResult triangulation,
-                        RunTriangulateStage(options.ForTriangulate(), capture, result, progress));
+  ARCO_RETURN_IF_ERROR(result.CheckWritable());  // before the work
+  ARCO_ASSIGN_OR_RETURN(TriangulateStageResult triangulation,
+                        RunTriangulateStage(options.ForTriangulate(), capture, progress));
+  ARCO_RETURN_IF_ERROR(WriteTriangulation(result, capture, &triangulation));
   summary.triangulate = triangulation.summary;
   summary.timings.push_back({"triangulate", SecondsSince(start)});
 
   start = stage(2, "instrument");
   ARCO_ASSIGN_OR_RETURN(
       const InstrumentRecord instrument,
-      RunInstrumentStage(options.ForInstrument(), capture, result, triangulation, progress));
+      RunInstrumentStage(options.ForInstrument(), capture, triangulation, progress));
+  ARCO_RETURN_IF_ERROR(result.WriteInstrument(instrument));
   summary.instrument = instrument.summary;
   summary.timings.push_back({"instrument", SecondsSince(start)});
   Append(&summary.warnings, summary.instrument.warnings);
@@ -127,7 +130,8 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
   start = stage(3, "hands");
   ARCO_ASSIGN_OR_RETURN(
       HandRecord hand,
-      RunHandStage(options.ForHands(), capture, result, triangulation, instrument, progress));
+      RunHandStage(options.ForHands(), capture, triangulation, instrument, progress));
+  ARCO_RETURN_IF_ERROR(result.WriteHand(hand));
   summary.hands = hand.summary;
   summary.timings.push_back({"hands", SecondsSince(start)});
   capture.keypoints2d.reset();  // the last stage that reads the 2D keypoints
@@ -135,7 +139,8 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
 
   start = stage(4, "pitch");
   ARCO_ASSIGN_OR_RETURN(const PitchRecord pitch,
-                        RunPitchStage(options.ForPitch(), capture, result, progress));
+                        RunPitchStage(options.ForPitch(), capture, progress));
+  if (pitch.summary.ran) ARCO_RETURN_IF_ERROR(result.WritePitch(pitch));
   summary.pitch = pitch.summary;
   capture.audio_bytes.reset();  // the last stage that decodes the audio (up to 256 MiB)
   if (summary.pitch.ran) summary.timings.push_back({"pitch", SecondsSince(start)});
@@ -183,8 +188,9 @@ StatusOr<RunSummary> RunStages(const RunOptions& options,
   progress.SetTotal(static_cast<int64_t>(modes.size()));
   for (refine::RefineMode mode : modes) {
     const RefineStageOptions ro = options.ForRefine(mode);
-    ARCO_ASSIGN_OR_RETURN(refine::RefineSummary s, RefineAndWrite(result, inputs, ro.refine));
-    summary.methods.push_back(s);
+    ARCO_ASSIGN_OR_RETURN(const MethodRecord method, RefineMethod(inputs, ro.refine));
+    ARCO_RETURN_IF_ERROR(result.WriteMethod(method));
+    summary.methods.push_back(method.summary);
     progress.Advance(1);
   }
   summary.timings.push_back({"refine", SecondsSince(start)});

@@ -161,16 +161,7 @@ StatusOr<SequenceTriangulation> LiftOneViewCapture(const CaptureContext& capture
 StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptions& o,
                                                      const CaptureContext& capture,
                                                      Progress& progress) {
-  return RunTriangulateStage(o, capture, ResultFolder(o.result_dir), progress);
-}
-
-StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptions& o,
-                                                     const CaptureContext& capture,
-                                                     const ResultFolder& result,
-                                                     Progress& progress) {
   ARCO_RETURN_IF_ERROR(o.Validate());
-  result.RequireDir(o.result_dir);
-  ARCO_RETURN_IF_ERROR(result.CheckWritable());  // before the work
   const CaptureManifest& manifest = capture.manifest;
   const KeypointLayout& layout = capture.layout;
   const std::string manifest_path = CaptureManifestPath(capture.capture_dir);
@@ -179,12 +170,13 @@ StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptio
   for (const auto& entry : o.filters) filter_groups.push_back(layout.Group(entry.first));
   ARCO_ASSIGN_OR_RETURN(const std::shared_ptr<const NpyArray<double>> keypoints2d,
                         ReadKeypoints2d(capture));
-  TriangulationRecord record;
+  TriangulateStageResult out;
+  TriangulationRecord& record = out.record;
   record.inputs =
       SelectInputs(capture.inputs, {kManifestInput, kCalibrationInput, kKeypoints2dInput});
   progress.SetTotal(manifest.frame_count);
   const bool one_view = capture.view_to_camera.size() == 1;
-  SequenceTriangulation raw;
+  SequenceTriangulation& raw = out.raw;
   if (one_view) {
     ARCO_ASSIGN_OR_RETURN(raw, LiftOneViewCapture(capture, *keypoints2d, o.one_view));
     progress.Advance(manifest.frame_count);
@@ -198,7 +190,6 @@ StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptio
                             &progress,
                             ResolveCapturePath(capture.capture_dir, manifest.keypoints2d)));
   }
-  TriangulateStageResult out;
   NpyArray<double>& filtered = out.points3d;
   filtered = raw.points3d;
   for (size_t i = 0; i < filter_groups.size(); ++i) {
@@ -216,13 +207,22 @@ StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptio
   record.summary = Summarize(raw);
   record.options = ToJson(o);
   TriangulateStageSummary& summary = out.summary;
-  ARCO_ASSIGN_OR_RETURN(summary.removed_stages,
-                        result.WriteTriangulation(manifest, layout, raw, filtered, record));
   summary.triangulation = record.summary;
   summary.units = record.units;
   summary.views = static_cast<int64_t>(capture.view_to_camera.size());
   summary.keypoints = layout.size();
   return out;
+}
+
+Status WriteTriangulation(const ResultFolder& result,
+                          const CaptureContext& capture,
+                          TriangulateStageResult* stage) {
+  ARCO_ASSIGN_OR_RETURN(
+      stage->summary.removed_stages,
+      result.WriteTriangulation(
+          capture.manifest, capture.layout, stage->raw, stage->points3d, stage->record));
+  stage->raw = {};
+  return Status::Ok();
 }
 
 StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOptions& o,
@@ -231,6 +231,7 @@ StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOpti
   ARCO_RETURN_IF_ERROR(ResultFolder(o.result_dir).CheckWritable());  // before the work
   ARCO_ASSIGN_OR_RETURN(const CaptureContext capture, OpenForTriangulation(o));
   ARCO_ASSIGN_OR_RETURN(TriangulateStageResult out, RunTriangulateStage(o, capture, progress));
+  ARCO_RETURN_IF_ERROR(WriteTriangulation(ResultFolder(o.result_dir), capture, &out));
   return std::move(out.summary);
 }
 

@@ -10,6 +10,7 @@
 #include "arco/mocap/temporal_filter.h"
 #include "arco/mocap/triangulate_sequence.h"
 #include "arco/pipeline/capture_context.h"
+#include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/summaries.h"
 #include "arco/track/monocular_lift.h"
 #include "arco/util/json_io.h"
@@ -18,8 +19,6 @@
 #include "arco/util/status.h"
 
 namespace arco::pipeline {
-
-class ResultFolder;
 
 struct TriangulateStageOptions {
   std::string capture_dir;
@@ -37,29 +36,31 @@ struct TriangulateStageOptions {
 // filter, max_gap_frames}].
 Json ToJson(const TriangulateStageOptions& options);
 
-// What the stage made, as the later stages of `arco run` take it: the values
-// triangulation/ holds, without reading them back.
+// What the stage made: the record that ResultFolder writes into triangulation/ and the
+// values the later stages of `arco run` take without reading them back.
 struct TriangulateStageResult {
-  TriangulateStageSummary summary;
-  NpyArray<double> points3d;  // (F, P, 3) filtered, world units (triangulation/points3d.npy)
+  TriangulateStageSummary summary;  // removed_stages: filled when written
+  NpyArray<double> points3d;        // (F, P, 3) filtered, world units (triangulation/points3d.npy)
+  SequenceTriangulation raw;        // before the filters (points3d_raw.npy and the masks)
+  TriangulationRecord record;       // result.json's header and entry
 };
 
 // Triangulates every frame of an opened capture (capture_context.h: its calibration,
-// view_to_camera, 2D keypoints (read here when null) and fingerprints), filters, writes
-// RESULT_DIR. options.capture_dir is not read: the capture is. Progress: the total is the
-// frame count, advanced per frame from worker threads.
+// view_to_camera, 2D keypoints (read here when null) and fingerprints) and filters; writes
+// nothing (WriteTriangulation does). options.capture_dir is not read: the capture is.
+// Progress: the total is the frame count, advanced per frame from worker threads.
 StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptions& options,
                                                      const CaptureContext& capture,
                                                      Progress& progress = NoProgress());
-// The same into `result` (options.result_dir's folder, result_folder.h: `arco run` hands
-// every stage its one ResultFolder).
-StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptions& options,
-                                                     const CaptureContext& capture,
-                                                     const ResultFolder& result,
-                                                     Progress& progress = NoProgress());
+// Writes the stage into `result` (ResultFolder::WriteTriangulation, which starts result.json
+// anew) and puts the later stages that it removed into stage->summary.removed_stages;
+// stage->raw is released (no later stage reads it).
+Status WriteTriangulation(const ResultFolder& result,
+                          const CaptureContext& capture,
+                          TriangulateStageResult* stage);
 
-// `arco triangulate CAPTURE`: opens options.capture_dir (no instrument needed) and runs
-// the stage on it.
+// `arco triangulate CAPTURE`: opens options.capture_dir (no instrument needed), runs the
+// stage on it and writes it into options.result_dir.
 StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOptions& options,
                                                       Progress& progress = NoProgress());
 
