@@ -5,7 +5,7 @@
 'use strict';
 const fs = require('fs');
 const path = require('path');
-const lib = require('../../src/arco/view/browser_test_lib.js');
+const lib = require('../view/browser_test_lib.js');
 
 async function main() {
   const [playwright, report, fingeringCsv, work] = process.argv.slice(2);

@@ -630,7 +630,7 @@
     view.ready = true;
   }
 
-  // ---- test hooks (src/arco/view/view_browser_test.js) -----------------------------------
+  // ---- test hooks (tests/view/view_browser_test.js) -----------------------------------
   view.methods = () => manifest.methods.map((m) => m.name);
   view.seek = (frame) => { setPlaying(false); seek(frame); return view.frame; };
   view.setMethod = (name) => setMethod(manifest.methods.findIndex((m) => m.name === name));

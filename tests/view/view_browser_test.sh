@@ -34,5 +34,5 @@ d = json.load(open(sys.argv[1]))
 del d["stages"]["arco"]
 json.dump(d, open(sys.argv[1], "w"), indent=1)
 PY
-node "$src/src/arco/view/view_browser_test.js" "$arco" "$work/res" "$work/res_no_arco" \
+node "$src/tests/view/view_browser_test.js" "$arco" "$work/res" "$work/res_no_arco" \
   "$work/shots" "$playwright"

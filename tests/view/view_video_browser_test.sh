@@ -79,5 +79,5 @@ fi
   { echo "FAILED: --no-videos still writes a video"; fail=1; }
 [ $fail -eq 0 ] || exit 1
 
-node "$src/src/arco/view/view_video_browser_test.js" "$arco" "$work/res" "$work/page" $cam \
+node "$src/tests/view/view_video_browser_test.js" "$arco" "$work/res" "$work/page" $cam \
   "$work/shots" "$playwright"
