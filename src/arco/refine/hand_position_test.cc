@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "arco/synth/fingering.h"
@@ -18,6 +19,13 @@ synth::ScoreInstrument ScoreInstrumentOf(InstrumentKind kind) {
   out.name = info.name;
   out.open_string_midi.assign(info.open_midi_low_to_high.begin(), info.open_midi_low_to_high.end());
   out.gm_program = info.gm_program;
+  // The closed hand frame's span, as synth::ScoreInstrumentFor gives it: the chords piece
+  // leaves out the shapes wider than it (the double bass's 4-note one).
+  out.hand_span_semitones = 0;
+  for (const FingerSpan& span : info.hand_frame) {
+    if (!span.extended)
+      out.hand_span_semitones = std::max(out.hand_span_semitones, span.offset_semitones);
+  }
   return out;
 }
 

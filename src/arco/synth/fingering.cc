@@ -109,6 +109,58 @@ void DoubleStopStates(const ScoreNote& note,
   }
 }
 
+// The span of `frame` that stops `semitone_on_string` with `finger` in `position` (the
+// extended flag of one finger of a double stop, which NoteFingering keeps for the pair).
+FingerSpan SpanOf(int finger,
+                  int semitone_on_string,
+                  int position,
+                  const std::vector<FingerSpan>& frame) {
+  FingerSpan span{finger, semitone_on_string - position, false};
+  for (const FingerSpan& s : frame) {
+    if (s.finger == finger && s.offset_semitones == span.offset_semitones)
+      span.extended = s.extended;
+  }
+  return span;
+}
+
+// True when one hand can hold a rolled chord's two pairs (ScoreNote::chord_upper_pair) down
+// together from the chord's start: the same position, the upper pair on the lower pair's
+// upper string (sharing that note, a 3-note chord) or on the next strings (a 4-note chord),
+// and every two stopped places of different strings playable together (SpansTogether; one
+// finger stops two strings only side by side, a fifth).
+bool ChordHoldable(const NoteFingering& lower,
+                   const NoteFingering& upper,
+                   const std::vector<FingerSpan>& frame) {
+  if (upper.position_semitones != lower.position_semitones) return false;
+  const bool shared = upper.string_index == lower.second_string_index;
+  if (!shared && upper.string_index != lower.second_string_index + 1) return false;
+  if (shared && upper.finger != lower.second_finger) return false;
+  struct Place {
+    int string, finger, semitone;
+  };
+  std::vector<Place> places = {
+      {lower.string_index, lower.finger, lower.semitone_on_string},
+      {lower.second_string_index, lower.second_finger, lower.second_semitone_on_string}};
+  if (!shared) places.push_back({upper.string_index, upper.finger, upper.semitone_on_string});
+  places.push_back(
+      {upper.second_string_index, upper.second_finger, upper.second_semitone_on_string});
+  const int p = lower.position_semitones;
+  for (size_t i = 0; i < places.size(); ++i) {
+    for (size_t j = i + 1; j < places.size(); ++j) {
+      const Place& a = places[i];
+      const Place& b = places[j];
+      if (a.finger == 0 || b.finger == 0) continue;
+      if (a.finger == b.finger && std::abs(a.string - b.string) != 1) return false;
+      if (!SpansTogether(SpanOf(a.finger, a.semitone, p, frame),
+                         SpanOf(b.finger, b.semitone, p, frame),
+                         frame)) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 Status FingeringOptions::Validate() const {
@@ -196,12 +248,22 @@ StatusOr<FingeringPlan> PlanFingering(const Score& score,
       num_states,
       [&](size_t i, int k) { return states[i][static_cast<size_t>(k)].note_cost; },
       [&](size_t i, int j, int k) {
+        if (score.notes[i].chord_upper_pair &&
+            !ChordHoldable(states[i - 1][static_cast<size_t>(j)].f,
+                           states[i][static_cast<size_t>(k)].f,
+                           frame)) {
+          return std::numeric_limits<double>::infinity();
+        }
         return TransitionCost(states[i - 1][static_cast<size_t>(j)],
                               score.notes[i - 1],
                               states[i][static_cast<size_t>(k)],
                               score.notes[i],
                               options);
       });
+  if (!std::isfinite(path.total_cost)) {
+    return Status::Error("a chord's two pairs cannot be held in one hand position on the " +
+                         instrument.name);
+  }
   plan.total_cost = path.total_cost;
   plan.notes.resize(n);
   for (size_t i = 0; i < n; ++i) {

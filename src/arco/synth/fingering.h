@@ -74,8 +74,10 @@ struct FingeringPlan {
   int num_string_crossings = 0;
 };
 
-// Plans the whole score. Errors when a note (or double stop) cannot be played on any
-// string (pair).
+// Plans the whole score. A chord's upper pair (ScoreNote::chord_upper_pair) keeps its lower
+// pair's hand position and continues its strings, with every finger of the chord held down
+// together. Errors when a note (or double stop, or chord) cannot be played on any string
+// (pair).
 StatusOr<FingeringPlan> PlanFingering(const Score& score,
                                       const ScoreInstrument& instrument,
                                       const FingeringOptions& options = {});

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdlib>
+
 #include "arco/synth/test_instruments.h"
 
 namespace arco::synth {
@@ -85,6 +88,62 @@ TEST(PlanFingering, DoubleStopsTakeAdjacentStringsAndAPlayableHand) {
     const bool in_fifths = ins.open_string_midi[1] - ins.open_string_midi[0] == 7;
     EXPECT_EQ(fifths_one_finger >= 1, in_fifths) << ins.name;
   }
+}
+
+// Every chord's two pairs: one hand position, the upper pair on the lower pair's upper
+// string (the same finger on the shared note) or on the next two strings, and no finger on
+// two places unless it stops a fifth across two neighbouring strings.
+TEST(PlanFingering, ChordsHoldEveryFingerInOnePosition) {
+  for (const auto& ins : {Cello(), Violin(), testing::Viola(), testing::Bass()}) {
+    auto score = MakeBuiltInPiece("chords", ins);
+    ASSERT_TRUE(score.ok());
+    auto plan = PlanFingering(*score, ins);
+    ASSERT_TRUE(plan.ok()) << ins.name << ": " << plan.status().message();
+    ExpectPlayable(*score, *plan, ins);
+    int chords = 0;
+    for (size_t i = 1; i < score->notes.size(); ++i) {
+      if (!score->notes[i].chord_upper_pair) continue;
+      ++chords;
+      const NoteFingering& lo = plan->notes[i - 1];
+      const NoteFingering& up = plan->notes[i];
+      EXPECT_EQ(up.position_semitones, lo.position_semitones) << ins.name << " note " << i;
+      const bool shared = score->notes[i].midi_note == score->notes[i - 1].second_midi_note;
+      EXPECT_EQ(up.string_index, lo.second_string_index + (shared ? 0 : 1)) << ins.name;
+      if (shared) {
+        EXPECT_EQ(up.finger, lo.second_finger) << ins.name;
+      }
+      // (string, finger, semitone) of every stopped place of the chord.
+      std::vector<std::array<int, 3>> places = {
+          {lo.string_index, lo.finger, lo.semitone_on_string},
+          {lo.second_string_index, lo.second_finger, lo.second_semitone_on_string},
+          {up.second_string_index, up.second_finger, up.second_semitone_on_string}};
+      if (!shared) places.push_back({up.string_index, up.finger, up.semitone_on_string});
+      for (size_t a = 0; a < places.size(); ++a) {
+        for (size_t b = a + 1; b < places.size(); ++b) {
+          if (places[a][1] == 0 || places[a][1] != places[b][1]) continue;
+          EXPECT_EQ(std::abs(places[a][0] - places[b][0]), 1) << ins.name << " note " << i;
+          EXPECT_EQ(places[a][2], places[b][2]) << ins.name << " note " << i;
+        }
+      }
+    }
+    EXPECT_GE(chords, 4) << ins.name;
+  }
+}
+
+// A chord whose pairs need two hand positions (A3 + E4 under one finger in second position,
+// then A5 + C#6 in the ninth) cannot be held and is an error, though each pair alone is
+// playable.
+TEST(PlanFingering, ChordThatOneHandCannotHoldIsAnError) {
+  Score s;
+  s.notes.push_back({57, 0.1, 0.4, 80, 64});
+  s.notes.push_back({81, 0.4, 1.0, 80, 85});
+  s.duration_s = 1.5;
+  ASSERT_TRUE(PlanFingering(s, Violin()).ok());
+  s.notes[1].chord_upper_pair = true;
+  auto plan = PlanFingering(s, Violin());
+  ASSERT_FALSE(plan.ok());
+  EXPECT_NE(plan.status().message().find("cannot be held"), std::string::npos)
+      << plan.status().message();
 }
 
 TEST(PlanFingering, DoubleStopThatNoHandSpansIsAnError) {

@@ -169,6 +169,57 @@ TEST(Generate, DoubleStopsPutTheSecondFingerOnTheNextString) {
   EXPECT_LT(c.max_second_residual_mm, 15.0);
 }
 
+// A rolled chord: the truth names the sounding pair at every frame, and the fingers of the
+// chord's other pair stay down on their strings where their notes sound (the left hand holds
+// the whole chord from its start), within the joints' limits.
+TEST(Generate, ChordsHoldTheOtherPairsFingersDown) {
+  const SyntheticCapture& c = Cached("cello", "chords", 0);
+  auto model = InstrumentModel::Create("cello");
+  ASSERT_TRUE(model.ok());
+  const auto left = hand::HandModel::Default(hand::HandSide::kLeft);
+  const int n_capture = static_cast<int>(c.points3d.shape[1]) - 13;
+  const int num_strings = model->num_strings();
+  const auto& notes = c.performance.notes;
+  int held_checked = 0;
+  for (int f = 0; f < c.num_frames; ++f) {
+    const ContactTruth& ct = c.contact[static_cast<size_t>(f)];
+    if (ct.note_index < 0) continue;
+    const size_t i = static_cast<size_t>(ct.note_index);
+    const bool upper = notes[i].note.chord_upper_pair;
+    const bool lower = i + 1 < notes.size() && notes[i + 1].note.chord_upper_pair;
+    if (!upper && !lower) continue;
+    ASSERT_TRUE(ct.double_stop) << "frame " << f;
+    // (The truth's string is 0 on an open string: only stopped notes have a contact.)
+    if (notes[i].fingering.finger > 0) {
+      EXPECT_EQ(ct.string, num_strings - notes[i].fingering.string_index);
+    }
+    EXPECT_EQ(ct.second_string, num_strings - notes[i].fingering.second_string_index);
+    EXPECT_EQ(hand::CountLimitViolations(left, c.left_hand[static_cast<size_t>(f)]), 0) << f;
+    const PerformedNote& other = notes[upper ? i - 1 : i + 1];
+    const std::pair<int, int> other_places[2] = {
+        {other.fingering.finger, other.fingering.string_index},
+        {other.fingering.second_finger, other.fingering.second_string_index}};
+    const int other_midi[2] = {other.note.midi_note, other.note.second_midi_note};
+    for (int k = 0; k < 2; ++k) {
+      const auto [finger, string_index] = other_places[k];
+      if (finger == 0 || finger == ct.finger || finger == ct.second_finger) continue;
+      if (other.fingering.finger == other.fingering.second_finger) continue;  // a fifth
+      const int string = num_strings - string_index;
+      const Contact contact = ContactPoint(*model, string, MidiToHz(other_midi[k]));
+      ASSERT_TRUE(contact.stopped());
+      const int s = num_strings - string;
+      const Eigen::Vector3d nut = Point(c, f, n_capture + 2 * s),
+                            bridge = Point(c, f, n_capture + 2 * s + 1);
+      const Eigen::Vector3d target = bridge + contact.fraction_from_bridge * (nut - bridge);
+      const Eigen::Vector3d tip = Point(
+          c, f, wholebody::kLeftHandFirst + hand::TipKeypoint(static_cast<hand::Finger>(finger)));
+      EXPECT_LT((tip - target).norm(), 15.0) << "frame " << f << " held finger " << finger;
+      ++held_checked;
+    }
+  }
+  EXPECT_GT(held_checked, 10);
+}
+
 TEST(Generate, VibratoRocksTheHandInPhaseWithThePitch) {
   const SyntheticCapture& c = Cached("cello", "slow-melody", 0);
   // Within one long vibrato note, the contact moves towards the bridge exactly

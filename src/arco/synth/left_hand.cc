@@ -130,6 +130,15 @@ LeftHandAnimator::LeftHandAnimator(const hand::HandModel& model,
     }
     glide_s_.push_back(glide);
   }
+  // A rolled chord's two pairs (ScoreNote::chord_upper_pair): the hand holds all the chord's
+  // fingers from its start, so it stays put between the pairs, midway between where each
+  // pair alone would put it.
+  for (size_t i = 1; i < notes.size(); ++i) {
+    if (!notes[i].note.chord_upper_pair) continue;
+    const Eigen::Vector3d held = 0.5 * (anchors_[i - 1] + anchors_[i]);
+    anchors_[i - 1] = held;
+    anchors_[i] = held;
+  }
 }
 
 double LeftHandAnimator::PlaceX(double semitones) const {
@@ -295,6 +304,41 @@ LeftHandFrame LeftHandAnimator::Next(double t) {
     } else {
       out.residual_shift_mm = residual.norm();
       pose.world_from_wrist.translation += residual;
+    }
+  }
+  // A rolled chord (ScoreNote::chord_upper_pair): from its lower pair's onset to its upper
+  // pair's offset every finger of the chord stays down on its string at the note's centre
+  // pitch, the sounding pair's as placed above, the others by IK alone (the hand is already
+  // where the chord puts it).
+  size_t chord_lower = notes.size();
+  if (hn.note.chord_upper_pair && held > 0) {
+    chord_lower = static_cast<size_t>(held) - 1;
+  } else if (static_cast<size_t>(held) + 1 < notes.size() &&
+             notes[static_cast<size_t>(held) + 1].note.chord_upper_pair) {
+    chord_lower = static_cast<size_t>(held);
+  }
+  if (chord_lower < notes.size() && t >= notes[chord_lower].note.onset_s &&
+      t <= notes[chord_lower + 1].note.offset_s) {
+    for (size_t c = chord_lower; c <= chord_lower + 1; ++c) {
+      const PerformedNote& pn = notes[c];
+      const Eigen::Vector3d first = ContactInInstrument(
+          instrument_,
+          tmpl_,
+          n - pn.fingering.string_index,
+          MidiToHz(pn.note.midi_note + pn.intonation_cents / 100.0, perf_.a4_hz));
+      const Eigen::Vector3d second = ContactInInstrument(
+          instrument_,
+          tmpl_,
+          n - pn.fingering.second_string_index,
+          MidiToHz(pn.note.second_midi_note + pn.second_intonation_cents / 100.0, perf_.a4_hz));
+      const bool fifth = pn.fingering.finger == pn.fingering.second_finger;
+      auto hold = [&](int finger, const Eigen::Vector3d& target) {
+        // The sounding pair's fingers (and a 3-note chord's shared one) are already down.
+        if (finger == 0 || finger == out.finger || finger == out.second_finger) return;
+        place(finger, target);
+      };
+      hold(pn.fingering.finger, fifth ? Eigen::Vector3d(0.5 * (first + second)) : first);
+      if (!fifth) hold(pn.fingering.second_finger, second);
     }
   }
   out.pose = pose;

@@ -33,6 +33,17 @@ class ScoreBuilder {
     Note(low, beats, velocity);
     score_.notes.back().second_midi_note = high;
   }
+  // A 3- or 4-note chord (`midi` lowest first, on adjacent strings), rolled 2+2: the lower
+  // pair for `lower_beats`, then the upper pair held for `beats`. A 3-note chord's pairs
+  // share its middle note.
+  void Chord(const std::vector<int>& midi, double lower_beats, double beats, int velocity = 80) {
+    if (midi.size() != 3 && midi.size() != 4) {
+      throw std::invalid_argument("ScoreBuilder::Chord: a chord has 3 or 4 notes");
+    }
+    DoubleStop(midi[0], midi[1], lower_beats, velocity);
+    DoubleStop(midi[midi.size() - 2], midi[midi.size() - 1], beats, velocity);
+    score_.notes.back().chord_upper_pair = true;
+  }
   void Rest(double beats) { t_ += beats * beat_s_; }
   void SetBeat(double beat_s) { beat_s_ = beat_s; }
   Score Finish(const std::string& name) {
@@ -161,6 +172,53 @@ Score DoubleStops(const ScoreInstrument& ins, double k) {
   return b.Finish("double-stops");
 }
 
+// Chords on adjacent strings, each given by its stops (semitones above each string's open
+// note, 0 = open) from string `first_string` up, so every instrument gets the same shapes
+// in one hand position. Tuned in fifths they are (violin / cello): (0,0,2,3) G major
+// G3-D4-B4-G5 / C major C2-G2-E3-C4; (0,0,2) from the second string D major / G major;
+// (2,2,4) A major / D major with one finger stopping the fifth; (2,2,4,5) the same with
+// its octave on top; (0,2,3) from the second string G / C major. A shape whose stopped
+// notes span more than the hand (ScoreInstrument::hand_span_semitones) is left out (the
+// double bass, tuned in fourths, keeps those within its span).
+struct ChordShape {
+  int first_string;
+  std::vector<int> stops;
+};
+
+// Before each chord its top note sounds alone (a single note between chords, as the
+// double-stops piece does), then the chord is rolled: the lower pair briefly (long enough
+// for the pitch tracker's window, about 0.3 s at the default tempo), the upper pair held.
+constexpr double kChordBeatS = 0.4;
+constexpr double kChordLowerPairBeats = 0.75;
+constexpr double kChordUpperPairBeats = 2.5;
+
+Score Chords(const ScoreInstrument& ins, double k) {
+  ScoreBuilder b(kChordBeatS * k);
+  const std::vector<ChordShape> shapes = {
+      {0, {0, 0, 2, 3}}, {1, {0, 0, 2}}, {0, {2, 2, 4}}, {0, {2, 2, 4, 5}}, {1, {0, 2, 3}}};
+  const int n = static_cast<int>(ins.open_string_midi.size());
+  for (const ChordShape& shape : shapes) {
+    const int num = static_cast<int>(shape.stops.size());
+    if (shape.first_string + num > n) continue;
+    int lo = 1000, hi = -1;
+    for (int a : shape.stops) {
+      if (a == 0) continue;
+      lo = std::min(lo, a);
+      hi = std::max(hi, a);
+    }
+    if (hi >= 0 && hi - lo > ins.hand_span_semitones) continue;
+    std::vector<int> midi;
+    for (int i = 0; i < num; ++i) {
+      midi.push_back(ins.open_string_midi[static_cast<size_t>(shape.first_string + i)] +
+                     shape.stops[static_cast<size_t>(i)]);
+    }
+    b.Note(midi.back(), 1);
+    b.Chord(midi, kChordLowerPairBeats, kChordUpperPairBeats);
+    b.Rest(1);
+  }
+  return b.Finish("chords");
+}
+
 }  // namespace
 
 int ScoreInstrument::LowestMidi() const {
@@ -192,8 +250,13 @@ Status CheckBuiltInPieceName(const std::string& name) {
 }
 
 const std::vector<std::string>& BuiltInPieceNames() {
-  static const std::vector<std::string> names = {
-      "scale-2oct", "arpeggios", "slow-melody", "fast-passage", "open-strings", "double-stops"};
+  static const std::vector<std::string> names = {"scale-2oct",
+                                                 "arpeggios",
+                                                 "slow-melody",
+                                                 "fast-passage",
+                                                 "open-strings",
+                                                 "double-stops",
+                                                 "chords"};
   return names;
 }
 
@@ -208,6 +271,9 @@ std::string DescribeBuiltInPiece(const std::string& name) {
   if (name == "double-stops")
     return "sixths, thirds, fifths and octaves on adjacent strings, each after its upper note "
            "alone";
+  if (name == "chords")
+    return "3- and 4-note chords on adjacent strings in one hand position, rolled 2+2 (lower "
+           "pair briefly, upper pair held), each after its top note alone";
   return "";
 }
 
@@ -233,6 +299,8 @@ StatusOr<Score> MakeBuiltInPiece(const std::string& name,
     score = OpenStrings(instrument, tempo_scale);
   } else if (name == "double-stops") {
     score = DoubleStops(instrument, tempo_scale);
+  } else if (name == "chords") {
+    score = Chords(instrument, tempo_scale);
   } else {
     return Status::Error("unknown piece '" + name + "' (built-in pieces: " + BuiltInPieceList() +
                          ")");
@@ -296,6 +364,19 @@ Status ValidateScore(const Score& score,
                     n.onset_s,
                     instrument.name.c_str());
       return Status::Error(buf);
+    }
+    if (n.chord_upper_pair) {
+      const ScoreNote* lower = i > 0 ? &score.notes[i - 1] : nullptr;
+      if (!n.IsDoubleStop() || lower == nullptr || !lower->IsDoubleStop() ||
+          n.midi_note < lower->second_midi_note) {
+        std::snprintf(buf,
+                      sizeof(buf),
+                      "%s: the chord's upper pair at %.3f s must be a double stop following its "
+                      "lower pair, at or above that pair's upper note",
+                      source.c_str(),
+                      n.onset_s);
+        return Status::Error(buf);
+      }
     }
     if (n.velocity < 1 || n.velocity > 127) {
       return Status::Error(source + ": velocity outside 1..127");

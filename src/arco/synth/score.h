@@ -2,7 +2,8 @@
 //
 // A Score is a list of notes (MIDI numbers, onset/offset in seconds), one at a time; a
 // note may carry a second, higher note sounding with it (a double stop on two adjacent
-// strings, ScoreNote::second_midi_note).
+// strings, ScoreNote::second_midi_note). A 3- or 4-note chord is two such double stops
+// in a row, rolled as on a bowed string (ScoreNote::chord_upper_pair).
 // Built-in pieces are generated per instrument from its open strings, so the same
 // piece name gives a sensible part on cello, violin, viola or double bass. Scores
 // can also be read from a Standard MIDI File (midi_reader.h).
@@ -44,6 +45,13 @@ struct ScoreNote {
   // The upper note of a double stop, played on the next higher string with the same
   // onset and offset; 0: a single note.
   int second_midi_note = 0;
+  // The upper pair of a 3- or 4-note chord, rolled 2+2: the bow sounds at most two
+  // adjacent strings, so the previous note (a double stop) is the chord's lower pair,
+  // sounding briefly, and this pair is held. The left hand stops all the chord's notes at
+  // once: this pair's lower note lies on the previous pair's upper string when they share
+  // it (a 3-note chord, midi_note == previous second_midi_note), else on the next string
+  // up (a 4-note chord), in the same hand position (synth/fingering.h).
+  bool chord_upper_pair = false;
   bool IsDoubleStop() const { return second_midi_note > 0; }
 };
 
@@ -69,8 +77,10 @@ StatusOr<Score> MakeBuiltInPiece(const std::string& name,
                                  const ScoreInstrument& instrument,
                                  double tempo_scale = 1.0);
 
-// Checks ordering, positive durations, no overlap, and that every note (and every double
-// stop's second note, above the first) is in the instrument's range; the error names the first
+// Checks ordering, positive durations, no overlap, that every note (and every double
+// stop's second note, above the first) is in the instrument's range, and that a chord's
+// upper pair is a double stop following its lower pair, at or above that pair's upper
+// note; the error names the first
 // offending note ("note 30 (F#1) at 2.500 s is below the cello's lowest note C2 (36)"). `source`
 // prefixes it.
 Status ValidateScore(const Score& score,

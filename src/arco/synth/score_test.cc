@@ -55,6 +55,64 @@ TEST(MakeBuiltInPiece, DoubleStopsPlayFourIntervalsOnEveryStringPairAfterTheirUp
   }
 }
 
+// Each chord: its top note alone, then its lower pair briefly and its upper pair held, the
+// pairs on adjacent strings from the same stops (a 3-note chord's pairs share the middle
+// note); shapes wider than the hand are left out (the double bass's 4-note A major).
+TEST(MakeBuiltInPiece, ChordsRollTwoPairsAfterTheirTopNote) {
+  for (const auto& ins : {Cello(), Violin(), Viola(), Bass()}) {
+    auto score = MakeBuiltInPiece("chords", ins);
+    ASSERT_TRUE(score.ok()) << score.status().message();
+    std::vector<std::vector<int>> chords;
+    for (size_t i = 0; i < score->notes.size(); ++i) {
+      const ScoreNote& upper = score->notes[i];
+      if (!upper.chord_upper_pair) continue;
+      ASSERT_GE(i, 2u);
+      const ScoreNote& lower = score->notes[i - 1];
+      const ScoreNote& top = score->notes[i - 2];
+      ASSERT_TRUE(lower.IsDoubleStop() && upper.IsDoubleStop());
+      EXPECT_FALSE(lower.chord_upper_pair);
+      EXPECT_FALSE(top.IsDoubleStop());
+      EXPECT_EQ(top.midi_note, upper.second_midi_note);
+      EXPECT_LT(lower.offset_s - lower.onset_s, 0.5 * (upper.offset_s - upper.onset_s));
+      EXPECT_LT(upper.onset_s - lower.offset_s, 0.05);  // rolled: no rest between the pairs
+      std::vector<int> chord = {lower.midi_note, lower.second_midi_note};
+      if (upper.midi_note != lower.second_midi_note) chord.push_back(upper.midi_note);
+      chord.push_back(upper.second_midi_note);
+      chords.push_back(chord);
+    }
+    const bool bass = ins.name == "double_bass";
+    ASSERT_EQ(chords.size(), bass ? 4u : 5u) << ins.name;
+    // The first chord: all four open strings' lowest octave shape, stops 0, 0, 2, 3.
+    const auto& open = ins.open_string_midi;
+    EXPECT_EQ(chords[0], (std::vector<int>{open[0], open[1], open[2] + 2, open[3] + 3}));
+    EXPECT_EQ(chords[1].size(), 3u);
+    if (ins.name == "violin") {
+      EXPECT_EQ(chords[0], (std::vector<int>{55, 62, 71, 79}));  // G major G3 D4 B4 G5
+      EXPECT_EQ(chords[3], (std::vector<int>{57, 64, 73, 81}));  // A major A3 E4 C#5 A5
+    }
+    if (ins.name == "cello") {
+      EXPECT_EQ(chords[0], (std::vector<int>{36, 43, 52, 60}));  // C major C2 G2 E3 C4
+      EXPECT_EQ(chords[2], (std::vector<int>{38, 45, 54}));      // D major D2 A2 F#3
+    }
+  }
+}
+
+TEST(ValidateScore, RejectsAChordUpperPairWithoutItsLowerPair) {
+  Score s;
+  s.notes.push_back({55, 0.1, 0.4, 80});
+  s.notes.push_back({62, 0.4, 1.0, 80, 71});
+  s.notes.back().chord_upper_pair = true;
+  s.duration_s = 1.5;
+  const Status status = ValidateScore(s, Violin(), "take");
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("take: the chord's upper pair at 0.400 s"), std::string::npos)
+      << status.message();
+  s.notes[0].second_midi_note = 62;  // G3 + D4, then D4 + B4: a 3-note chord
+  EXPECT_TRUE(ValidateScore(s, Violin(), "take").ok());
+  s.notes[1].midi_note = 60;  // C4 + B4 under the lower pair's D4
+  EXPECT_FALSE(ValidateScore(s, Violin(), "take").ok());
+}
+
 TEST(ValidateScore, RejectsADoubleStopWhoseSecondNoteIsNotAbove) {
   Score s;
   s.notes.push_back({60, 0.1, 0.5, 80, 55});
