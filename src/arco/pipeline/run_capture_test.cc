@@ -205,6 +205,48 @@ TEST(RunCapture, ThePerformersPalmIsFittedStoredAndReadBack) {
   }
 }
 
+// The violin's `piece` (its first `seconds`) in the SPD rig, written to `capture` with
+// its audio (the soundfont untuned: faster, the notes as played).
+StatusOr<synth::SyntheticCapture> WriteViolinTake(const std::string& piece,
+                                                  double seconds,
+                                                  const std::string& capture) {
+  ARCO_ASSIGN_OR_RETURN(const Calibration calibration,
+                        calibration::LoadCalibration(std::string(ARCO_SHARED_DATA_DIR) +
+                                                     "/spd/cello_1113_scale_camera.xml"));
+  synth::SynthOptions so;
+  so.instrument = "violin";
+  so.piece = piece;
+  so.max_duration_s = seconds;
+  so.num_threads = 2;
+  ARCO_ASSIGN_OR_RETURN(synth::SyntheticCapture generated, synth::Generate(calibration.rig, so));
+  synth::WriteOptions w;
+  w.audio_render.tune_soundfont = false;
+  ARCO_RETURN_IF_ERROR(synth::WriteCapture(generated, capture, w));
+  return generated;
+}
+
+// `arco run CAPTURE -o RESULT --double-stops --threads 2`.
+RunOptions DoubleStopsRun(const std::string& capture, const std::string& result) {
+  RunOptions o;
+  o.capture_dir = capture;
+  o.result_dir = result;
+  o.num_threads = 2;
+  o.double_stops = true;
+  return o;
+}
+
+// `arco eval RESULT --truth TRUTH`, each method's metrics by its name.
+StatusOr<std::map<std::string, eval::MethodMetrics>> EvaluateByMethod(const std::string& result,
+                                                                      const std::string& truth) {
+  eval::EvalRequest request;
+  request.result_dir = result;
+  request.truth = truth;
+  ARCO_ASSIGN_OR_RETURN(const auto report, eval::Evaluate(request));
+  std::map<std::string, eval::MethodMetrics> m;
+  for (const auto& method : report.methods) m[method.method] = method;
+  return m;
+}
+
 // `arco run --double-stops` on the first 3 s of the violin's double-stops piece (two double
 // stops: a sixth and a third on the G and D strings): arco gets a second voice
 // (contacts_2.csv) that eval scores; the other methods have none (null). The figures are
@@ -212,24 +254,9 @@ TEST(RunCapture, ThePerformersPalmIsFittedStoredAndReadBack) {
 TEST(RunCapture, DoubleStopsGiveArcoASecondVoiceThatEvalScores) {
   arco::testing::TempDir out;
   const std::string capture = out / "capture";
-  auto calibration = calibration::LoadCalibration(std::string(ARCO_SHARED_DATA_DIR) +
-                                                  "/spd/cello_1113_scale_camera.xml");
-  ASSERT_TRUE(calibration.ok());
-  synth::SynthOptions so;
-  so.instrument = "violin";
-  so.piece = "double-stops";
-  so.max_duration_s = 3.0;
-  so.num_threads = 2;
-  auto generated = synth::Generate(calibration->rig, so);
+  StatusOr<synth::SyntheticCapture> generated = WriteViolinTake("double-stops", 3.0, capture);
   ASSERT_TRUE(generated.ok()) << generated.status().message();
-  synth::WriteOptions w;
-  w.audio_render.tune_soundfont = false;
-  ASSERT_TRUE(synth::WriteCapture(*generated, capture, w).ok());
-  RunOptions o;
-  o.capture_dir = capture;
-  o.result_dir = out / "result";
-  o.num_threads = 2;
-  o.double_stops = true;
+  RunOptions o = DoubleStopsRun(capture, out / "result");
   auto summary = RunCapture(o);
   ASSERT_TRUE(summary.ok()) << summary.status().message();
   EXPECT_TRUE(FileExists(JoinPath(o.result_dir, "arco/contacts_2.csv")));
@@ -238,13 +265,10 @@ TEST(RunCapture, DoubleStopsGiveArcoASecondVoiceThatEvalScores) {
   ASSERT_TRUE(manifest.ok());
   EXPECT_NE(manifest->find("\"double_stops\""), std::string::npos);
   EXPECT_NE(manifest->find("\"contact_2\": \"contacts_2.csv\""), std::string::npos);
-  eval::EvalRequest request;
-  request.result_dir = o.result_dir;
-  request.truth = JoinPath(capture, "truth");
-  auto report = eval::Evaluate(request);
-  ASSERT_TRUE(report.ok()) << report.status().message();
-  std::map<std::string, eval::MethodMetrics> m;
-  for (const auto& method : report->methods) m[method.method] = method;
+  StatusOr<std::map<std::string, eval::MethodMetrics>> metrics =
+      EvaluateByMethod(o.result_dir, JoinPath(capture, "truth"));
+  ASSERT_TRUE(metrics.ok()) << metrics.status().message();
+  std::map<std::string, eval::MethodMetrics>& m = *metrics;
   std::printf("[ run ] double stops: %d frames, arco string %.3f finger %.3f\n",
               m["arco"].double_stop_frames,
               m["arco"].double_stop_string_accuracy,
@@ -301,35 +325,17 @@ TEST(RunCapture, DoubleStopsGiveArcoASecondVoiceThatEvalScores) {
 TEST(RunCapture, ChordsGiveArcoEachPairInTurn) {
   arco::testing::TempDir out;
   const std::string capture = out / "capture";
-  auto calibration = calibration::LoadCalibration(std::string(ARCO_SHARED_DATA_DIR) +
-                                                  "/spd/cello_1113_scale_camera.xml");
-  ASSERT_TRUE(calibration.ok());
-  synth::SynthOptions so;
-  so.instrument = "violin";
-  so.piece = "chords";
-  so.max_duration_s = 2.4;
-  so.num_threads = 2;
-  auto generated = synth::Generate(calibration->rig, so);
+  StatusOr<synth::SyntheticCapture> generated = WriteViolinTake("chords", 2.4, capture);
   ASSERT_TRUE(generated.ok()) << generated.status().message();
   ASSERT_GE(generated->score.notes.size(), 3u);
   ASSERT_TRUE(generated->score.notes[2].chord_upper_pair);
-  synth::WriteOptions w;
-  w.audio_render.tune_soundfont = false;
-  ASSERT_TRUE(synth::WriteCapture(*generated, capture, w).ok());
-  RunOptions o;
-  o.capture_dir = capture;
-  o.result_dir = out / "result";
-  o.num_threads = 2;
-  o.double_stops = true;
+  RunOptions o = DoubleStopsRun(capture, out / "result");
   auto summary = RunCapture(o);
   ASSERT_TRUE(summary.ok()) << summary.status().message();
-  eval::EvalRequest request;
-  request.result_dir = o.result_dir;
-  request.truth = JoinPath(capture, "truth");
-  auto report = eval::Evaluate(request);
-  ASSERT_TRUE(report.ok()) << report.status().message();
-  std::map<std::string, eval::MethodMetrics> m;
-  for (const auto& method : report->methods) m[method.method] = method;
+  StatusOr<std::map<std::string, eval::MethodMetrics>> metrics =
+      EvaluateByMethod(o.result_dir, JoinPath(capture, "truth"));
+  ASSERT_TRUE(metrics.ok()) << metrics.status().message();
+  std::map<std::string, eval::MethodMetrics>& m = *metrics;
   std::printf("[ run ] chord: %d double-stop frames, arco string %.3f finger %.3f\n",
               m["arco"].double_stop_frames,
               m["arco"].double_stop_string_accuracy,

@@ -87,6 +87,18 @@ World MakeWorld(int frames, bool sway = true) {
   return w;
 }
 
+// Gaussian pixel noise (sigma_px) on the instrument's points, columns 0-6.
+void AddInstrumentNoise(double sigma_px, unsigned seed, World* w) {
+  std::mt19937 random(seed);
+  std::normal_distribution<double> noise(0.0, sigma_px);
+  const int64_t frames = w->keypoints.shape[0];
+  for (int64_t f = 0; f < frames; ++f) {
+    for (int p = 0; p < 7; ++p) {
+      for (int c = 0; c < 2; ++c) w->keypoints.at(f, 0, p, c) += noise(random);
+    }
+  }
+}
+
 TEST(LiftOneView, PlacesTheInstrumentAndTheHandAtTheirDepthsAndFlagsTheRest) {
   const World w = MakeWorld(20);
   MonocularLiftOptions o;
@@ -165,13 +177,7 @@ TEST(LiftOneView, SaysHowFarTheInstrumentsDepthMayBeOff) {
   ASSERT_EQ(a->depth_sigma_mm.shape, std::vector<int64_t>{31});
   for (float sigma : a->depth_sigma_mm.data) EXPECT_LT(sigma, 0.1);
   World noisy = MakeWorld(31, /*sway=*/false);
-  std::mt19937 random(3);
-  std::normal_distribution<double> noise(0.0, 2.0);
-  for (int f = 0; f < 31; ++f) {
-    for (int p = 0; p < 7; ++p) {
-      for (int c = 0; c < 2; ++c) noisy.keypoints.at(f, 0, p, c) += noise(random);
-    }
-  }
+  AddInstrumentNoise(2.0, /*seed=*/3, &noisy);
   const StatusOr<MonocularLift> b = LiftOneView(noisy.camera, noisy.keypoints, noisy.scene, {});
   ASSERT_TRUE(b.ok());
   int within = 0;
@@ -192,13 +198,7 @@ TEST(LiftOneView, AveragesTheInstrumentsOrientationOverTheFramesAround) {
   // strings' plane about the strings by a degree or more (the nut and the bridge are 24
   // and 48 mm wide); the held instrument's average over the frames around does not.
   World w = MakeWorld(31, /*sway=*/false);
-  std::mt19937 random(7);
-  std::normal_distribution<double> noise(0.0, 2.0);
-  for (int f = 0; f < 31; ++f) {
-    for (int p = 0; p < 7; ++p) {
-      for (int c = 0; c < 2; ++c) w.keypoints.at(f, 0, p, c) += noise(random);
-    }
-  }
+  AddInstrumentNoise(2.0, /*seed=*/7, &w);
   auto median_error_deg = [&](int window) {
     MonocularLiftOptions o;
     o.rotation_window_frames = window;
