@@ -111,6 +111,10 @@ std::function<int()> SetupRefine(CLI::App& app) {
                 r.ik.keep_unreachable,
                 "arco: reject a contact the finger cannot reach even after the hand's move "
                 "(uncertain, out_of_reach) instead of keeping the decoded note and finger");
+  sub->add_flag("!--semitone-hand-frame",
+                r.decode.hand_frame_in_mm,
+                "arco decoding: the hand frame's finger spacing in semitones on every "
+                "instrument (the former rule), not in mm on the cello and the double bass");
   sub->add_flag("!--whole-hand-shift",
                 r.ik.detected_hand_shift,
                 "arco: move the whole hand by all of the offset its finger cannot reach (the "

@@ -102,8 +102,10 @@ std::vector<State> NoteStates(const DecodeContext& context,
       State st;
       st.string = s;
       st.finger = k;
-      st.position_semitones =
-          median_contact.cents_from_open / 100.0 - FingerOffsetSemitones(model.kind(), k);
+      const double stop_semitones = median_contact.cents_from_open / 100.0;
+      st.position_semitones = options.hand_frame_in_mm
+                                  ? HandPositionSemitones(model.kind(), k, stop_semitones)
+                                  : stop_semitones - FingerOffsetSemitones(model.kind(), k);
       if (!distances.empty()) {
         const double d = Median(distances);
         st.cost = d + options.order_weight * Median(orders);

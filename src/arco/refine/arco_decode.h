@@ -25,7 +25,8 @@
 // Transition between consecutive notes: none for the same state; for (nearly) the same
 // pitch, same_pitch_change_cost for any change; otherwise shift_cost_per_semitone x the
 // change of hand position (semitones of finger 1 above the open string, from the finger's
-// offset in the instrument's hand frame) + string_cross_cost x strings crossed; scaled by
+// offset in the instrument's hand frame, in mm on the cello and the double bass with
+// hand_frame_in_mm: HandPositionSemitones) + string_cross_cost x strings crossed; scaled by
 // rest_factor after a gap of rest_gap_s or more. Ties go to the lower state index.
 //
 // Boundary frames (the audio's onsets place them in a note, their own pitch is not

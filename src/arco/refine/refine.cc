@@ -330,6 +330,7 @@ Json ToJson(const RefineOptions& o) {
             {"order_weight", o.decode.order_weight},
             {"open_cost_mm", o.decode.open_cost_mm},
             {"shift_cost_per_semitone", o.decode.shift_cost_per_semitone},
+            {"hand_frame_in_mm", o.decode.hand_frame_in_mm},
             {"string_cross_cost", o.decode.string_cross_cost},
             {"same_pitch_change_cost", o.decode.same_pitch_change_cost},
             {"same_pitch_cents", o.decode.same_pitch_cents},

@@ -108,6 +108,13 @@ struct ArcoDecodeOptions {
   double order_weight = 0.5;
   double open_cost_mm = 12.0;            // an open string instead of a fingered candidate
   double shift_cost_per_semitone = 1.0;  // hand position change between notes
+  // The hand position of a candidate (finger 1's place) from the instrument's hand frame
+  // with its spacing in mm where the instrument keeps it so (cello, double bass:
+  // HandPositionSemitones in registry/instruments.h): high on the cello's neck a finger
+  // covers more than a semitone. false: the frame in semitones everywhere (the former rule).
+  // On SPD's real take, a ring finger a whole tone above the second finger at 311 and 346 mm
+  // from the nut had been decided as the little finger (docs/refine.md).
+  bool hand_frame_in_mm = true;
   double string_cross_cost = 3.0;        // per string crossed between notes
   double same_pitch_change_cost = 40.0;  // other string/finger for (nearly) the same pitch
   double same_pitch_cents = 50.0;

@@ -259,6 +259,31 @@ TEST(Refine, StringChangesAndShiftsAreFollowedOnTheViolinToo) {
   }
 }
 
+// A note the cameras lost (no hand on its frames) is fingered by the hand frame alone.
+// High on the cello's A string a finger covers more than a semitone: after the second
+// finger at 12 semitones, the note a whole tone above and then finger 1 at 10 is the ring
+// finger's (as SPD's cellist plays it at 311 and 346 mm from the nut); the semitone frame
+// gives it to the little finger. In the first position the two frames agree.
+TEST(Refine, HighOnTheCelloAFingerSpansMoreThanASemitone) {
+  auto finger_of_the_lost_note = [](double base, bool in_mm) {
+    const int played = base > 5 ? 3 : 4;  // the scene's hand; its frames are then lost
+    const std::vector<SceneNote> notes = {
+        {1, 1, base, 12}, {1, 2, base + 2, 12}, {1, played, base + 4, 12}, {1, 1, base, 12}};
+    testing::Scene scene = Cello(notes);
+    const auto [first, last] = NoteFrames(notes, 2);
+    for (int f = first; f <= last; ++f) scene.input.vision_hand[static_cast<size_t>(f)].reset();
+    RefineOptions o = Options(RefineMode::kArco);
+    o.decode.hand_frame_in_mm = in_mm;
+    const RefineResult r = Refine(scene.input, o);
+    EXPECT_EQ(r.contacts[static_cast<size_t>(first + 6)].reason, ContactReason::kNoHand);
+    return r.contacts[static_cast<size_t>(first + 6)].finger;
+  };
+  EXPECT_EQ(finger_of_the_lost_note(10, true), 3);
+  EXPECT_EQ(finger_of_the_lost_note(10, false), 4);
+  EXPECT_EQ(finger_of_the_lost_note(2, true), 4);
+  EXPECT_EQ(finger_of_the_lost_note(2, false), 4);
+}
+
 TEST(Refine, AnOpenStringPitchThatVibratesIsStopped) {
   // E5 on the violin: the open E string, or the A string's fourth finger in first position.
   // Without vibrato arco takes the open string; an open string cannot vibrate.

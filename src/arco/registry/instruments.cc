@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <functional>
 #include <stdexcept>
 
@@ -61,7 +62,8 @@ const std::vector<InstrumentInfo>& AllInstruments() {
         {4, 3, false},
         {2, 2, true},
         {3, 3, true},
-        {4, 4, true}}},
+        {4, 4, true}},
+       /*frame_spacing_in_mm=*/true},
       // Simandl: in the lower positions the bass hand spans a whole tone (a semitone is
       // about 59 mm at the nut of a 1050 mm string, against 39 mm on the cello), stopped
       // by fingers 1, 2 and 4; the third finger stops with the fourth.
@@ -72,7 +74,8 @@ const std::vector<InstrumentInfo>& AllInstruments() {
        43,
        "spd_cello",
        {38.0, 1200.0, 16000},
-       {{1, 0, false}, {2, 1, false}, {4, 2, false}}},
+       {{1, 0, false}, {2, 1, false}, {4, 2, false}},
+       /*frame_spacing_in_mm=*/true},
   };
   return *instruments;
 }
@@ -111,6 +114,16 @@ double FingerOffsetSemitones(InstrumentKind kind, int finger) {
     if (offset >= 0) return offset;
   }
   throw std::logic_error("instrument hand frame without a fourth finger");
+}
+
+double HandPositionSemitones(InstrumentKind kind, int finger, double stop_semitones) {
+  const double offset = FingerOffsetSemitones(kind, finger);
+  if (!GetInstrumentInfo(kind).frame_spacing_in_mm) return stop_semitones - offset;
+  constexpr double kFirstPositionSemitones = 2.0;  // finger 1 in the first position
+  const double remaining = std::exp2(-stop_semitones / 12.0) +
+                           std::exp2(-kFirstPositionSemitones / 12.0) -
+                           std::exp2(-(kFirstPositionSemitones + offset) / 12.0);
+  return -12.0 * std::log2(remaining);
 }
 
 std::vector<FingerSpan> FingerReaches(InstrumentKind kind, int finger) {

@@ -60,6 +60,11 @@ struct InstrumentInfo {
   // The hand frame (FingerSpan): cello closed 0/1/2/3 and extended 0/2/3/4; violin and
   // viola 0, 1-2, 3-4, 5 (6 stretched); double bass (Simandl) fingers 1, 2, 4 at 0/1/2.
   std::vector<FingerSpan> hand_frame;
+  // Whether the hand frame's spacing holds in mm up the neck (cello, double bass: low on
+  // the neck one finger per semitone, widening to a scale step per finger in the upper and
+  // thumb positions, where a semitone is half as long) rather than in semitones (violin,
+  // viola: the fingers close up with the semitones and keep their intervals).
+  bool frame_spacing_in_mm = false;
 };
 
 // Every instrument, in InstrumentKind order.
@@ -79,6 +84,15 @@ const char* InstrumentKindName(InstrumentKind kind);
 // higher one (double bass finger 3 with finger 4: 0/1/2/2). Finger 0 (open) is 0; fingers
 // outside 0..4 are clamped.
 double FingerOffsetSemitones(InstrumentKind kind, int finger);
+// Finger 1's place (semitones above the open string) when finger `finger` stops the string
+// `stop_semitones` above it: stop_semitones - FingerOffsetSemitones, or, where
+// frame_spacing_in_mm, finger 1 the frame's offset in mm below the stop, the mm of the first
+// position (finger 1 a whole tone above the open string; with l = 2^(-s/12) the stop's
+// remaining fraction of the string, finger 1 is at l + 2^(-2/12) - 2^(-(2+o)/12)). The two
+// agree in the first position; on the cello's A string, finger 3 a whole tone above
+// finger 2 at 311 mm from the nut (SPD cello01) is one semitone of offset in semitones and
+// 1.7 in mm.
+double HandPositionSemitones(InstrumentKind kind, int finger, double stop_semitones);
 // Every offset from finger 1's stop that finger `finger` reaches: first
 // FingerOffsetSemitones, then the other closed-frame reaches, largest first (violin and
 // viola finger 2: 2, 1; finger 3: 4, 3), then the extended ones (cello extension, the

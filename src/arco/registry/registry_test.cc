@@ -190,5 +190,33 @@ TEST(InstrumentRegistry, FingerTables) {
   EXPECT_EQ(offsets(InstrumentKind::kDoubleBass), (std::vector<double>{0, 1, 2, 2}));
 }
 
+// Finger 1's place from a stopping finger: in semitones on the violin and the viola; in mm
+// of the first position on the cello and the double bass, the same in the first position
+// and more semitones per finger higher up.
+TEST(InstrumentRegistry, HandPositionFromAStoppingFinger) {
+  for (InstrumentKind kind : {InstrumentKind::kViolin, InstrumentKind::kViola}) {
+    EXPECT_DOUBLE_EQ(HandPositionSemitones(kind, 3, 12.0), 12.0 - 4.0);
+    EXPECT_DOUBLE_EQ(HandPositionSemitones(kind, 1, 7.5), 7.5);
+  }
+  for (InstrumentKind kind : {InstrumentKind::kCello, InstrumentKind::kDoubleBass}) {
+    SCOPED_TRACE(InstrumentKindName(kind));
+    EXPECT_DOUBLE_EQ(HandPositionSemitones(kind, 1, 9.0), 9.0);
+    for (int finger = 2; finger <= 4; ++finger) {
+      const double offset = FingerOffsetSemitones(kind, finger);
+      // First position: finger 1 a whole tone above the open string, as in semitones.
+      EXPECT_NEAR(HandPositionSemitones(kind, finger, 2.0 + offset), 2.0, 1e-12);
+      // Higher up the same mm span more semitones: finger 1 lies farther below the stop.
+      EXPECT_LT(HandPositionSemitones(kind, finger, 12.0 + offset), 12.0);
+    }
+  }
+  // Ten semitones up the cello's A string (SPD cello01, 311 mm from the nut): finger 2 there
+  // and finger 3 a whole tone higher move finger 1 by 0.4 semitones, where the semitone
+  // frame moves it by one.
+  const double f2 = HandPositionSemitones(InstrumentKind::kCello, 2, 10.0);
+  const double f3 = HandPositionSemitones(InstrumentKind::kCello, 3, 12.0);
+  EXPECT_GT(f3 - f2, 0.3);
+  EXPECT_LT(f3 - f2, 0.5);
+}
+
 }  // namespace
 }  // namespace arco
