@@ -1,6 +1,5 @@
 #include "arco/body/skeleton_fit.h"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 #include <algorithm>
@@ -137,6 +136,40 @@ bool RestOffsets(std::vector<Node>& nodes, int j, const Points& pts, int64_t fra
   return true;
 }
 
+// Solves a x = -b for a symmetric positive definite a by Cholesky, a = U^T U, U stored
+// over a's upper triangle (columns contiguous); false when a is not positive definite.
+// Plain loops: at a few dozen unknowns Eigen's blocked LLT spent most of its time in
+// packing for its matrix products.
+bool SolveCholesky(Eigen::MatrixXd& a, const Eigen::VectorXd& b, Eigen::VectorXd* x) {
+  const int n = static_cast<int>(a.rows());
+  for (int j = 0; j < n; ++j) {
+    double* cj = &a(0, j);
+    for (int i = 0; i < j; ++i) {
+      const double* ci = &a(0, i);
+      double sum = cj[i];
+      for (int k = 0; k < i; ++k) sum -= ci[k] * cj[k];
+      cj[i] = sum / ci[i];
+    }
+    double d = cj[j];
+    for (int k = 0; k < j; ++k) d -= cj[k] * cj[k];
+    if (!(d > 0)) return false;
+    cj[j] = std::sqrt(d);
+  }
+  x->resize(n);
+  for (int i = 0; i < n; ++i) {  // U^T y = -b
+    const double* ci = &a(0, i);
+    double sum = -b[i];
+    for (int k = 0; k < i; ++k) sum -= ci[k] * (*x)[k];
+    (*x)[i] = sum / ci[i];
+  }
+  for (int i = n - 1; i >= 0; --i) {  // U x = y
+    double sum = (*x)[i];
+    for (int k = i + 1; k < n; ++k) sum -= a(i, k) * (*x)[k];
+    (*x)[i] = sum / a(i, i);
+  }
+  return true;
+}
+
 // One frame's robust least squares (see skeleton_fit.h): parameters x = (dp, delta[j] for
 // the joints on a measured point's path), the keypoint of node i at
 //   x_i = root + dp + sum over its path's bones (j -> c) of R_prev[j] Exp(delta[j]) offset[c],
@@ -209,18 +242,17 @@ class FrameSolver {
       if (!(g_.lpNorm<Eigen::Infinity>() > kGradientTolerance)) break;
       damped_ = h_;
       for (int i = 0; i < size; ++i) damped_(i, i) += std::clamp(h_(i, i), 1e-6, 1e32) / radius;
-      llt_.compute(damped_);
-      if (llt_.info() != Eigen::Success) {
+      if (!SolveCholesky(damped_, g_, &step_)) {
         radius /= decrease;
         decrease *= 2;
         if (radius < 1e-32) break;
         continue;
       }
-      step_ = llt_.solve(-g_);
       if (!(step_.norm() > kParameterTolerance * (x_.norm() + kParameterTolerance))) break;
       candidate_ = x_ + step_;
       const double candidate_cost = Evaluate(candidate_, &candidate_h_, &candidate_g_);
-      const double model_decrease = -(g_.dot(step_) + 0.5 * step_.dot(h_ * step_));
+      h_step_.noalias() = h_ * step_;
+      const double model_decrease = -(g_.dot(step_) + 0.5 * step_.dot(h_step_));
       const double change = cost - candidate_cost;
       const double quality = change / model_decrease;
       const bool success = std::isfinite(candidate_cost) && model_decrease > 0 && quality > 1e-3;
@@ -320,8 +352,7 @@ class FrameSolver {
   std::vector<Eigen::Matrix3d> blocks_;
   std::vector<int> block_columns_;
   Eigen::MatrixXd h_, candidate_h_, damped_;
-  Eigen::VectorXd g_, candidate_g_, x_, candidate_, step_;
-  Eigen::LLT<Eigen::MatrixXd> llt_;
+  Eigen::VectorXd g_, candidate_g_, x_, candidate_, step_, h_step_;
 };
 
 Eigen::Matrix3d Exp(const Eigen::Vector3d& v) {
