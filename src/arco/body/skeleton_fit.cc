@@ -1,14 +1,11 @@
 #include "arco/body/skeleton_fit.h"
 
-#include <ceres/ceres.h>
-#include <ceres/rotation.h>
-
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <memory>
+#include <limits>
+#include <utility>
 
 #include "arco/geometry/rotation.h"
 #include "arco/util/parallel.h"
@@ -139,68 +136,278 @@ bool RestOffsets(std::vector<Node>& nodes, int j, const Points& pts, int64_t fra
   return true;
 }
 
-// The weighted distance of one keypoint from forward kinematics along its path:
-// x = root + sum over the path's bones (j -> c) of R_prev[j] * exp(delta[j]) * offset[c].
-// Parameter blocks: the root's translation, then each path joint's delta (3 each).
-// Analytic Jacobians, d x / d delta[j] = -R_prev[j] exp(delta[j]) [offset[c]]x J_r(delta[j])
-// (geometry/rotation.h): the same derivatives as automatic differentiation, which took
-// ceil(3 (1 + path) / 4) passes of jets per evaluation and a quarter of `arco run`'s CPU.
-class PointCost final : public ceres::CostFunction {
+// The inverse of the Cholesky factor L (a = L L^T, lower triangular) of a symmetric 3x3
+// matrix, from its lower triangle; false when a is not positive definite.
+bool InverseCholesky3(const Eigen::Ref<const Eigen::MatrixXd>& a, Eigen::Matrix3d* inverse) {
+  const double d0 = a(0, 0);
+  if (!(d0 > 0)) return false;
+  const double l00 = std::sqrt(d0);
+  const double l10 = a(1, 0) / l00, l20 = a(2, 0) / l00;
+  const double d1 = a(1, 1) - l10 * l10;
+  if (!(d1 > 0)) return false;
+  const double l11 = std::sqrt(d1);
+  const double l21 = (a(2, 1) - l20 * l10) / l11;
+  const double d2 = a(2, 2) - l20 * l20 - l21 * l21;
+  if (!(d2 > 0)) return false;
+  const double l22 = std::sqrt(d2);
+  const double i00 = 1 / l00, i11 = 1 / l11, i22 = 1 / l22;
+  const double i10 = -l10 * i00 * i11;
+  const double i21 = -l21 * i11 * i22;
+  const double i20 = -(l20 * i00 + l21 * i10) * i22;
+  *inverse << i00, 0, 0, i10, i11, 0, i20, i21, i22;
+  return true;
+}
+
+// One frame's robust least squares (see skeleton_fit.h): parameters x = (dp, delta[j] for
+// the joints on a measured point's path), the keypoint of node i at
+//   x_i = root + dp + sum over its path's bones (j -> c) of R_prev[j] Exp(delta[j]) offset[c],
+// residuals sqrt(w) (x_i - measured) under a Huber loss plus a pull w_prior delta[j] of
+// each rotation towards the previous frame. d x_i / d delta[j] =
+// -R_prev[j] Exp(delta[j]) [offset[c]]x J_r(delta[j]) (geometry/rotation.h).
+//
+// Solved by Levenberg-Marquardt on the dense normal equations (a few dozen parameters),
+// with Ceres' trust-region rules (Marquardt's diagonal clamped to [1e-6, 1e32] and divided
+// by the radius, starting at 1e4; radius update by the step quality, Nielsen's rule) and its
+// stopping tests (function tolerance 1e-8 relative, gradient 1e-10, step 1e-8 relative),
+// the Huber loss applied as Ceres does (residual and Jacobian scaled by sqrt(rho'), rho''
+// being 0 or negative). Until issue 28 part 3 this was a ceres::Problem built per frame
+// with a sparse normal Cholesky: the same minimiser, but its set-up, sparse symbolic
+// analysis and bookkeeping cost about ten times the arithmetic (a quarter of `arco run`'s
+// CPU); joints moved by the solvers' tolerance (docs/performance.md).
+class FrameSolver {
  public:
-  PointCost(const Eigen::Vector3d& base,
-            std::vector<Eigen::Matrix3d> rotations,
-            std::vector<Eigen::Vector3d> offsets,
-            const Eigen::Vector3d& measured,
-            double sqrt_weight)
-      : base_(base),
-        rotations_(std::move(rotations)),
-        offsets_(std::move(offsets)),
-        measured_(measured),
-        sqrt_weight_(sqrt_weight) {
-    set_num_residuals(3);
-    mutable_parameter_block_sizes()->assign(offsets_.size() + 1, 3);
+  struct Observation {
+    int node = 0;
+    Eigen::Vector3d measured;
+    double sqrt_weight = 1;
+  };
+
+  FrameSolver(const std::vector<Node>& nodes, const SkeletonFitOptions& options)
+      : nodes_(nodes),
+        options_(options),
+        paths_(nodes.size()),
+        column_(nodes.size(), -1),
+        turned_(nodes.size()),
+        right_jacobian_(nodes.size()) {
+    // Each node's path from the group's root, as (joint, child) bones in root-first order.
+    for (size_t i = 0; i < nodes.size(); ++i) {
+      for (int c = static_cast<int>(i); nodes[c].parent >= 0; c = nodes[c].parent) {
+        paths_[i].push_back({nodes[c].parent, c});
+      }
+      std::reverse(paths_[i].begin(), paths_[i].end());
+      max_path_ = std::max(max_path_, paths_[i].size());
+    }
+    blocks_.resize(max_path_ + 1);
+    block_columns_.resize(max_path_ + 1);
   }
 
-  bool Evaluate(double const* const* p, double* residuals, double** jacobians) const override {
-    using RowMajor3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
-    Eigen::Vector3d x = base_ + Eigen::Map<const Eigen::Vector3d>(p[0]);
-    for (size_t i = 0; i < offsets_.size(); ++i) {
-      const Eigen::Vector3d delta = Eigen::Map<const Eigen::Vector3d>(p[i + 1]);
-      const Eigen::Matrix3d turned = rotations_[i] * RotationFromAxisAngle(delta);
-      x += turned * offsets_[i];
-      if (jacobians != nullptr && jacobians[i + 1] != nullptr) {
-        Eigen::Map<RowMajor3> jacobian(jacobians[i + 1]);
-        jacobian = -sqrt_weight_ * turned * CrossMatrix(offsets_[i]) * RightJacobianSO3(delta);
+  // Solves one frame from delta = 0 and dp = 0; `rot` and `root` are the previous pose.
+  void Solve(const std::vector<Observation>& observations,
+             const std::vector<Eigen::Matrix3d>& rot,
+             const Eigen::Vector3d& root,
+             Eigen::Vector3d* dp,
+             std::vector<Eigen::Vector3d>* delta) {
+    observations_ = &observations;
+    rot_ = &rot;
+    root_ = root;
+    std::fill(column_.begin(), column_.end(), -1);
+    active_.clear();
+    for (const Observation& o : observations) {
+      for (const auto& [j, c] : paths_[o.node]) column_[j] = 0;
+    }
+    int size = 3;
+    for (size_t j = 0; j < nodes_.size(); ++j) {
+      if (column_[j] < 0) continue;
+      column_[j] = size;
+      size += 3;
+      active_.push_back(static_cast<int>(j));
+    }
+    // The elimination order of SolveDamped: every joint before its ancestors (nodes come
+    // after their parents), the root's translation last; each with its ancestors' columns.
+    ancestors_.resize(active_.size());
+    inverse_.resize(active_.size() + 1);
+    for (size_t a = 0; a < active_.size(); ++a) {
+      std::vector<int>& up = ancestors_[a];
+      up.clear();
+      for (int p = nodes_[active_[active_.size() - 1 - a]].parent; p >= 0; p = nodes_[p].parent) {
+        up.push_back(column_[p]);
+      }
+      up.push_back(0);
+    }
+    x_.setZero(size);
+    double cost = Evaluate(x_, &h_, &g_);
+    double radius = 1e4;
+    double decrease = 2;
+    for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
+      if (!(g_.lpNorm<Eigen::Infinity>() > kGradientTolerance)) break;
+      damped_ = h_;
+      for (int i = 0; i < size; ++i) damped_(i, i) += std::clamp(h_(i, i), 1e-6, 1e32) / radius;
+      if (!SolveDamped()) {
+        radius /= decrease;
+        decrease *= 2;
+        if (radius < 1e-32) break;
+        continue;
+      }
+      if (!(step_.norm() > kParameterTolerance * (x_.norm() + kParameterTolerance))) break;
+      candidate_ = x_ + step_;
+      const double candidate_cost = Evaluate(candidate_, &candidate_h_, &candidate_g_);
+      h_step_.noalias() = h_ * step_;
+      const double model_decrease = -(g_.dot(step_) + 0.5 * step_.dot(h_step_));
+      const double change = cost - candidate_cost;
+      const double quality = change / model_decrease;
+      const bool success = std::isfinite(candidate_cost) && model_decrease > 0 && quality > 1e-3;
+      if (success) {
+        x_.swap(candidate_);
+        h_.swap(candidate_h_);
+        g_.swap(candidate_g_);
+        cost = candidate_cost;
+      }
+      if (std::abs(change) <= kFunctionTolerance * (cost + (success ? change : 0))) break;
+      if (success) {
+        const double t = 2 * quality - 1;
+        radius = std::min(1e16, radius / std::max(1.0 / 3.0, 1.0 - t * t * t));
+        decrease = 2;
+      } else {
+        radius /= decrease;
+        decrease *= 2;
+        if (radius < 1e-32) break;
       }
     }
-    Eigen::Map<Eigen::Vector3d> r(residuals);
-    r = sqrt_weight_ * (x - measured_);
-    if (jacobians != nullptr && jacobians[0] != nullptr) {
-      Eigen::Map<RowMajor3> jacobian(jacobians[0]);
-      jacobian = sqrt_weight_ * Eigen::Matrix3d::Identity();
-    }
-    return true;
+    *dp = x_.head<3>();
+    for (int j : active_) (*delta)[j] = x_.segment<3>(column_[j]);
   }
 
  private:
-  Eigen::Vector3d base_;  // previous root position
-  std::vector<Eigen::Matrix3d> rotations_;
-  std::vector<Eigen::Vector3d> offsets_;
-  Eigen::Vector3d measured_;
-  double sqrt_weight_ = 1.0;
-};
+  static constexpr double kFunctionTolerance = 1e-8;
+  static constexpr double kGradientTolerance = 1e-10;
+  static constexpr double kParameterTolerance = 1e-8;
 
-struct PriorCost {
-  double weight;
-  template <typename T>
-  bool operator()(const T* d, T* r) const {
-    for (int a = 0; a < 3; ++a) r[a] = T(weight) * d[a];
+  // step_ = -damped_^-1 g_ by a block Cholesky factorisation in the elimination order set
+  // up by Solve (false when damped_ is not positive definite). A joint's delta shares
+  // residuals only with its ancestors' and the root's (a point depends on the rotations
+  // along its path), so eliminating every joint before its ancestors fills in no block
+  // that is not already non-zero: about 10 3x3 block updates per joint instead of a
+  // dense factorisation, whose dependent sums (a few dozen unknowns) took 70% of the fit.
+  // Blocks are read and written at (later column, earlier column) in that order.
+  bool SolveDamped() {
+    using Block = Eigen::Matrix3d;
+    Eigen::MatrixXd& a = damped_;
+    step_ = -g_;
+    const int joints = static_cast<int>(active_.size());
+    auto column_of = [&](int e) { return e < joints ? column_[active_[joints - 1 - e]] : 0; };
+    for (int e = 0; e <= joints; ++e) {
+      const int c = column_of(e);
+      if (!InverseCholesky3(a.block<3, 3>(c, c), &inverse_[e])) return false;
+      if (e == joints) break;
+      const std::vector<int>& up = ancestors_[e];
+      for (int u : up) {  // L_uc = A_uc L_cc^-T
+        const Block l = a.block<3, 3>(u, c) * inverse_[e].transpose();
+        a.block<3, 3>(u, c) = l;
+      }
+      // Ancestors are listed nearest first, so up[i] comes later than up[k] for i > k.
+      for (size_t k = 0; k < up.size(); ++k) {
+        const Block lk = a.block<3, 3>(up[k], c).transpose();
+        for (size_t i = k; i < up.size(); ++i) {
+          a.block<3, 3>(up[i], up[k]).noalias() -= a.block<3, 3>(up[i], c) * lk;
+        }
+      }
+    }
+    for (int e = 0; e <= joints; ++e) {  // L y = -g
+      const int c = column_of(e);
+      const Eigen::Vector3d y = inverse_[e] * step_.segment<3>(c);
+      step_.segment<3>(c) = y;
+      if (e == joints) break;
+      for (int u : ancestors_[e]) step_.segment<3>(u).noalias() -= a.block<3, 3>(u, c) * y;
+    }
+    for (int e = joints; e >= 0; --e) {  // L^T x = y
+      const int c = column_of(e);
+      Eigen::Vector3d y = step_.segment<3>(c);
+      if (e < joints) {
+        for (int u : ancestors_[e]) {
+          y.noalias() -= a.block<3, 3>(u, c).transpose() * step_.segment<3>(u);
+        }
+      }
+      step_.segment<3>(c) = inverse_[e].transpose() * y;
+    }
     return true;
   }
+
+  // The cost 1/2 sum rho(|r|^2) + 1/2 |prior|^2 at x, with the Gauss-Newton matrix J^T J
+  // and gradient J^T r of the loss-scaled residuals.
+  double Evaluate(const Eigen::VectorXd& x, Eigen::MatrixXd* h, Eigen::VectorXd* g) {
+    using Block = Eigen::Matrix3d;
+    h->setZero(x.size(), x.size());
+    g->setZero(x.size());
+    for (int j : active_) {
+      const Eigen::Vector3d d = x.segment<3>(column_[j]);
+      turned_[j] = (*rot_)[j] * RotationFromAxisAngle(d);
+      right_jacobian_[j] = RightJacobianSO3(d);
+    }
+    const double b = options_.robust_scale_mm;
+    double cost = 0;
+    for (const Observation& o : *observations_) {
+      const auto& path = paths_[o.node];
+      Eigen::Vector3d p = root_ + x.head<3>();
+      for (const auto& [j, c] : path) p += turned_[j] * nodes_[c].offset;
+      const Eigen::Vector3d r = o.sqrt_weight * (p - o.measured);
+      const double s = r.squaredNorm();
+      double rho1 = 1;  // rho'(s) of the Huber loss rho(s) = s, or 2 b sqrt(s) - b^2
+      if (s > b * b) {
+        const double e = std::sqrt(s);
+        cost += 0.5 * (2 * b * e - b * b);
+        rho1 = b / e;
+      } else {
+        cost += 0.5 * s;
+      }
+      size_t n = 0;
+      blocks_[n] = o.sqrt_weight * Block::Identity();
+      block_columns_[n++] = 0;
+      for (const auto& [j, c] : path) {
+        blocks_[n] =
+            -o.sqrt_weight * turned_[j] * CrossMatrix(nodes_[c].offset) * right_jacobian_[j];
+        block_columns_[n++] = column_[j];
+      }
+      for (size_t a = 0; a < n; ++a) {
+        const Block ja = rho1 * blocks_[a].transpose();
+        g->segment<3>(block_columns_[a]).noalias() += ja * r;
+        for (size_t c = a; c < n; ++c) {
+          const Block jj = ja * blocks_[c];
+          h->block<3, 3>(block_columns_[a], block_columns_[c]) += jj;
+          if (c != a) h->block<3, 3>(block_columns_[c], block_columns_[a]) += jj.transpose();
+        }
+      }
+    }
+    const double w2 = options_.rotation_prior_mm_per_rad * options_.rotation_prior_mm_per_rad;
+    for (int j : active_) {
+      const Eigen::Vector3d d = x.segment<3>(column_[j]);
+      cost += 0.5 * w2 * d.squaredNorm();
+      g->segment<3>(column_[j]) += w2 * d;
+      h->block<3, 3>(column_[j], column_[j]).diagonal().array() += w2;
+    }
+    return cost;
+  }
+
+  const std::vector<Node>& nodes_;
+  const SkeletonFitOptions& options_;
+  std::vector<std::vector<std::pair<int, int>>> paths_;
+  size_t max_path_ = 0;
+  // Per frame.
+  const std::vector<Observation>* observations_ = nullptr;
+  const std::vector<Eigen::Matrix3d>* rot_ = nullptr;
+  Eigen::Vector3d root_;
+  std::vector<int> column_;  // first column of joint j's delta, -1 when not a parameter
+  std::vector<int> active_;
+  std::vector<std::vector<int>> ancestors_;  // per eliminated joint, ancestors' columns
+  std::vector<Eigen::Matrix3d> inverse_;     // per eliminated block, L^-1 of its diagonal
+  // Scratch, kept across frames.
+  std::vector<Eigen::Matrix3d> turned_, right_jacobian_;
+  std::vector<Eigen::Matrix3d> blocks_;
+  std::vector<int> block_columns_;
+  Eigen::MatrixXd h_, candidate_h_, damped_;
+  Eigen::VectorXd g_, candidate_g_, x_, candidate_, step_, h_step_;
 };
 
-Eigen::Matrix3d Exp(const std::array<double, 3>& d) {
-  const Eigen::Vector3d v(d[0], d[1], d[2]);
+Eigen::Matrix3d Exp(const Eigen::Vector3d& v) {
   const double angle = v.norm();
   if (angle < 1e-300) return Eigen::Matrix3d::Identity();
   return Eigen::AngleAxisd(angle, v / angle).toRotationMatrix();
@@ -221,6 +428,9 @@ void FitGroup(const std::vector<Node>& nodes,
   Eigen::Vector3d root = Eigen::Vector3d::Zero();
   bool initialised = false;
   std::vector<Eigen::Vector3d> fk(n);
+  FrameSolver solver(nodes, options);
+  std::vector<FrameSolver::Observation> observations;
+  std::vector<Eigen::Vector3d> delta(n, Eigen::Vector3d::Zero());
   auto forward = [&](const std::vector<Eigen::Matrix3d>& r, const Eigen::Vector3d& p0) {
     for (int i = 0; i < n; ++i) {
       fk[i] = nodes[i].parent < 0
@@ -257,60 +467,15 @@ void FitGroup(const std::vector<Node>& nodes,
       }
       initialised = true;
     }
-    std::array<double, 3> dp = {0, 0, 0};
-    std::vector<std::array<double, 3>> delta(n, {0, 0, 0});
-    ceres::Problem::Options po;
-    po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
-    ceres::Problem problem(po);
-    problem.AddParameterBlock(dp.data(), 3);
+    observations.clear();
     for (int i : observed) {
-      std::vector<double*> blocks = {dp.data()};
-      std::vector<Eigen::Matrix3d> rotations;
-      std::vector<Eigen::Vector3d> offsets;
-      std::vector<int> path;
-      for (int c = i; nodes[c].parent >= 0; c = nodes[c].parent) path.push_back(c);
-      std::reverse(path.begin(), path.end());
-      for (int c : path) {
-        const int j = nodes[c].parent;
-        rotations.push_back(rot[j]);
-        offsets.push_back(nodes[c].offset);
-        blocks.push_back(delta[j].data());
-      }
-      auto* fn = new PointCost(root,
-                               std::move(rotations),
-                               std::move(offsets),
-                               pts.At(f, nodes[i].keypoint),
-                               std::sqrt(pts.Weight(f, nodes[i].keypoint)));
-      problem.AddResidualBlock(fn, new ceres::HuberLoss(options.robust_scale_mm), blocks);
+      const int k = nodes[i].keypoint;
+      observations.push_back({i, pts.At(f, k), std::sqrt(pts.Weight(f, k))});
     }
-    for (int j = 0; j < n; ++j) {
-      if (nodes[j].children.empty() || !problem.HasParameterBlock(delta[j].data())) continue;
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(
-                                   new PriorCost{options.rotation_prior_mm_per_rad}),
-                               nullptr,
-                               delta[j].data());
-    }
-    ceres::Solver::Options so;
-    // Each point's residual depends on the root and the rotations along its path only, so
-    // J^T J is mostly zeros: the sparse Cholesky took 25% less time than the dense one on
-    // the same iterates (58 s take, docs/performance.md). Tolerances 1e-8 instead of 1e-10
-    // took 8.6 instead of 12.7 iterations per frame and moved no joint by more than
-    // 0.05 mm (p99 0.002 mm; arco eval unchanged to 0.01 mm).
-    so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    // Eigen's sparse Cholesky: at these sizes (a few dozen parameters) its per-frame
-    // analysis costs less than CHOLMOD's; `arco refine --mode arco --threads 1` on the
-    // one-minute take 2.7 -> 2.5 s of CPU, joints moved by at most 1e-8 mm.
-    if (ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE))
-      so.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
-    so.max_num_iterations = options.max_iterations;
-    so.num_threads = 1;
-    so.function_tolerance = 1e-8;
-    so.gradient_tolerance = 1e-10;
-    so.parameter_tolerance = 1e-8;
-    so.logging_type = ceres::SILENT;
-    ceres::Solver::Summary summary;
-    ceres::Solve(so, &problem, &summary);
-    root += Eigen::Vector3d(dp[0], dp[1], dp[2]);
+    Eigen::Vector3d dp = Eigen::Vector3d::Zero();
+    std::fill(delta.begin(), delta.end(), Eigen::Vector3d::Zero());
+    solver.Solve(observations, rot, root, &dp, &delta);
+    root += dp;
     for (int j = 0; j < n; ++j) rot[j] = rot[j] * Exp(delta[j]);
     forward(rot, root);
     if (f < write_from) continue;  // a warm-up frame
