@@ -230,6 +230,16 @@ StatusOr<CaptureContext> PreflightOpened(const RunOptions& options, CaptureConte
   return capture;
 }
 
+// PreflightRun on an opened capture, its options validated.
+StatusOr<CaptureContext> PreflightValidated(const RunOptions& options, CaptureContext opened) {
+  if (opened.capture_dir != options.capture_dir) {
+    throw std::invalid_argument("PreflightRun: capture " + opened.capture_dir +
+                                " opened for capture_dir " + options.capture_dir);
+  }
+  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options.result_dir, options.Replace()));
+  return PreflightOpened(options, std::move(opened));
+}
+
 // The stages of a preflighted capture.
 StatusOr<RunSummary> RunPreflighted(const RunOptions& options,
                                     CaptureContext capture,
@@ -271,26 +281,29 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
 }
 
 StatusOr<CaptureContext> PreflightRun(const RunOptions& options, CaptureContext opened) {
-  if (opened.capture_dir != options.capture_dir) {
-    throw std::invalid_argument("PreflightRun: capture " + opened.capture_dir +
-                                " opened for capture_dir " + options.capture_dir);
-  }
   ARCO_RETURN_IF_ERROR(options.Validate());
-  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options.result_dir, options.Replace()));
-  return PreflightOpened(options, std::move(opened));
+  return PreflightValidated(options, std::move(opened));
 }
 
 StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
-  // Every input checked before the first stage (and before the result folder exists).
-  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, PreflightRun(options));
-  return RunPreflighted(options, std::move(capture), progress);
+  // The one validation of the run's options.
+  ARCO_ASSIGN_OR_RETURN(const Validated<RunOptions> valid, Validated<RunOptions>::Check(options));
+  return RunCapture(valid, progress);
 }
 
-StatusOr<RunSummary> RunCapture(const RunOptions& options,
+StatusOr<RunSummary> RunCapture(const Validated<RunOptions>& options, Progress& progress) {
+  // Every input checked before the first stage (and before the result folder exists).
+  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options->result_dir, options->Replace()));
+  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, OpenCapture(options->capture_dir));
+  ARCO_ASSIGN_OR_RETURN(capture, PreflightOpened(*options, std::move(capture)));
+  return RunPreflighted(*options, std::move(capture), progress);
+}
+
+StatusOr<RunSummary> RunCapture(const Validated<RunOptions>& options,
                                 CaptureContext opened,
                                 Progress& progress) {
-  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, PreflightRun(options, std::move(opened)));
-  return RunPreflighted(options, std::move(capture), progress);
+  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, PreflightValidated(*options, std::move(opened)));
+  return RunPreflighted(*options, std::move(capture), progress);
 }
 
 }  // namespace arco::pipeline

@@ -23,6 +23,7 @@
 #include "arco/util/output_set.h"
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
+#include "arco/util/validated.h"
 
 namespace arco::pipeline {
 
@@ -95,10 +96,18 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options);
 // Throws std::invalid_argument when `opened` is another folder's (a caller bug).
 StatusOr<CaptureContext> PreflightRun(const RunOptions& options, CaptureContext opened);
 
-// Progress: StartStage(i, 5, name) for each stage, then that stage's SetTotal / Advance.
+// The options are validated once, here at the entry (Validated<RunOptions>::Check, the
+// first of PreflightRun's checks); the stages take them as validated and do not check
+// them again. Progress: StartStage(i, 5, name) for each stage, then that stage's
+// SetTotal / Advance.
 StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress = NoProgress());
-// The same on a capture already opened (PreflightRun(options, opened)).
-StatusOr<RunSummary> RunCapture(const RunOptions& options,
+// The same with options already validated (`arco run` checks them when it parses its
+// command line, and hands them on): opens the capture.
+StatusOr<RunSummary> RunCapture(const Validated<RunOptions>& options,
+                                Progress& progress = NoProgress());
+// The same on a capture already opened (OpenCapture(options->capture_dir), e.g. by `arco
+// run` to list its files): PreflightRun's checks after the options then run on it.
+StatusOr<RunSummary> RunCapture(const Validated<RunOptions>& options,
                                 CaptureContext opened,
                                 Progress& progress = NoProgress());
 
