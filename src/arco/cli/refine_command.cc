@@ -3,6 +3,7 @@
 // options.
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "arco/cli/command.h"
 #include "arco/cli/flag_names.h"
@@ -20,6 +21,9 @@ struct RefineArgs {
   std::string joints = hand::FingerIkJointsName(refine::ArcoIkOptions{}.joints);
   bool exact_reach = false;
   bool no_audio_onsets = false;
+  // The options as validated when the command line was parsed: RunRefineStage takes them
+  // as they are (one validation).
+  std::optional<Validated<pipeline::RefineStageOptions>> valid;
 };
 
 // The parse-complete step: the named choices into the options, then their Validate().
@@ -32,12 +36,16 @@ void ApplyAndValidate(RefineArgs& a) {
   if (a.joints == "mcp_flex_pip_dip") a.o.refine.ik.joints = hand::FingerIkJoints::kMcpFlexPipDip;
   a.o.refine.ik.exact_reach = a.exact_reach;
   a.o.refine.decode.audio_onsets = !a.no_audio_onsets;
-  const Status valid = a.o.Validate();
-  if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kRefineFlags)));
+  StatusOr<Validated<pipeline::RefineStageOptions>> valid =
+      Validated<pipeline::RefineStageOptions>::Check(a.o);
+  if (!valid.ok()) {
+    ThrowIfInvalid(Status::Error(WithFlagNames(valid.status().message(), kRefineFlags)));
+  }
+  a.valid = std::move(valid).value();
 }
 
 int RunRefine(const RefineArgs& a) {
-  auto summary = pipeline::RunRefineStage(a.o);
+  auto summary = pipeline::RunRefineStage(*a.valid);
   if (!summary.ok()) return PrintError(summary.status().message());
   std::printf("%s\nwrote %s/%s/\n",
               FormatRefineSummary(*summary).c_str(),

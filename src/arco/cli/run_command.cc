@@ -24,6 +24,9 @@ struct RunArgs {
   // run then takes: capture.json is read once. Empty when it did not open: RunCapture
   // opens it again and reports why, in the order of its checks.
   std::optional<pipeline::CaptureContext> opened;
+  // The options as validated when the command line was parsed (the run's one validation:
+  // RunCapture and its stages take them as they are).
+  std::optional<Validated<pipeline::RunOptions>> valid;
 };
 
 // The capture folder and the files its manifest names (cli/command_paths.h), from the
@@ -48,9 +51,9 @@ int RunRun(RunArgs& a) {
   if (a.opened) {
     pipeline::CaptureContext opened = std::move(*a.opened);
     a.opened.reset();
-    summary = pipeline::RunCapture(o, std::move(opened), progress);
+    summary = pipeline::RunCapture(*a.valid, std::move(opened), progress);
   } else {
-    summary = pipeline::RunCapture(o, progress);
+    summary = pipeline::RunCapture(*a.valid, progress);
   }
   progress.Finish();
   if (!summary.ok()) return PrintError(summary.status().message());
@@ -104,8 +107,11 @@ CommandRun SetupRun(CLI::App& app) {
       ->capture_default_str();
   sub->parse_complete_callback([a] {
     a->o.hands.palm.enabled = !a->average_palm;
-    const Status valid = a->o.Validate();
-    if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kRefineFlags)));
+    StatusOr<Validated<pipeline::RunOptions>> valid = Validated<pipeline::RunOptions>::Check(a->o);
+    if (!valid.ok()) {
+      ThrowIfInvalid(Status::Error(WithFlagNames(valid.status().message(), kRefineFlags)));
+    }
+    a->valid = std::move(valid).value();
   });
   return CommandRun([a]() { return RunRun(*a); }, [a] { return RunPaths(*a); });
 }

@@ -110,7 +110,11 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
     }
   }
 
-  ARCO_ASSIGN_OR_RETURN(const CaptureManifest manifest, ReadCaptureManifest(options.capture_dir));
+  // The capture is read through its context's readers (capture_context.h), each file once.
+  CaptureContext capture;
+  capture.capture_dir = options.capture_dir;
+  ARCO_ASSIGN_OR_RETURN(capture.manifest, ReadCaptureManifest(options.capture_dir));
+  const CaptureManifest& manifest = capture.manifest;
   if (manifest.keypoints2d.empty())
     return Status::Error(options.capture_dir + "/capture.json: no keypoints2d to refine with");
   CalibrationRefineSummary summary;
@@ -121,9 +125,11 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
   Calibration calibration;
   if (options.input_rig) {
     calibration.rig = *options.input_rig;
+  } else if (options.calibration.empty()) {
+    // The capture's own: checked and parsed from one read.
+    ARCO_RETURN_IF_ERROR(LoadCaptureCalibration(&capture));
+    calibration = capture.calibration;
   } else {
-    if (options.calibration.empty())
-      ARCO_RETURN_IF_ERROR(CheckCaptureCalibration(options.capture_dir, manifest));
     ARCO_ASSIGN_OR_RETURN(calibration, calibration::LoadCalibration(summary.calibration));
   }
   const Rig& input = calibration.rig;
@@ -178,13 +184,9 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
     fit_options.world_units_per_mm = units_per_mm = 1e-3;
   }
 
-  NpyArray<double> read_keypoints;
-  if (options.input_keypoints == nullptr) {
-    ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(options.capture_dir, manifest));
-    ARCO_ASSIGN_OR_RETURN(read_keypoints, ReadCaptureKeypoints2d(options.capture_dir, manifest));
-  }
+  if (options.input_keypoints == nullptr) ARCO_RETURN_IF_ERROR(LoadCaptureKeypoints2d(&capture));
   const NpyArray<double>& keypoints =
-      options.input_keypoints != nullptr ? *options.input_keypoints : read_keypoints;
+      options.input_keypoints != nullptr ? *options.input_keypoints : *capture.keypoints2d;
   const int64_t frames = keypoints.shape[0], views = keypoints.shape[1],
                 points = keypoints.shape[2];
   if (points != layout->size())

@@ -85,6 +85,17 @@ std::vector<Camera> ViewCamerasInMm(const CaptureContext& capture, double world_
   return cameras;
 }
 
+Status LoadCaptureKeypoints2d(CaptureContext* capture) {
+  const CaptureManifest& m = capture->manifest;
+  ARCO_ASSIGN_OR_RETURN(const FileBytes bytes,
+                        ReadCaptureKeypoints2dBytes(capture->capture_dir, m));
+  ARCO_ASSIGN_OR_RETURN(NpyArray<double> k,
+                        ParseCaptureKeypoints2d(bytes.view(), capture->capture_dir, m));
+  capture->keypoints2d = std::make_shared<const NpyArray<double>>(std::move(k));
+  capture->inputs[kKeypoints2dInput] = {m.keypoints2d, FingerprintBytes(bytes.view())};
+  return Status::Ok();
+}
+
 StatusOr<std::shared_ptr<const NpyArray<double>>> ReadKeypoints2d(const CaptureContext& capture) {
   if (capture.keypoints2d) return capture.keypoints2d;
   ARCO_ASSIGN_OR_RETURN(NpyArray<double> k,

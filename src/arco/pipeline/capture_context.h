@@ -57,6 +57,11 @@ inline Eigen::Vector3d PointInMm(const Eigen::Vector3d& point_in_world, double w
 // The cameras of the capture's views (view_to_camera) with the world in mm.
 std::vector<Camera> ViewCamerasInMm(const CaptureContext& capture, double world_units_per_mm);
 
+// Reads keypoints2d.npy once into capture->keypoints2d: checked (CheckCaptureKeypoints2d's
+// checks and messages), parsed and fingerprinted (capture->inputs["keypoints2d"]) from the
+// same bytes.
+Status LoadCaptureKeypoints2d(CaptureContext* capture);
+
 // capture.keypoints2d when set, else the file read (ReadCaptureKeypoints2d).
 StatusOr<std::shared_ptr<const NpyArray<double>>> ReadKeypoints2d(const CaptureContext& capture);
 

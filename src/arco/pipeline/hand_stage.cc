@@ -85,7 +85,6 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
                                   const TriangulateStageResult& triangulation,
                                   const InstrumentRecord& instrument,
                                   Progress& progress) {
-  ARCO_RETURN_IF_ERROR(options.Validate());
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   const double s = instrument.world_units_per_mm;
   if (!(s > 0)) return Status::Error("hand stage: the instrument has no world_units_per_mm");

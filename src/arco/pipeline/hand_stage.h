@@ -44,13 +44,15 @@ Json ToJson(const HandStageOptions& options);
 // `capture` (as `arco run` holds them, not read back), with the capture's 2D keypoints
 // and calibration (capture_context.h); writes nothing: the record is what
 // ResultFolder::WriteHand writes into hand/ (record.summary: the stage's summary).
+// Precondition: options.Validate() is ok (RunCapture validates the run's options once at
+// its entry; a caller of the stage alone validates first); not checked here.
 StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
                                   const CaptureContext& capture,
                                   const TriangulateStageResult& triangulation,
                                   const InstrumentRecord& instrument,
                                   Progress& progress = NoProgress());
 // The same on the stages in options.result_dir, which must come from `capture`, written
-// into it.
+// into it; this entry validates the options.
 StatusOr<HandStageSummary> RunHandStage(const HandStageOptions& options,
                                         const CaptureContext& capture,
                                         Progress& progress = NoProgress());

@@ -79,7 +79,6 @@ StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& opti
                                               const CaptureContext& capture,
                                               const TriangulateStageResult& triangulation,
                                               Progress& /*progress*/) {
-  ARCO_RETURN_IF_ERROR(options.Validate());
   const NpyArray<double>& points = triangulation.points3d;
   const InstrumentModel& model = *capture.instrument;
   const int64_t frames = points.shape[0];

@@ -37,13 +37,15 @@ Json ToJson(const InstrumentStageOptions& options);
 
 // Fits the instrument to the triangulation made from `capture` (as `arco run` holds it,
 // not read back); writes nothing: the record is what ResultFolder::WriteInstrument writes
-// into instrument/ (record.summary: the stage's summary).
+// into instrument/ (record.summary: the stage's summary). Precondition: options.Validate()
+// is ok (RunCapture validates the run's options once at its entry; a caller of the stage
+// alone validates first); not checked here.
 StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& options,
                                               const CaptureContext& capture,
                                               const TriangulateStageResult& triangulation,
                                               Progress& progress = NoProgress());
 // The same on the triangulation in options.result_dir, which must come from `capture`,
-// written into it.
+// written into it; this entry validates the options.
 StatusOr<InstrumentStageSummary> RunInstrumentStage(const InstrumentStageOptions& options,
                                                     const CaptureContext& capture,
                                                     Progress& progress = NoProgress());

@@ -15,7 +15,6 @@ Status PitchStageOptions::Validate() const { return Status::Ok(); }
 StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
                                     const CaptureContext& capture,
                                     Progress& progress) {
-  ARCO_RETURN_IF_ERROR(options.Validate());
   const CaptureManifest& m = capture.manifest;
   PitchRecord record;
   PitchStageSummary& summary = record.summary;
@@ -34,7 +33,6 @@ StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
   ARCO_ASSIGN_OR_RETURN(const audio::PitchTrackerOptions po, capture::PitchTrackerOptionsFor(run));
   const std::string audio_path = ResolveCapturePath(capture.capture_dir, m.audio);
   audio::PitchSummary tracked;
-  ARCO_RETURN_IF_ERROR(po.Validate());
   ARCO_ASSIGN_OR_RETURN(auto reader, OpenCaptureAudio(capture, audio_path));
   ARCO_ASSIGN_OR_RETURN(audio::PitchTrack track,
                         audio::TrackPitch(std::move(reader), po, &tracked, progress));

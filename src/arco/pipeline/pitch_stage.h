@@ -26,7 +26,8 @@ struct PitchStageOptions {
 // (record.summary: the stage's summary), which ResultFolder::WritePitch writes; without
 // audio only the summary (summary.ran false: nothing to write). Reads no result folder.
 // The tracker's options are `arco pitch --capture`'s (PitchTrackerOptionsFor): one way to
-// pitch a capture.
+// pitch a capture. Precondition: options.Validate() is ok (RunCapture validates the run's
+// options once at its entry); not checked here.
 StatusOr<PitchRecord> RunPitchStage(const PitchStageOptions& options,
                                     const CaptureContext& capture,
                                     Progress& progress = NoProgress());

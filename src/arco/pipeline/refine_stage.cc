@@ -345,9 +345,14 @@ StatusOr<MethodRecord> RefineMethod(const RefineInputs& inputs,
 }
 
 StatusOr<refine::RefineSummary> RunRefineStage(const RefineStageOptions& options) {
-  ARCO_RETURN_IF_ERROR(options.Validate());
-  ARCO_ASSIGN_OR_RETURN(RefineInputs inputs, LoadRefineInputs(options.result_dir));
-  return RefineAndWrite(options.result_dir, inputs, options.refine, options.bowing);
+  ARCO_ASSIGN_OR_RETURN(const Validated<RefineStageOptions> valid,
+                        Validated<RefineStageOptions>::Check(options));
+  return RunRefineStage(valid);
+}
+
+StatusOr<refine::RefineSummary> RunRefineStage(const Validated<RefineStageOptions>& options) {
+  ARCO_ASSIGN_OR_RETURN(RefineInputs inputs, LoadRefineInputs(options->result_dir));
+  return RefineAndWrite(options->result_dir, inputs, options->refine, options->bowing);
 }
 
 }  // namespace arco::pipeline

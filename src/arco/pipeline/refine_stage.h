@@ -14,6 +14,7 @@
 #include "arco/refine/method_result.h"
 #include "arco/refine/refine.h"
 #include "arco/util/status.h"
+#include "arco/util/validated.h"
 
 namespace arco::pipeline {
 
@@ -69,7 +70,9 @@ StatusOr<RefineInputs> MakeRefineInputs(const std::string& result_dir, const Sta
 // bowing.csv, bowing_notes.csv). Writes nothing: the record is what
 // ResultFolder::WriteMethod writes into RESULT_DIR/<method>/ (record.summary: the method's
 // summary). A method that needs audio on inputs without pitch is a caller bug
-// (std::invalid_argument): RefineAndWrite checks it first.
+// (std::invalid_argument): RefineAndWrite checks it first. Precondition: the options are
+// valid (RefineStageOptions::Validate: RunCapture and RunRefineStage check them once at
+// their entry); not checked here.
 StatusOr<MethodRecord> RefineMethod(const RefineInputs& inputs,
                                     const refine::RefineOptions& options,
                                     const refine::BowingOptions& bowing = {});
@@ -80,7 +83,11 @@ StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
                                                const refine::RefineOptions& options,
                                                const refine::BowingOptions& bowing = {});
 
-// LoadRefineInputs + RefineAndWrite.
+// `arco refine`: the options validated once, here at the entry, then LoadRefineInputs +
+// RefineAndWrite.
 StatusOr<refine::RefineSummary> RunRefineStage(const RefineStageOptions& options);
+// The same with options already validated (`arco refine` checks them when it parses its
+// command line).
+StatusOr<refine::RefineSummary> RunRefineStage(const Validated<RefineStageOptions>& options);
 
 }  // namespace arco::pipeline

@@ -1,6 +1,7 @@
 #include "arco/pipeline/run_capture.h"
 
 #include <chrono>
+#include <functional>
 #include <stdexcept>
 #include <utility>
 
@@ -24,6 +25,19 @@ double SecondsSince(Clock::time_point start) {
 
 void Append(std::vector<std::string>* to, const std::vector<std::string>& from) {
   to->insert(to->end(), from.begin(), from.end());
+}
+
+// The run's summary from its records: every stage's summary, the warnings in the stages'
+// order.
+void Summarize(const RunRecords& records, RunSummary* summary) {
+  summary->triangulate = records.triangulation.summary;
+  summary->instrument = records.instrument.summary;
+  summary->hands = records.hand.summary;
+  summary->pitch = records.pitch.summary;
+  for (const MethodRecord& method : records.methods) summary->methods.push_back(method.summary);
+  Append(&summary->warnings, summary->instrument.warnings);
+  Append(&summary->warnings, summary->hands.warnings);
+  Append(&summary->warnings, summary->pitch.warnings);
 }
 
 }  // namespace
@@ -95,122 +109,55 @@ FolderReplace RunOptions::Replace() const {
 
 namespace {
 
-// Every stage, in order, into `result` (options.result_dir's folder, Exclusive: its
-// result.json is held, never read back).
-StatusOr<RunSummary> RunStages(const RunOptions& options,
-                               const ResultFolder& result,
-                               CaptureContext capture,
-                               Progress& progress) {
-  RunSummary summary;
+// Every stage, in order, each taking the records of the stages before it as made (not read
+// back from the result folder: the files hold the same values) and returning its own.
+StatusOr<RunRecords> RunStages(const RunOptions& options,
+                               CaptureContext* opened,
+                               Progress& progress,
+                               RunSummary* summary) {
+  CaptureContext& capture = *opened;
+  RunRecords records;
   auto stage = [&](int index, const char* name) {
     progress.StartStage(index, kRunStages, name);
     return Clock::now();
   };
 
-  // Each stage takes the records of the stages before it as made, not read back from
-  // the result folder (the files hold the same values), and returns its own, which the
-  // run writes through its one ResultFolder.
   auto start = stage(1, "triangulate");
-  ARCO_RETURN_IF_ERROR(result.CheckWritable());  // before the work
-  ARCO_ASSIGN_OR_RETURN(TriangulateStageResult triangulation,
+  ARCO_ASSIGN_OR_RETURN(records.triangulation,
                         RunTriangulateStage(options.ForTriangulate(), capture, progress));
-  ARCO_RETURN_IF_ERROR(WriteTriangulation(result, capture, &triangulation));
-  summary.triangulate = triangulation.summary;
-  summary.timings.push_back({"triangulate", SecondsSince(start)});
+  summary->timings.push_back({"triangulate", SecondsSince(start)});
 
   start = stage(2, "instrument");
   ARCO_ASSIGN_OR_RETURN(
-      const InstrumentRecord instrument,
-      RunInstrumentStage(options.ForInstrument(), capture, triangulation, progress));
-  ARCO_RETURN_IF_ERROR(result.WriteInstrument(instrument));
-  summary.instrument = instrument.summary;
-  summary.timings.push_back({"instrument", SecondsSince(start)});
-  Append(&summary.warnings, summary.instrument.warnings);
+      records.instrument,
+      RunInstrumentStage(options.ForInstrument(), capture, records.triangulation, progress));
+  summary->timings.push_back({"instrument", SecondsSince(start)});
 
   start = stage(3, "hands");
   ARCO_ASSIGN_OR_RETURN(
-      HandRecord hand,
-      RunHandStage(options.ForHands(), capture, triangulation, instrument, progress));
-  ARCO_RETURN_IF_ERROR(result.WriteHand(hand));
-  summary.hands = hand.summary;
-  summary.timings.push_back({"hands", SecondsSince(start)});
+      records.hand,
+      RunHandStage(
+          options.ForHands(), capture, records.triangulation, records.instrument, progress));
+  summary->timings.push_back({"hands", SecondsSince(start)});
   capture.keypoints2d.reset();  // the last stage that reads the 2D keypoints
-  Append(&summary.warnings, summary.hands.warnings);
 
   start = stage(4, "pitch");
-  ARCO_ASSIGN_OR_RETURN(const PitchRecord pitch,
-                        RunPitchStage(options.ForPitch(), capture, progress));
-  if (pitch.summary.ran) ARCO_RETURN_IF_ERROR(result.WritePitch(pitch));
-  summary.pitch = pitch.summary;
+  ARCO_ASSIGN_OR_RETURN(records.pitch, RunPitchStage(options.ForPitch(), capture, progress));
   capture.audio_bytes.reset();  // the last stage that decodes the audio (up to 256 MiB)
-  if (summary.pitch.ran) summary.timings.push_back({"pitch", SecondsSince(start)});
-  Append(&summary.warnings, summary.pitch.warnings);
+  if (records.pitch.summary.ran) summary->timings.push_back({"pitch", SecondsSince(start)});
 
-  // Refinement: vision, then paper and arco when there is pitch. The hands, pitch and
-  // notes go through their files' encodings (in memory), so that the run refines exactly
-  // what `arco refine` reads from the folder.
   start = stage(5, "refine");
-  const std::string pitch_path = result.PitchPath();
-  ARCO_ASSIGN_OR_RETURN(
-      hand.hands, hand::HandsFromParams(hand::HandParams(hand.hands), result.HandParamsPath()));
-  StageRecords records;
-  records.fps = capture.manifest.fps;
-  records.points3d_in_world = &triangulation.points3d;
-  records.instrument = &instrument;
-  records.hand = &hand;
-  records.model = capture.instrument;
-  if (capture.view_to_camera.size() == 1) {
-    records.one_view_camera_centre_in_world =
-        capture.calibration.rig.cameras.at(static_cast<size_t>(capture.view_to_camera[0]))
-            .CenterInWorld();
-  }
-  std::vector<audio::PitchFrame> pitch_as_written;
-  if (summary.pitch.ran) {
-    ARCO_ASSIGN_OR_RETURN(pitch_as_written,
-                          audio::ParsePitchCsv(audio::FormatPitchCsv(pitch.frames), pitch_path));
-    records.pitch = &pitch_as_written;
-    ARCO_ASSIGN_OR_RETURN(records.notes,
-                          audio::ParseNotesCsv(audio::FormatNotesCsv(pitch.notes), pitch_path));
-  }
-  std::vector<audio::PolyPitchFrame> double_stops_as_written;
-  if (!pitch.double_stops.empty()) {
-    ARCO_ASSIGN_OR_RETURN(
-        double_stops_as_written,
-        audio::ParseDoubleStopsCsv(audio::FormatDoubleStopsCsv(pitch.double_stops), pitch_path));
-  }
-  ARCO_ASSIGN_OR_RETURN(RefineInputs inputs, MakeRefineInputs(options.result_dir, records));
-  if (!double_stops_as_written.empty()) AddDoubleStops(double_stops_as_written, &inputs);
-  std::vector<refine::RefineMode> modes = {refine::RefineMode::kVision};
-  if (inputs.has_pitch) {
-    modes.push_back(refine::RefineMode::kPaper);
-    modes.push_back(refine::RefineMode::kArco);
-  }
-  progress.SetTotal(static_cast<int64_t>(modes.size()));
-  for (refine::RefineMode mode : modes) {
-    const RefineStageOptions ro = options.ForRefine(mode);
-    ARCO_ASSIGN_OR_RETURN(const MethodRecord method, RefineMethod(inputs, ro.refine));
-    ARCO_RETURN_IF_ERROR(result.WriteMethod(method));
-    summary.methods.push_back(method.summary);
-    progress.Advance(1);
-  }
-  summary.timings.push_back({"refine", SecondsSince(start)});
-  return summary;
+  ARCO_ASSIGN_OR_RETURN(records.methods, RunRefineMethods(options, capture, records, progress));
+  summary->timings.push_back({"refine", SecondsSince(start)});
+  return records;
 }
 
 // PreflightRun's checks after the capture is opened.
 StatusOr<CaptureContext> PreflightOpened(const RunOptions& options, CaptureContext capture) {
   const CaptureManifest& m = capture.manifest;
   ARCO_RETURN_IF_ERROR(LoadCaptureCalibration(&capture));
-  // Read once here, checked, parsed and fingerprinted from the same bytes; the stages of
-  // the run use the array (CaptureContext::keypoints2d).
-  {
-    ARCO_ASSIGN_OR_RETURN(const FileBytes bytes,
-                          ReadCaptureKeypoints2dBytes(options.capture_dir, m));
-    ARCO_ASSIGN_OR_RETURN(NpyArray<double> k,
-                          ParseCaptureKeypoints2d(bytes.view(), options.capture_dir, m));
-    capture.keypoints2d = std::make_shared<const NpyArray<double>>(std::move(k));
-    capture.inputs[kKeypoints2dInput] = {m.keypoints2d, FingerprintBytes(bytes.view())};
-  }
+  // Read once here; the stages of the run use the array (CaptureContext::keypoints2d).
+  ARCO_RETURN_IF_ERROR(LoadCaptureKeypoints2d(&capture));
   ARCO_RETURN_IF_ERROR(CheckCaptureInstrumentPoints(capture));
   ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(
       options.ForTriangulate(), capture.layout, m.fps, CaptureManifestPath(options.capture_dir)));
@@ -230,24 +177,33 @@ StatusOr<CaptureContext> PreflightOpened(const RunOptions& options, CaptureConte
   return capture;
 }
 
-// The stages of a preflighted capture.
-StatusOr<RunSummary> RunPreflighted(const RunOptions& options,
-                                    CaptureContext capture,
-                                    Progress& progress) {
-  // The stages fill a hidden temporary result folder, moved into place once all are done:
-  // a failed run leaves no result folder and an old one as it was.
-  RunSummary summary;
-  ARCO_RETURN_IF_ERROR(AtomicWriteDirectory(
+// PreflightRun on an opened capture, its options validated.
+StatusOr<CaptureContext> PreflightValidated(const RunOptions& options, CaptureContext opened) {
+  if (opened.capture_dir != options.capture_dir) {
+    throw std::invalid_argument("PreflightRun: capture " + opened.capture_dir +
+                                " opened for capture_dir " + options.capture_dir);
+  }
+  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options.result_dir, options.Replace()));
+  return PreflightOpened(options, std::move(opened));
+}
+
+// Writes `result_dir` as one folder (a hidden temporary, moved into place when complete: a
+// failure leaves no result folder and an old one as it was) through one Exclusive
+// ResultFolder, which `fill` writes into. Messages name the result folder the user gave,
+// not its temporary.
+Status WriteResultFolder(
+    const RunOptions& options,
+    const std::function<Status(const RunOptions& staged, const ResultFolder& result)>& fill) {
+  return AtomicWriteDirectory(
       options.result_dir, options.Replace(), [&](const std::string& tmp_dir) -> Status {
         RunOptions staged = options;
         staged.result_dir = tmp_dir;
-        // The one ResultFolder of the run: every stage writes through it (or its copies),
-        // which hold result.json as last written.
+        // The one ResultFolder of the run: every record is written through it, which holds
+        // result.json as last written.
         const ResultFolder result = ResultFolder::Exclusive(tmp_dir);
-        StatusOr<RunSummary> ran = RunStages(staged, result, std::move(capture), progress);
-        if (!ran.ok()) {
-          // Messages name the result folder the user gave, not its temporary.
-          std::string message = ran.status().message();
+        Status filled = fill(staged, result);
+        if (!filled.ok()) {
+          std::string message = filled.message();
           const std::string given = NormalizeOutputPath(options.result_dir);
           for (size_t at = message.find(tmp_dir); at != std::string::npos;
                at = message.find(tmp_dir, at + given.size())) {
@@ -255,13 +211,111 @@ StatusOr<RunSummary> RunPreflighted(const RunOptions& options,
           }
           return Status::Error(message);
         }
-        summary = std::move(ran).value();
         return result.WriteRunOptions(ToJson(options));
+      });
+}
+
+// The stages of a preflighted capture, their records written as made.
+StatusOr<RunSummary> RunPreflighted(const RunOptions& options,
+                                    CaptureContext capture,
+                                    Progress& progress) {
+  RunSummary summary;
+  ARCO_RETURN_IF_ERROR(WriteResultFolder(
+      options, [&](const RunOptions& staged, const ResultFolder& result) -> Status {
+        ARCO_RETURN_IF_ERROR(result.CheckWritable());  // before the work
+        // The stages release the 2D keypoints and the audio from the context once read for
+        // the last time; the writers need only its manifest, layout and inputs.
+        ARCO_ASSIGN_OR_RETURN(RunRecords records, RunStages(staged, &capture, progress, &summary));
+        ARCO_RETURN_IF_ERROR(WriteRunRecords(result, capture, &records));
+        Summarize(records, &summary);
+        return Status::Ok();
       }));
   return summary;
 }
 
 }  // namespace
+
+StatusOr<std::vector<MethodRecord>> RunRefineMethods(const RunOptions& options,
+                                                     const CaptureContext& capture,
+                                                     const RunRecords& records,
+                                                     Progress& progress) {
+  // The hands, pitch and notes go through their files' encodings (in memory), so that the
+  // run refines exactly what `arco refine` reads from the folder.
+  const ResultFolder result(options.result_dir);
+  const std::string pitch_path = result.PitchPath();
+  HandRecord hand = records.hand;
+  ARCO_ASSIGN_OR_RETURN(
+      hand.hands, hand::HandsFromParams(hand::HandParams(hand.hands), result.HandParamsPath()));
+  StageRecords stages;
+  stages.fps = capture.manifest.fps;
+  stages.points3d_in_world = &records.triangulation.points3d;
+  stages.instrument = &records.instrument;
+  stages.hand = &hand;
+  stages.model = capture.instrument;
+  if (capture.view_to_camera.size() == 1) {
+    stages.one_view_camera_centre_in_world =
+        capture.calibration.rig.cameras.at(static_cast<size_t>(capture.view_to_camera[0]))
+            .CenterInWorld();
+  }
+  const PitchRecord& pitch = records.pitch;
+  std::vector<audio::PitchFrame> pitch_as_written;
+  if (pitch.summary.ran) {
+    ARCO_ASSIGN_OR_RETURN(pitch_as_written,
+                          audio::ParsePitchCsv(audio::FormatPitchCsv(pitch.frames), pitch_path));
+    stages.pitch = &pitch_as_written;
+    ARCO_ASSIGN_OR_RETURN(stages.notes,
+                          audio::ParseNotesCsv(audio::FormatNotesCsv(pitch.notes), pitch_path));
+  }
+  std::vector<audio::PolyPitchFrame> double_stops_as_written;
+  if (!pitch.double_stops.empty()) {
+    ARCO_ASSIGN_OR_RETURN(
+        double_stops_as_written,
+        audio::ParseDoubleStopsCsv(audio::FormatDoubleStopsCsv(pitch.double_stops), pitch_path));
+  }
+  ARCO_ASSIGN_OR_RETURN(RefineInputs inputs, MakeRefineInputs(options.result_dir, stages));
+  if (!double_stops_as_written.empty()) AddDoubleStops(double_stops_as_written, &inputs);
+  std::vector<refine::RefineMode> modes = {refine::RefineMode::kVision};
+  if (inputs.has_pitch) {
+    modes.push_back(refine::RefineMode::kPaper);
+    modes.push_back(refine::RefineMode::kArco);
+  }
+  progress.SetTotal(static_cast<int64_t>(modes.size()));
+  std::vector<MethodRecord> methods;
+  for (refine::RefineMode mode : modes) {
+    const RefineStageOptions ro = options.ForRefine(mode);
+    ARCO_ASSIGN_OR_RETURN(MethodRecord method, RefineMethod(inputs, ro.refine));
+    methods.push_back(std::move(method));
+    progress.Advance(1);
+  }
+  return methods;
+}
+
+Status WriteRunRecords(const ResultFolder& result,
+                       const CaptureContext& capture,
+                       RunRecords* records) {
+  ARCO_RETURN_IF_ERROR(WriteTriangulation(result, capture, &records->triangulation));
+  ARCO_RETURN_IF_ERROR(result.WriteInstrument(records->instrument));
+  ARCO_RETURN_IF_ERROR(result.WriteHand(records->hand));
+  if (records->pitch.summary.ran) ARCO_RETURN_IF_ERROR(result.WritePitch(records->pitch));
+  for (const MethodRecord& method : records->methods) {
+    ARCO_RETURN_IF_ERROR(result.WriteMethod(method));
+  }
+  return Status::Ok();
+}
+
+Status WriteRunResult(const Validated<RunOptions>& options,
+                      const CaptureContext& capture,
+                      RunRecords records) {
+  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options->result_dir, options->Replace()));
+  return WriteResultFolder(*options, [&](const RunOptions&, const ResultFolder& result) {
+    return WriteRunRecords(result, capture, &records);
+  });
+}
+
+StatusOr<CaptureContext> OpenRunCapture(const Validated<RunOptions>& options) {
+  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, OpenCapture(options->capture_dir));
+  return PreflightOpened(*options, std::move(capture));
+}
 
 StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
   ARCO_RETURN_IF_ERROR(options.Validate());
@@ -271,26 +325,29 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options) {
 }
 
 StatusOr<CaptureContext> PreflightRun(const RunOptions& options, CaptureContext opened) {
-  if (opened.capture_dir != options.capture_dir) {
-    throw std::invalid_argument("PreflightRun: capture " + opened.capture_dir +
-                                " opened for capture_dir " + options.capture_dir);
-  }
   ARCO_RETURN_IF_ERROR(options.Validate());
-  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options.result_dir, options.Replace()));
-  return PreflightOpened(options, std::move(opened));
+  return PreflightValidated(options, std::move(opened));
 }
 
 StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress) {
-  // Every input checked before the first stage (and before the result folder exists).
-  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, PreflightRun(options));
-  return RunPreflighted(options, std::move(capture), progress);
+  // The one validation of the run's options.
+  ARCO_ASSIGN_OR_RETURN(const Validated<RunOptions> valid, Validated<RunOptions>::Check(options));
+  return RunCapture(valid, progress);
 }
 
-StatusOr<RunSummary> RunCapture(const RunOptions& options,
+StatusOr<RunSummary> RunCapture(const Validated<RunOptions>& options, Progress& progress) {
+  // Every input checked before the first stage (and before the result folder exists).
+  ARCO_RETURN_IF_ERROR(CheckOutputFolder(options->result_dir, options->Replace()));
+  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, OpenCapture(options->capture_dir));
+  ARCO_ASSIGN_OR_RETURN(capture, PreflightOpened(*options, std::move(capture)));
+  return RunPreflighted(*options, std::move(capture), progress);
+}
+
+StatusOr<RunSummary> RunCapture(const Validated<RunOptions>& options,
                                 CaptureContext opened,
                                 Progress& progress) {
-  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, PreflightRun(options, std::move(opened)));
-  return RunPreflighted(options, std::move(capture), progress);
+  ARCO_ASSIGN_OR_RETURN(CaptureContext capture, PreflightValidated(*options, std::move(opened)));
+  return RunPreflighted(*options, std::move(capture), progress);
 }
 
 }  // namespace arco::pipeline

@@ -18,11 +18,13 @@
 #include "arco/pipeline/instrument_stage.h"
 #include "arco/pipeline/pitch_stage.h"
 #include "arco/pipeline/refine_stage.h"
+#include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/summaries.h"
 #include "arco/pipeline/triangulate_stage.h"
 #include "arco/util/output_set.h"
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
+#include "arco/util/validated.h"
 
 namespace arco::pipeline {
 
@@ -80,6 +82,45 @@ Json ToJson(const RunOptions& options);
 
 inline constexpr int kRunStages = 5;
 
+// The records of a run's stages as they made them (result_folder.h), which the result
+// folder's writers take.
+struct RunRecords {
+  TriangulateStageResult triangulation;
+  InstrumentRecord instrument;
+  HandRecord hand;
+  PitchRecord pitch;                  // summary.ran false: no audio (nothing written)
+  std::vector<MethodRecord> methods;  // vision, then paper and arco when the pitch ran
+};
+
+// Stage 5 of the run: vision, then paper and arco when the pitch stage ran, refined from
+// the records of stages 1-4 (methods ignored), the hands, pitch and notes passed through
+// their files' encodings in memory, so that the run refines exactly what `arco refine`
+// reads (MakeRefineInputs). Messages name the files of options.result_dir. Precondition:
+// options validated. Progress: a total of the methods, advanced per method.
+StatusOr<std::vector<MethodRecord>> RunRefineMethods(const RunOptions& options,
+                                                     const CaptureContext& capture,
+                                                     const RunRecords& records,
+                                                     Progress& progress = NoProgress());
+
+// Writes every record into `result` in the stages' order (the pitch only when it ran);
+// records->triangulation.raw is released (WriteTriangulation).
+Status WriteRunRecords(const ResultFolder& result,
+                       const CaptureContext& capture,
+                       RunRecords* records);
+
+// options.result_dir written from `records` as `arco run` writes it: one folder moved into
+// place when complete (replaced only with options.overwrite), result.json's "options"
+// from `options`. With the records of the stages run one by one on OpenRunCapture's
+// context (the Python bindings' arco.write_result), the folder is `arco run`'s, byte for
+// byte.
+Status WriteRunResult(const Validated<RunOptions>& options,
+                      const CaptureContext& capture,
+                      RunRecords records);
+
+// The capture opened with every input the stages read, checked as PreflightRun checks them
+// but for the result folder (nothing is written): for running the stages one by one.
+StatusOr<CaptureContext> OpenRunCapture(const Validated<RunOptions>& options);
+
 // Fail early: every input `arco run` will need is checked before its first stage
 // (pipeline/capture_checks.h), so a bad capture costs milliseconds, not the triangulation
 // and hand fitting before it, and leaves no result folder (docs/architecture.md,
@@ -95,10 +136,18 @@ StatusOr<CaptureContext> PreflightRun(const RunOptions& options);
 // Throws std::invalid_argument when `opened` is another folder's (a caller bug).
 StatusOr<CaptureContext> PreflightRun(const RunOptions& options, CaptureContext opened);
 
-// Progress: StartStage(i, 5, name) for each stage, then that stage's SetTotal / Advance.
+// The options are validated once, here at the entry (Validated<RunOptions>::Check, the
+// first of PreflightRun's checks); the stages take them as validated and do not check
+// them again. Progress: StartStage(i, 5, name) for each stage, then that stage's
+// SetTotal / Advance.
 StatusOr<RunSummary> RunCapture(const RunOptions& options, Progress& progress = NoProgress());
-// The same on a capture already opened (PreflightRun(options, opened)).
-StatusOr<RunSummary> RunCapture(const RunOptions& options,
+// The same with options already validated (`arco run` checks them when it parses its
+// command line, and hands them on): opens the capture.
+StatusOr<RunSummary> RunCapture(const Validated<RunOptions>& options,
+                                Progress& progress = NoProgress());
+// The same on a capture already opened (OpenCapture(options->capture_dir), e.g. by `arco
+// run` to list its files): PreflightRun's checks after the options then run on it.
+StatusOr<RunSummary> RunCapture(const Validated<RunOptions>& options,
                                 CaptureContext opened,
                                 Progress& progress = NoProgress());
 

@@ -161,11 +161,10 @@ StatusOr<SequenceTriangulation> LiftOneViewCapture(const CaptureContext& capture
 StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptions& o,
                                                      const CaptureContext& capture,
                                                      Progress& progress) {
-  ARCO_RETURN_IF_ERROR(o.Validate());
+  // Options validated and their filters checked against the capture by the caller
+  // (RunCapture's preflight, OpenForTriangulation).
   const CaptureManifest& manifest = capture.manifest;
   const KeypointLayout& layout = capture.layout;
-  const std::string manifest_path = CaptureManifestPath(capture.capture_dir);
-  ARCO_RETURN_IF_ERROR(CheckTriangulationFilters(o, layout, manifest.fps, manifest_path));
   std::vector<const std::vector<int>*> filter_groups;
   for (const auto& entry : o.filters) filter_groups.push_back(layout.Group(entry.first));
   ARCO_ASSIGN_OR_RETURN(const std::shared_ptr<const NpyArray<double>> keypoints2d,

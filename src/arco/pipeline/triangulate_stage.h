@@ -49,6 +49,9 @@ struct TriangulateStageResult {
 // view_to_camera, 2D keypoints (read here when null) and fingerprints) and filters; writes
 // nothing (WriteTriangulation does). options.capture_dir is not read: the capture is.
 // Progress: the total is the frame count, advanced per frame from worker threads.
+// Precondition: options.Validate() is ok and its filters suit the capture
+// (CheckTriangulationFilters, capture_checks.h): RunCapture checks both once, before its
+// first stage; not checked here.
 StatusOr<TriangulateStageResult> RunTriangulateStage(const TriangulateStageOptions& options,
                                                      const CaptureContext& capture,
                                                      Progress& progress = NoProgress());
@@ -59,8 +62,9 @@ Status WriteTriangulation(const ResultFolder& result,
                           const CaptureContext& capture,
                           TriangulateStageResult* stage);
 
-// `arco triangulate CAPTURE`: opens options.capture_dir (no instrument needed), runs the
-// stage on it and writes it into options.result_dir.
+// `arco triangulate CAPTURE`: validates the options, opens options.capture_dir (no
+// instrument needed; the filters checked against it), runs the stage on it and writes it
+// into options.result_dir.
 StatusOr<TriangulateStageSummary> RunTriangulateStage(const TriangulateStageOptions& options,
                                                       Progress& progress = NoProgress());
 

@@ -8,6 +8,8 @@
 //   eval.cc         arco.evaluate_pitch, arco.evaluate
 //   result.cc       arco.read_result
 //   run.cc          arco.run, arco.refine (`arco run`, `arco refine`)
+//   stages.cc       arco.open_capture, the stages of `arco run` one by one
+//                   (arco.triangulate_stage ... arco.refine_stage), arco.write_result
 // module.cc defines the module and calls them. Errors:
 //   ValueError    bad arguments (Validate(), std::invalid_argument, wrong array shapes)
 //   OSError       a file or folder that does not exist
@@ -129,5 +131,6 @@ void BindHand(py::module_& m);
 void BindEval(py::module_& m);
 void BindResult(py::module_& m);
 void BindRun(py::module_& m);
+void BindStages(py::module_& m);
 
 }  // namespace arco::python

@@ -17,4 +17,5 @@ PYBIND11_MODULE(arco, m) {
   BindEval(m);
   BindResult(m);
   BindRun(m);
+  BindStages(m);
 }

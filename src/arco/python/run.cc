@@ -31,10 +31,12 @@ py::dict RunPy(const std::filesystem::path& capture_dir,
   o.result_dir = result_dir.string();
   o.overwrite = overwrite;
   o.num_threads = num_threads;
-  CheckValid(o.Validate());
+  // Validated once, here (a ValueError), and run as validated.
+  StatusOr<Validated<pipeline::RunOptions>> valid = Validated<pipeline::RunOptions>::Check(o);
+  CheckValid(valid.status());
   StatusOr<pipeline::RunSummary> summary = [&] {
     py::gil_scoped_release release;
-    return pipeline::RunCapture(o);
+    return pipeline::RunCapture(*valid);
   }();
   if (!summary.ok()) RaiseStatus(summary.status(), o.capture_dir);
   py::dict timings;
@@ -61,10 +63,12 @@ py::object RefinePy(const std::filesystem::path& result_dir,
   o.refine.mode = *parsed;
   o.refine.num_threads = num_threads;
   o.refine.pitch.min_confidence = min_confidence;
-  CheckValid(o.Validate());
+  StatusOr<Validated<pipeline::RefineStageOptions>> valid =
+      Validated<pipeline::RefineStageOptions>::Check(o);
+  CheckValid(valid.status());
   StatusOr<refine::RefineSummary> summary = [&] {
     py::gil_scoped_release release;
-    return pipeline::RunRefineStage(o);
+    return pipeline::RunRefineStage(*valid);
   }();
   if (!summary.ok()) RaiseStatus(summary.status(), o.result_dir);
   return MethodSummary(*summary);

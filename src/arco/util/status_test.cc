@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "arco/util/validated.h"
+
 namespace arco {
 namespace {
 
@@ -25,6 +27,27 @@ TEST(StatusOr, PropagatesErrorsAndValues) {
   EXPECT_FALSE(s.ok());
   EXPECT_EQ(s.message(), "odd");
   EXPECT_EQ(s.WithContext("f.json").message(), "f.json: odd");
+}
+
+struct CountedOptions {
+  int value = 1;
+  mutable int checks = 0;
+  Status Validate() const {
+    ++checks;
+    return value > 0 ? Status::Ok() : Status::Error("value must be > 0");
+  }
+};
+
+TEST(Validated, ChecksOnceAndCarriesTheOptionsOrTheError) {
+  CountedOptions o;
+  StatusOr<Validated<CountedOptions>> valid = Validated<CountedOptions>::Check(o);
+  ASSERT_TRUE(valid.ok());
+  EXPECT_EQ((*valid)->value, 1);
+  EXPECT_EQ((*valid)->checks, 1);  // the copy it holds was checked once
+  o.value = 0;
+  StatusOr<Validated<CountedOptions>> invalid = Validated<CountedOptions>::Check(o);
+  ASSERT_FALSE(invalid.ok());
+  EXPECT_EQ(invalid.status().message(), "value must be > 0");
 }
 
 TEST(StatusOrDeathTest, ValueOfErrorAborts) {
