@@ -8,8 +8,13 @@ strings), ours in the frame of our instrument, SPD's in the frame of SPD's.
 
 usage: hand_in_instrument.py RESULT_DIR TRUTH_POINTS3D [METHOD ...]
 Prints per method: the median over frames of the 21 joints' mean error (mm), the fraction
-of all frames within 15 mm, and the fraction of frames with a hand. As a module:
-left_hand_in_instrument(result_dir, truth_points3d, method) -> those three numbers.
+of all frames within 15 mm, and the fraction of frames with a hand; then where that error
+lies: the wrist's median signed offset along the strings (+: toward the nut), across them
+and off the top, and the median error left once each frame's mean offset (the hand's
+translation) is taken away (the hand's orientation and shape). As a module:
+left_hand_in_instrument(result_dir, truth_points3d, method) -> those three numbers;
+left_hand_error_parts(result_dir, truth_points3d, method) -> (wrist offset x, y, z,
+error without the translation).
 """
 import json
 import sys
@@ -33,7 +38,7 @@ def _in_frame(points, bridge, rows):
     return np.einsum("fij,fpj->fpi", rows, points - bridge[:, None])
 
 
-def left_hand_in_instrument(result_dir, truth_points3d, method):
+def _hands_in_frame(result_dir, truth_points3d, method):
     names = json.load(open(result_dir + "/result.json"))["keypoint_names"]
     col = names.index
     hand = list(range(col("left_hand_wrist"), col("left_hand_wrist") + 21))
@@ -41,6 +46,24 @@ def left_hand_in_instrument(result_dir, truth_points3d, method):
     ours = np.load("%s/%s/points3d.npy" % (result_dir, method))
     want = _in_frame(truth[:, hand], *_frame(truth, col))
     got = _in_frame(ours[:, hand], *_frame(ours, col))
+    return got, want
+
+
+def left_hand_error_parts(result_dir, truth_points3d, method):
+    got, want = _hands_in_frame(result_dir, truth_points3d, method)
+    offset = got - want
+    framed = np.isfinite(offset).all(axis=(1, 2))
+    if not framed.any():
+        return float("nan"), float("nan"), float("nan"), float("nan")
+    offset = offset[framed]
+    wrist = np.median(offset[:, 0], axis=0)
+    shape = offset - offset.mean(axis=1, keepdims=True)
+    without_translation = np.median(np.linalg.norm(shape, axis=2).mean(axis=1))
+    return float(wrist[0]), float(wrist[1]), float(wrist[2]), float(without_translation)
+
+
+def left_hand_in_instrument(result_dir, truth_points3d, method):
+    got, want = _hands_in_frame(result_dir, truth_points3d, method)
     distances = np.linalg.norm(got - want, axis=2)
     counted = np.isfinite(distances).sum(1)
     error = np.where(counted > 0, np.nansum(distances, 1) / np.maximum(counted, 1), np.nan)
@@ -56,3 +79,7 @@ if __name__ == "__main__":
         median, within, fitted = left_hand_in_instrument(sys.argv[1], sys.argv[2], m)
         print("%-6s median %.1f mm, within 15 mm on %.3f of frames, a hand on %.3f"
               % (m, median, within, fitted))
+        x, y, z, shape = left_hand_error_parts(sys.argv[1], sys.argv[2], m)
+        print("%-6s wrist off by %+.1f / %+.1f / %+.1f mm (along toward the nut / across / off "
+              "the top), %.1f mm once each frame's translation is taken away"
+              % (m, x, y, z, shape))
