@@ -415,6 +415,8 @@ void ConsistentDoubleStops(int window_frames, std::vector<PolyPitchFrame>* frame
     const auto own = PairKey(heard[i]);
     const int64_t lo = std::max<int64_t>(0, i - window_frames);
     const int64_t hi = std::min<int64_t>(n - 1, i + window_frames);
+    int own_support = 0;  // frames of the window (i included) that heard i's own pair
+    for (int64_t k = lo; k <= hi; ++k) own_support += is_pair(k) && PairKey(heard[k]) == own;
     int64_t best = -1;  // nearest frame of the chosen pair
     int best_support = 0;
     std::array<int64_t, 2> best_key{};
@@ -433,7 +435,7 @@ void ConsistentDoubleStops(int window_frames, std::vector<PolyPitchFrame>* frame
           before |= k < i;
           after |= k > i;
         }
-        if (!before || !after) continue;
+        if (!before || !after || 2 * support < own_support) continue;
         if (support > best_support || (support == best_support && key < best_key)) {
           best = j;
           best_support = support;

@@ -157,9 +157,11 @@ class DoubleStopAnalyzer {
 // before and after) when every note of frame i's pair is one of K's notes or its 2nd, 3rd
 // or 4th partial (within half a semitone): the simpler explanation the neighbours confirm.
 // Among such K, the one on most frames of the window (then the lowest); its f0s and
-// saliences are those of its nearest frame (the earlier on a tie). Frames with fewer than
-// two notes are left as they are; decisions are made on the input, so the order of frames
-// plays no part. window_frames 0: unchanged.
+// saliences are those of its nearest frame (the earlier on a tie). K must be on at least
+// half as many frames of the window as frame i's own pair: a chord's short lower pair
+// D4 + A4 heard right on 6 of its 8 frames and as A3 + D4 at its two onsets stays D4 + A4. Frames
+// with fewer than two notes are left as they are; decisions are made on the input, so the order of
+// frames plays no part. window_frames 0: unchanged.
 void ConsistentDoubleStops(int window_frames, std::vector<PolyPitchFrame>* frames);
 
 // The second note beside the single-note tracker's f0, one per tracker frame (poly[i] must
