@@ -218,6 +218,20 @@ TEST(ConsistentDoubleStops, APairHeardOnMostOfTheWindowIsKept) {
   for (int i : {1, 3, 5}) EXPECT_EQ(made[i].notes[0].f0_hz, 220.0) << i;
 }
 
+// A fundamental is present only as a peak: the band's maximum on the slope of a stronger
+// peak outside it (a neighbour's main lobe, an onset's smear) is none; a peak inside the
+// band, even a weak one or one at the band's edge, is.
+TEST(BandPeak, APeakInsideTheBandNotTheSlopeOfAPeakOutside) {
+  const std::vector<double> spectrum = {0.0, 0.1, 0.3, 0.2, 0.5, 1.0, 0.5, 0.1, 0.02, 0.01};
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 1, 3), 0.3);  // a weak peak inside
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 2, 2), 0.3);  // one bin wide
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 3, 4), 0.0);  // 1.0's rising slope
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 6, 8), 0.0);  // its falling slope
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 5, 7), 1.0);
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 8, 9), 0.0);  // the slope up to the spectrum's end
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 9, 10), -1.0);
+}
+
 TEST(SecondNoteHz, TheNoteBesideTheTrackersF0) {
   std::vector<PitchFrame> frames(4);
   for (auto& f : frames) f.voiced = true, f.f0_hz = 440.0;
