@@ -152,6 +152,23 @@ double DoubleStopAnalyzer::BandMax(int candidate,
   return spectrum[best];
 }
 
+double BandPeak(const std::vector<double>& spectrum, int lo, int hi) {
+  if (lo < 0 || hi < lo || hi >= static_cast<int>(spectrum.size())) return -1.0;
+  int k = lo;
+  for (int j = lo + 1; j <= hi; ++j) {
+    if (spectrum[j] > spectrum[k]) k = j;
+  }
+  const double a = spectrum[k];
+  const bool below = k > 0 && spectrum[k - 1] > a;
+  const bool above = k + 1 < static_cast<int>(spectrum.size()) && spectrum[k + 1] > a;
+  return below || above ? 0.0 : a;
+}
+
+double DoubleStopAnalyzer::Fundamental(int candidate, const std::vector<double>& spectrum) const {
+  const auto& band = bands_[static_cast<size_t>(candidate) * options_.harmonics];
+  return band[0] < 0 ? -1.0 : BandPeak(spectrum, band[0], band[1]);
+}
+
 double DoubleStopAnalyzer::Salience(int candidate, const std::vector<double>& spectrum) const {
   double s = 0;
   for (int m = 1; m <= options_.harmonics; ++m) {
@@ -183,7 +200,7 @@ DoubleStopAnalyzer::Best DoubleStopAnalyzer::Search(const std::vector<double>& s
     // fundamental is the first note's 2nd partial, which may have interfered away.
     const bool octave = first >= 0 && std::abs(candidates_midi_[c] - candidates_midi_[first] -
                                                12.0) < kPartialCents / 100.0;
-    if (!octave && BandMax(c, 1, spectrum, nullptr) < min_fundamental) continue;
+    if (!octave && Fundamental(c, spectrum) < min_fundamental) continue;
     const double s = Salience(c, spectrum);
     if (s > best.salience) best = {c, s};
   }
@@ -281,7 +298,7 @@ int DoubleStopAnalyzer::LostFundamental(int note, int partner) {
   const double peak = *std::max_element(magnitude_.begin(), magnitude_.end());
   // Half the usual bar: the low strings' fundamentals (a double bass's E1 at 41 Hz) are
   // 2-5% of the strongest partial; the odd partials below are the stronger evidence.
-  if (BandMax(below, 1, residual_, nullptr) < 0.5 * options_.min_fundamental_ratio * peak) {
+  if (Fundamental(below, residual_) < 0.5 * options_.min_fundamental_ratio * peak) {
     return -1;
   }
   double odd = 0, even = 0;
@@ -304,7 +321,7 @@ int DoubleStopAnalyzer::PartialFifth(int low, int high) const {
   const int below = low - static_cast<int>(std::lround(1200.0 / options_.grid_cents));
   if (below < 0) return -1;
   const double peak = *std::max_element(magnitude_.begin(), magnitude_.end());
-  if (BandMax(below, 1, magnitude_, nullptr) < 0.5 * options_.min_fundamental_ratio * peak) {
+  if (Fundamental(below, magnitude_) < 0.5 * options_.min_fundamental_ratio * peak) {
     return -1;
   }
   double unique = 0, heard = 0;
@@ -415,6 +432,8 @@ void ConsistentDoubleStops(int window_frames, std::vector<PolyPitchFrame>* frame
     const auto own = PairKey(heard[i]);
     const int64_t lo = std::max<int64_t>(0, i - window_frames);
     const int64_t hi = std::min<int64_t>(n - 1, i + window_frames);
+    int own_support = 0;  // frames of the window (i included) that heard i's own pair
+    for (int64_t k = lo; k <= hi; ++k) own_support += is_pair(k) && PairKey(heard[k]) == own;
     int64_t best = -1;  // nearest frame of the chosen pair
     int best_support = 0;
     std::array<int64_t, 2> best_key{};
@@ -433,7 +452,7 @@ void ConsistentDoubleStops(int window_frames, std::vector<PolyPitchFrame>* frame
           before |= k < i;
           after |= k > i;
         }
-        if (!before || !after) continue;
+        if (!before || !after || 2 * support < own_support) continue;
         if (support > best_support || (support == best_support && key < best_key)) {
           best = j;
           best_support = support;

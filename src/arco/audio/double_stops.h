@@ -16,7 +16,8 @@
 //       strings, each at or above its open string, and their stops lie within
 //       max_span_semitones of each other along the fingerboard (PlayableDoubleStop);
 //   (2) its fundamental is present in the residual (kills the sub-octave, sub-fifth and
-//       fifth-above ghosts of a single note, whose fundamentals are no partial);
+//       fifth-above ghosts of a single note, whose fundamentals are no partial): a peak
+//       (BandPeak), not the slope of a neighbour's;
 //   (3) its residual salience is at least second_min_ratio of the first note's;
 //   (4) then, for each note of the pair, its octave below replaces it when that forms a
 //       playable pair with the partner, its fundamental is present and its odd partials
@@ -107,6 +108,12 @@ bool PlayableDoubleStop(const std::array<double, 4>& open_midi_low_to_high,
                         double high_midi,
                         double max_span_semitones);
 
+// The largest magnitude of spectrum[lo..hi] when it is a local maximum of the spectrum
+// (a peak inside the band); 0 when the band only holds the slope of a peak outside it (a
+// neighbouring partial's main lobe, or the smear of an onset inside the window); -1 for a
+// band outside the spectrum. A candidate's fundamental is present only as such a peak.
+double BandPeak(const std::vector<double>& spectrum, int lo, int hi);
+
 // One window at a time; buffers and the FFT plan are made once (options validated by the
 // caller: the constructor throws std::invalid_argument on invalid options).
 class DoubleStopAnalyzer {
@@ -126,6 +133,9 @@ class DoubleStopAnalyzer {
     double salience = 0;
   };
   double Salience(int candidate, const std::vector<double>& spectrum) const;
+  // The fundamental's magnitude (BandMax of partial 1) when it is a local maximum of the
+  // spectrum; 0 when the band only holds the slope of a peak outside it.
+  double Fundamental(int candidate, const std::vector<double>& spectrum) const;
   double BandMax(int candidate, int m, const std::vector<double>& spectrum, int* at) const;
   Best Search(const std::vector<double>& spectrum, int first) const;
   double Refine(int candidate, const std::vector<double>& spectrum);
@@ -157,9 +167,11 @@ class DoubleStopAnalyzer {
 // before and after) when every note of frame i's pair is one of K's notes or its 2nd, 3rd
 // or 4th partial (within half a semitone): the simpler explanation the neighbours confirm.
 // Among such K, the one on most frames of the window (then the lowest); its f0s and
-// saliences are those of its nearest frame (the earlier on a tie). Frames with fewer than
-// two notes are left as they are; decisions are made on the input, so the order of frames
-// plays no part. window_frames 0: unchanged.
+// saliences are those of its nearest frame (the earlier on a tie). K must be on at least
+// half as many frames of the window as frame i's own pair: a chord's short lower pair
+// D4 + A4 heard right on 6 of its 8 frames and as A3 + D4 at its two onsets stays D4 + A4. Frames
+// with fewer than two notes are left as they are; decisions are made on the input, so the order of
+// frames plays no part. window_frames 0: unchanged.
 void ConsistentDoubleStops(int window_frames, std::vector<PolyPitchFrame>* frames);
 
 // The second note beside the single-note tracker's f0, one per tracker frame (poly[i] must

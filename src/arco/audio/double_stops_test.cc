@@ -199,6 +199,39 @@ TEST(ConsistentDoubleStops, KeepsNoteChangesAndPairsNoNeighbourExplains) {
   }
 }
 
+// A chord's short lower pair D4 + A4 heard right on its middle frames and inverted (A3 + D4:
+// A4 is A3's 2nd partial) at its two edges, where the window holds the onsets: A3 + D4 is
+// seen on both sides of every middle frame and explains it, but the window hears the pair
+// itself on more than twice as many frames, so the pair stays. Where the two readings are
+// as frequent (the viola's alternations), the explanation still wins.
+TEST(ConsistentDoubleStops, APairHeardOnMostOfTheWindowIsKept) {
+  const PolyPitchFrame pair = Pair(293.7, 440.0), inverted = Pair(220.0, 293.7);
+  std::vector<PolyPitchFrame> frames = {inverted, pair, pair, pair, pair, pair, pair, inverted};
+  std::vector<PolyPitchFrame> made = frames;
+  ConsistentDoubleStops(5, &made);
+  for (int i = 1; i <= 6; ++i) EXPECT_EQ(made[i].notes[0].f0_hz, 293.7) << i;
+  EXPECT_EQ(made[0].notes[0].f0_hz, 220.0);  // a pair on one side only: a note change
+  // Alternating, each reading on about half the window's frames: the simpler one.
+  frames = {inverted, pair, inverted, pair, inverted, pair, inverted};
+  made = frames;
+  ConsistentDoubleStops(5, &made);
+  for (int i : {1, 3, 5}) EXPECT_EQ(made[i].notes[0].f0_hz, 220.0) << i;
+}
+
+// A fundamental is present only as a peak: the band's maximum on the slope of a stronger
+// peak outside it (a neighbour's main lobe, an onset's smear) is none; a peak inside the
+// band, even a weak one or one at the band's edge, is.
+TEST(BandPeak, APeakInsideTheBandNotTheSlopeOfAPeakOutside) {
+  const std::vector<double> spectrum = {0.0, 0.1, 0.3, 0.2, 0.5, 1.0, 0.5, 0.1, 0.02, 0.01};
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 1, 3), 0.3);  // a weak peak inside
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 2, 2), 0.3);  // one bin wide
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 3, 4), 0.0);  // 1.0's rising slope
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 6, 8), 0.0);  // its falling slope
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 5, 7), 1.0);
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 8, 9), 0.0);  // the slope up to the spectrum's end
+  EXPECT_DOUBLE_EQ(BandPeak(spectrum, 9, 10), -1.0);
+}
+
 TEST(SecondNoteHz, TheNoteBesideTheTrackersF0) {
   std::vector<PitchFrame> frames(4);
   for (auto& f : frames) f.voiced = true, f.f0_hz = 440.0;

@@ -298,7 +298,7 @@ StatusOr<MethodRecord> RefineMethod(const RefineInputs& inputs,
     r.hand = std::move(ds.hand);
     // The pair of fingers may have given first-voice notes another finger: their rows of
     // fingering.csv follow.
-    if (ds.summary.first_fingers_changed > 0) {
+    if (ds.summary.first_fingers_changed > 0 || ds.summary.chord_frames_moved > 0) {
       r.contacts = std::move(ds.first);
       r.fingering = refine::Transcribe(
           *inputs.input.instrument, r.analysis, r.contacts, inputs.input.fps, inputs.input.a4_hz);

@@ -845,13 +845,17 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
                                {"fifth_semitones", o.fifth_semitones},
                                {"max_tip_distance_mm", o.max_tip_distance_mm},
                                {"max_iterations", o.max_iterations},
-                               {"fill_notes", o.fill_notes}}},
+                               {"fill_notes", o.fill_notes},
+                               {"tie_chords", o.tie_chords},
+                               {"chord_gap_s", o.chord_gap_s},
+                               {"chord_lower_max_s", o.chord_lower_max_s}}},
                              {"summary",
                               {{"frames", d.frames},
                                {"pressed", d.pressed},
                                {"open_string", d.open_string},
                                {"one_finger_fifths", d.one_finger_fifths},
                                {"first_fingers_changed", d.first_fingers_changed},
+                               {"chord_frames_moved", d.chord_frames_moved},
                                {"uncertain", d.uncertain},
                                {"joint_limit_violations", d.joint_limit_violations}}}};
   }

@@ -120,6 +120,155 @@ FingerPair ChooseFingers(const RefineInput& input,
   return pair;
 }
 
+// Moves the first voice of frame f to `string` at its own pitch (open within the
+// tolerance, else stopped by the fingertip the cameras saw nearest the new contact, placed
+// there by IK after the old finger went back to the cameras' pose). False, and nothing
+// changed, where the string cannot give the pitch or there is no hand or no strings.
+bool MoveFirstVoice(const RefineInput& input,
+                    size_t f,
+                    int string,
+                    const hand::FingerIkOptions& ik,
+                    const DoubleStopRefineOptions& options,
+                    FrameContact* c1,
+                    std::optional<hand::HandPose>* hand) {
+  const InstrumentModel& model = *input.instrument;
+  const double above_open = SemitonesAboveOpen(model, string, c1->f0_hz);
+  if (above_open < -options.open_tolerance_cents / 100.0 || !*hand) return false;
+  hand::HandPose pose = **hand;
+  const std::optional<hand::HandPose>& vision = input.vision_hand[f];
+  if (c1->pressed() && vision) {  // the old finger leaves its stop
+    for (int d = 0; d < 4; ++d) {
+      const int i =
+          hand::DofIndex(static_cast<hand::Finger>(c1->finger), static_cast<hand::FingerDof>(d));
+      pose.angles_rad[static_cast<size_t>(i)] = vision->angles_rad[static_cast<size_t>(i)];
+    }
+  }
+  FrameContact moved = *c1;
+  moved.string = string;
+  moved.reason = ContactReason::kNone;
+  if (above_open <= options.open_tolerance_cents / 100.0) {
+    moved.state = ContactState::kOpenString;
+    moved.finger = 0;
+    moved.point_in_world_mm = Eigen::Vector3d::Constant(kNaN);
+    moved.from_nut_mm = moved.tip_distance_vision_mm = moved.tip_distance_refined_mm = kNaN;
+  } else {
+    const std::vector<StringSegment>& strings = input.strings_in_world_mm[f];
+    const Contact contact = ContactPoint(model, string, c1->f0_hz);
+    if (strings.empty() || !contact.stopped()) return false;
+    moved.state = ContactState::kPressed;
+    moved.point_in_world_mm =
+        strings[static_cast<size_t>(string - 1)].PointAtFraction(contact.fraction_from_bridge);
+    moved.from_nut_mm = model.string_length_mm() - contact.contact_from_bridge_mm;
+    const hand::HandPose& seen = vision ? *vision : **hand;
+    double best_mm = std::numeric_limits<double>::infinity();
+    for (int finger = 1; finger <= 4; ++finger) {
+      const double d = TipDistance(input.hand_model, seen, finger, moved.point_in_world_mm);
+      if (d < best_mm) best_mm = d, moved.finger = finger;
+    }
+    const hand::FingerIkResult r = hand::SolveFingertipIk(input.hand_model,
+                                                          pose,
+                                                          static_cast<hand::Finger>(moved.finger),
+                                                          moved.point_in_world_mm,
+                                                          ik);
+    if (r.status.ok()) pose = r.pose;
+    moved.tip_distance_vision_mm = best_mm;
+    moved.tip_distance_refined_mm =
+        TipDistance(input.hand_model, pose, moved.finger, moved.point_in_world_mm);
+  }
+  *c1 = moved;
+  *hand = pose;
+  return true;
+}
+
+// A rolled chord is two double stops in a row: a short lower pair, then the upper pair held.
+// The two pairs share one hand, so the lower pair's strings follow the upper pair's: when
+// the lower pair's upper note is the upper pair's lower note (a 3-note chord: one finger
+// holds it on one string) the lower pair lies on the string below the upper pair's and the
+// one it shares; when all four notes differ (a 4-note chord) on the two strings below the
+// upper pair's. A lower pair is a double-stop note of at most chord_lower_max_s; its upper
+// pair the next longer double-stop note, beginning at most chord_gap_s after it ends.
+// Returns the first-voice frames moved to another string (MoveFirstVoice).
+int TieChords(const RefineInput& input,
+              const std::map<int, double>& note_upper_hz,
+              const hand::FingerIkOptions& ik,
+              const DoubleStopRefineOptions& options,
+              DoubleStopRefineResult* out) {
+  const InstrumentModel& model = *input.instrument;
+  struct Span {
+    int note = -1;
+    size_t first = 0, last = 0;
+    std::vector<double> f0_hz;    // the first voice's sounding frames
+    std::array<int, 8> string{};  // votes of its sounding frames
+  };
+  std::map<int, Span> spans;
+  for (size_t f = 0; f < out->first.size(); ++f) {
+    const FrameContact& c = out->first[f];
+    if (note_upper_hz.count(c.note) == 0) continue;
+    auto [it, fresh] = spans.try_emplace(c.note);
+    Span& span = it->second;
+    if (fresh) span.note = c.note, span.first = f;
+    span.last = f;
+    const bool sounding = c.state == ContactState::kPressed || c.state == ContactState::kOpenString;
+    if (sounding && c.string >= 1 && c.string < static_cast<int>(span.string.size())) {
+      span.f0_hz.push_back(c.f0_hz);
+      ++span.string[static_cast<size_t>(c.string)];
+    }
+  }
+  std::vector<Span> order;
+  for (auto& [note, span] : spans) order.push_back(std::move(span));
+  std::sort(
+      order.begin(), order.end(), [](const Span& a, const Span& b) { return a.first < b.first; });
+  const double gap_frames = options.chord_gap_s * input.fps;
+  const double lower_frames = options.chord_lower_max_s * input.fps;
+  const double tolerance = options.open_tolerance_cents / 100.0;
+  int moved = 0;
+  for (size_t k = 0; k + 1 < order.size(); ++k) {
+    const Span& lower = order[k];
+    const size_t length = lower.last - lower.first + 1;
+    if (static_cast<double>(length) > lower_frames || lower.f0_hz.empty()) continue;
+    // The held pair: the next double-stop note longer than this one (a short note between
+    // is the held pair's onset, heard while the window still holds the lower pair).
+    size_t u = k + 1;
+    while (u < order.size() && order[u].last - order[u].first + 1 <= length &&
+           static_cast<double>(order[u].first - lower.last - 1) <= gap_frames) {
+      ++u;
+    }
+    if (u == order.size() || static_cast<double>(order[u].first - lower.last - 1) > gap_frames ||
+        order[u].f0_hz.empty()) {
+      continue;
+    }
+    const Span& upper = order[u];
+    const int upper_string = static_cast<int>(
+        std::max_element(upper.string.begin(), upper.string.end()) - upper.string.begin());
+    std::vector<double> f0 = lower.f0_hz;
+    const double low1 = UpperMedian(f0);
+    f0 = upper.f0_hz;
+    const double low2 = UpperMedian(f0);
+    const double high1 = note_upper_hz.at(lower.note);
+    const double cents = 1200.0 * std::log2(low2 / high1);
+    const int string = std::abs(cents) <= 50.0 ? upper_string + 1
+                       : cents > 50.0          ? upper_string + 2
+                                               : 0;
+    if (string < 2 || string > model.num_strings()) continue;
+    // Both notes of the lower pair playable there, within a hand's span.
+    const double stop1 = SemitonesAboveOpen(model, string, low1);
+    const double stop2 = SemitonesAboveOpen(model, string - 1, high1);
+    if (stop1 < -tolerance || stop2 < -tolerance ||
+        (stop1 > tolerance && stop2 > tolerance &&
+         std::abs(stop1 - stop2) > options.max_span_semitones)) {
+      continue;
+    }
+    for (size_t f = lower.first; f <= lower.last; ++f) {
+      FrameContact& c1 = out->first[f];
+      const bool sounding =
+          c1.state == ContactState::kPressed || c1.state == ContactState::kOpenString;
+      if (c1.note != lower.note || !sounding || c1.string == string) continue;
+      moved += MoveFirstVoice(input, f, string, ik, options, &c1, &out->hand[f]);
+    }
+  }
+  return moved;
+}
+
 }  // namespace
 
 Status DoubleStopRefineOptions::Validate() const {
@@ -129,6 +278,8 @@ Status DoubleStopRefineOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(CheckInRange("fifth_semitones", fifth_semitones, kSpanRangeSemitones));
   ARCO_RETURN_IF_ERROR(
       CheckInRange("max_tip_distance_mm", max_tip_distance_mm, kTipDistanceRangeMm));
+  ARCO_RETURN_IF_ERROR(CheckInRange("chord_gap_s", chord_gap_s, kChordWindowRangeS));
+  ARCO_RETURN_IF_ERROR(CheckInRange("chord_lower_max_s", chord_lower_max_s, kChordWindowRangeS));
   if (max_iterations < 1 || max_iterations > 1000)
     return Status::Error("max_iterations must be in [1, 1000]");
   return Status::Ok();
@@ -173,10 +324,14 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
     if (2 * static_cast<int>(values.size()) < note_frames[note]) continue;
     note_median[note] = UpperMedian(values);
   }
+  // Chords: the lower pair on the strings its upper pair leaves it.
+  if (options.tie_chords) {
+    out.summary.chord_frames_moved = TieChords(input, note_median, ik, options, &out);
+  }
   // Pass 1: each frame's second voice up to its finger; `stopped` frames need one.
   std::vector<Stop> stops(frames);
   for (size_t f = 0; f < frames; ++f) {
-    const FrameContact& c1 = first.contacts[f];
+    const FrameContact& c1 = out.first[f];
     double upper = upper_f0_hz[f];
     if (!(upper > 0) && options.fill_notes) {
       const auto it = note_median.find(c1.note);
@@ -256,8 +411,8 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
   for (const auto& [key, members] : groups) {
     const int note = key.first;
     const bool may_change = note >= 0 && 2 * note_double_frames[note] >= note_frames[note];
-    const FingerPair pair = ChooseFingers(
-        input, first.contacts, out.second, out.hand, stops, members, may_change, options);
+    const FingerPair pair =
+        ChooseFingers(input, out.first, out.second, out.hand, stops, members, may_change, options);
     for (size_t f : members) fingers[f] = pair;
   }
 

@@ -35,6 +35,12 @@
 //   0. A first-voice note (FrameContact::note) with an upper note on at least half its
 //      frames gets their median on its frames without one, where it lies above the frame's
 //      pitch (fill_notes).
+//  0b. Chords (tie_chords): a rolled chord reaches the refinement as a short lower pair
+//      right before its held upper pair, and the first voice of each was decoded alone. The
+//      lower pair's first voice moves to the string below the upper pair's lower note when
+//      the two pairs share that note (one finger holds it on one string), or two below when
+//      the four notes differ: the string (open within open_tolerance_cents, else the
+//      fingertip nearest the new contact, by IK) where both of its notes are playable.
 //   5. IK: that finger's tip to the contact by the hand layer's bounded IK (MCP, PIP, DIP
 //      within the joint limits, regularised toward the refined pose); a fifth's finger is
 //      left where the first voice put it (its pad covers both strings).
@@ -57,6 +63,7 @@ namespace arco::refine {
 inline constexpr NumberRange kOpenToleranceRangeCents = Closed(0, 100);
 inline constexpr NumberRange kSpanRangeSemitones = Closed(0, 24);
 inline constexpr NumberRange kTipDistanceRangeMm = Closed(0, 500);
+inline constexpr NumberRange kChordWindowRangeS = Closed(0, 2);
 
 struct DoubleStopRefineOptions {
   double open_tolerance_cents = 40.0;  // an upper note this near its open string is open
@@ -67,6 +74,13 @@ struct DoubleStopRefineOptions {
   // A first-voice note with an upper note on at least half its frames keeps the median of
   // them on its other frames (the tracker's window misses the second note near the ends).
   bool fill_notes = true;
+  // A rolled chord's lower pair (a double-stop note of at most chord_lower_max_s, ending at
+  // most chord_gap_s before the next longer double-stop note, its upper pair) is put on the
+  // strings its upper pair leaves it (step 0b): below the shared note's string, or the two
+  // below a 4-note chord's upper pair.
+  bool tie_chords = true;
+  double chord_gap_s = 0.2;
+  double chord_lower_max_s = 0.5;
   Status Validate() const;
 };
 
@@ -75,6 +89,7 @@ struct DoubleStopRefineSummary {
   int pressed = 0, open_string = 0;  // second voices assigned
   int one_finger_fifths = 0;         // pressed by the first voice's finger
   int first_fingers_changed = 0;     // first-voice frames given another finger (step 4)
+  int chord_frames_moved = 0;        // first-voice frames of chords' lower pairs moved (0b)
   int uncertain = 0;                 // no playable string / hand
   int joint_limit_violations = 0;    // refined poses outside the limits (must stay 0)
 };

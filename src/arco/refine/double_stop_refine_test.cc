@@ -184,3 +184,71 @@ TEST(RefineSecondVoice, NoHigherStringOrAnUnplayableSpanIsUncertain) {
 
 }  // namespace
 }  // namespace arco::refine
+
+namespace arco::refine {
+namespace {
+
+// A rolled 3-note chord D4 + A4 + F#5 on the violin: the lower pair D4 + A4 (9 frames), then
+// the upper pair A4 + F#5 held (30 frames), A4 stopped by finger 3 on the D string in both.
+// The first voice of the lower pair, decoded alone, took D4 as the open D string (set here on
+// Refine's result: the scene's hand stops it on the G string); the chord puts it back on
+// the G string below the shared A4, and the pair becomes a fifth under one finger. Not when
+// the pairs are further apart than chord_gap_s (two double stops, no chord), nor with
+// tie_chords off; and a lower pair already on those strings is left as it is.
+TEST(RefineSecondVoice, AChordsLowerPairTakesTheStringsItsUpperPairLeaves) {
+  for (const int rest_frames : {0, 12}) {
+    testing::SceneOptions o;
+    o.sway = false;
+    std::vector<testing::SceneNote> notes = {{4, 3, 7.0, 9}};
+    if (rest_frames > 0) notes.push_back({0, 0, 0.0, rest_frames});
+    notes.push_back({3, 3, 7.0, 30});
+    const testing::Scene scene = testing::MakeScene(InstrumentKind::kViolin, notes, o);
+    RefineOptions options;
+    options.num_threads = 1;
+    const RefineResult decoded = Refine(scene.input, options);
+    ASSERT_TRUE(decoded.contacts[4].pressed());
+    ASSERT_EQ(decoded.contacts[4].string, 4);
+    RefineResult first = decoded;
+    for (size_t f = 0; f < 9; ++f) {
+      FrameContact& c = first.contacts[f];
+      if (!c.pressed()) continue;
+      c.state = ContactState::kOpenString, c.string = 3, c.finger = 0;
+      c.point_in_world_mm = Eigen::Vector3d::Constant(kNaN);
+    }
+    const size_t upper_start = 9 + static_cast<size_t>(rest_frames);
+    ASSERT_TRUE(first.contacts[upper_start + 10].pressed());
+    const double a4 = scene.model->open_hz(3) * std::exp2(7.0 / 12.0);
+    std::vector<double> upper(scene.input.pitch.size(), 0.0);
+    for (size_t f = 0; f < 9; ++f) upper[f] = a4;
+    for (size_t f = upper_start; f < upper_start + 30; ++f)
+      upper[f] = scene.model->open_hz(2) * std::exp2(9.0 / 12.0);  // F#5
+    const DoubleStopRefineResult r = RefineSecondVoice(scene.input, first, upper, {});
+    if (rest_frames > 0) {
+      EXPECT_EQ(r.summary.chord_frames_moved, 0);
+      EXPECT_EQ(r.first[4].string, 3);
+      continue;
+    }
+    int moved = 0;
+    for (size_t f = 0; f < 9; ++f) {
+      if (first.contacts[f].state != ContactState::kOpenString) continue;
+      ++moved;
+      EXPECT_TRUE(r.first[f].pressed()) << f;
+      EXPECT_EQ(r.first[f].string, 4) << f;
+      EXPECT_EQ(r.second[f].string, 3) << f;
+      EXPECT_EQ(r.second[f].finger, r.first[f].finger) << f;  // a fifth: one finger
+      EXPECT_LT(r.first[f].tip_distance_refined_mm, 10.0) << f;
+    }
+    EXPECT_GT(moved, 0);
+    EXPECT_EQ(r.summary.chord_frames_moved, moved);
+    EXPECT_EQ(r.summary.joint_limit_violations, 0);
+    DoubleStopRefineOptions off;
+    off.tie_chords = false;
+    EXPECT_EQ(RefineSecondVoice(scene.input, first, upper, off).first[4].string, 3);
+    const DoubleStopRefineResult kept = RefineSecondVoice(scene.input, decoded, upper, {});
+    EXPECT_EQ(kept.summary.chord_frames_moved, 0);
+    EXPECT_EQ(kept.first[4].string, 4);
+  }
+}
+
+}  // namespace
+}  // namespace arco::refine
