@@ -1,5 +1,5 @@
 // The bundle adjustment of a rig over points seen by its cameras, without a board: what
-// `arco calibrate refine` (pipeline/calibration_refine.h) solves in each of its passes on
+// `arco calibrate refine` (calibrate/calibration_refine.h) solves in each of its passes on
 // the performer's keypoints and the instrument (docs/calibration.md "Refining with the
 // performer"). The caller finds the points (triangulation, gating, the instrument's fit);
 // this solves for them and the rig.

@@ -7,15 +7,15 @@
 #include <string>
 #include <vector>
 
+#include "arco/calibrate/calibration_check.h"
+#include "arco/calibrate/calibration_from_instrument.h"
+#include "arco/calibrate/calibration_refine.h"
 #include "arco/calibration/calibrate.h"
 #include "arco/cli/command.h"
 #include "arco/cli/command_paths.h"
 #include "arco/cli/flag_names.h"
 #include "arco/cli/number_option.h"
 #include "arco/cli/progress.h"
-#include "arco/pipeline/calibration_check.h"
-#include "arco/pipeline/calibration_from_instrument.h"
-#include "arco/pipeline/calibration_refine.h"
 
 namespace arco::cli {
 namespace {
@@ -35,9 +35,9 @@ inline constexpr FieldFlag kCheckFlags[] = {{"min_score", "--min-score"},
                                             {"min_flag_px", "--min-flag-px"},
                                             {"frame_step", "--frame-step"}};
 
-int RunCheck(const pipeline::CalibrationCheckOptions& options, bool json) {
+int RunCheck(const calibrate::CalibrationCheckOptions& options, bool json) {
   ProgressBar bar("check");
-  auto result = pipeline::CheckCalibration(options, bar);
+  auto result = calibrate::CheckCalibration(options, bar);
   bar.Finish();
   if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kCheckFlags));
   // Flagged cameras: exit kExitFoundProblems (after the report), as a linter does.
@@ -83,9 +83,9 @@ inline constexpr FieldFlag kRefineFlags[] = {{"min_score", "--min-score"},
                                              {"loss_scale_px", "--loss-px"},
                                              {"max_iterations", "--max-iterations"}};
 
-int RunRefine(const pipeline::CalibrationRefineOptions& options) {
+int RunRefine(const calibrate::CalibrationRefineOptions& options) {
   ProgressBar bar("refine");
-  auto result = pipeline::RefineCalibration(options, bar);
+  auto result = calibrate::RefineCalibration(options, bar);
   bar.Finish();
   if (!result.ok()) return PrintError(WithFlagNames(result.status().message(), kRefineFlags));
   std::printf(
@@ -136,9 +136,9 @@ inline constexpr FieldFlag kFromInstrumentFlags[] = {{"focal_px", "--focal-px"},
                                                      {"labels_frame", "--labels-frame"},
                                                      {"labels", "--labels"}};
 
-int RunFromInstrument(const pipeline::CalibrationFromInstrumentOptions& options) {
+int RunFromInstrument(const calibrate::CalibrationFromInstrumentOptions& options) {
   ProgressBar bar("from-instrument");
-  auto result = pipeline::CalibrateFromInstrument(options, bar);
+  auto result = calibrate::CalibrateFromInstrument(options, bar);
   bar.Finish();
   if (!result.ok())
     return PrintError(WithFlagNames(result.status().message(), kFromInstrumentFlags));
@@ -367,7 +367,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
                   o.output,
                   "Calibration to write: .json arco JSON, .yaml/.yml OpenCV YAML, .xml OpenCV "
                   "XML; the report goes beside it as NAME.report.json; required");
-  auto c = std::make_shared<pipeline::CalibrationCheckOptions>();
+  auto c = std::make_shared<calibrate::CalibrationCheckOptions>();
   auto json = std::make_shared<bool>(false);
   auto* check = cmd->add_subcommand(
       "check",
@@ -400,13 +400,13 @@ CommandRun SetupCalibrate(CLI::App& app) {
             "--flag-ratio",
             c->flag_ratio,
             "Flag a camera whose median residual exceeds this times the rig's median",
-            pipeline::kCheckRatioRange)
+            calibrate::kCheckRatioRange)
       ->capture_default_str();
   AddNumber(check,
             "--min-flag-px",
             c->min_flag_px,
             "... and this many pixels (px)",
-            pipeline::kCheckMinFlagRangePx)
+            calibrate::kCheckMinFlagRangePx)
       ->capture_default_str();
   AddNumber(
       check, "--frame-step", c->frame_step, "Check every n-th frame", calibration::kFrameStepRange)
@@ -428,7 +428,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
     const Status valid = c->Validate();
     if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kCheckFlags)));
   });
-  auto r = std::make_shared<pipeline::CalibrationRefineOptions>();
+  auto r = std::make_shared<calibrate::CalibrationRefineOptions>();
   auto* refine = cmd->add_subcommand(
       "refine",
       "Refine a calibration's extrinsics (and optionally focal lengths) by bundle adjustment "
@@ -466,37 +466,37 @@ CommandRun SetupCalibrate(CLI::App& app) {
             "--max-frames",
             r->max_frames,
             "Use at most this many frames, evenly spread over the capture",
-            pipeline::kRefineMaxFramesRange)
+            calibrate::kRefineMaxFramesRange)
       ->capture_default_str();
   AddNumber(refine,
             "--initial-gate-px",
             r->initial_gate_px,
             "First pass: leave out views farther than this from their point (px)",
-            pipeline::kRefineGateRangePx)
+            calibrate::kRefineGateRangePx)
       ->capture_default_str();
   AddNumber(refine,
             "--gate-px",
             r->gate_px,
             "Last pass: keep views within this residual (px)",
-            pipeline::kRefineGateRangePx)
+            calibrate::kRefineGateRangePx)
       ->capture_default_str();
   AddNumber(refine,
             "--loss-px",
             r->loss_scale_px,
             "Cauchy loss scale of the last pass (px)",
-            pipeline::kRefineLossRangePx)
+            calibrate::kRefineLossRangePx)
       ->capture_default_str();
   AddNumber(refine,
             "--max-iterations",
             r->max_iterations,
             "Bundle adjustment iterations per pass at most",
-            pipeline::kRefineIterationsRange)
+            calibrate::kRefineIterationsRange)
       ->capture_default_str();
   refine->parse_complete_callback([r] {
     const Status valid = r->Validate();
     if (!valid.ok()) ThrowIfInvalid(Status::Error(WithFlagNames(valid.message(), kRefineFlags)));
   });
-  auto fi = std::make_shared<pipeline::CalibrationFromInstrumentOptions>();
+  auto fi = std::make_shared<calibrate::CalibrationFromInstrumentOptions>();
   auto image_size = std::make_shared<std::string>();
   auto fix_focal = std::make_shared<bool>(false);
   auto labels = std::make_shared<std::vector<std::string>>();
@@ -522,13 +522,13 @@ CommandRun SetupCalibrate(CLI::App& app) {
             "--focal-px",
             fi->focal_px,
             "Every camera's focal length to start from (px); default: from --fov-deg",
-            pipeline::kFromInstrumentFocalRangePx);
+            calibrate::kFromInstrumentFocalRangePx);
   AddNumber(from_instrument,
             "--fov-deg",
             fi->fov_deg,
             "Field of view across the image's longer side to start from (degrees); default: a "
             "phone's main camera, 67 (26 mm equivalent)",
-            pipeline::kFromInstrumentFovRangeDeg);
+            calibrate::kFromInstrumentFovRangeDeg);
   from_instrument->add_option(
       "--image-size",
       *image_size,
@@ -545,25 +545,25 @@ CommandRun SetupCalibrate(CLI::App& app) {
             "--min-points",
             fi->min_points,
             "Instrument points a camera needs in a frame for a PnP pose",
-            pipeline::kFromInstrumentPointsRange)
+            calibrate::kFromInstrumentPointsRange)
       ->capture_default_str();
   AddNumber(from_instrument,
             "--pnp-gate-px",
             fi->pnp_gate_px,
             "RANSAC inlier threshold of the PnP (px)",
-            pipeline::kFromInstrumentGateRangePx)
+            calibrate::kFromInstrumentGateRangePx)
       ->capture_default_str();
   AddNumber(from_instrument,
             "--max-frames",
             fi->max_frames,
             "Bundle adjustment: use at most this many frames, evenly spread",
-            pipeline::kRefineMaxFramesRange)
+            calibrate::kRefineMaxFramesRange)
       ->capture_default_str();
   AddNumber(from_instrument,
             "--max-iterations",
             fi->max_iterations,
             "Bundle adjustment iterations per pass at most",
-            pipeline::kRefineIterationsRange)
+            calibrate::kRefineIterationsRange)
       ->capture_default_str();
   from_instrument->add_option(
       "--labels",

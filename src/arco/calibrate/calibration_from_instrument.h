@@ -34,14 +34,14 @@
 #include <string>
 #include <vector>
 
+#include "arco/calibrate/calibration_refine.h"
 #include "arco/camera/rig.h"
-#include "arco/pipeline/calibration_refine.h"
 #include "arco/util/json_io.h"
 #include "arco/util/number_range.h"
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
 
-namespace arco::pipeline {
+namespace arco::calibrate {
 
 inline constexpr double kPhoneFovDeg = 67.0;
 inline constexpr NumberRange kFromInstrumentFocalRangePx = AboveZero(100000);
@@ -126,4 +126,4 @@ struct CalibrationFromInstrumentSummary {
 StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
     const CalibrationFromInstrumentOptions& options, Progress& progress = NoProgress());
 
-}  // namespace arco::pipeline
+}  // namespace arco::calibrate

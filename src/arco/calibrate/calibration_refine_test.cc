@@ -3,18 +3,18 @@
 // degrees and 20-50 mm per camera (all but the reference camera, which holds the world
 // frame): the refined rig against the truth, `arco run`'s accuracy against the unperturbed
 // run, and bad input.
-#include "arco/pipeline/calibration_refine.h"
+#include "arco/calibrate/calibration_refine.h"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <random>
 
+#include "arco/calibrate/calibration_check.h"
 #include "arco/calibration/calibration_file.h"
 #include "arco/eval/evaluate.h"
 #include "arco/geometry/rotation.h"
 #include "arco/mocap/capture.h"
-#include "arco/pipeline/calibration_check.h"
 #include "arco/pipeline/run_capture.h"
 #include "arco/pipeline/run_with_rig_test_support.h"
 #include "arco/synth/capture_writer.h"
@@ -23,7 +23,7 @@
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
 
-namespace arco::pipeline {
+namespace arco::calibrate {
 namespace {
 
 namespace fs = std::filesystem;
@@ -255,4 +255,4 @@ TEST(RefineCalibration, BadInputIsOneErrorAndNothingWritten) {
 }
 
 }  // namespace
-}  // namespace arco::pipeline
+}  // namespace arco::calibrate

@@ -35,7 +35,7 @@
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
 
-namespace arco::pipeline {
+namespace arco::calibrate {
 
 inline constexpr NumberRange kRefineMaxFramesRange = Closed(1, 100000);
 inline constexpr NumberRange kRefineGateRangePx = AboveZero(10000);
@@ -44,7 +44,7 @@ inline constexpr NumberRange kRefineIterationsRange = Closed(1, 10000);
 
 struct CalibrationRefineOptions {
   std::string capture_dir;
-  std::string calibration;       // "" = the capture's own; else this file is refined
+  std::string calibration;  // "" = the capture's own; else this file is refined
   // Set: this rig is refined (calibration, if set, only names it in messages), as
   // `arco calibrate from-instrument` does with the rig it made.
   std::optional<Rig> input_rig;
@@ -119,4 +119,4 @@ std::string RefineReportPath(const std::string& output);
 StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOptions& options,
                                                      Progress& progress = NoProgress());
 
-}  // namespace arco::pipeline
+}  // namespace arco::calibrate

@@ -3,7 +3,7 @@
 // video has it; the instrument's 2D points with detector-like noise): the estimated rig
 // against the exact truth with the true focal length and one 10 % off, `arco run` with
 // it, and bad input.
-#include "arco/pipeline/calibration_from_instrument.h"
+#include "arco/calibrate/calibration_from_instrument.h"
 
 #include <gtest/gtest.h>
 
@@ -25,7 +25,7 @@
 #include "arco/util/json_io.h"
 #include "arco/util/npy.h"
 
-namespace arco::pipeline {
+namespace arco::calibrate {
 namespace {
 
 namespace fs = std::filesystem;
@@ -406,4 +406,4 @@ TEST(CalibrateFromInstrument, ReadsLabelsInsteadOfTrackedPoints) {
 }
 
 }  // namespace
-}  // namespace arco::pipeline
+}  // namespace arco::calibrate

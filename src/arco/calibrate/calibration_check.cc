@@ -1,4 +1,4 @@
-#include "arco/pipeline/calibration_check.h"
+#include "arco/calibrate/calibration_check.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +14,12 @@
 #include "arco/util/file_io.h"
 #include "arco/util/stats.h"
 
-namespace arco::pipeline {
+namespace arco::calibrate {
+
+using pipeline::CheckCaptureCalibration;
+using pipeline::kTriangulationStage;
+using pipeline::ResultFolder;
+using pipeline::ResultHeader;
 
 Status CalibrationCheckOptions::Validate() const {
   if (!label_views.empty() && calibration.empty())
@@ -212,4 +217,4 @@ StatusOr<CalibrationCheckSummary> CheckCalibration(const CalibrationCheckOptions
   return summary;
 }
 
-}  // namespace arco::pipeline
+}  // namespace arco::calibrate

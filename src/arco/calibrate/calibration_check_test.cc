@@ -1,4 +1,4 @@
-#include "arco/pipeline/calibration_check.h"
+#include "arco/calibrate/calibration_check.h"
 
 #include <gtest/gtest.h>
 
@@ -11,10 +11,12 @@
 #include "arco/util/file_io.h"
 #include "arco/util/npy.h"
 
-namespace arco::pipeline {
+namespace arco::calibrate {
 namespace {
 
 using arco::testing::TempDir;
+using pipeline::RunTriangulateStage;
+using pipeline::TriangulateStageOptions;
 
 // 8 cameras, 21 points in 40 frames, 1 px noise and 5 % outliers.
 void WriteCapture(const std::string& dir, Rig* rig) {
@@ -182,4 +184,4 @@ TEST(CheckCalibration, ErrorsNameTheFile) {
 }
 
 }  // namespace
-}  // namespace arco::pipeline
+}  // namespace arco::calibrate

@@ -17,7 +17,7 @@
 #include "arco/util/progress.h"
 #include "arco/util/status.h"
 
-namespace arco::pipeline {
+namespace arco::calibrate {
 
 inline constexpr NumberRange kCheckRatioRange = Closed(1, 1000);
 inline constexpr NumberRange kCheckMinFlagRangePx = AboveZero(10000);
@@ -64,4 +64,4 @@ struct CalibrationCheckSummary {
 StatusOr<CalibrationCheckSummary> CheckCalibration(const CalibrationCheckOptions& options,
                                                    Progress& progress = NoProgress());
 
-}  // namespace arco::pipeline
+}  // namespace arco::calibrate

@@ -1,4 +1,4 @@
-#include "arco/pipeline/calibration_from_instrument.h"
+#include "arco/calibrate/calibration_from_instrument.h"
 
 #include <algorithm>
 #include <cmath>
@@ -22,7 +22,7 @@
 #include "arco/util/output_set.h"
 #include "arco/util/stats.h"
 
-namespace arco::pipeline {
+namespace arco::calibrate {
 namespace {
 
 // Shared frames the medoid looks at, at most (evenly spread): it is quadratic in them.
@@ -548,4 +548,4 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
   return summary;
 }
 
-}  // namespace arco::pipeline
+}  // namespace arco::calibrate

@@ -1,4 +1,4 @@
-#include "arco/pipeline/calibration_refine.h"
+#include "arco/calibrate/calibration_refine.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +18,12 @@
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/output_set.h"
 
-namespace arco::pipeline {
+namespace arco::calibrate {
+
+using pipeline::CaptureContext;
+using pipeline::kNaN;
+using pipeline::LoadCaptureCalibration;
+using pipeline::LoadCaptureKeypoints2d;
 namespace {
 
 // Every camera must keep this many detections, or its pose is left to a handful of points.
@@ -435,4 +440,4 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
   return summary;
 }
 
-}  // namespace arco::pipeline
+}  // namespace arco::calibrate
