@@ -8,6 +8,7 @@
 #include "arco/geometry/alignment.h"
 #include "arco/geometry/triangulation.h"
 #include "arco/hand/fit_costs.h"
+#include "arco/util/dense_lm.h"
 #include "arco/util/stats.h"
 
 namespace arco::hand {
@@ -54,19 +55,22 @@ void AddBounds(const HandModel& model, ceres::Problem* problem, double* angles) 
     problem->SetManifold(angles, new ceres::SubsetManifold(kNumJointDofs, locked));
 }
 
+// A relative cost change of 1e-5 ends the solve. 1e-10 (until issue 16) took twice the
+// iterations of Ceres' default 1e-6; 1e-5 takes a quarter fewer again (per frame of the
+// one-minute 20-camera take: 17 -> 12.5 iterations in solve 1, 28 -> 24 in the 3D
+// initialisation) for changes far below the keypoints' noise: docs/accuracy.md's
+// table (seed 0) within 0.01 mm on average per method and setting. 1e-4 halves solve
+// 1 again but moved the arco method's harsh contact deviation by +0.04 mm
+// (docs/performance.md, issue 28 part 3).
+constexpr double kFunctionTolerance = 1e-5;
+constexpr double kParameterTolerance = 1e-8;
+
 ceres::Solver::Options SolverOptions(int max_iterations) {
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   options.max_num_iterations = max_iterations;
-  // A relative cost change of 1e-5 ends the solve. 1e-10 (until issue 16) took twice the
-  // iterations of Ceres' default 1e-6; 1e-5 takes a quarter fewer again (per frame of the
-  // one-minute 20-camera take: 17 -> 12.5 iterations in solve 1, 28 -> 24 in the 3D
-  // initialisation) for changes far below the keypoints' noise: docs/accuracy.md's
-  // table (seed 0) within 0.01 mm on average per method and setting. 1e-4 halves solve
-  // 1 again but moved the arco method's harsh contact deviation by +0.04 mm
-  // (docs/performance.md, issue 28 part 3).
-  options.function_tolerance = 1e-5;
-  options.parameter_tolerance = 1e-8;
+  options.function_tolerance = kFunctionTolerance;
+  options.parameter_tolerance = kParameterTolerance;
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
   // No projected line search after each trust-region step (Ceres runs one on problems
@@ -263,36 +267,39 @@ HandFitResult FitHandMultiView(const HandModel& model,
     return result;
   }
 
-  PoseParams params(*start);
-  auto solve = [&](const std::vector<PixelObservation>& observations,
-                   ceres::Solver::Summary* summary) {
-    ceres::Problem problem;
-    const double c = options.robust_loss_px;
-    problem.AddResidualBlock(
-        new internal::CompressedReprojectionCost({&model, &observations, c * c}),
-        nullptr,
-        params.aa,
-        params.t,
-        params.angles);
-    if (has_previous) {
-      const HandPose& prev = *init.previous_pose;
-      TemporalResiduals temporal{prev.world_from_wrist.rotation,
+  using internal::ReprojectionProblem;
+  ReprojectionProblem::Vector x;
+  {
+    const PoseParams p(*start);
+    x << p.aa[0], p.aa[1], p.aa[2], p.t[0], p.t[1], p.t[2];
+    for (int d = 0; d < kNumJointDofs; ++d) x[6 + d] = p.angles[d];
+  }
+  std::optional<TemporalResiduals> temporal;
+  if (has_previous) {
+    const HandPose& prev = *init.previous_pose;
+    temporal = TemporalResiduals{prev.world_from_wrist.rotation,
                                  prev.world_from_wrist.translation,
                                  ClampToLimits(model, prev).angles_rad,
                                  options.temporal_rotation_weight_px_per_rad,
                                  options.temporal_translation_weight_px_per_mm,
                                  options.temporal_angle_weight_px_per_rad};
-      problem.AddResidualBlock(
-          new ceres::
-              AutoDiffCostFunction<TemporalResiduals, 6 + kNumJointDofs, 3, 3, kNumJointDofs>(
-                  new TemporalResiduals(temporal)),
-          nullptr,
-          params.aa,
-          params.t,
-          params.angles);
-    }
-    AddBounds(model, &problem, params.angles);
-    ceres::Solve(SolverOptions(options.max_iterations), &problem, summary);
+  }
+  DenseLm<ReprojectionProblem::Vector, ReprojectionProblem::Matrix> lm;
+  DenseLmOptions lm_options;
+  lm_options.max_iterations = options.max_iterations;
+  lm_options.function_tolerance = kFunctionTolerance;
+  lm_options.parameter_tolerance = kParameterTolerance;
+  auto solve = [&](const std::vector<PixelObservation>& observations) {
+    const double c = options.robust_loss_px;
+    ReprojectionProblem problem({&model, &observations, c * c}, temporal ? &*temporal : nullptr);
+    return lm.Minimize(problem, lm_options, &x);
+  };
+  auto pose_of = [&] {
+    HandPose pose;
+    pose.SetWristAngleAxis(x.head<3>());
+    pose.world_from_wrist.translation = x.segment<3>(3);
+    std::copy(x.data() + 6, x.data() + 6 + kNumJointDofs, pose.angles_rad.begin());
+    return ClampToLimits(model, pose);  // the solver keeps bounds; this guards rounding
   };
   auto collect = [&](const std::vector<uint8_t>& use) {
     std::vector<PixelObservation> obs;
@@ -314,10 +321,9 @@ HandFitResult FitHandMultiView(const HandModel& model,
   // Solve 1: every usable view, robust loss. Then gate views on their median
   // residual and solve again with the trusted ones.
   std::vector<PixelObservation> observations = collect(usable);
-  ceres::Solver::Summary summary;
-  solve(observations, &summary);
-  result.iterations = static_cast<int>(summary.iterations.size());
-  HandPose pose = params.ToPose(model);
+  DenseLmSummary summary = solve(observations);
+  result.iterations = 1 + summary.steps;  // as Ceres counted: the start and each step
+  HandPose pose = pose_of();
   std::vector<double> errors = PixelErrors(model, pose, observations);
   std::vector<std::vector<double>> per_view(num_views);
   for (size_t i = 0; i < observations.size(); ++i)
@@ -331,13 +337,13 @@ HandFitResult FitHandMultiView(const HandModel& model,
   }
   if (trusted != result.num_views_with_hand && trusted > 0) {
     observations = collect(result.trusted_views);
-    solve(observations, &summary);
-    result.iterations += static_cast<int>(summary.iterations.size());
-    pose = params.ToPose(model);
+    summary = solve(observations);
+    result.iterations += 1 + summary.steps;
+    pose = pose_of();
     errors = PixelErrors(model, pose, observations);
   }
   result.pose = pose;
-  result.termination = ceres::TerminationTypeToString(summary.termination_type);
+  result.termination = summary.converged ? "CONVERGENCE" : "NO_CONVERGENCE";
   result.initial_cost = summary.initial_cost;
   result.final_cost = summary.final_cost;
   result.num_observations = static_cast<int>(observations.size());
@@ -350,8 +356,8 @@ HandFitResult FitHandMultiView(const HandModel& model,
     msg << "only " << trusted << " of " << result.num_views_with_hand << " views agree within "
         << options.view_gate_px << " px";
     result.problem = msg.str();
-  } else if (!summary.IsSolutionUsable()) {
-    result.problem = "solver failed: " + summary.message;
+  } else if (!std::isfinite(summary.final_cost)) {
+    result.problem = "solver failed: the cost is not finite";
   } else {
     result.ok = true;
   }
