@@ -14,45 +14,27 @@
 namespace arco::hand {
 namespace {
 
-using internal::HandCostFunction;
 using internal::PixelObservation;
-using internal::PointResiduals;
 using internal::ReprojectionResiduals;
 using internal::TemporalResiduals;
 
 constexpr int kPalmKeypoints[6] = {0, 1, 5, 9, 13, 17};
 const double kNaN = std::nan("");
 
-// Parameter blocks of a pose, for Ceres.
-struct PoseParams {
-  double aa[3], t[3], angles[kNumJointDofs];
-  explicit PoseParams(const HandPose& pose) {
-    const Eigen::Vector3d a = pose.WristAngleAxis();
-    for (int i = 0; i < 3; ++i) aa[i] = a[i], t[i] = pose.world_from_wrist.translation[i];
-    std::copy(pose.angles_rad.begin(), pose.angles_rad.end(), angles);
-  }
-  HandPose ToPose(const HandModel& model) const {
-    HandPose pose;
-    pose.SetWristAngleAxis(Eigen::Vector3d(aa[0], aa[1], aa[2]));
-    pose.world_from_wrist.translation = Eigen::Vector3d(t[0], t[1], t[2]);
-    std::copy(angles, angles + kNumJointDofs, pose.angles_rad.begin());
-    return ClampToLimits(model, pose);  // Ceres keeps bounds; this guards rounding
-  }
-};
-
-// Joint limits as bounds; locked joints (min == max) are held constant.
-void AddBounds(const HandModel& model, ceres::Problem* problem, double* angles) {
-  std::vector<int> locked;
-  for (int d = 0; d < kNumJointDofs; ++d) {
-    if (model.max_rad(d) - model.min_rad(d) < 1e-12) {
-      locked.push_back(d);
-      continue;
-    }
-    problem->SetParameterLowerBound(angles, d, model.min_rad(d));
-    problem->SetParameterUpperBound(angles, d, model.max_rad(d));
-  }
-  if (!locked.empty())
-    problem->SetManifold(angles, new ceres::SubsetManifold(kNumJointDofs, locked));
+// A pose as the fits' parameters: wrist angle-axis, wrist position mm, 20 angles.
+using PoseVector = Eigen::Matrix<double, 6 + kNumJointDofs, 1>;
+PoseVector ToVector(const HandPose& pose) {
+  PoseVector x;
+  x << pose.WristAngleAxis(), pose.world_from_wrist.translation;
+  std::copy(pose.angles_rad.begin(), pose.angles_rad.end(), x.data() + 6);
+  return x;
+}
+HandPose ToPose(const HandModel& model, const PoseVector& x) {
+  HandPose pose;
+  pose.SetWristAngleAxis(x.head<3>());
+  pose.world_from_wrist.translation = x.segment<3>(3);
+  std::copy(x.data() + 6, x.data() + 6 + kNumJointDofs, pose.angles_rad.begin());
+  return ClampToLimits(model, pose);  // the solver keeps bounds; this guards rounding
 }
 
 // A relative cost change of 1e-5 ends the solve. 1e-10 (until issue 16) took twice the
@@ -65,18 +47,11 @@ void AddBounds(const HandModel& model, ceres::Problem* problem, double* angles) 
 constexpr double kFunctionTolerance = 1e-5;
 constexpr double kParameterTolerance = 1e-8;
 
-ceres::Solver::Options SolverOptions(int max_iterations) {
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  options.max_num_iterations = max_iterations;
+DenseLmOptions LmOptions(int max_iterations) {
+  DenseLmOptions options;
+  options.max_iterations = max_iterations;
   options.function_tolerance = kFunctionTolerance;
   options.parameter_tolerance = kParameterTolerance;
-  options.num_threads = 1;
-  options.logging_type = ceres::SILENT;
-  // No projected line search after each trust-region step (Ceres runs one on problems
-  // with bounds, the joint limits here): it evaluated the Jacobian a second time per
-  // iteration. Steps still stay within the bounds (Ceres projects them).
-  options.max_num_line_search_step_size_iterations = 0;
   return options;
 }
 
@@ -185,21 +160,14 @@ HandFit3dResult FitHandToPoints3d(const HandModel& model,
     result.pose = ClampToLimits(model, HandPose{});
     return result;
   }
-  PoseParams params(ClampToLimits(model, *start));
-  ceres::Problem problem;
+  PoseVector x = ToVector(ClampToLimits(model, *start));
   const double c = options.robust_loss_mm;
-  problem.AddResidualBlock(
-      new HandCostFunction<PointResiduals>({&model, &points_in_world_mm, c * c}),
-      nullptr,
-      params.aa,
-      params.t,
-      params.angles);
-  AddBounds(model, &problem, params.angles);
-  ceres::Solver::Summary summary;
-  ceres::Solve(SolverOptions(options.max_iterations), &problem, &summary);
-  result.pose = params.ToPose(model);
-  result.iterations = static_cast<int>(summary.iterations.size());
-  result.termination = ceres::TerminationTypeToString(summary.termination_type);
+  internal::PointProblem problem({&model, &points_in_world_mm, c * c}, nullptr);
+  DenseLm<PoseVector, internal::PointProblem::Matrix> lm;
+  const DenseLmSummary summary = lm.Minimize(problem, LmOptions(options.max_iterations), &x);
+  result.pose = ToPose(model, x);
+  result.iterations = 1 + summary.steps;  // as Ceres counted: the start and each step
+  result.termination = summary.converged ? "CONVERGENCE" : "NO_CONVERGENCE";
   const HandPointsMm fitted = ForwardKinematics(model, result.pose);
   double sum2 = 0;
   for (int k = 0; k < kNumHandKeypoints; ++k) {
@@ -207,8 +175,8 @@ HandFit3dResult FitHandToPoints3d(const HandModel& model,
       sum2 += (fitted[k] - points_in_world_mm[k]).squaredNorm();
   }
   result.rms_error_mm = std::sqrt(sum2 / result.num_points);
-  result.ok = summary.IsSolutionUsable();
-  if (!result.ok) result.problem = "solver failed: " + summary.message;
+  result.ok = std::isfinite(summary.final_cost);
+  if (!result.ok) result.problem = "solver failed: the cost is not finite";
   return result;
 }
 
@@ -268,12 +236,7 @@ HandFitResult FitHandMultiView(const HandModel& model,
   }
 
   using internal::ReprojectionProblem;
-  ReprojectionProblem::Vector x;
-  {
-    const PoseParams p(*start);
-    x << p.aa[0], p.aa[1], p.aa[2], p.t[0], p.t[1], p.t[2];
-    for (int d = 0; d < kNumJointDofs; ++d) x[6 + d] = p.angles[d];
-  }
+  PoseVector x = ToVector(*start);
   std::optional<TemporalResiduals> temporal;
   if (has_previous) {
     const HandPose& prev = *init.previous_pose;
@@ -284,22 +247,12 @@ HandFitResult FitHandMultiView(const HandModel& model,
                                  options.temporal_translation_weight_px_per_mm,
                                  options.temporal_angle_weight_px_per_rad};
   }
-  DenseLm<ReprojectionProblem::Vector, ReprojectionProblem::Matrix> lm;
-  DenseLmOptions lm_options;
-  lm_options.max_iterations = options.max_iterations;
-  lm_options.function_tolerance = kFunctionTolerance;
-  lm_options.parameter_tolerance = kParameterTolerance;
+  DenseLm<PoseVector, ReprojectionProblem::Matrix> lm;
+  const DenseLmOptions lm_options = LmOptions(options.max_iterations);
   auto solve = [&](const std::vector<PixelObservation>& observations) {
     const double c = options.robust_loss_px;
     ReprojectionProblem problem({&model, &observations, c * c}, temporal ? &*temporal : nullptr);
     return lm.Minimize(problem, lm_options, &x);
-  };
-  auto pose_of = [&] {
-    HandPose pose;
-    pose.SetWristAngleAxis(x.head<3>());
-    pose.world_from_wrist.translation = x.segment<3>(3);
-    std::copy(x.data() + 6, x.data() + 6 + kNumJointDofs, pose.angles_rad.begin());
-    return ClampToLimits(model, pose);  // the solver keeps bounds; this guards rounding
   };
   auto collect = [&](const std::vector<uint8_t>& use) {
     std::vector<PixelObservation> obs;
@@ -323,7 +276,7 @@ HandFitResult FitHandMultiView(const HandModel& model,
   std::vector<PixelObservation> observations = collect(usable);
   DenseLmSummary summary = solve(observations);
   result.iterations = 1 + summary.steps;  // as Ceres counted: the start and each step
-  HandPose pose = pose_of();
+  HandPose pose = ToPose(model, x);
   std::vector<double> errors = PixelErrors(model, pose, observations);
   std::vector<std::vector<double>> per_view(num_views);
   for (size_t i = 0; i < observations.size(); ++i)
@@ -339,7 +292,7 @@ HandFitResult FitHandMultiView(const HandModel& model,
     observations = collect(result.trusted_views);
     summary = solve(observations);
     result.iterations += 1 + summary.steps;
-    pose = pose_of();
+    pose = ToPose(model, x);
     errors = PixelErrors(model, pose, observations);
   }
   result.pose = pose;

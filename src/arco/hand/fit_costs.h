@@ -50,7 +50,9 @@ struct ReprojectionResiduals {
   const std::vector<PixelObservation>* observations;
   double loss_c2;  // squared Cauchy scale, px^2
 
-  int num_residuals() const { return 2 * static_cast<int>(observations->size()); }
+  static constexpr int kRowsPerUnit = 2;  // per observation
+  int num_units() const { return static_cast<int>(observations->size()); }
+  int num_residuals() const { return 2 * num_units(); }
   template <typename T>
   void operator()(const T* aa, const T* t, const T* angles, T* residuals) const {
     Eigen::Matrix<T, 3, 1> points[kNumHandKeypoints];
@@ -111,6 +113,8 @@ struct PointResiduals {
   const HandPointsMm* targets;  // NaN = missing (zero residual)
   double loss_c2;               // squared Cauchy scale, mm^2
 
+  static constexpr int kRowsPerUnit = 3;  // per keypoint
+  int num_units() const { return kNumHandKeypoints; }
   int num_residuals() const { return 3 * kNumHandKeypoints; }
   template <typename T>
   void operator()(const T* aa, const T* t, const T* angles, T* residuals) const {
@@ -218,26 +222,28 @@ class HandCostFunction : public ceres::CostFunction {
   Residuals r_;
 };
 
-// The multi-view hand fit as a problem for DenseLm (util/dense_lm.h): parameters x =
-// (wrist angle-axis, wrist position mm, 20 angles), cost 1/2 |r|^2 over the reprojection
-// residuals of HandCostFunction<ReprojectionResiduals> (2 per observation: 840 for 20
-// views) and, with a previous frame, TemporalResiduals. Levenberg-Marquardt uses the
-// residuals r and Jacobian J only through the cost, J^T J and J^T r, so those are summed
-// per keypoint, J_k^T (sum_o D_o^T D_o) J_k with D_o the 2x3 derivative of observation o
-// and J_k the keypoint's 3x26 Jacobian: no 840-row matrix is formed. Locked joints
-// (min == max) are held (their rows and columns of J^T J and J^T r are 0, so their step
-// is 0), the others are kept within their limits by projecting each step (as Ceres does
-// with bounds). Until issue 28 part 3 this was a ceres::Problem with the reprojection
-// block compressed to 27 residuals of the same normal equations (an LDLT per
-// evaluation) and the cost evaluated a second time for each accepted step.
-class ReprojectionProblem {
+// A hand fit as a problem for DenseLm (util/dense_lm.h): parameters x = (wrist
+// angle-axis, wrist position mm, 20 angles), cost 1/2 |r|^2 over the residuals of
+// HandCostFunction<Residuals> (ReprojectionResiduals: 2 per observation, 840 for 20
+// views; PointResiduals: 3 per keypoint) and, with a previous frame, TemporalResiduals.
+// Levenberg-Marquardt uses the residuals r and Jacobian J only through the cost, J^T J and
+// J^T r, so those are summed per keypoint, J_k^T (sum_o D_o^T D_o) J_k with D_o the
+// derivative of unit o (2x3 or 3x3) and J_k the keypoint's 3x26 Jacobian: no 840-row
+// matrix is formed. Locked joints (min == max) are held (their rows and columns of J^T J
+// and J^T r are 0, so their step is 0), the others are kept within their limits by
+// projecting each step (as Ceres does with bounds). Until issue 28 part 3 these were
+// ceres::Problems (the reprojection block compressed to 27 residuals of the same normal
+// equations, an LDLT per evaluation), which evaluated the cost a second time for each
+// accepted step.
+template <typename Residuals>
+class HandProblem {
  public:
   static constexpr int kParams = 6 + kNumJointDofs;
   using Vector = Eigen::Matrix<double, kParams, 1>;
   using Matrix = Eigen::Matrix<double, kParams, kParams>;
 
   // `temporal`: nullptr for none.
-  ReprojectionProblem(ReprojectionResiduals residuals, const TemporalResiduals* temporal)
+  HandProblem(Residuals residuals, const TemporalResiduals* temporal)
       : r_(residuals), temporal_(temporal) {
     for (int d = 0; d < kNumJointDofs; ++d)
       locked_[d] = r_.model->max_rad(d) - r_.model->min_rad(d) < 1e-12;
@@ -253,17 +259,18 @@ class ReprojectionProblem {
     bool seen[kNumHandKeypoints] = {};
     for (int k = 0; k < kNumHandKeypoints; ++k) hk[k].setZero(), gk[k].setZero();
     double rr = 0;
-    const int n = static_cast<int>(r_.observations->size());
+    constexpr int kRows = Residuals::kRowsPerUnit;
+    const int n = r_.num_units();
     for (int i = 0; i < n; ++i) {
       Eigen::Matrix3d d;
       double r[3];
       int k;
       r_.ResidualWithDerivative(i, points, r, &d, &k);
-      const Eigen::Matrix<double, 2, 3> d2 = d.topRows<2>();
-      const Eigen::Vector2d r2(r[0], r[1]);
-      hk[k].noalias() += d2.transpose() * d2;
-      gk[k].noalias() += d2.transpose() * r2;
-      rr += r2.squaredNorm();
+      const Eigen::Matrix<double, kRows, 3> dr = d.topRows<kRows>();
+      const Eigen::Matrix<double, kRows, 1> rv = Eigen::Map<Eigen::Matrix<double, kRows, 1>>(r);
+      hk[k].noalias() += dr.transpose() * dr;
+      gk[k].noalias() += dr.transpose() * rv;
+      rr += rv.squaredNorm();
       seen[k] = true;
     }
     Matrix& jtj = *h;
@@ -361,9 +368,11 @@ class ReprojectionProblem {
     return rr;
   }
 
-  ReprojectionResiduals r_;
+  Residuals r_;
   const TemporalResiduals* temporal_;
   bool locked_[kNumJointDofs];
 };
+using ReprojectionProblem = HandProblem<ReprojectionResiduals>;
+using PointProblem = HandProblem<PointResiduals>;
 
 }  // namespace arco::hand::internal
