@@ -52,6 +52,7 @@ DenseLmOptions LmOptions(int max_iterations) {
   options.max_iterations = max_iterations;
   options.function_tolerance = kFunctionTolerance;
   options.parameter_tolerance = kParameterTolerance;
+  options.keep_last_step = false;
   return options;
 }
 

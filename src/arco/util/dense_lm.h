@@ -19,8 +19,9 @@
 // parameter_tolerance (|x| + parameter_tolerance), the cost's change (accepted or not) at
 // most function_tolerance times the cost, the radius below 1e-32, or after max_iterations
 // steps. Unlike Ceres: the Jacobian is evaluated with every candidate's cost (one
-// evaluation per step instead of two when the step is accepted, the usual case), and a
-// step that meets the function tolerance is kept when it lowered the cost.
+// evaluation per step instead of two when the step is accepted, the usual case), and
+// (keep_last_step) a step that meets the function tolerance is kept when it lowered the
+// cost.
 #pragma once
 
 #include <Eigen/Core>
@@ -35,6 +36,9 @@ struct DenseLmOptions {
   double gradient_tolerance = 1e-10;
   double parameter_tolerance = 1e-8;
   double initial_radius = 1e4;
+  // Whether a step that meets the function tolerance is kept when it lowered the cost
+  // (false: the solve ends at the point before it, as Ceres does).
+  bool keep_last_step = true;
 };
 
 struct DenseLmSummary {
@@ -82,13 +86,17 @@ class DenseLm {
       const double change = cost - candidate_cost;
       const double quality = change / model_decrease;
       const bool success = std::isfinite(candidate_cost) && model_decrease > 0 && quality > 1e-3;
-      if (success) {
+      // The cost before the step, as candidate_cost + change when it succeeded (FitSkeleton's
+      // outputs stay bit-identical to its own loop's).
+      const bool converged = std::abs(change) <= options.function_tolerance *
+                                                     (success ? candidate_cost + change : cost);
+      if (success && (options.keep_last_step || !converged)) {
         x->swap(candidate_);
         h_.swap(candidate_h_);
         g_.swap(candidate_g_);
         cost = candidate_cost;
       }
-      if (std::abs(change) <= options.function_tolerance * (cost + (success ? change : 0))) break;
+      if (converged) break;
       if (success) {
         const double t = 2 * quality - 1;
         radius = std::min(1e16, radius / std::max(1.0 / 3.0, 1.0 - t * t * t));
