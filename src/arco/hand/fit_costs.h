@@ -1,6 +1,8 @@
-// Ceres cost functions of the hand fits (internal to arco_hand). All take the
-// parameter blocks {wrist angle-axis (3), wrist position mm (3), angles (20)}
-// and run forward kinematics once per evaluation for all their residuals.
+// Residuals of the hand fits (internal to arco_hand), the problems the fits solve with
+// util/dense_lm.h (HandProblem) and the Ceres cost function of the same residuals
+// (HandCostFunction, the tests' reference). All take the parameters {wrist angle-axis (3),
+// wrist position mm (3), angles (20)} and run forward kinematics once per evaluation for
+// all their residuals.
 //
 // Robust losses are applied inside the residual ("square-root of rho"):
 // r' = sqrt(rho(|r|^2) / |r|^2) r, so that sum |r'|^2 = sum rho(|r_i|^2) with a

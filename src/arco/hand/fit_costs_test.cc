@@ -109,5 +109,56 @@ TEST(ReprojectionProblem, SameNormalEquationsWhenAFingerIsSeenInNoView) {
   ExpectSameNormalEquations(true);
 }
 
+// PointProblem (the 3D initialisation's) against HandCostFunction<PointResiduals>, with
+// missing points, and the temporal prior's terms against its autodiff cost function.
+TEST(PointProblem, SameNormalEquationsAsTheCostFunctionsWithTheTemporalPrior) {
+  const HandModel model = HandModel::Default(HandSide::kLeft);
+  std::mt19937 rng(5);
+  const HandPose truth = testing::RandomPose(model, rng, 0.1);
+  HandPointsMm targets = ForwardKinematics(model, truth);
+  targets[7] = targets[18] = Eigen::Vector3d::Constant(std::nan(""));
+  targets[3] += Eigen::Vector3d(30, -20, 10);  // an outlier, on the Cauchy loss's tail
+  HandPose start = truth;
+  start.world_from_wrist.translation += Eigen::Vector3d(4, -3, 5);
+  for (double& a : start.angles_rad) a += 0.05;
+  start = ClampToLimits(model, start);
+  const Eigen::Vector3d aa = start.WristAngleAxis();
+  const PointResiduals residuals{&model, &targets, 10.0 * 10.0};
+  const TemporalResiduals temporal{truth.world_from_wrist.rotation,
+                                   truth.world_from_wrist.translation,
+                                   truth.angles_rad,
+                                   2.0,
+                                   0.5,
+                                   3.0};
+  Normal full = Evaluate(HandCostFunction<PointResiduals>(residuals),
+                         aa.data(),
+                         start.world_from_wrist.translation.data(),
+                         start.angles_rad.data());
+  const Normal prior =
+      Evaluate(ceres::AutoDiffCostFunction<TemporalResiduals, kParams, 3, 3, kNumJointDofs>(
+                   new TemporalResiduals(temporal)),
+               aa.data(),
+               start.world_from_wrist.translation.data(),
+               start.angles_rad.data());
+  full.rr += prior.rr;
+  full.jtj += prior.jtj;
+  full.jtr += prior.jtr;
+  PointProblem::Vector x;
+  x << aa, start.world_from_wrist.translation;
+  for (int d = 0; d < kNumJointDofs; ++d) x[6 + d] = start.angles_rad[d];
+  PointProblem::Matrix h;
+  PointProblem::Vector g;
+  const double rr = 2 * PointProblem(residuals, &temporal).Evaluate(x, &h, &g);
+  for (int d = 0; d < kNumJointDofs; ++d) {
+    if (model.max_rad(d) - model.min_rad(d) >= 1e-12) continue;
+    full.jtj.row(6 + d).setZero();
+    full.jtj.col(6 + d).setZero();
+    full.jtr[6 + d] = 0;
+  }
+  EXPECT_NEAR(rr, full.rr, 1e-9 * full.rr);
+  EXPECT_LT((h - full.jtj).cwiseAbs().maxCoeff(), 1e-10 * full.jtj.cwiseAbs().maxCoeff());
+  EXPECT_LT((g - full.jtr).cwiseAbs().maxCoeff(), 1e-9 * full.jtr.cwiseAbs().maxCoeff());
+}
+
 }  // namespace
 }  // namespace arco::hand::internal
