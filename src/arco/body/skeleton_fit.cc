@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "arco/geometry/rotation.h"
+#include "arco/util/dense_lm.h"
 #include "arco/util/parallel.h"
 #include "arco/util/stats.h"
 
@@ -165,15 +166,15 @@ bool InverseCholesky3(const Eigen::Ref<const Eigen::MatrixXd>& a, Eigen::Matrix3
 // each rotation towards the previous frame. d x_i / d delta[j] =
 // -R_prev[j] Exp(delta[j]) [offset[c]]x J_r(delta[j]) (geometry/rotation.h).
 //
-// Solved by Levenberg-Marquardt on the dense normal equations (a few dozen parameters),
-// with Ceres' trust-region rules (Marquardt's diagonal clamped to [1e-6, 1e32] and divided
-// by the radius, starting at 1e4; radius update by the step quality, Nielsen's rule) and its
-// stopping tests (function tolerance 1e-8 relative, gradient 1e-10, step 1e-8 relative),
-// the Huber loss applied as Ceres does (residual and Jacobian scaled by sqrt(rho'), rho''
-// being 0 or negative). Until issue 28 part 3 this was a ceres::Problem built per frame
-// with a sparse normal Cholesky: the same minimiser, but its set-up, sparse symbolic
-// analysis and bookkeeping cost about ten times the arithmetic (a quarter of `arco run`'s
-// CPU); joints moved by the solvers' tolerance (docs/performance.md).
+// Solved by Levenberg-Marquardt (util/dense_lm.h) on the dense normal equations (a few dozen
+// parameters), with Ceres' trust-region rules (Marquardt's diagonal clamped to [1e-6, 1e32] and
+// divided by the radius, starting at 1e4; radius update by the step quality, Nielsen's rule) and
+// its stopping tests (function tolerance 1e-8 relative, gradient 1e-10, step 1e-8 relative), the
+// Huber loss applied as Ceres does (residual and Jacobian scaled by sqrt(rho'), rho'' being 0 or
+// negative). Until issue 28 part 3 this was a ceres::Problem built per frame with a sparse normal
+// Cholesky: the same minimiser, but its set-up, sparse symbolic analysis and bookkeeping cost about
+// ten times the arithmetic (a quarter of `arco run`'s CPU); joints moved by the solvers' tolerance
+// (docs/performance.md).
 class FrameSolver {
  public:
   struct Observation {
@@ -235,64 +236,29 @@ class FrameSolver {
       up.push_back(0);
     }
     x_.setZero(size);
-    double cost = Evaluate(x_, &h_, &g_);
-    double radius = 1e4;
-    double decrease = 2;
-    for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
-      if (!(g_.lpNorm<Eigen::Infinity>() > kGradientTolerance)) break;
-      damped_ = h_;
-      for (int i = 0; i < size; ++i) damped_(i, i) += std::clamp(h_(i, i), 1e-6, 1e32) / radius;
-      if (!SolveDamped()) {
-        radius /= decrease;
-        decrease *= 2;
-        if (radius < 1e-32) break;
-        continue;
-      }
-      if (!(step_.norm() > kParameterTolerance * (x_.norm() + kParameterTolerance))) break;
-      candidate_ = x_ + step_;
-      const double candidate_cost = Evaluate(candidate_, &candidate_h_, &candidate_g_);
-      h_step_.noalias() = h_ * step_;
-      const double model_decrease = -(g_.dot(step_) + 0.5 * step_.dot(h_step_));
-      const double change = cost - candidate_cost;
-      const double quality = change / model_decrease;
-      const bool success = std::isfinite(candidate_cost) && model_decrease > 0 && quality > 1e-3;
-      if (success) {
-        x_.swap(candidate_);
-        h_.swap(candidate_h_);
-        g_.swap(candidate_g_);
-        cost = candidate_cost;
-      }
-      if (std::abs(change) <= kFunctionTolerance * (cost + (success ? change : 0))) break;
-      if (success) {
-        const double t = 2 * quality - 1;
-        radius = std::min(1e16, radius / std::max(1.0 / 3.0, 1.0 - t * t * t));
-        decrease = 2;
-      } else {
-        radius /= decrease;
-        decrease *= 2;
-        if (radius < 1e-32) break;
-      }
-    }
+    DenseLmOptions lm;
+    lm.max_iterations = options_.max_iterations;
+    lm.function_tolerance = 1e-8;
+    lm.gradient_tolerance = 1e-10;
+    lm.parameter_tolerance = 1e-8;
+    lm.initial_radius = 1e4;
+    lm_.Minimize(*this, lm, &x_);
     *dp = x_.head<3>();
     for (int j : active_) (*delta)[j] = x_.segment<3>(column_[j]);
   }
 
- private:
-  static constexpr double kFunctionTolerance = 1e-8;
-  static constexpr double kGradientTolerance = 1e-10;
-  static constexpr double kParameterTolerance = 1e-8;
-
-  // step_ = -damped_^-1 g_ by a block Cholesky factorisation in the elimination order set
-  // up by Solve (false when damped_ is not positive definite). A joint's delta shares
+ public:  // DenseLm's problem
+  // step = -a^-1 g by a block Cholesky factorisation in the elimination order set
+  // up by Solve (false when a is not positive definite). A joint's delta shares
   // residuals only with its ancestors' and the root's (a point depends on the rotations
   // along its path), so eliminating every joint before its ancestors fills in no block
   // that is not already non-zero: about 10 3x3 block updates per joint instead of a
   // dense factorisation, whose dependent sums (a few dozen unknowns) took 70% of the fit.
   // Blocks are read and written at (later column, earlier column) in that order.
-  bool SolveDamped() {
+  bool SolveDamped(Eigen::MatrixXd& a, const Eigen::VectorXd& g, Eigen::VectorXd* step) {
     using Block = Eigen::Matrix3d;
-    Eigen::MatrixXd& a = damped_;
-    step_ = -g_;
+    Eigen::VectorXd& x = *step;
+    x = -g;
     const int joints = static_cast<int>(active_.size());
     auto column_of = [&](int e) { return e < joints ? column_[active_[joints - 1 - e]] : 0; };
     for (int e = 0; e <= joints; ++e) {
@@ -314,22 +280,26 @@ class FrameSolver {
     }
     for (int e = 0; e <= joints; ++e) {  // L y = -g
       const int c = column_of(e);
-      const Eigen::Vector3d y = inverse_[e] * step_.segment<3>(c);
-      step_.segment<3>(c) = y;
+      const Eigen::Vector3d y = inverse_[e] * x.segment<3>(c);
+      x.segment<3>(c) = y;
       if (e == joints) break;
-      for (int u : ancestors_[e]) step_.segment<3>(u).noalias() -= a.block<3, 3>(u, c) * y;
+      for (int u : ancestors_[e]) x.segment<3>(u).noalias() -= a.block<3, 3>(u, c) * y;
     }
     for (int e = joints; e >= 0; --e) {  // L^T x = y
       const int c = column_of(e);
-      Eigen::Vector3d y = step_.segment<3>(c);
+      Eigen::Vector3d y = x.segment<3>(c);
       if (e < joints) {
         for (int u : ancestors_[e]) {
-          y.noalias() -= a.block<3, 3>(u, c).transpose() * step_.segment<3>(u);
+          y.noalias() -= a.block<3, 3>(u, c).transpose() * x.segment<3>(u);
         }
       }
-      step_.segment<3>(c) = inverse_[e].transpose() * y;
+      x.segment<3>(c) = inverse_[e].transpose() * y;
     }
     return true;
+  }
+
+  void Plus(const Eigen::VectorXd& x, const Eigen::VectorXd& step, Eigen::VectorXd* candidate) {
+    *candidate = x + step;
   }
 
   // The cost 1/2 sum rho(|r|^2) + 1/2 |prior|^2 at x, with the Gauss-Newton matrix J^T J
@@ -387,6 +357,7 @@ class FrameSolver {
     return cost;
   }
 
+ private:
   const std::vector<Node>& nodes_;
   const SkeletonFitOptions& options_;
   std::vector<std::vector<std::pair<int, int>>> paths_;
@@ -403,8 +374,8 @@ class FrameSolver {
   std::vector<Eigen::Matrix3d> turned_, right_jacobian_;
   std::vector<Eigen::Matrix3d> blocks_;
   std::vector<int> block_columns_;
-  Eigen::MatrixXd h_, candidate_h_, damped_;
-  Eigen::VectorXd g_, candidate_g_, x_, candidate_, step_, h_step_;
+  DenseLm<Eigen::VectorXd, Eigen::MatrixXd> lm_;
+  Eigen::VectorXd x_;
 };
 
 Eigen::Matrix3d Exp(const Eigen::Vector3d& v) {

@@ -8,71 +8,51 @@
 #include "arco/geometry/alignment.h"
 #include "arco/geometry/triangulation.h"
 #include "arco/hand/fit_costs.h"
+#include "arco/util/dense_lm.h"
 #include "arco/util/stats.h"
 
 namespace arco::hand {
 namespace {
 
-using internal::HandCostFunction;
 using internal::PixelObservation;
-using internal::PointResiduals;
 using internal::ReprojectionResiduals;
 using internal::TemporalResiduals;
 
 constexpr int kPalmKeypoints[6] = {0, 1, 5, 9, 13, 17};
 const double kNaN = std::nan("");
 
-// Parameter blocks of a pose, for Ceres.
-struct PoseParams {
-  double aa[3], t[3], angles[kNumJointDofs];
-  explicit PoseParams(const HandPose& pose) {
-    const Eigen::Vector3d a = pose.WristAngleAxis();
-    for (int i = 0; i < 3; ++i) aa[i] = a[i], t[i] = pose.world_from_wrist.translation[i];
-    std::copy(pose.angles_rad.begin(), pose.angles_rad.end(), angles);
-  }
-  HandPose ToPose(const HandModel& model) const {
-    HandPose pose;
-    pose.SetWristAngleAxis(Eigen::Vector3d(aa[0], aa[1], aa[2]));
-    pose.world_from_wrist.translation = Eigen::Vector3d(t[0], t[1], t[2]);
-    std::copy(angles, angles + kNumJointDofs, pose.angles_rad.begin());
-    return ClampToLimits(model, pose);  // Ceres keeps bounds; this guards rounding
-  }
-};
-
-// Joint limits as bounds; locked joints (min == max) are held constant.
-void AddBounds(const HandModel& model, ceres::Problem* problem, double* angles) {
-  std::vector<int> locked;
-  for (int d = 0; d < kNumJointDofs; ++d) {
-    if (model.max_rad(d) - model.min_rad(d) < 1e-12) {
-      locked.push_back(d);
-      continue;
-    }
-    problem->SetParameterLowerBound(angles, d, model.min_rad(d));
-    problem->SetParameterUpperBound(angles, d, model.max_rad(d));
-  }
-  if (!locked.empty())
-    problem->SetManifold(angles, new ceres::SubsetManifold(kNumJointDofs, locked));
+// A pose as the fits' parameters: wrist angle-axis, wrist position mm, 20 angles.
+using PoseVector = Eigen::Matrix<double, 6 + kNumJointDofs, 1>;
+PoseVector ToVector(const HandPose& pose) {
+  PoseVector x;
+  x << pose.WristAngleAxis(), pose.world_from_wrist.translation;
+  std::copy(pose.angles_rad.begin(), pose.angles_rad.end(), x.data() + 6);
+  return x;
+}
+HandPose ToPose(const HandModel& model, const PoseVector& x) {
+  HandPose pose;
+  pose.SetWristAngleAxis(x.head<3>());
+  pose.world_from_wrist.translation = x.segment<3>(3);
+  std::copy(x.data() + 6, x.data() + 6 + kNumJointDofs, pose.angles_rad.begin());
+  return ClampToLimits(model, pose);  // the solver keeps bounds; this guards rounding
 }
 
-ceres::Solver::Options SolverOptions(int max_iterations) {
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  options.max_num_iterations = max_iterations;
-  // A relative cost change of 1e-5 ends the solve. 1e-10 (until issue 16) took twice the
-  // iterations of Ceres' default 1e-6; 1e-5 takes a quarter fewer again (per frame of the
-  // one-minute 20-camera take: 17 -> 12.5 iterations in solve 1, 28 -> 24 in the 3D
-  // initialisation) for changes far below the keypoints' noise: docs/accuracy.md's
-  // table (seed 0) within 0.01 mm on average per method and setting. 1e-4 halves solve
-  // 1 again but moved the arco method's harsh contact deviation by +0.04 mm
-  // (docs/performance.md, issue 28 part 3).
-  options.function_tolerance = 1e-5;
-  options.parameter_tolerance = 1e-8;
-  options.num_threads = 1;
-  options.logging_type = ceres::SILENT;
-  // No projected line search after each trust-region step (Ceres runs one on problems
-  // with bounds, the joint limits here): it evaluated the Jacobian a second time per
-  // iteration. Steps still stay within the bounds (Ceres projects them).
-  options.max_num_line_search_step_size_iterations = 0;
+// A relative cost change of 1e-5 ends the solve. 1e-10 (until issue 16) took twice the
+// iterations of Ceres' default 1e-6; 1e-5 takes a quarter fewer again (per frame of the
+// one-minute 20-camera take: 17 -> 12.5 iterations in solve 1, 28 -> 24 in the 3D
+// initialisation) for changes far below the keypoints' noise: docs/accuracy.md's
+// table (seed 0) within 0.01 mm on average per method and setting. 1e-4 halves solve
+// 1 again but moved the arco method's harsh contact deviation by +0.04 mm
+// (docs/performance.md, issue 28 part 3).
+constexpr double kFunctionTolerance = 1e-5;
+constexpr double kParameterTolerance = 1e-8;
+
+DenseLmOptions LmOptions(int max_iterations) {
+  DenseLmOptions options;
+  options.max_iterations = max_iterations;
+  options.function_tolerance = kFunctionTolerance;
+  options.parameter_tolerance = kParameterTolerance;
+  options.keep_last_step = false;
   return options;
 }
 
@@ -181,21 +161,14 @@ HandFit3dResult FitHandToPoints3d(const HandModel& model,
     result.pose = ClampToLimits(model, HandPose{});
     return result;
   }
-  PoseParams params(ClampToLimits(model, *start));
-  ceres::Problem problem;
+  PoseVector x = ToVector(ClampToLimits(model, *start));
   const double c = options.robust_loss_mm;
-  problem.AddResidualBlock(
-      new HandCostFunction<PointResiduals>({&model, &points_in_world_mm, c * c}),
-      nullptr,
-      params.aa,
-      params.t,
-      params.angles);
-  AddBounds(model, &problem, params.angles);
-  ceres::Solver::Summary summary;
-  ceres::Solve(SolverOptions(options.max_iterations), &problem, &summary);
-  result.pose = params.ToPose(model);
-  result.iterations = static_cast<int>(summary.iterations.size());
-  result.termination = ceres::TerminationTypeToString(summary.termination_type);
+  internal::PointProblem problem({&model, &points_in_world_mm, c * c}, nullptr);
+  DenseLm<PoseVector, internal::PointProblem::Matrix> lm;
+  const DenseLmSummary summary = lm.Minimize(problem, LmOptions(options.max_iterations), &x);
+  result.pose = ToPose(model, x);
+  result.iterations = 1 + summary.steps;  // as Ceres counted: the start and each step
+  result.termination = summary.converged ? "CONVERGENCE" : "NO_CONVERGENCE";
   const HandPointsMm fitted = ForwardKinematics(model, result.pose);
   double sum2 = 0;
   for (int k = 0; k < kNumHandKeypoints; ++k) {
@@ -203,8 +176,8 @@ HandFit3dResult FitHandToPoints3d(const HandModel& model,
       sum2 += (fitted[k] - points_in_world_mm[k]).squaredNorm();
   }
   result.rms_error_mm = std::sqrt(sum2 / result.num_points);
-  result.ok = summary.IsSolutionUsable();
-  if (!result.ok) result.problem = "solver failed: " + summary.message;
+  result.ok = std::isfinite(summary.final_cost);
+  if (!result.ok) result.problem = "solver failed: the cost is not finite";
   return result;
 }
 
@@ -263,36 +236,24 @@ HandFitResult FitHandMultiView(const HandModel& model,
     return result;
   }
 
-  PoseParams params(*start);
-  auto solve = [&](const std::vector<PixelObservation>& observations,
-                   ceres::Solver::Summary* summary) {
-    ceres::Problem problem;
-    const double c = options.robust_loss_px;
-    problem.AddResidualBlock(
-        new internal::CompressedReprojectionCost({&model, &observations, c * c}),
-        nullptr,
-        params.aa,
-        params.t,
-        params.angles);
-    if (has_previous) {
-      const HandPose& prev = *init.previous_pose;
-      TemporalResiduals temporal{prev.world_from_wrist.rotation,
+  using internal::ReprojectionProblem;
+  PoseVector x = ToVector(*start);
+  std::optional<TemporalResiduals> temporal;
+  if (has_previous) {
+    const HandPose& prev = *init.previous_pose;
+    temporal = TemporalResiduals{prev.world_from_wrist.rotation,
                                  prev.world_from_wrist.translation,
                                  ClampToLimits(model, prev).angles_rad,
                                  options.temporal_rotation_weight_px_per_rad,
                                  options.temporal_translation_weight_px_per_mm,
                                  options.temporal_angle_weight_px_per_rad};
-      problem.AddResidualBlock(
-          new ceres::
-              AutoDiffCostFunction<TemporalResiduals, 6 + kNumJointDofs, 3, 3, kNumJointDofs>(
-                  new TemporalResiduals(temporal)),
-          nullptr,
-          params.aa,
-          params.t,
-          params.angles);
-    }
-    AddBounds(model, &problem, params.angles);
-    ceres::Solve(SolverOptions(options.max_iterations), &problem, summary);
+  }
+  DenseLm<PoseVector, ReprojectionProblem::Matrix> lm;
+  const DenseLmOptions lm_options = LmOptions(options.max_iterations);
+  auto solve = [&](const std::vector<PixelObservation>& observations) {
+    const double c = options.robust_loss_px;
+    ReprojectionProblem problem({&model, &observations, c * c}, temporal ? &*temporal : nullptr);
+    return lm.Minimize(problem, lm_options, &x);
   };
   auto collect = [&](const std::vector<uint8_t>& use) {
     std::vector<PixelObservation> obs;
@@ -314,10 +275,9 @@ HandFitResult FitHandMultiView(const HandModel& model,
   // Solve 1: every usable view, robust loss. Then gate views on their median
   // residual and solve again with the trusted ones.
   std::vector<PixelObservation> observations = collect(usable);
-  ceres::Solver::Summary summary;
-  solve(observations, &summary);
-  result.iterations = static_cast<int>(summary.iterations.size());
-  HandPose pose = params.ToPose(model);
+  DenseLmSummary summary = solve(observations);
+  result.iterations = 1 + summary.steps;  // as Ceres counted: the start and each step
+  HandPose pose = ToPose(model, x);
   std::vector<double> errors = PixelErrors(model, pose, observations);
   std::vector<std::vector<double>> per_view(num_views);
   for (size_t i = 0; i < observations.size(); ++i)
@@ -331,13 +291,13 @@ HandFitResult FitHandMultiView(const HandModel& model,
   }
   if (trusted != result.num_views_with_hand && trusted > 0) {
     observations = collect(result.trusted_views);
-    solve(observations, &summary);
-    result.iterations += static_cast<int>(summary.iterations.size());
-    pose = params.ToPose(model);
+    summary = solve(observations);
+    result.iterations += 1 + summary.steps;
+    pose = ToPose(model, x);
     errors = PixelErrors(model, pose, observations);
   }
   result.pose = pose;
-  result.termination = ceres::TerminationTypeToString(summary.termination_type);
+  result.termination = summary.converged ? "CONVERGENCE" : "NO_CONVERGENCE";
   result.initial_cost = summary.initial_cost;
   result.final_cost = summary.final_cost;
   result.num_observations = static_cast<int>(observations.size());
@@ -350,8 +310,8 @@ HandFitResult FitHandMultiView(const HandModel& model,
     msg << "only " << trusted << " of " << result.num_views_with_hand << " views agree within "
         << options.view_gate_px << " px";
     result.problem = msg.str();
-  } else if (!summary.IsSolutionUsable()) {
-    result.problem = "solver failed: " + summary.message;
+  } else if (!std::isfinite(summary.final_cost)) {
+    result.problem = "solver failed: the cost is not finite";
   } else {
     result.ok = true;
   }

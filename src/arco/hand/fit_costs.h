@@ -1,6 +1,8 @@
-// Ceres cost functions of the hand fits (internal to arco_hand). All take the
-// parameter blocks {wrist angle-axis (3), wrist position mm (3), angles (20)}
-// and run forward kinematics once per evaluation for all their residuals.
+// Residuals of the hand fits (internal to arco_hand), the problems the fits solve with
+// util/dense_lm.h (HandProblem) and the Ceres cost function of the same residuals
+// (HandCostFunction, the tests' reference). All take the parameters {wrist angle-axis (3),
+// wrist position mm (3), angles (20)} and run forward kinematics once per evaluation for
+// all their residuals.
 //
 // Robust losses are applied inside the residual ("square-root of rho"):
 // r' = sqrt(rho(|r|^2) / |r|^2) r, so that sum |r'|^2 = sum rho(|r_i|^2) with a
@@ -50,7 +52,9 @@ struct ReprojectionResiduals {
   const std::vector<PixelObservation>* observations;
   double loss_c2;  // squared Cauchy scale, px^2
 
-  int num_residuals() const { return 2 * static_cast<int>(observations->size()); }
+  static constexpr int kRowsPerUnit = 2;  // per observation
+  int num_units() const { return static_cast<int>(observations->size()); }
+  int num_residuals() const { return 2 * num_units(); }
   template <typename T>
   void operator()(const T* aa, const T* t, const T* angles, T* residuals) const {
     Eigen::Matrix<T, 3, 1> points[kNumHandKeypoints];
@@ -111,6 +115,8 @@ struct PointResiduals {
   const HandPointsMm* targets;  // NaN = missing (zero residual)
   double loss_c2;               // squared Cauchy scale, mm^2
 
+  static constexpr int kRowsPerUnit = 3;  // per keypoint
+  int num_units() const { return kNumHandKeypoints; }
   int num_residuals() const { return 3 * kNumHandKeypoints; }
   template <typename T>
   void operator()(const T* aa, const T* t, const T* angles, T* residuals) const {
@@ -218,73 +224,71 @@ class HandCostFunction : public ceres::CostFunction {
   Residuals r_;
 };
 
-// The reprojection block of HandCostFunction<ReprojectionResiduals> (2 residuals per
-// observation: 840 for 20 views) as an equivalent block of 27 residuals. Levenberg-
-// Marquardt uses the residuals r and Jacobian J only through the cost |r|^2, J^T J,
-// J^T r and, for the model's predicted decrease, r^T J d and |J d|^2. With the pivoted
-// factorisation J^T J = P^T L D L^T P (Eigen's LDLT, Golub & Van Loan 4.2), the rows
-// J' = D^(1/2) L^T P and residuals r' = D^(-1/2) L^-1 P J^T r (0 where D_i = 0), plus
-// r'_26 = sqrt(|r|^2 - |r'|^2), give J'^T J' = J^T J, J'^T r' = J^T r (J^T r lies in the
-// range of J^T), r'^T J' = r^T J and |r'| = |r|: the same iterates up to rounding. (An
-// eigen-decomposition gives the same block; at 26 x 26 it took 90 us per evaluation,
-// most of the hand fit's time, against 8 us for the LDLT.) J^T J and J^T r are summed
-// per keypoint, J_k^T (sum_o D_o^T D_o) J_k with D_o the 2x3 derivative of observation
-// o and J_k the keypoint's 3x26 Jacobian, so Ceres never sees the 840-row matrix
-// (it checked, copied and multiplied it: two thirds of the fit's time).
-class CompressedReprojectionCost : public ceres::CostFunction {
+// A hand fit as a problem for DenseLm (util/dense_lm.h): parameters x = (wrist
+// angle-axis, wrist position mm, 20 angles), cost 1/2 |r|^2 over the residuals of
+// HandCostFunction<Residuals> (ReprojectionResiduals: 2 per observation, 840 for 20
+// views; PointResiduals: 3 per keypoint) and, with a previous frame, TemporalResiduals.
+// Levenberg-Marquardt uses the residuals r and Jacobian J only through the cost, J^T J and
+// J^T r, so those are summed per keypoint, J_k^T (sum_o D_o^T D_o) J_k with D_o the
+// derivative of unit o (2x3 or 3x3) and J_k the keypoint's 3x26 Jacobian: no 840-row
+// matrix is formed. Locked joints (min == max) are held (their rows and columns of J^T J
+// and J^T r are 0, so their step is 0), the others are kept within their limits by
+// projecting each step (as Ceres does with bounds). Until issue 28 part 3 these were
+// ceres::Problems (the reprojection block compressed to 27 residuals of the same normal
+// equations, an LDLT per evaluation), which evaluated the cost a second time for each
+// accepted step.
+template <typename Residuals>
+class HandProblem {
  public:
   static constexpr int kParams = 6 + kNumJointDofs;
-  explicit CompressedReprojectionCost(ReprojectionResiduals residuals)
-      : r_(residuals), full_(static_cast<size_t>(residuals.num_residuals())) {
-    set_num_residuals(kParams + 1);
-    mutable_parameter_block_sizes()->assign({3, 3, kNumJointDofs});
+  using Vector = Eigen::Matrix<double, kParams, 1>;
+  using Matrix = Eigen::Matrix<double, kParams, kParams>;
+
+  // `temporal`: nullptr for none.
+  HandProblem(Residuals residuals, const TemporalResiduals* temporal)
+      : r_(residuals), temporal_(temporal) {
+    for (int d = 0; d < kNumJointDofs; ++d)
+      locked_[d] = r_.model->max_rad(d) - r_.model->min_rad(d) < 1e-12;
   }
-  ARCO_FLATTEN bool Evaluate(double const* const* x,
-                             double* residuals,
-                             double** jacobians) const override {
-    std::fill(residuals, residuals + kParams + 1, 0.0);
-    if (jacobians == nullptr) {
-      r_(x[0], x[1], x[2], full_.data());
-      double rr = 0;
-      for (double v : full_) rr += v * v;
-      residuals[kParams] = std::sqrt(rr);
-      return true;
-    }
+
+  ARCO_FLATTEN double Evaluate(const Vector& x, Matrix* h, Vector* g) const {
     Eigen::Vector3d points[kNumHandKeypoints];
     HandPointJacobian point_jacobians[kNumHandKeypoints];
-    HandPointsAndJacobians(*r_.model, x[0], x[1], x[2], points, point_jacobians);
-    Eigen::Matrix3d h[kNumHandKeypoints];  // sum of D^T D per keypoint
-    Eigen::Vector3d g[kNumHandKeypoints];  // sum of D^T r per keypoint
+    HandPointsAndJacobians(
+        *r_.model, x.data(), x.data() + 3, x.data() + 6, points, point_jacobians);
+    Eigen::Matrix3d hk[kNumHandKeypoints];  // sum of D^T D per keypoint
+    Eigen::Vector3d gk[kNumHandKeypoints];  // sum of D^T r per keypoint
     bool seen[kNumHandKeypoints] = {};
-    for (int k = 0; k < kNumHandKeypoints; ++k) h[k].setZero(), g[k].setZero();
+    for (int k = 0; k < kNumHandKeypoints; ++k) hk[k].setZero(), gk[k].setZero();
     double rr = 0;
-    const int n = static_cast<int>(r_.observations->size());
+    constexpr int kRows = Residuals::kRowsPerUnit;
+    const int n = r_.num_units();
     for (int i = 0; i < n; ++i) {
       Eigen::Matrix3d d;
       double r[3];
       int k;
       r_.ResidualWithDerivative(i, points, r, &d, &k);
-      const Eigen::Matrix<double, 2, 3> d2 = d.topRows<2>();
-      const Eigen::Vector2d r2(r[0], r[1]);
-      h[k].noalias() += d2.transpose() * d2;
-      g[k].noalias() += d2.transpose() * r2;
-      rr += r2.squaredNorm();
+      const Eigen::Matrix<double, kRows, 3> dr = d.topRows<kRows>();
+      const Eigen::Matrix<double, kRows, 1> rv = Eigen::Map<Eigen::Matrix<double, kRows, 1>>(r);
+      hk[k].noalias() += dr.transpose() * dr;
+      gk[k].noalias() += dr.transpose() * rv;
+      rr += rv.squaredNorm();
       seen[k] = true;
     }
-    Eigen::Matrix<double, kParams, kParams> jtj = Eigen::Matrix<double, kParams, kParams>::Zero();
-    Eigen::Matrix<double, kParams, 1> jtr = Eigen::Matrix<double, kParams, 1>::Zero();
+    Matrix& jtj = *h;
+    Vector& jtr = *g;
+    jtj.setZero();
+    jtr.setZero();
     for (int k = 0; k < kNumHandKeypoints; ++k) {
       if (!seen[k]) continue;
       const HandPointJacobian& jk = point_jacobians[k];
       // Coefficient-wise products: at these fixed sizes Eigen's default (a blocked GEMM
       // with packing) spent more time in copies than in arithmetic.
-      const Eigen::Matrix<double, kParams, 3> jh = jk.transpose().lazyProduct(h[k]);
-      // Only the lower triangle (the LDLT below reads no other) and only the columns the
-      // keypoint moves with (HandPointsAndJacobians leaves the rest exactly 0): the wrist's
-      // translation, and for a finger's keypoint the wrist's rotation and the finger's 4
-      // angles. The entries computed are the same sums in the same order as the full
-      // product's, ((a0 b0 + a1 b1) + a2 b2), and the terms left out are exact zeros,
-      // so J^T J is the same bit for bit at a twelfth of the products.
+      const Eigen::Matrix<double, kParams, 3> jh = jk.transpose().lazyProduct(hk[k]);
+      // Only the lower triangle and only the columns the keypoint moves with
+      // (HandPointsAndJacobians leaves the rest exactly 0): the wrist's translation, and
+      // for a finger's keypoint the wrist's rotation and the finger's 4 angles. The terms
+      // left out are exact zeros, at a twelfth of the products.
       int columns[10];
       int num_columns = 0;
       for (int c = k == 0 ? 3 : 0; c < 6; ++c) columns[num_columns++] = c;
@@ -299,46 +303,78 @@ class CompressedReprojectionCost : public ceres::CostFunction {
           const int i = columns[a];
           jtj(i, j) += (jh(i, 0) * j0 + jh(i, 1) * j1) + jh(i, 2) * j2;
         }
+        jtr[j] += (j0 * gk[k][0] + j1 * gk[k][1]) + j2 * gk[k][2];
       }
-      jtr.noalias() += jk.transpose().lazyProduct(g[k]);
     }
-    const Eigen::LDLT<Eigen::Matrix<double, kParams, kParams>> ldlt(jtj);
-    const auto& s = ldlt.vectorD();
-    // Pivots below this are rounding of a direction no observation constrains (a finger
-    // seen in no view): that row is left out, as a zero eigenvalue would be.
-    const double floor = 1e-14 * std::max(s.maxCoeff(), 0.0);
-    using Square = Eigen::Matrix<double, kParams, kParams>;
-    // L^T P, then each row scaled by sqrt(D_i); P as column swaps, not a 26^3 product.
-    const Square u = ldlt.matrixU();
-    const Eigen::PermutationMatrix<kParams, kParams> p(ldlt.transpositionsP());
-    Square jc = u * p;
-    Eigen::Matrix<double, kParams, 1> y = ldlt.transpositionsP() * jtr;
-    ldlt.matrixL().solveInPlace(y);  // L^-1 P J^T r
-    double explained = 0;
-    for (int i = 0; i < kParams; ++i) {
-      const double si = s[i] > floor ? s[i] : 0.0;
-      const double root = std::sqrt(si);
-      jc.row(i) *= root;
-      residuals[i] = si > 0 ? y[i] / root : 0.0;
-      explained += residuals[i] * residuals[i];
+    if (temporal_ != nullptr) rr += AddTemporal(x, &jtj, &jtr);
+    for (int d = 0; d < kNumJointDofs; ++d) {
+      if (!locked_[d]) continue;
+      jtj.row(6 + d).setZero();
+      jtj.col(6 + d).setZero();
+      jtr[6 + d] = 0;
     }
-    residuals[kParams] = std::sqrt(std::max(0.0, rr - explained));
-    const int sizes[3] = {3, 3, kNumJointDofs};
-    const int offsets[3] = {0, 3, 6};
-    for (int b = 0; b < 3; ++b) {
-      if (jacobians[b] == nullptr) continue;
-      for (int row = 0; row < kParams; ++row) {
-        for (int c = 0; c < sizes[b]; ++c)
-          jacobians[b][row * sizes[b] + c] = jc(row, offsets[b] + c);
-      }
-      for (int c = 0; c < sizes[b]; ++c) jacobians[b][kParams * sizes[b] + c] = 0.0;
+    jtj.triangularView<Eigen::StrictlyUpper>() = jtj.transpose();
+    return 0.5 * rr;
+  }
+
+  // step = -a^-1 g (Cholesky: a is J^T J plus Marquardt's positive diagonal).
+  bool SolveDamped(Matrix& a, const Vector& g, Vector* step) const {
+    const Eigen::LLT<Matrix> llt(a);
+    if (llt.info() != Eigen::Success) return false;
+    *step = -llt.solve(g);
+    return step->allFinite();
+  }
+
+  void Plus(const Vector& x, const Vector& step, Vector* candidate) const {
+    *candidate = x + step;
+    for (int d = 0; d < kNumJointDofs; ++d) {
+      if (locked_[d]) continue;
+      double& a = (*candidate)[6 + d];
+      a = std::min(std::max(a, r_.model->min_rad(d)), r_.model->max_rad(d));
     }
-    return true;
   }
 
  private:
-  ReprojectionResiduals r_;
-  mutable std::vector<double> full_;  // all 2n residuals (one problem, one thread)
+  // TemporalResiduals' |r|^2, added to J^T J (lower triangle) and J^T r: the rotation's 3
+  // residuals depend on the angle-axis only (derivative from a 3-Jet), the others are
+  // weighted differences of one parameter each.
+  double AddTemporal(const Vector& x, Matrix* jtj, Vector* jtr) const {
+    using Jet3 = ceres::Jet<double, 3>;
+    const TemporalResiduals& p = *temporal_;
+    const Jet3 aa[3] = {Jet3(x[0], 0), Jet3(x[1], 1), Jet3(x[2], 2)};
+    const Eigen::Matrix<Jet3, 3, 3> m =
+        p.previous_rotation.transpose().cast<Jet3>() * AngleAxisToMatrix(aa);
+    const Jet3 rotation[3] = {Jet3(0.5 * p.w_rotation) * (m(2, 1) - m(1, 2)),
+                              Jet3(0.5 * p.w_rotation) * (m(0, 2) - m(2, 0)),
+                              Jet3(0.5 * p.w_rotation) * (m(1, 0) - m(0, 1))};
+    double rr = 0;
+    for (const Jet3& r : rotation) {
+      rr += r.a * r.a;
+      for (int j = 0; j < 3; ++j) {
+        for (int i = j; i < 3; ++i) (*jtj)(i, j) += r.v[i] * r.v[j];
+        (*jtr)[j] += r.v[j] * r.a;
+      }
+    }
+    for (int c = 0; c < 3; ++c) {
+      const double r = p.w_translation * (x[3 + c] - p.previous_translation[c]);
+      rr += r * r;
+      (*jtj)(3 + c, 3 + c) += p.w_translation * p.w_translation;
+      (*jtr)[3 + c] += p.w_translation * r;
+    }
+    for (int d = 0; d < kNumJointDofs; ++d) {
+      const double r = p.w_angle * (x[6 + d] - p.previous_angles[d]);
+      rr += r * r;
+      (*jtj)(6 + d, 6 + d) += p.w_angle * p.w_angle;
+      (*jtr)[6 + d] += p.w_angle * r;
+    }
+    return rr;
+  }
+
+  Residuals r_;
+  const TemporalResiduals* temporal_;
+  bool locked_[kNumJointDofs];
 };
+using ReprojectionProblem = HandProblem<ReprojectionResiduals>;
+using PointProblem = HandProblem<PointResiduals>;
 
 }  // namespace arco::hand::internal

@@ -1,6 +1,7 @@
-// CompressedReprojectionCost against the block it stands for (HandCostFunction over all
+// ReprojectionProblem against the block it stands for (HandCostFunction over all
 // observations): Levenberg-Marquardt sees a block only through |r|^2, J^T r and J^T J,
-// so those must agree, also when a finger is seen in no view (J^T J singular).
+// so those must agree (but in the rows and columns of locked joints, which the problem
+// holds at 0), also when a finger is seen in no view (J^T J singular).
 #include "arco/hand/fit_costs.h"
 
 #include <gtest/gtest.h>
@@ -13,7 +14,7 @@
 namespace arco::hand::internal {
 namespace {
 
-constexpr int kParams = CompressedReprojectionCost::kParams;
+constexpr int kParams = ReprojectionProblem::kParams;
 using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 struct Normal {
@@ -66,22 +67,35 @@ void ExpectSameNormalEquations(bool hide_a_finger) {
   start = ClampToLimits(model, start);
   const Eigen::Vector3d aa = start.WristAngleAxis();
   const ReprojectionResiduals residuals{&model, &observations, 5.0 * 5.0};
-  const Normal full = Evaluate(HandCostFunction<ReprojectionResiduals>(residuals),
-                               aa.data(),
-                               start.world_from_wrist.translation.data(),
-                               start.angles_rad.data());
-  const Normal compressed = Evaluate(CompressedReprojectionCost(residuals),
-                                     aa.data(),
-                                     start.world_from_wrist.translation.data(),
-                                     start.angles_rad.data());
-  ASSERT_EQ(compressed.jtj.rows(), kParams);
+  Normal full = Evaluate(HandCostFunction<ReprojectionResiduals>(residuals),
+                         aa.data(),
+                         start.world_from_wrist.translation.data(),
+                         start.angles_rad.data());
+  ReprojectionProblem::Vector x;
+  x << aa, start.world_from_wrist.translation;
+  for (int d = 0; d < kNumJointDofs; ++d) x[6 + d] = start.angles_rad[d];
+  ReprojectionProblem::Matrix h;
+  ReprojectionProblem::Vector g;
+  const Eigen::MatrixXd full_jtj = full.jtj;  // before the locked joints' rows go
+  Normal compressed;
+  compressed.rr = 2 * ReprojectionProblem(residuals, nullptr).Evaluate(x, &h, &g);
+  compressed.jtj = h;
+  compressed.jtr = g;
+  for (int d = 0; d < kNumJointDofs; ++d) {
+    if (model.max_rad(d) - model.min_rad(d) >= 1e-12) continue;
+    EXPECT_EQ(compressed.jtj.row(6 + d).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_EQ(compressed.jtr[6 + d], 0.0);
+    full.jtj.row(6 + d).setZero();
+    full.jtj.col(6 + d).setZero();
+    full.jtr[6 + d] = 0;
+  }
   EXPECT_NEAR(compressed.rr, full.rr, 1e-9 * full.rr);
   const double scale = full.jtj.cwiseAbs().maxCoeff();
   EXPECT_LT((compressed.jtj - full.jtj).cwiseAbs().maxCoeff(), 1e-10 * scale);
   EXPECT_LT((compressed.jtr - full.jtr).cwiseAbs().maxCoeff(),
             1e-9 * full.jtr.cwiseAbs().maxCoeff());
   // The hidden finger's angles are unconstrained: J^T J is singular there.
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(full.jtj);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(full_jtj);
   if (hide_a_finger) {
     EXPECT_LT(eig.eigenvalues()[0], 1e-12 * eig.eigenvalues().maxCoeff());
   } else {
@@ -89,12 +103,61 @@ void ExpectSameNormalEquations(bool hide_a_finger) {
   }
 }
 
-TEST(CompressedReprojectionCost, SameNormalEquationsAsTheFullBlock) {
-  ExpectSameNormalEquations(false);
+TEST(ReprojectionProblem, SameNormalEquationsAsTheFullBlock) { ExpectSameNormalEquations(false); }
+
+TEST(ReprojectionProblem, SameNormalEquationsWhenAFingerIsSeenInNoView) {
+  ExpectSameNormalEquations(true);
 }
 
-TEST(CompressedReprojectionCost, SameNormalEquationsWhenAFingerIsSeenInNoView) {
-  ExpectSameNormalEquations(true);
+// PointProblem (the 3D initialisation's) against HandCostFunction<PointResiduals>, with
+// missing points, and the temporal prior's terms against its autodiff cost function.
+TEST(PointProblem, SameNormalEquationsAsTheCostFunctionsWithTheTemporalPrior) {
+  const HandModel model = HandModel::Default(HandSide::kLeft);
+  std::mt19937 rng(5);
+  const HandPose truth = testing::RandomPose(model, rng, 0.1);
+  HandPointsMm targets = ForwardKinematics(model, truth);
+  targets[7] = targets[18] = Eigen::Vector3d::Constant(std::nan(""));
+  targets[3] += Eigen::Vector3d(30, -20, 10);  // an outlier, on the Cauchy loss's tail
+  HandPose start = truth;
+  start.world_from_wrist.translation += Eigen::Vector3d(4, -3, 5);
+  for (double& a : start.angles_rad) a += 0.05;
+  start = ClampToLimits(model, start);
+  const Eigen::Vector3d aa = start.WristAngleAxis();
+  const PointResiduals residuals{&model, &targets, 10.0 * 10.0};
+  const TemporalResiduals temporal{truth.world_from_wrist.rotation,
+                                   truth.world_from_wrist.translation,
+                                   truth.angles_rad,
+                                   2.0,
+                                   0.5,
+                                   3.0};
+  Normal full = Evaluate(HandCostFunction<PointResiduals>(residuals),
+                         aa.data(),
+                         start.world_from_wrist.translation.data(),
+                         start.angles_rad.data());
+  const Normal prior =
+      Evaluate(ceres::AutoDiffCostFunction<TemporalResiduals, kParams, 3, 3, kNumJointDofs>(
+                   new TemporalResiduals(temporal)),
+               aa.data(),
+               start.world_from_wrist.translation.data(),
+               start.angles_rad.data());
+  full.rr += prior.rr;
+  full.jtj += prior.jtj;
+  full.jtr += prior.jtr;
+  PointProblem::Vector x;
+  x << aa, start.world_from_wrist.translation;
+  for (int d = 0; d < kNumJointDofs; ++d) x[6 + d] = start.angles_rad[d];
+  PointProblem::Matrix h;
+  PointProblem::Vector g;
+  const double rr = 2 * PointProblem(residuals, &temporal).Evaluate(x, &h, &g);
+  for (int d = 0; d < kNumJointDofs; ++d) {
+    if (model.max_rad(d) - model.min_rad(d) >= 1e-12) continue;
+    full.jtj.row(6 + d).setZero();
+    full.jtj.col(6 + d).setZero();
+    full.jtr[6 + d] = 0;
+  }
+  EXPECT_NEAR(rr, full.rr, 1e-9 * full.rr);
+  EXPECT_LT((h - full.jtj).cwiseAbs().maxCoeff(), 1e-10 * full.jtj.cwiseAbs().maxCoeff());
+  EXPECT_LT((g - full.jtr).cwiseAbs().maxCoeff(), 1e-9 * full.jtr.cwiseAbs().maxCoeff());
 }
 
 }  // namespace
