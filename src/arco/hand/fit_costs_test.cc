@@ -4,6 +4,7 @@
 // holds at 0), also when a finger is seen in no view (J^T J singular).
 #include "arco/hand/fit_costs.h"
 
+#include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
 #include <random>
@@ -13,6 +14,51 @@
 
 namespace arco::hand::internal {
 namespace {
+
+// The reference: the same residuals as a ceres::CostFunction (what the fits solved with
+// before issue 28 part 3). Jacobians by the chain rule: keypoint Jacobians from the kinematic tree
+// (HandPointsAndJacobians), times the 2x3 (projection + robust scaling) or 3x3
+// (robust scaling) derivative of each residual with respect to its keypoint,
+// both from small Jets. Values come from the templated residual functors.
+template <typename Residuals>
+class HandCostFunction : public ceres::CostFunction {
+ public:
+  explicit HandCostFunction(Residuals residuals) : r_(residuals) {
+    set_num_residuals(r_.num_residuals());
+    mutable_parameter_block_sizes()->assign({3, 3, kNumJointDofs});
+  }
+  ARCO_FLATTEN bool Evaluate(double const* const* x,
+                             double* residuals,
+                             double** jacobians) const override {
+    if (jacobians == nullptr) {
+      r_(x[0], x[1], x[2], residuals);
+      return true;
+    }
+    Eigen::Vector3d points[kNumHandKeypoints];
+    HandPointJacobian point_jacobians[kNumHandKeypoints];
+    HandPointsAndJacobians(*r_.model, x[0], x[1], x[2], points, point_jacobians);
+    const int sizes[3] = {3, 3, kNumJointDofs};
+    const int offsets[3] = {0, 3, 6};
+    Eigen::Matrix<double, 3, 3> d_residual;  // rows: residual components (<= 3)
+    int row = 0;
+    for (int i = 0; row < num_residuals(); ++i) {
+      int keypoint;
+      const int dim = r_.ResidualWithDerivative(i, points, residuals + row, &d_residual, &keypoint);
+      for (int j = 0; j < dim; ++j, ++row) {
+        const Eigen::Matrix<double, 1, 6 + kNumJointDofs> d =
+            d_residual.row(j) * point_jacobians[keypoint];
+        for (int b = 0; b < 3; ++b) {
+          if (jacobians[b] == nullptr) continue;
+          for (int c = 0; c < sizes[b]; ++c) jacobians[b][row * sizes[b] + c] = d[offsets[b] + c];
+        }
+      }
+    }
+    return true;
+  }
+
+ private:
+  Residuals r_;
+};
 
 constexpr int kParams = ReprojectionProblem::kParams;
 using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
