@@ -107,8 +107,7 @@ TEST(FitSkeleton, ExactOnExactPointsAndDeterministic) {
   EXPECT_LT(worst, 1e-6);
 }
 
-// Chunks fitted in parallel: the same bits for any thread count, and chunk starts (cold,
-// from the tree fit) that agree with one warm-started pass over the whole take.
+// Chunks fitted in parallel: the same bits for any thread count.
 TEST(FitSkeleton, ChunksGiveTheSameBitsForAnyThreadCount) {
   const Take t = MakeTake(60, 2.0, 5);
   SkeletonFitOptions o;
@@ -123,6 +122,23 @@ TEST(FitSkeleton, ChunksGiveTheSameBitsForAnyThreadCount) {
     EXPECT_TRUE(SameBits(one->points_mm, many->points_mm)) << threads << " threads";
     EXPECT_EQ(one->median_residual_mm, many->median_residual_mm);
   }
+  o.chunk_frames = 0;
+  EXPECT_FALSE(FitSkeleton(t.noisy, t.names, {}, o).ok());
+  o.chunk_frames = 7;
+  o.num_threads = -1;
+  EXPECT_FALSE(FitSkeleton(t.noisy, t.names, {}, o).ok());
+}
+
+// Chunk starts (cold, from the tree fit, then the warm-up) agree with one warm-started pass
+// over the whole take. (Its bound moves with the compiler: the Makefile's
+// ASAN_COMPILER_SENSITIVE says by how much.)
+TEST(FitSkeleton, ChunkStartsAgreeWithOnePassOverTheTake) {
+  const Take t = MakeTake(60, 2.0, 5);
+  SkeletonFitOptions o;
+  o.chunk_frames = 7;  // 9 chunks, the last one short
+  o.num_threads = 1;
+  const StatusOr<SkeletonFitResult> one = FitSkeleton(t.noisy, t.names, {}, o);
+  ASSERT_TRUE(one.ok()) << one.status().message();
   SkeletonFitOptions whole;
   whole.chunk_frames = 60;
   const StatusOr<SkeletonFitResult> warm = FitSkeleton(t.noisy, t.names, {}, whole);
@@ -150,11 +166,6 @@ TEST(FitSkeleton, ChunksGiveTheSameBitsForAnyThreadCount) {
   ASSERT_GT(filled_chunks.size(), 100u);
   EXPECT_LT(Median(filled_chunks), 1.05 * Median(filled_one_pass) + 0.05)
       << Median(filled_one_pass) << " mm in one pass";
-  o.chunk_frames = 0;
-  EXPECT_FALSE(FitSkeleton(t.noisy, t.names, {}, o).ok());
-  o.chunk_frames = 7;
-  o.num_threads = -1;
-  EXPECT_FALSE(FitSkeleton(t.noisy, t.names, {}, o).ok());
 }
 
 TEST(FitSkeleton, RejectsBadShapesAndLeavesUnmeasuredGroupsRaw) {

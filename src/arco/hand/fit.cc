@@ -25,7 +25,7 @@ const double kNaN = std::nan("");
 using PoseVector = Eigen::Matrix<double, 6 + kNumJointDofs, 1>;
 PoseVector ToVector(const HandPose& pose) {
   PoseVector x;
-  x << pose.WristAngleAxis(), pose.world_from_wrist.translation;
+  x.head<6>() << pose.WristAngleAxis(), pose.world_from_wrist.translation;
   std::copy(pose.angles_rad.begin(), pose.angles_rad.end(), x.data() + 6);
   return x;
 }

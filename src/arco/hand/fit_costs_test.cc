@@ -118,7 +118,7 @@ void ExpectSameNormalEquations(bool hide_a_finger) {
                          start.world_from_wrist.translation.data(),
                          start.angles_rad.data());
   ReprojectionProblem::Vector x;
-  x << aa, start.world_from_wrist.translation;
+  x.head<6>() << aa, start.world_from_wrist.translation;
   for (int d = 0; d < kNumJointDofs; ++d) x[6 + d] = start.angles_rad[d];
   ReprojectionProblem::Matrix h;
   ReprojectionProblem::Vector g;
@@ -190,7 +190,7 @@ TEST(PointProblem, SameNormalEquationsAsTheCostFunctionsWithTheTemporalPrior) {
   full.jtj += prior.jtj;
   full.jtr += prior.jtr;
   PointProblem::Vector x;
-  x << aa, start.world_from_wrist.translation;
+  x.head<6>() << aa, start.world_from_wrist.translation;
   for (int d = 0; d < kNumJointDofs; ++d) x[6 + d] = start.angles_rad[d];
   PointProblem::Matrix h;
   PointProblem::Vector g;
