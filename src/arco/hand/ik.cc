@@ -1,7 +1,8 @@
 #include "arco/hand/ik.h"
 
-#include <ceres/ceres.h>
+#include <ceres/jet.h>
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -9,6 +10,8 @@
 #include <stdexcept>
 
 #include "arco/hand/kinematics.h"
+#include "arco/util/check.h"
+#include "arco/util/dense_lm.h"
 
 namespace arco::hand {
 namespace {
@@ -17,64 +20,6 @@ constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kActiveTolRad = 1e-6;
 // Grid levels per free joint for restarts, by number of free joints (<= 1296 points).
 constexpr int kAutoSeedLevels[5] = {2, 33, 17, 9, 6};
-
-// Tip position error (mm, world) as a function of the N free angles of a finger, and
-// pip_weight times the PIP keypoint's error toward pip_target (zero residuals when the
-// weight is 0); the other dofs stay at their reference values.
-template <int N>
-struct TipCost {
-  const HandModel* model;
-  Finger finger;
-  std::array<double, 4> fixed;  // reference dofs of the finger
-  std::array<int, N> slots;     // which of the 4 slots are free
-  Eigen::Matrix3d rotation;     // world_from_wrist
-  Eigen::Vector3d translation;  // wrist in world
-  Eigen::Vector3d target;
-  double pip_weight = 0;
-  Eigen::Vector3d pip_target = Eigen::Vector3d::Zero();
-  double dip_weight = 0;
-  Eigen::Vector3d dip_target = Eigen::Vector3d::Zero();
-
-  template <typename T>
-  bool operator()(const T* x, T* residual) const {
-    T dof[4];
-    for (int i = 0; i < 4; ++i) dof[i] = T(fixed[i]);
-    for (int i = 0; i < N; ++i) dof[slots[i]] = x[i];
-    Eigen::Matrix<T, 3, 1> p[4];
-    FingerPointsInWrist(*model, finger, dof, p);
-    const Eigen::Matrix<T, 3, 1> tip = rotation.cast<T>() * p[3] + translation.cast<T>();
-    const Eigen::Matrix<T, 3, 1> pip = rotation.cast<T>() * p[1] + translation.cast<T>();
-    const Eigen::Matrix<T, 3, 1> dip = rotation.cast<T>() * p[2] + translation.cast<T>();
-    for (int r = 0; r < 3; ++r) {
-      residual[r] = tip[r] - T(target[r]);
-      residual[3 + r] = T(pip_weight) * (pip[r] - T(pip_target[r]));
-      residual[6 + r] = T(dip_weight) * (dip[r] - T(dip_target[r]));
-    }
-    return true;
-  }
-};
-
-// weight * (x - anchor), analytic.
-class AnchorCost : public ceres::CostFunction {
- public:
-  AnchorCost(std::vector<double> anchor, double weight) : anchor_(std::move(anchor)), w_(weight) {
-    set_num_residuals(static_cast<int>(anchor_.size()));
-    mutable_parameter_block_sizes()->push_back(static_cast<int>(anchor_.size()));
-  }
-  bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override {
-    const int n = static_cast<int>(anchor_.size());
-    for (int i = 0; i < n; ++i) residuals[i] = w_ * (x[0][i] - anchor_[i]);
-    if (jacobians && jacobians[0]) {
-      for (int i = 0; i < n * n; ++i) jacobians[0][i] = 0;
-      for (int i = 0; i < n; ++i) jacobians[0][i * n + i] = w_;
-    }
-    return true;
-  }
-
- private:
-  std::vector<double> anchor_;
-  double w_;
-};
 
 struct SolveOutcome {
   std::vector<double> x;
@@ -85,11 +30,6 @@ struct SolveOutcome {
   int solves = 0;
   std::string termination;
 };
-
-template <int N>
-ceres::CostFunction* MakeTipCost(const TipCost<N>& functor) {
-  return new ceres::AutoDiffCostFunction<TipCost<N>, 9, N>(new TipCost<N>(functor));
-}
 
 struct IkProblemSpec {
   const HandModel* model;
@@ -126,7 +66,84 @@ double KeypointTerms(const IkProblemSpec& s, const std::vector<double>& x) {
          std::pow(s.dip_weight * (s.rotation * p[2] + s.translation - s.dip_target).norm(), 2);
 }
 
-// One bounded trust-region solve from x (in place) with the given weights.
+// The free angles (at most 4) and their normal equations, fixed-capacity (no allocation).
+using IkVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 4, 1>;
+using IkMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 4, 4>;
+
+// The cost of the header's comment as a least-squares problem for DenseLm: the tip's 3
+// residuals (mm, world), the PIP's and DIP's weighted 3 each (zero without a target), and
+// the anchors w_ref (x - x_ref) and w_prev (x - x_prev). The 9 x n Jacobian of the
+// keypoint residuals comes from 4-Jets through the finger's forward kinematics; J^T J and
+// J^T r are summed from it and the anchors' diagonal.
+class IkProblem {
+ public:
+  IkProblem(const IkProblemSpec& s, double w_ref, double w_prev)
+      : s_(s), w_ref2_(w_ref * w_ref), w_prev2_(s.has_prev ? w_prev * w_prev : 0.0) {}
+
+  double Evaluate(const IkVector& x, IkMatrix* h, IkVector* g) const {
+    using Jet = ceres::Jet<double, 4>;
+    const int n = static_cast<int>(x.size());
+    Jet dof[4];
+    for (int i = 0; i < 4; ++i) dof[i] = Jet(s_.reference[i]);
+    for (int i = 0; i < n; ++i) dof[s_.slots[i]] = Jet(x[i], i);
+    Eigen::Matrix<Jet, 3, 1> p[4];
+    FingerPointsInWrist(*s_.model, s_.finger, dof, p);
+    const Eigen::Matrix<Jet, 3, 3> rotation = s_.rotation.cast<Jet>();
+    Eigen::Matrix<Jet, 9, 1> r;
+    r.segment<3>(0) = rotation * p[3] + (s_.translation - s_.target).cast<Jet>();
+    r.segment<3>(3) =
+        (rotation * p[1] + (s_.translation - s_.pip_target).cast<Jet>()) * Jet(s_.pip_weight);
+    r.segment<3>(6) =
+        (rotation * p[2] + (s_.translation - s_.dip_target).cast<Jet>()) * Jet(s_.dip_weight);
+    Eigen::Matrix<double, 9, Eigen::Dynamic, 0, 9, 4> jacobian(9, n);
+    Eigen::Matrix<double, 9, 1> rv;
+    for (int k = 0; k < 9; ++k) {
+      rv[k] = r[k].a;
+      for (int i = 0; i < n; ++i) jacobian(k, i) = r[k].v[i];
+    }
+    h->noalias() = jacobian.transpose() * jacobian;
+    g->noalias() = jacobian.transpose() * rv;
+    double anchors = 0;
+    for (int i = 0; i < n; ++i) {
+      const double d_ref = x[i] - s_.ref_free[i];
+      (*h)(i, i) += w_ref2_;
+      (*g)[i] += w_ref2_ * d_ref;
+      anchors += w_ref2_ * d_ref * d_ref;
+      if (w_prev2_ > 0) {
+        const double d_prev = x[i] - s_.prev_free[i];
+        (*h)(i, i) += w_prev2_;
+        (*g)[i] += w_prev2_ * d_prev;
+        anchors += w_prev2_ * d_prev * d_prev;
+      }
+    }
+    return 0.5 * (rv.squaredNorm() + anchors);
+  }
+
+  bool SolveDamped(IkMatrix& a, const IkVector& g, IkVector* step) const {
+    const Eigen::LLT<IkMatrix> llt(a);
+    if (llt.info() != Eigen::Success) return false;
+    *step = -llt.solve(g);
+    return step->allFinite();
+  }
+
+  // The step projected onto the joints' bounds (as Ceres projects a step onto parameter
+  // bounds).
+  void Plus(const IkVector& x, const IkVector& step, IkVector* candidate) const {
+    *candidate = x + step;
+    for (int i = 0; i < candidate->size(); ++i) {
+      (*candidate)[i] = std::clamp((*candidate)[i], s_.lower[i], s_.upper[i]);
+    }
+  }
+
+ private:
+  const IkProblemSpec& s_;
+  double w_ref2_, w_prev2_;
+};
+
+// One bounded trust-region solve from x (in place) with the given weights: Levenberg-
+// Marquardt with Ceres' rules (util/dense_lm.h), steps projected onto the bounds; the
+// active-set loop below handles joints that end on a limit. (Until issue 28 a
+// ceres::Problem per solve, DENSE_QR: its set-up cost more than the 2-4 angles' arithmetic.)
 void SolveOnce(const IkProblemSpec& s,
                double w_ref,
                double w_prev,
@@ -134,65 +151,22 @@ void SolveOnce(const IkProblemSpec& s,
                std::vector<double>* x,
                SolveOutcome* out) {
   const int n = static_cast<int>(s.slots.size());
-  ceres::Problem problem;
-  ceres::CostFunction* tip = nullptr;
-  auto fill = [&](auto functor) {
-    functor.model = s.model;
-    functor.finger = s.finger;
-    functor.fixed = s.reference;
-    for (int i = 0; i < n; ++i) functor.slots[i] = s.slots[i];
-    functor.rotation = s.rotation;
-    functor.translation = s.translation;
-    functor.target = s.target;
-    functor.pip_weight = s.pip_weight;
-    functor.pip_target = s.pip_target;
-    functor.dip_weight = s.dip_weight;
-    functor.dip_target = s.dip_target;
-    return MakeTipCost(functor);
-  };
-  switch (n) {
-    case 1:
-      tip = fill(TipCost<1>{});
-      break;
-    case 2:
-      tip = fill(TipCost<2>{});
-      break;
-    case 3:
-      tip = fill(TipCost<3>{});
-      break;
-    case 4:
-      tip = fill(TipCost<4>{});
-      break;
-    default:
-      ARCO_CHECK(false) << "unsupported free dof count " << n;
-  }
-  problem.AddResidualBlock(tip, nullptr, x->data());
-  if (w_ref > 0) problem.AddResidualBlock(new AnchorCost(s.ref_free, w_ref), nullptr, x->data());
-  if (s.has_prev && w_prev > 0) {
-    problem.AddResidualBlock(new AnchorCost(s.prev_free, w_prev), nullptr, x->data());
-  }
-  for (int i = 0; i < n; ++i) {
-    problem.SetParameterLowerBound(x->data(), i, s.lower[i]);
-    problem.SetParameterUpperBound(x->data(), i, s.upper[i]);
-  }
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
-  options.max_num_iterations = max_iterations;
+  ARCO_CHECK(n >= 1 && n <= 4) << "unsupported free dof count " << n;
+  IkProblem problem(s, w_ref, w_prev);
+  DenseLmOptions options;
+  options.max_iterations = max_iterations;
   options.function_tolerance = 1e-14;
   options.gradient_tolerance = 1e-14;
   options.parameter_tolerance = 1e-12;
-  options.num_threads = 1;
-  options.logging_type = ceres::SILENT;
-  // No projected line search per step (a second Jacobian evaluation per iteration);
-  // Ceres still projects each step onto the bounds. The active-set loop around this
-  // solve handles the limits.
-  options.max_num_line_search_step_size_iterations = 0;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
-  out->converged = summary.termination_type == ceres::CONVERGENCE;
-  out->iterations += static_cast<int>(summary.iterations.size());
+  options.keep_last_step = false;  // Ceres' stopping point
+  IkVector v = Eigen::Map<const IkVector>(x->data(), n);
+  DenseLm<IkVector, IkMatrix> solver;
+  const DenseLmSummary summary = solver.Minimize(problem, options, &v);
+  std::copy(v.data(), v.data() + n, x->begin());
+  out->converged = summary.converged;
+  out->iterations += summary.steps + 1;  // counted as Ceres did: the start is iteration 0
   out->solves += 1;
-  out->termination = ceres::TerminationTypeToString(summary.termination_type);
+  out->termination = summary.converged ? "CONVERGENCE" : "NO_CONVERGENCE";
 }
 
 // Gradient of the weighted cost with respect to the free angles.

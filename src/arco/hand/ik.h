@@ -1,8 +1,8 @@
 // Inverse kinematics: "put this fingertip at this point" with a chosen set of
-// free joints, joint limits as hard bounds (Ceres trust region with parameter
-// bounds), and regularisation towards a reference pose (and optionally the
-// previous frame's pose). This is the audio-guided correction's solver (the
-// paper's Eq. 3 adjusts PIP and DIP of the note-playing finger: kPipDip).
+// free joints, joint limits as hard bounds (a Levenberg-Marquardt trust region with Ceres'
+// rules, util/dense_lm.h, steps projected onto the bounds), and regularisation towards a reference
+// pose (and optionally the previous frame's pose). This is the audio-guided correction's solver
+// (the paper's Eq. 3 adjusts PIP and DIP of the note-playing finger: kPipDip).
 //
 // Cost over the free angles x (rad) of one finger:
 //   |tip(x) - target|^2 + w_pip^2 |pip(x) - pip_target|^2 + w_dip^2 |dip(x) - dip_target|^2
@@ -66,7 +66,7 @@ struct FingerIkResult {
   // is then the reference clamped into the limits.
   Status status;
   HandPose pose;                   // reference with the free angles solved; within limits
-  bool converged = false;          // Ceres reported convergence of the chosen solve
+  bool converged = false;          // the chosen solve converged (not out of iterations)
   int iterations = 0;              // all trust-region iterations, all solves
   int solves = 0;                  // 1 or 2 per start, more with restarts
   double initial_distance_mm = 0;  // from the (clamped) reference
@@ -74,7 +74,7 @@ struct FingerIkResult {
   std::vector<int> active_limit_dofs;  // dofs (DofIndex) at an anatomical limit
   bool step_limited = false;           // a free dof ended on the max_change box
   int clamped_reference_dofs = 0;      // reference angles that were outside limits
-  std::string termination;             // Ceres' termination of the chosen solve
+  std::string termination;             // CONVERGENCE or NO_CONVERGENCE (Ceres' words)
 };
 
 // Throws std::invalid_argument on invalid options.
