@@ -289,6 +289,63 @@ bool Better(const SolveOutcome& a, const SolveOutcome& b, double tol_mm) {
 
 }  // namespace
 
+namespace internal {
+
+std::vector<double> RestartGridTipDistances(const HandModel& model,
+                                            Finger finger,
+                                            const std::array<double, 4>& reference,
+                                            const std::vector<int>& slots,
+                                            const std::vector<double>& lower,
+                                            const std::vector<double>& upper,
+                                            int levels,
+                                            const Eigen::Matrix3d& rotation,
+                                            const Eigen::Vector3d& translation,
+                                            const Eigen::Vector3d& target) {
+  // Per slot its values (the reference alone when fixed) and its step in the point index.
+  std::array<std::vector<double>, 4> values;
+  std::array<int, 4> stride{};
+  for (int slot = 0; slot < 4; ++slot) values[slot] = {reference[slot]};
+  int combos = 1;
+  for (size_t i = 0; i < slots.size(); ++i) {
+    std::vector<double>& v = values[slots[i]];
+    v.resize(static_cast<size_t>(levels));
+    for (int l = 0; l < levels; ++l) v[l] = lower[i] + (upper[i] - lower[i]) * l / (levels - 1.0);
+    stride[slots[i]] = combos;
+    combos *= levels;
+  }
+  const int k0 = KeypointIndex(finger, 0);
+  const Eigen::Vector3d out0 = model.rest_offset_mm(k0);
+  const Eigen::Vector3d& r1 = model.rest_offset_mm(k0 + 1);
+  const Eigen::Vector3d& r2 = model.rest_offset_mm(k0 + 2);
+  const Eigen::Vector3d& r3 = model.rest_offset_mm(k0 + 3);
+  std::vector<Eigen::Matrix3d> middle, distal;
+  for (double a : values[2])
+    middle.push_back(AxisRotation<double>(model.axis(DofIndex(finger, FingerDof::kMiddleFlex)), a));
+  for (double a : values[3])
+    distal.push_back(AxisRotation<double>(model.axis(DofIndex(finger, FingerDof::kDistalFlex)), a));
+  std::vector<double> distances(static_cast<size_t>(combos));
+  for (size_t l0 = 0; l0 < values[0].size(); ++l0) {
+    for (size_t l1 = 0; l1 < values[1].size(); ++l1) {
+      const double base_dofs[4] = {values[0][l0], values[1][l1], 0.0, 0.0};
+      const Eigen::Matrix3d g0 = BaseJointRotation(model, finger, base_dofs);
+      const Eigen::Vector3d out1 = out0 + g0 * r1;
+      for (size_t l2 = 0; l2 < middle.size(); ++l2) {
+        const Eigen::Matrix3d g2 = g0 * middle[l2];
+        const Eigen::Vector3d out2 = out1 + g2 * r2;
+        for (size_t l3 = 0; l3 < distal.size(); ++l3) {
+          const Eigen::Matrix3d g3 = g2 * distal[l3];
+          const Eigen::Vector3d out3 = out2 + g3 * r3;
+          const size_t c = l0 * stride[0] + l1 * stride[1] + l2 * stride[2] + l3 * stride[3];
+          distances[c] = (rotation * out3 + translation - target).norm();
+        }
+      }
+    }
+  }
+  return distances;
+}
+
+}  // namespace internal
+
 const char* FingerIkJointsName(FingerIkJoints joints) {
   switch (joints) {
     case FingerIkJoints::kPipDip:
@@ -427,10 +484,17 @@ FingerIkResult SolveFingertipIk(const HandModel& model,
         seed[i] = s.lower[i] + (s.upper[i] - s.lower[i]) * (c % levels) / (levels - 1.0);
       }
     };
-    for (int c = 0; c < combos; ++c) {
-      decode(c);
-      scored[c] = {TipDistance(s, seed), c};
-    }
+    const std::vector<double> distances = internal::RestartGridTipDistances(model,
+                                                                            finger,
+                                                                            s.reference,
+                                                                            s.slots,
+                                                                            s.lower,
+                                                                            s.upper,
+                                                                            levels,
+                                                                            s.rotation,
+                                                                            s.translation,
+                                                                            s.target);
+    for (int c = 0; c < combos; ++c) scored[c] = {distances[c], c};
     const int keep = std::min(options.restarts, combos);
     std::partial_sort(scored.begin(), scored.begin() + keep, scored.end());
     for (int r = 0; r < keep; ++r) {

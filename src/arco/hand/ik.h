@@ -17,6 +17,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -86,5 +87,25 @@ FingerIkResult SolveFingertipIk(const HandModel& model,
 
 // Slots (FingerDof) freed by a joints choice.
 std::vector<FingerDof> FreeDofs(FingerIkJoints joints);
+
+namespace internal {
+
+// The restart grid's scores: the fingertip's distance (mm) from target_in_world_mm at every
+// point of a grid of `levels` values per free slot (slots[i], value lower[i] + (upper[i] -
+// lower[i]) l / (levels - 1)), the other slots at `reference`; point c = sum_i l_i levels^i.
+// Each joint's rotation per level is made once and the kinematic chain's prefixes are
+// shared, in FingerPointsInWrist's arithmetic: the same bits as evaluating each point.
+std::vector<double> RestartGridTipDistances(const HandModel& model,
+                                            Finger finger,
+                                            const std::array<double, 4>& reference,
+                                            const std::vector<int>& slots,
+                                            const std::vector<double>& lower,
+                                            const std::vector<double>& upper,
+                                            int levels,
+                                            const Eigen::Matrix3d& world_from_wrist_rotation,
+                                            const Eigen::Vector3d& wrist_in_world_mm,
+                                            const Eigen::Vector3d& target_in_world_mm);
+
+}  // namespace internal
 
 }  // namespace arco::hand

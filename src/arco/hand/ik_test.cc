@@ -325,3 +325,66 @@ TEST(SolveFingertipIk, ADipObservationHoldsTheDipWhereItWasSeen) {
 
 }  // namespace
 }  // namespace arco::hand
+
+namespace arco::hand {
+namespace {
+
+// The restart grid's shared-prefix scores are each point's own tip distance, bit for bit
+// (so the restarts chosen are those of evaluating every point).
+TEST(SolveFingertipIk, RestartGridScoresAreEachPointsOwnTipDistance) {
+  std::mt19937 rng(7);
+  const HandModel model = HandModel::Default(HandSide::kLeft);
+  int points = 0;
+  for (FingerIkJoints joints :
+       {FingerIkJoints::kPipDip, FingerIkJoints::kMcpFlexPipDip, FingerIkJoints::kAll}) {
+    for (int f = 0; f < kNumFingers; ++f) {
+      const Finger finger = static_cast<Finger>(f);
+      const HandPose pose = testing::RandomPose(model, rng, 0.3);
+      std::array<double, 4> reference;
+      for (int i = 0; i < 4; ++i) reference[i] = pose.angles_rad[4 * f + i];
+      std::vector<int> slots;
+      std::vector<double> lower, upper;
+      for (FingerDof slot : FreeDofs(joints)) {
+        const int d = DofIndex(finger, slot);
+        if (!(model.max_rad(d) > model.min_rad(d))) continue;
+        slots.push_back(static_cast<int>(slot));
+        lower.push_back(model.min_rad(d));
+        upper.push_back(model.max_rad(d));
+      }
+      const int levels = 5;
+      const Eigen::Vector3d target(10.0, -40.0, 75.0);
+      const std::vector<double> grid =
+          internal::RestartGridTipDistances(model,
+                                            finger,
+                                            reference,
+                                            slots,
+                                            lower,
+                                            upper,
+                                            levels,
+                                            pose.world_from_wrist.rotation,
+                                            pose.world_from_wrist.translation,
+                                            target);
+      int combos = 1;
+      for (size_t i = 0; i < slots.size(); ++i) combos *= levels;
+      ASSERT_EQ(grid.size(), static_cast<size_t>(combos));
+      for (int c = 0; c < combos; ++c) {
+        std::array<double, 4> dof = reference;
+        for (size_t i = 0, rest = c; i < slots.size(); ++i, rest /= levels) {
+          dof[slots[i]] = lower[i] + (upper[i] - lower[i]) * (rest % levels) / (levels - 1.0);
+        }
+        Eigen::Vector3d p[4];
+        FingerPointsInWrist(model, finger, dof.data(), p);
+        const double own =
+            (pose.world_from_wrist.rotation * p[3] + pose.world_from_wrist.translation - target)
+                .norm();
+        ASSERT_EQ(grid[c], own) << FingerName(finger) << " " << FingerIkJointsName(joints)
+                                << " point " << c;
+        ++points;
+      }
+    }
+  }
+  EXPECT_GT(points, 100);
+}
+
+}  // namespace
+}  // namespace arco::hand
