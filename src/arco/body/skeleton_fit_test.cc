@@ -107,12 +107,19 @@ TEST(FitSkeleton, ExactOnExactPointsAndDeterministic) {
   EXPECT_LT(worst, 1e-6);
 }
 
+// The chunk tests' fit: chunks of 7 frames (of a 60-frame take: 9 chunks, the last one
+// short) on `threads` threads.
+SkeletonFitOptions SevenFrameChunks(int threads) {
+  SkeletonFitOptions o;
+  o.chunk_frames = 7;
+  o.num_threads = threads;
+  return o;
+}
+
 // Chunks fitted in parallel: the same bits for any thread count.
 TEST(FitSkeleton, ChunksGiveTheSameBitsForAnyThreadCount) {
   const Take t = MakeTake(60, 2.0, 5);
-  SkeletonFitOptions o;
-  o.chunk_frames = 7;  // 9 chunks, the last one short
-  o.num_threads = 1;
+  SkeletonFitOptions o = SevenFrameChunks(1);
   const StatusOr<SkeletonFitResult> one = FitSkeleton(t.noisy, t.names, {}, o);
   ASSERT_TRUE(one.ok()) << one.status().message();
   for (int threads : {2, 3, 0}) {
@@ -134,10 +141,7 @@ TEST(FitSkeleton, ChunksGiveTheSameBitsForAnyThreadCount) {
 // ASAN_COMPILER_SENSITIVE says by how much.)
 TEST(FitSkeleton, ChunkStartsAgreeWithOnePassOverTheTake) {
   const Take t = MakeTake(60, 2.0, 5);
-  SkeletonFitOptions o;
-  o.chunk_frames = 7;  // 9 chunks, the last one short
-  o.num_threads = 1;
-  const StatusOr<SkeletonFitResult> one = FitSkeleton(t.noisy, t.names, {}, o);
+  const StatusOr<SkeletonFitResult> one = FitSkeleton(t.noisy, t.names, {}, SevenFrameChunks(1));
   ASSERT_TRUE(one.ok()) << one.status().message();
   SkeletonFitOptions whole;
   whole.chunk_frames = 60;
