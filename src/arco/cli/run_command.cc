@@ -59,9 +59,12 @@ int RunRun(RunArgs& a) {
   if (!summary.ok()) return PrintError(summary.status().message());
   double total_s = 0;
   for (const pipeline::StageTiming& t : summary->timings) {
-    std::printf(
-        "%-12s %7.2f s  %s\n", t.name.c_str(), t.seconds, FormatStageLine(*summary, t).c_str());
-    total_s += t.seconds;
+    std::printf("%-12s %7.2f s  %s%s\n",
+                t.name.c_str(),
+                t.seconds,
+                FormatStageLine(*summary, t).c_str(),
+                t.beside ? " (beside the stages before it)" : "");
+    if (!t.beside) total_s += t.seconds;
   }
   for (const auto& m : summary->methods) std::printf("%s\n", FormatRefineSummary(m).c_str());
   for (const std::string& w : summary->warnings) PrintWarning(w);

@@ -62,6 +62,9 @@ struct RunOptions {
 struct StageTiming {
   std::string name;    // triangulate, instrument, hands, pitch (when it ran), refine
   double seconds = 0;  // wall time (informational, not in results)
+  // Ran on a thread of its own beside the stages before it (the pitch stage with more than
+  // one thread): its seconds overlap theirs and are not part of the run's total.
+  bool beside = false;
 };
 
 struct RunSummary {

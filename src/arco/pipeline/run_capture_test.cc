@@ -148,6 +148,56 @@ TEST(RunCapture, EveryStageAndThreeMethodsThatEvalScores) {
   EXPECT_EQ(*arco_before, *ReadFileToString(JoinPath(result, "arco/contacts.csv")));
 }
 
+// With more than one thread the pitch stage runs beside stages 1-3 (run_capture.cc): its
+// timing says so, and every file of the result is that of one thread, byte for byte
+// (result.json records the thread count, so it is compared without it).
+TEST(RunCapture, ThePitchStageBesideTheOthersChangesNoByte) {
+  arco::testing::TempDir out;
+  std::map<int, RunSummary> summaries;
+  for (int threads : {1, 2}) {
+    RunOptions o;
+    o.capture_dir = SyntheticCapture();
+    o.result_dir = out / ("result" + std::to_string(threads));
+    o.num_threads = threads;
+    auto summary = RunCapture(o);
+    ASSERT_TRUE(summary.ok()) << summary.status().message();
+    summaries[threads] = *summary;
+  }
+  for (int threads : {1, 2}) {
+    const auto& timings = summaries[threads].timings;
+    const auto pitch = std::find_if(
+        timings.begin(), timings.end(), [](const StageTiming& t) { return t.name == "pitch"; });
+    ASSERT_NE(pitch, timings.end());
+    EXPECT_EQ(pitch->beside, threads > 1);
+    EXPECT_EQ(pitch - timings.begin(), 3);  // listed in the stages' order
+  }
+  namespace fs = std::filesystem;
+  const fs::path one = out / "result1", two = out / "result2";
+  int compared = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(one)) {
+    if (!entry.is_regular_file()) continue;
+    const fs::path relative = fs::relative(entry.path(), one);
+    auto a = ReadFileToString(entry.path().string());
+    auto b = ReadFileToString((two / relative).string());
+    ASSERT_TRUE(a.ok() && b.ok()) << relative;
+    if (relative == "result.json") {
+      std::function<void(Json&)> without_threads = [&](Json& j) {
+        if (!j.is_object() && !j.is_array()) return;
+        if (j.is_object()) j.erase("num_threads");
+        for (Json& child : j) without_threads(child);
+      };
+      Json ja = Json::parse(*a), jb = Json::parse(*b);
+      without_threads(ja);
+      without_threads(jb);
+      EXPECT_EQ(ja, jb);
+      continue;
+    }
+    EXPECT_EQ(*a, *b) << relative;
+    ++compared;
+  }
+  EXPECT_GE(compared, 15);
+}
+
 // The performer's palm (hand/palm_shape.h): estimated, stored in hand/rest_points_mm.npy
 // and used by every reader, so the refinement's vision hand is the stored model's
 // forward kinematics; off, the stored model is the average hand sized by the bones.
