@@ -42,6 +42,49 @@ void Summarize(const RunRecords& records, RunSummary* summary) {
   Append(&summary->warnings, summary->pitch.warnings);
 }
 
+// Writes the records of a run in the order given, each when its stage has made it. With
+// more than one thread the writes run on a thread of their own, one after the other, while
+// the next stage computes (a one-minute take writes about 40 MB, which otherwise waited for
+// the last stage); with one thread each is written at once. Either way the folder is
+// written in the same order, so it is the same byte for byte. A failed write stops the
+// later ones; Finish returns the first failure. Whatever a write reads must stay alive and
+// unchanged until Finish.
+class OrderedWriter {
+ public:
+  explicit OrderedWriter(bool beside) : beside_(beside) {}
+  OrderedWriter(const OrderedWriter&) = delete;
+  OrderedWriter& operator=(const OrderedWriter&) = delete;
+  ~OrderedWriter() {
+    if (last_.valid()) last_.wait();
+  }
+
+  void Write(std::function<Status()> write) {
+    if (!beside_) {
+      if (status_.ok()) status_ = write();
+      return;
+    }
+    last_ = std::async(std::launch::async,
+                       [previous = std::move(last_), write = std::move(write)]() mutable {
+                         if (previous.valid()) {
+                           Status before = previous.get();
+                           if (!before.ok()) return before;
+                         }
+                         return write();
+                       });
+  }
+
+  // Waits for every write; the first failure, or Ok.
+  Status Finish() {
+    if (last_.valid()) status_ = last_.get();
+    return status_;
+  }
+
+ private:
+  bool beside_;
+  Status status_ = Status::Ok();
+  std::future<Status> last_;
+};
+
 }  // namespace
 
 TriangulateStageOptions RunOptions::ForTriangulate() const {
@@ -112,13 +155,20 @@ FolderReplace RunOptions::Replace() const {
 namespace {
 
 // Every stage, in order, each taking the records of the stages before it as made (not read
-// back from the result folder: the files hold the same values) and returning its own.
+// back from the result folder: the files hold the same values) and returning its own;
+// each record is written into `result` once made (OrderedWriter), all of them by the time
+// this returns.
 StatusOr<RunRecords> RunStages(const RunOptions& options,
                                CaptureContext* opened,
+                               const ResultFolder& result,
                                Progress& progress,
                                RunSummary* summary) {
   CaptureContext& capture = *opened;
   RunRecords records;
+  const bool threads = ResolveThreadCount(options.num_threads) > 1;
+  // Declared after `records`, so that on an early return it waits for its writes before
+  // the records they read are destroyed.
+  OrderedWriter writer(threads);
   auto stage = [&](int index, const char* name) {
     progress.StartStage(index, kRunStages, name);
     return Clock::now();
@@ -138,7 +188,7 @@ StatusOr<RunRecords> RunStages(const RunOptions& options,
     return TimedPitch{std::move(record), SecondsSince(pitch_start)};
   };
   std::future<TimedPitch> pitch_beside;
-  if (ResolveThreadCount(options.num_threads) > 1) {
+  if (threads) {
     pitch_beside = std::async(std::launch::async, run_pitch, std::ref(NoProgress()));
   }
 
@@ -146,12 +196,15 @@ StatusOr<RunRecords> RunStages(const RunOptions& options,
   ARCO_ASSIGN_OR_RETURN(records.triangulation,
                         RunTriangulateStage(options.ForTriangulate(), capture, progress));
   summary->timings.push_back({"triangulate", SecondsSince(start)});
+  // The stages after it read the filtered points only; the write releases the raw ones.
+  writer.Write([&] { return WriteTriangulation(result, capture, &records.triangulation); });
 
   start = stage(2, "instrument");
   ARCO_ASSIGN_OR_RETURN(
       records.instrument,
       RunInstrumentStage(options.ForInstrument(), capture, records.triangulation, progress));
   summary->timings.push_back({"instrument", SecondsSince(start)});
+  writer.Write([&] { return result.WriteInstrument(records.instrument); });
 
   start = stage(3, "hands");
   ARCO_ASSIGN_OR_RETURN(
@@ -159,6 +212,7 @@ StatusOr<RunRecords> RunStages(const RunOptions& options,
       RunHandStage(
           options.ForHands(), capture, records.triangulation, records.instrument, progress));
   summary->timings.push_back({"hands", SecondsSince(start)});
+  writer.Write([&] { return result.WriteHand(records.hand); });
   capture.keypoints2d.reset();  // the last stage that reads the 2D keypoints
 
   stage(4, "pitch");
@@ -166,11 +220,21 @@ StatusOr<RunRecords> RunStages(const RunOptions& options,
   TimedPitch pitch = beside ? pitch_beside.get() : run_pitch(progress);
   ARCO_ASSIGN_OR_RETURN(records.pitch, std::move(pitch.record));
   capture.audio_bytes.reset();  // the last stage that decodes the audio (up to 256 MiB)
-  if (records.pitch.summary.ran) summary->timings.push_back({"pitch", pitch.seconds, beside});
+  if (records.pitch.summary.ran) {
+    summary->timings.push_back({"pitch", pitch.seconds, beside});
+    writer.Write([&] { return result.WritePitch(records.pitch); });
+  }
 
   start = stage(5, "refine");
-  ARCO_ASSIGN_OR_RETURN(records.methods, RunRefineMethods(options, capture, records, progress));
+  StatusOr<std::vector<MethodRecord>> methods =
+      RunRefineMethods(options, capture, records, progress, [&](const MethodRecord& method) {
+        writer.Write([&result, &method] { return result.WriteMethod(method); });
+      });
+  // A failed stage's error first, as when every record was written after the stages.
+  if (!methods.ok()) return methods.status();
+  ARCO_RETURN_IF_ERROR(writer.Finish());
   summary->timings.push_back({"refine", SecondsSince(start)});
+  records.methods = std::move(*methods);
   return records;
 }
 
@@ -247,8 +311,8 @@ StatusOr<RunSummary> RunPreflighted(const RunOptions& options,
         ARCO_RETURN_IF_ERROR(result.CheckWritable());  // before the work
         // The stages release the 2D keypoints and the audio from the context once read for
         // the last time; the writers need only its manifest, layout and inputs.
-        ARCO_ASSIGN_OR_RETURN(RunRecords records, RunStages(staged, &capture, progress, &summary));
-        ARCO_RETURN_IF_ERROR(WriteRunRecords(result, capture, &records));
+        ARCO_ASSIGN_OR_RETURN(RunRecords records,
+                              RunStages(staged, &capture, result, progress, &summary));
         Summarize(records, &summary);
         return Status::Ok();
       }));
@@ -257,10 +321,12 @@ StatusOr<RunSummary> RunPreflighted(const RunOptions& options,
 
 }  // namespace
 
-StatusOr<std::vector<MethodRecord>> RunRefineMethods(const RunOptions& options,
-                                                     const CaptureContext& capture,
-                                                     const RunRecords& records,
-                                                     Progress& progress) {
+StatusOr<std::vector<MethodRecord>> RunRefineMethods(
+    const RunOptions& options,
+    const CaptureContext& capture,
+    const RunRecords& records,
+    Progress& progress,
+    const std::function<void(const MethodRecord&)>& made) {
   // The hands, pitch and notes go through their files' encodings (in memory), so that the
   // run refines exactly what `arco refine` reads from the folder.
   const ResultFolder result(options.result_dir);
@@ -303,10 +369,12 @@ StatusOr<std::vector<MethodRecord>> RunRefineMethods(const RunOptions& options,
   }
   progress.SetTotal(static_cast<int64_t>(modes.size()));
   std::vector<MethodRecord> methods;
+  methods.reserve(modes.size());  // `made`'s records stay where they are (and when moved)
   for (refine::RefineMode mode : modes) {
     const RefineStageOptions ro = options.ForRefine(mode);
     ARCO_ASSIGN_OR_RETURN(MethodRecord method, RefineMethod(inputs, ro.refine));
     methods.push_back(std::move(method));
+    if (made) made(methods.back());
     progress.Advance(1);
   }
   return methods;

@@ -9,6 +9,7 @@
 //                                    the pitch)
 #pragma once
 
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -99,11 +100,15 @@ struct RunRecords {
 // the records of stages 1-4 (methods ignored), the hands, pitch and notes passed through
 // their files' encodings in memory, so that the run refines exactly what `arco refine`
 // reads (MakeRefineInputs). Messages name the files of options.result_dir. Precondition:
-// options validated. Progress: a total of the methods, advanced per method.
-StatusOr<std::vector<MethodRecord>> RunRefineMethods(const RunOptions& options,
-                                                     const CaptureContext& capture,
-                                                     const RunRecords& records,
-                                                     Progress& progress = NoProgress());
+// options validated. Progress: a total of the methods, advanced per method. `made`, when
+// given, is called with each method's record as it is made (`arco run` writes it then);
+// the record stays at that address in the returned vector.
+StatusOr<std::vector<MethodRecord>> RunRefineMethods(
+    const RunOptions& options,
+    const CaptureContext& capture,
+    const RunRecords& records,
+    Progress& progress = NoProgress(),
+    const std::function<void(const MethodRecord&)>& made = nullptr);
 
 // Writes every record into `result` in the stages' order (the pitch only when it ran);
 // records->triangulation.raw is released (WriteTriangulation).
