@@ -4,7 +4,9 @@
 # the calibration, keypoints2d.npy) is opened for reading exactly once and the audio at most
 # twice (a file too large to hold is streamed by each reader), and no file under the result
 # folder, its hidden temporary included (result.json, the stages' arrays), is opened for
-# reading at all. On a cello capture and on a violin one with --double-stops.
+# reading at all. On a cello capture and on a violin one with --double-stops. And `arco
+# calibrate refine` and `arco calibrate from-instrument` read capture.json and
+# keypoints2d.npy once each (the CLI reads the manifest to check the paths and hands it on).
 # Needs strace (scripts/setup installs it): without it the test skips (exit 77), and fails
 # when CI is set; where ptrace is not allowed (a container without it) it skips.
 # usage: run_opens_once_cli_test.sh ARCO_BINARY [SHARED_DATA_DIR]
@@ -87,5 +89,35 @@ traced_run cello "$tmp/in/cello" --threads 2
 check '[ $? -eq 0 ] && [ -f "$tmp/in/violin/audio.wav" ]' "synth violin: $(tail -1 "$tmp/log")"
 traced_run violin "$tmp/in/violin" --threads 2 --double-stops
 check '[ -f "$tmp/out/violin/double_stops.csv" ]' "violin: no double_stops.csv"
+
+# traced_calibrate NAME CAPTURE FILES ARGS...: `arco calibrate ARGS` under strace; each of
+# FILES (names in CAPTURE, space-separated) opened for reading exactly once.
+traced_calibrate() {
+  local name=$1 cap=$2 files=$3; shift 3
+  local trace=$tmp/$name.trace f n
+  strace -f -qq -e trace=openat -o "$trace" "$arco" calibrate "$@" >"$tmp/log" 2>&1
+  check '[ $? -eq 0 ]' "$name: $(tail -1 "$tmp/log")"
+  opens "$trace" >"$tmp/$name.opens"
+  for f in $files; do
+    n=$(grep -cxF "$cap/$f" "$tmp/$name.opens")
+    check '[ "$n" -eq 1 ]' "$name: $cap/$f opened for reading $n times (once expected)"
+  done
+}
+traced_calibrate refine "$tmp/in/cello" "capture.json calibration.json keypoints2d.npy" \
+  refine "$tmp/in/cello" -o "$tmp/out/refined.json"
+# Two of the SPD rig's cameras without distortion, as calibration_cli_test.sh's from-instrument.
+"$arco" calibration show "${ARCO_SHARED_DATA_DIR:-}/spd/cello_1113_scale_camera.xml" --json |
+  /usr/bin/python3 -c "
+import json, sys
+d = json.load(sys.stdin)
+d['cameras'] = [d['cameras'][0], d['cameras'][18]]
+for c in d['cameras']:
+    c['distortion'] = {k: 0 for k in c['distortion']}
+json.dump(d, open(sys.argv[1], 'w'))" "$tmp/two.json"
+"$arco" synth --calibration "$tmp/two.json" --duration-s 4 -o "$tmp/in/two" >"$tmp/log" 2>&1
+check '[ $? -eq 0 ]' "synth two cameras: $(tail -1 "$tmp/log")"
+traced_calibrate from-instrument "$tmp/in/two" "capture.json keypoints2d.npy" \
+  from-instrument "$tmp/in/two" --image-size 2300x2656 --focal-px 2261.66 --fix-focal \
+  --max-frames 30 -o "$tmp/out/fi.json"
 
 exit $fail

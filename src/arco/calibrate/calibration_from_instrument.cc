@@ -275,7 +275,12 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
     if (!options.overwrite && std::filesystem::exists(path))
       return Status::Error(path + ": exists; give --overwrite to replace it");
   }
-  ARCO_ASSIGN_OR_RETURN(const CaptureManifest manifest, ReadCaptureManifest(options.capture_dir));
+  CaptureManifest manifest;
+  if (options.capture_manifest) {
+    manifest = *options.capture_manifest;
+  } else {
+    ARCO_ASSIGN_OR_RETURN(manifest, ReadCaptureManifest(options.capture_dir));
+  }
   const std::string manifest_file = options.capture_dir + "/capture.json";
   if (manifest.instrument.empty() || manifest.instrument == "none")
     return Status::Error(manifest_file +
@@ -342,9 +347,12 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
   }
 
   // 2. PnP per view and frame.
-  ARCO_RETURN_IF_ERROR(CheckCaptureKeypoints2d(options.capture_dir, manifest));
-  ARCO_ASSIGN_OR_RETURN(NpyArray<double> keypoints,
-                        ReadCaptureKeypoints2d(options.capture_dir, manifest));
+  // Checked and parsed from one read (CheckCaptureKeypoints2d's checks and messages).
+  ARCO_ASSIGN_OR_RETURN(const FileBytes keypoint_bytes,
+                        ReadCaptureKeypoints2dBytes(options.capture_dir, manifest));
+  ARCO_ASSIGN_OR_RETURN(
+      NpyArray<double> keypoints,
+      ParseCaptureKeypoints2d(keypoint_bytes.view(), options.capture_dir, manifest));
   std::string keypoints_file = ResolveCapturePath(options.capture_dir, manifest.keypoints2d);
   const int64_t frames = keypoints.shape[0];
   if (keypoints.shape[2] != layout->size())
@@ -466,6 +474,7 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
   // 4. Bundle adjustment with the performer and the instrument (calibration_refine.h).
   CalibrationRefineOptions refine;
   refine.capture_dir = options.capture_dir;
+  refine.capture_manifest = manifest;
   refine.calibration = "the rig from the instrument's PnP poses";
   refine.input_rig = rig;
   refine.input_keypoints = &keypoints;

@@ -31,6 +31,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,9 @@ struct InstrumentLabelsFile {
 
 struct CalibrationFromInstrumentOptions {
   std::string capture_dir;
+  // Set: capture_dir's capture.json as the caller already read it (the CLI's paths' check),
+  // so it is read once (and handed on to the refinement); unset: read here.
+  std::optional<CaptureManifest> capture_manifest;
   std::string output;        // calibration to write (.json, .yaml/.yml, .xml)
   bool overwrite = false;    // replace an existing output file
   double focal_px = 0;       // fx = fy of every camera; 0 = from fov_deg

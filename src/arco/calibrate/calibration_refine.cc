@@ -118,7 +118,11 @@ StatusOr<CalibrationRefineSummary> RefineCalibration(const CalibrationRefineOpti
   // The capture is read through its context's readers (capture_context.h), each file once.
   CaptureContext capture;
   capture.capture_dir = options.capture_dir;
-  ARCO_ASSIGN_OR_RETURN(capture.manifest, ReadCaptureManifest(options.capture_dir));
+  if (options.capture_manifest) {
+    capture.manifest = *options.capture_manifest;
+  } else {
+    ARCO_ASSIGN_OR_RETURN(capture.manifest, ReadCaptureManifest(options.capture_dir));
+  }
   const CaptureManifest& manifest = capture.manifest;
   if (manifest.keypoints2d.empty())
     return Status::Error(options.capture_dir + "/capture.json: no keypoints2d to refine with");

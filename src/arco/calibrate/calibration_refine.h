@@ -29,6 +29,7 @@
 
 #include "arco/camera/calibration_io.h"
 #include "arco/camera/rig.h"
+#include "arco/mocap/capture.h"
 #include "arco/util/json_io.h"
 #include "arco/util/npy.h"
 #include "arco/util/number_range.h"
@@ -44,6 +45,10 @@ inline constexpr NumberRange kRefineIterationsRange = Closed(1, 10000);
 
 struct CalibrationRefineOptions {
   std::string capture_dir;
+  // Set: capture_dir's capture.json as the caller already read it (`arco calibrate refine`
+  // reads it once to list the capture's files for its paths' check), so it is read once;
+  // unset: read here.
+  std::optional<CaptureManifest> capture_manifest;
   std::string calibration;  // "" = the capture's own; else this file is refined
   // Set: this rig is refined (calibration, if set, only names it in messages), as
   // `arco calibrate from-instrument` does with the rig it made.

@@ -4,6 +4,7 @@
 // `arco calibration show|convert`, which inspects and converts existing files.
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -608,15 +609,27 @@ CommandRun SetupCalibrate(CLI::App& app) {
   // its report beside it.
   auto paths = [a, r, fi, check, refine, from_instrument] {
     PathRoles roles;
+    // capture.json read once: its files listed here, the manifest handed to the command.
+    auto add_capture = [&roles](const std::string& capture_dir,
+                                std::optional<CaptureManifest>* manifest) {
+      if (capture_dir.empty()) return;
+      StatusOr<CaptureManifest> read = ReadCaptureManifest(capture_dir);
+      if (!read.ok()) {  // the command reports it, reading it again
+        roles.AddInput("CAPTURE", capture_dir);
+        return;
+      }
+      AddCaptureInputs(&roles, "CAPTURE", capture_dir, *read);
+      *manifest = std::move(read).value();
+    };
     if (from_instrument->parsed()) {
-      AddCaptureInputs(&roles, "CAPTURE", fi->capture_dir);
+      add_capture(fi->capture_dir, &fi->capture_manifest);
       for (const auto& l : fi->labels) roles.AddInput("--labels", l.path);
       roles.AddOutput("-o", fi->output);
       if (!fi->output.empty()) {
         roles.AddOutput("-o's report", calibration::ReportPath(fi->output));
       }
     } else if (refine->parsed()) {
-      AddCaptureInputs(&roles, "CAPTURE", r->capture_dir);
+      add_capture(r->capture_dir, &r->capture_manifest);
       roles.AddInput("--calibration", r->calibration);
       roles.AddOutput("-o", r->output);
       if (!r->output.empty()) {
