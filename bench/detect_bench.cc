@@ -22,6 +22,7 @@
 //   FOLDER/h264/capture), e.g. to run `arco detect` of two builds on the same videos.
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -251,6 +252,7 @@ void BM_DetectStagePlane(benchmark::State& state) {
                  (o.decode_ahead ? "decode ahead" : "decode in turn") + ", " +
                  std::to_string(o.num_threads) + " threads");
   double decode_s = 0, wait_s = 0, inference_s = 0;
+  std::array<double, 4> model_s{};
   int64_t runs = 0;
   for (auto _ : state) {
     StatusOr<capture::DetectStageSummary> s = capture::RunDetectStage(o);
@@ -261,6 +263,7 @@ void BM_DetectStagePlane(benchmark::State& state) {
     decode_s += s->decode_s;
     wait_s += s->decode_wait_s;
     inference_s += s->total.inference_s;
+    for (size_t k = 0; k < model_s.size(); ++k) model_s[k] += s->total.models[k].inference_s;
     ++runs;
   }
   // Per view-frame: the wall time is the benchmark's own (Time / view_frames); the
@@ -270,6 +273,9 @@ void BM_DetectStagePlane(benchmark::State& state) {
   state.counters["decode_ms"] = decode_s * per_view_frame;
   state.counters["decode_wait_ms"] = wait_s * per_view_frame;
   state.counters["inference_ms"] = inference_s * per_view_frame;
+  const char* names[] = {"detector_ms", "pose_ms", "recrop_ms", "hands_ms"};
+  for (size_t k = 0; k < model_s.size(); ++k)
+    state.counters[names[k]] = model_s[k] * per_view_frame;
 }
 BENCHMARK(BM_DetectStagePlane)
     ->ArgsProduct({{1, 2}, {0, 1}, {0, 1}})

@@ -12,6 +12,10 @@ Our own converter, written from the op semantics of TensorFlow Lite and ONNX
 - OpenCV 4.6's ONNX dialect: Clip with min/max attributes (opset-6 style, although the
   model says opset 11, which cv::dnn needs for Resize's half_pixel mode), Slice listing
   only the sliced axes.
+- Only the outputs arco reads are kept (`keep_outputs`), with the nodes and constants they
+  need: cv::dnn runs every layer up to the last requested output in node order, so a head
+  nobody reads (pose_landmark's segmentation mask and heatmaps) would cost its time on
+  every frame even when not requested.
 Deterministic: the same TFLite file gives the same ONNX bytes.
 """
 
@@ -302,7 +306,20 @@ class Converter:
             return
         raise NotImplementedError("TFLite op %s" % op.name)
 
-    def convert(self, graph_name):
+    def prune(self, output_names):
+        """Drops the nodes and constants that no output in `output_names` depends on."""
+        needed = set(output_names)
+        kept = []
+        for node in reversed(self.nodes):
+            if any(o in needed for o in node.output):
+                kept.append(node)
+                needed.update(node.input)
+        kept.reverse()
+        self.nodes = kept
+        self.initializers = [i for i in self.initializers if i.name in needed]
+
+    def convert(self, graph_name, keep_outputs=None):
+        """The ONNX model; `keep_outputs` lists the TFLite output tensors to keep (all: None)."""
         m = self.model
         (in_idx,) = m.inputs
         n, h, w, c = self.shape(in_idx)
@@ -310,8 +327,15 @@ class Converter:
         self.names[in_idx] = in_name
         for op in m.operators:
             self.convert_op(op)
+        kept = list(m.outputs)
+        if keep_outputs is not None:
+            names = [m.tensors[o].name for o in m.outputs]
+            missing = [k for k in keep_outputs if k not in names]
+            if missing:
+                raise ValueError("%s: no output %s (it has %s)" % (graph_name, missing, names))
+            kept = [o for o in m.outputs if m.tensors[o].name in keep_outputs]
         outputs = []
-        for o in m.outputs:
+        for o in kept:
             name = m.tensors[o].name
             shape = self.shape(o)
             if len(shape) == 4:
@@ -319,6 +343,7 @@ class Converter:
             elif self.names[o] != name:
                 self.node("Identity", [self.names[o]], [name])
             outputs.append(helper.make_tensor_value_info(name, TensorProto.FLOAT, shape))
+        self.prune([o.name for o in outputs])
         graph = helper.make_graph(
             self.nodes, graph_name,
             [helper.make_tensor_value_info(in_name, TensorProto.FLOAT, [n, c, h, w])],
@@ -329,8 +354,8 @@ class Converter:
         return model
 
 
-def convert_file(tflite_path, onnx_path, graph_name):
-    model = Converter(TfliteModel(tflite_path)).convert(graph_name)
+def convert_file(tflite_path, onnx_path, graph_name, keep_outputs=None):
+    model = Converter(TfliteModel(tflite_path)).convert(graph_name, keep_outputs)
     with open(onnx_path, "wb") as f:
         f.write(model.SerializeToString())
 

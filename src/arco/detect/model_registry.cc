@@ -22,9 +22,6 @@ std::vector<ModelOutput> PoseLandmarkOutputs() {
        {1, 195},
        "39 x (x, y, z, visibility logit, presence logit), x/y in crop pixels"},
       {"presence", "Identity_1", {1, 1}, "pose presence, sigmoid applied"},
-      {"segmentation", "Identity_2", {1, 256, 256, 1}, "person segmentation logits"},
-      {"heatmaps", "Identity_3", {1, 64, 64, 39}, "landmark heatmaps"},
-      {"world_landmarks", "Identity_4", {1, 117}, "39 x (x, y, z) in metres, hip-centred"},
   };
 }
 
@@ -32,8 +29,6 @@ std::vector<ModelOutput> HandLandmarkOutputs() {
   return {
       {"landmarks", "Identity", {1, 63}, "21 x (x, y, z), x/y in crop pixels"},
       {"presence", "Identity_1", {1, 1}, "hand presence, sigmoid applied"},
-      {"handedness", "Identity_2", {1, 1}, "probability of a right hand (unused by arco)"},
-      {"world_landmarks", "Identity_3", {1, 63}, "21 x (x, y, z) in metres, hand-centred"},
   };
 }
 

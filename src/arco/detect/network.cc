@@ -64,6 +64,19 @@ StatusOr<Network> Network::LoadFile(ModelId id,
     }
     impl->onnx_names.push_back(output.onnx_name);
   }
+  // A graph with heads arco does not read (a conversion before tools/tflite_onnx kept only
+  // the read outputs) computes them on every frame: cv::dnn runs every layer up to the last
+  // requested one. Refused, so a stale models folder is converted again, not silently slow.
+  if (graph_outputs.size() != info.outputs.size()) {
+    std::string extra;
+    for (const cv::String& name : graph_outputs) {
+      bool read = false;
+      for (const ModelOutput& output : info.outputs) read = read || name == output.onnx_name;
+      if (!read) extra += (extra.empty() ? "'" : ", '") + name + "'";
+    }
+    return Status::Error(path + ": the model computes outputs arco does not read (" + extra +
+                         "); run scripts/setup to convert it again");
+  }
   const int blob_shape[] = {1, 3, info.input_height, info.input_width};
   impl->blob.create(4, blob_shape, CV_32F);
   return Network(info, path, options, std::move(impl));
