@@ -169,31 +169,19 @@ void SolveOnce(const IkProblemSpec& s,
   out->termination = summary.converged ? "CONVERGENCE" : "NO_CONVERGENCE";
 }
 
-// Gradient of the weighted cost with respect to the free angles.
+// Gradient of the weighted cost with respect to the free angles: twice the least-squares
+// problem's J^T r (IkProblem::Evaluate's g is that of half the cost).
 std::vector<double> CostGradient(const IkProblemSpec& s,
                                  double w_ref,
                                  double w_prev,
                                  const std::vector<double>& x) {
-  using Jet = ceres::Jet<double, 4>;
-  Jet dof[4];
-  for (int i = 0; i < 4; ++i) dof[i] = Jet(s.reference[i]);
-  for (size_t i = 0; i < s.slots.size(); ++i) dof[s.slots[i]] = Jet(x[i], static_cast<int>(i));
-  Eigen::Matrix<Jet, 3, 1> p[4];
-  FingerPointsInWrist(*s.model, s.finger, dof, p);
-  const Eigen::Matrix<Jet, 3, 1> r =
-      s.rotation.cast<Jet>() * p[3] + (s.translation - s.target).cast<Jet>();
-  const Eigen::Matrix<Jet, 3, 1> r_pip =
-      s.rotation.cast<Jet>() * p[1] + (s.translation - s.pip_target).cast<Jet>();
-  const Eigen::Matrix<Jet, 3, 1> r_dip =
-      s.rotation.cast<Jet>() * p[2] + (s.translation - s.dip_target).cast<Jet>();
-  const Jet cost = r.squaredNorm() + s.pip_weight * s.pip_weight * r_pip.squaredNorm() +
-                   s.dip_weight * s.dip_weight * r_dip.squaredNorm();
-  std::vector<double> g(x.size());
-  for (size_t i = 0; i < x.size(); ++i) {
-    g[i] = cost.v[i] + 2 * w_ref * w_ref * (x[i] - s.ref_free[i]);
-    if (s.has_prev) g[i] += 2 * w_prev * w_prev * (x[i] - s.prev_free[i]);
-  }
-  return g;
+  const int n = static_cast<int>(x.size());
+  IkMatrix h(n, n);
+  IkVector g(n);
+  IkProblem(s, w_ref, w_prev).Evaluate(Eigen::Map<const IkVector>(x.data(), n), &h, &g);
+  std::vector<double> gradient(x.size());
+  for (int i = 0; i < n; ++i) gradient[i] = 2 * g[i];
+  return gradient;
 }
 
 // Ceres projects trust-region steps onto the bounds, which crawls when a joint
@@ -298,9 +286,9 @@ std::vector<double> RestartGridTipDistances(const HandModel& model,
                                             const std::vector<double>& lower,
                                             const std::vector<double>& upper,
                                             int levels,
-                                            const Eigen::Matrix3d& rotation,
-                                            const Eigen::Vector3d& translation,
-                                            const Eigen::Vector3d& target) {
+                                            const Eigen::Matrix3d& world_from_wrist_rotation,
+                                            const Eigen::Vector3d& wrist_in_world_mm,
+                                            const Eigen::Vector3d& target_in_world_mm) {
   // Per slot its values (the reference alone when fixed) and its step in the point index.
   std::array<std::vector<double>, 4> values;
   std::array<int, 4> stride{};
@@ -336,7 +324,8 @@ std::vector<double> RestartGridTipDistances(const HandModel& model,
           const Eigen::Matrix3d g3 = g2 * distal[l3];
           const Eigen::Vector3d out3 = out2 + g3 * r3;
           const size_t c = l0 * stride[0] + l1 * stride[1] + l2 * stride[2] + l3 * stride[3];
-          distances[c] = (rotation * out3 + translation - target).norm();
+          distances[c] =
+              (world_from_wrist_rotation * out3 + wrist_in_world_mm - target_in_world_mm).norm();
         }
       }
     }
