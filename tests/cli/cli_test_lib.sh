@@ -76,3 +76,33 @@ require_browser() {
     exit 1
   fi
 }
+
+# synth_and_run CAP RES DURATION_S: a synthetic capture (`arco synth`) and its result
+# (`arco run`); exits the test on failure. Sets `frames`, the result's frame count.
+synth_and_run() {
+  "$arco" synth -o "$1" --duration-s "$3" >/dev/null 2>&1 &&
+    "$arco" run "$1" -o "$2" >/dev/null 2>&1 ||
+    { echo "FAILED: synth + run"; exit 1; }
+  frames=$(/usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['frames']['count'])" \
+    "$2/result.json")
+}
+
+# give_turned_video CAP CAM FRAMES [FILTER]: camera CAM of capture CAP gets a video of
+# FRAMES frames (ffmpeg's testsrc2 at 30 fps, through the ffmpeg filter FILTER if given),
+# stored turned as SPD's: the calibration's image is 2300x2656, the file 2656x2300, and
+# capture.json's rotate_deg 90 turns it back. Exits the test on failure.
+give_turned_video() {
+  local cap=$1 cam=$2 count=$3 filter=(); [ $# -ge 4 ] && filter=(-vf "$4")
+  ffmpeg -v error -f lavfi -i "testsrc2=size=2656x2300:rate=30" "${filter[@]}" -frames:v "$count" \
+    -c:v mpeg4 -q:v 3 "$cap/$cam.mp4" || { echo "FAILED: making the test video"; exit 1; }
+  /usr/bin/python3 - "$cap/capture.json" "$cam" <<'PY' || { echo "FAILED: editing capture.json"; exit 1; }
+import json, sys
+path, cam = sys.argv[1:3]
+c = json.load(open(path))
+for x in c["cameras"]:
+    if x["name"] == cam:
+        x["video"] = cam + ".mp4"
+        x["rotate_deg"] = 90
+json.dump(c, open(path, "w"), indent=1)
+PY
+}

@@ -19,9 +19,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 
-"$arco" synth -o "$tmp/cap" --duration-s 2 >/dev/null 2>&1 &&
-  "$arco" run "$tmp/cap" -o "$tmp/res" >/dev/null 2>&1 ||
-  { echo "FAILED: synth + run"; exit 1; }
+synth_and_run "$tmp/cap" "$tmp/res" 2
 # Gaps: a fingertip for three frames, the nose for one (the contact point has its own).
 "$py" - "$tmp/res" <<'PY' || { echo "FAILED: making gaps"; exit 1; }
 import json, sys

@@ -25,11 +25,7 @@ trap 'rm -rf "$tmp"' EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 SNAPSHOT_DIR=$tmp/w
 
-"$arco" synth -o "$tmp/cap" --duration-s 1 >/dev/null 2>&1 &&
-  "$arco" run "$tmp/cap" -o "$tmp/res" >/dev/null 2>&1 ||
-  { echo "FAILED: synth + run"; exit 1; }
-frames=$("$py" -c "import json,sys; print(json.load(open(sys.argv[1]))['frames']['count'])" \
-  "$tmp/res/result.json")
+synth_and_run "$tmp/cap" "$tmp/res" 1
 cam=camera_21334181_1
 mkdir -p "$tmp/w"
 
@@ -72,20 +68,8 @@ check '"$arco" overlay "$tmp/res" --camera $cam --scale 0.25 -o "$tmp/w/small.mk
   "overlay .mkv"
 check '"$py" "$check_py" "$tmp/w/small.mkv" "$tmp/res" $cam 0.25 1 $frames' "blank frames, all"
 
-# A video for the camera, stored turned (the calibration's image is 2300x2656: the file is
-# 2656x2300, rotate_deg 90 turns it back), frame count and rate the capture's.
-ffmpeg -v error -f lavfi -i "testsrc2=size=2656x2300:rate=30" -frames:v "$frames" \
-  -c:v mpeg4 -q:v 3 "$tmp/cap/$cam.mp4" || { echo "FAILED: making the test video"; exit 1; }
-"$py" - "$tmp/cap/capture.json" $cam <<'PY' || { echo "FAILED: editing capture.json"; exit 1; }
-import json, sys
-path, cam = sys.argv[1:3]
-c = json.load(open(path))
-for x in c["cameras"]:
-    if x["name"] == cam:
-        x["video"] = cam + ".mp4"
-        x["rotate_deg"] = 90
-json.dump(c, open(path, "w"), indent=2)
-PY
+# A video for the camera, stored turned, frame count and rate the capture's.
+give_turned_video "$tmp/cap" $cam "$frames"
 check '"$arco" overlay "$tmp/res" --camera $cam --scale 0.25 -o "$tmp/w/video.mp4" >"$tmp/out"' \
   "overlay with video: $(cat "$tmp/out" 2>/dev/null)"
 grep -q "$cam.mp4" "$tmp/out" || { echo "FAILED: the video is not named: $(cat "$tmp/out")"; fail=1; }

@@ -24,9 +24,7 @@ trap 'rm -rf "$tmp"' EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/cli_test_lib.sh"
 SNAPSHOT_DIR=$tmp/w
 
-"$arco" synth -o "$tmp/cap" --duration-s 3 >/dev/null 2>&1 &&
-  "$arco" run "$tmp/cap" -o "$tmp/res" >/dev/null 2>&1 ||
-  { echo "FAILED: synth + run"; exit 1; }
+synth_and_run "$tmp/cap" "$tmp/res" 3
 mkdir -p "$tmp/w"
 
 check '"$arco" plot "$tmp/res" -o "$tmp/w/plots" >"$tmp/out"' "plot: $(cat "$tmp/out" 2>/dev/null)"

@@ -25,25 +25,9 @@ source "$src/tests/cli/cli_test_lib.sh"
 mkdir -p "$tmp/w"
 SNAPSHOT_DIR=$tmp/w
 
-"$arco" synth -o "$tmp/cap" --duration-s 1 >/dev/null 2>&1 &&
-  "$arco" run "$tmp/cap" -o "$tmp/res" >/dev/null 2>&1 ||
-  { echo "FAILED: synth + run"; exit 1; }
-frames=$("$py" -c "import json,sys; print(json.load(open(sys.argv[1]))['frames']['count'])" \
-  "$tmp/res/result.json")
+synth_and_run "$tmp/cap" "$tmp/res" 1
 cam=camera_21334181_1
-# The calibration's image is 2300x2656: the file is 2656x2300, rotate_deg 90 turns it back.
-ffmpeg -v error -f lavfi -i "testsrc2=size=2656x2300:rate=30" -vf hue=s=0 -frames:v "$frames" \
-  -c:v mpeg4 -q:v 3 "$tmp/cap/$cam.mp4" || { echo "FAILED: making the test video"; exit 1; }
-"$py" - "$tmp/cap/capture.json" $cam <<'PY' || { echo "FAILED: editing capture.json"; exit 1; }
-import json, sys
-path, cam = sys.argv[1:3]
-c = json.load(open(path))
-for x in c["cameras"]:
-    if x["name"] == cam:
-        x["video"] = cam + ".mp4"
-        x["rotate_deg"] = 90
-json.dump(c, open(path, "w"), indent=1)
-PY
+give_turned_video "$tmp/cap" $cam "$frames" hue=s=0
 # The capture changed: its result is made again (a result is tied to its capture's files).
 "$arco" run "$tmp/cap" -o "$tmp/res" --overwrite >/dev/null 2>&1 ||
   { echo "FAILED: run again after editing capture.json"; exit 1; }

@@ -18,26 +18,10 @@ mkdir -p "$work"
 export XDG_CACHE_HOME=$work/cache
 source "$src/tests/cli/cli_test_lib.sh"
 require_browser "$src" ffmpeg ffprobe
-"$arco" synth -o "$work/cap" --duration-s 3 >/dev/null 2>&1 &&
-  "$arco" run "$work/cap" -o "$work/res" >/dev/null 2>&1 ||
-  { echo "FAILED: synth + run"; exit 1; }
-frames=$(/usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['frames']['count'])" \
-  "$work/res/result.json")
-# The calibration's image is 2300x2656: the file is 2656x2300, rotate_deg 90 turns it back.
+synth_and_run "$work/cap" "$work/res" 3
 cam=camera_21334181_1
 # Grey (hue=s=0): no magenta in the picture but the overlay's fingertip marks.
-ffmpeg -v error -f lavfi -i "testsrc2=size=2656x2300:rate=30" -vf hue=s=0 -frames:v "$frames" \
-  -c:v mpeg4 -q:v 3 "$work/cap/$cam.mp4" || { echo "FAILED: making the test video"; exit 1; }
-/usr/bin/python3 - "$work/cap/capture.json" $cam <<'PY' || { echo "FAILED: editing capture.json"; exit 1; }
-import json, sys
-path, cam = sys.argv[1:3]
-c = json.load(open(path))
-for x in c["cameras"]:
-    if x["name"] == cam:
-        x["video"] = cam + ".mp4"
-        x["rotate_deg"] = 90
-json.dump(c, open(path, "w"), indent=1)
-PY
+give_turned_video "$work/cap" $cam "$frames" hue=s=0
 # The capture changed: its result is made again (a result is tied to its capture's files).
 "$arco" run "$work/cap" -o "$work/res" --overwrite >/dev/null 2>&1 ||
   { echo "FAILED: run again after editing capture.json"; exit 1; }
