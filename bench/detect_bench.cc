@@ -1,8 +1,9 @@
 // Detector latency (docs/performance.md, section "Detect"), 2 OpenCV threads, wall
 // time (OpenCV's pool threads do the work, not the calling thread: real time):
-// - BM_Inference: one forward pass of each converted MediaPipe model
+// - BM_Inference/MODEL/THREADS: one forward pass of each converted MediaPipe model
 //   (detect::Network::Run: NHWC -> NCHW copy, forward, outputs copied out) on a fixed
-//   pseudo-random input of the model's size (the time does not depend on the content);
+//   pseudo-random input of the model's size (the time does not depend on the content),
+//   on 2 OpenCV threads and on 1 (as each worker of `arco detect` runs);
 // - BM_WholeBodyTracked / BM_WholeBodyDetected: detect::WholeBodyTracker::Track per
 //   view-frame on the real SPD cellist (2300 x 2656): a tracked frame (pose landmarks in
 //   the carried ROI, hand_recrop and hand landmarks for both hands) and a frame that
@@ -43,9 +44,9 @@ namespace {
 
 void BM_Inference(benchmark::State& state) {
   const ModelInfo& info = AllModels()[state.range(0)];
-  state.SetLabel(info.name);
+  state.SetLabel(std::string(info.name) + ", " + std::to_string(state.range(1)) + " thread(s)");
   NetworkOptions options;
-  options.num_threads = 2;
+  options.num_threads = static_cast<int>(state.range(1));
   StatusOr<Network> network = Network::Load(info.id, DefaultModelsDir(), options);
   if (!network.ok()) {
     state.SkipWithError(network.status().message().c_str());
@@ -64,7 +65,10 @@ void BM_Inference(benchmark::State& state) {
     benchmark::DoNotOptimize(status);
   }
 }
-BENCHMARK(BM_Inference)->DenseRange(0, 7)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Inference)
+    ->ArgsProduct({benchmark::CreateDenseRange(0, 7, 1), {2, 1}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 const char* const kCellist = ARCO_SHARED_DATA_DIR "/spd/example.jpg";
 const char* const kVtest = "/usr/share/doc/opencv-doc/examples/data/vtest.avi";
