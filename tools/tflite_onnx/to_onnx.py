@@ -89,6 +89,18 @@ class Converter:
         self.nodes.append(helper.make_node(op_type, inputs, outputs,
                                            name=self.fresh(op_type), **attrs))
 
+    def pad(self, x, onnx_pads, out):
+        """A constant-zero Pad of `x` by `onnx_pads` (ONNX order: all begins, then all ends)."""
+        self.node("Pad", [x, self.const("pads", np.array(onnx_pads, np.int64)),
+                          self.const("value", np.array(0, np.float32))], [out], mode="constant")
+
+    def slice(self, x, starts, ends, axes, steps, out):
+        """A Slice of `x` (OpenCV 4.6: only the sliced axes listed)."""
+        self.node("Slice", [x, self.const("starts", np.array(starts, np.int64)),
+                            self.const("ends", np.array(ends, np.int64)),
+                            self.const("axes", np.array(axes, np.int64)),
+                            self.const("steps", np.array(steps, np.int64))], [out])
+
     def cval(self, index):
         return constant_value(self.model, self.producers, index)
 
@@ -200,8 +212,7 @@ class Converter:
         padded = x
         if not direct and (top or left or bottom or right):
             padded = self.fresh("pad_dw")
-            self.node("Pad", [x, self.const("pads", np.array([0, 0, top, left, 0, 0, bottom, right], np.int64)),
-                              self.const("value", np.array(0, np.float32))], [padded], mode="constant")
+            self.pad(x, [0, 0, top, left, 0, 0, bottom, right], padded)
         offsets = (0,) if k == 3 else (0, 2)
         parts = []
         for du in offsets:
@@ -218,12 +229,9 @@ class Converter:
                     block_pads = [top - du, left - dv, bottom - 2 + du, right - 2 + dv]
                 else:
                     window, block_pads = self.fresh("window"), [0, 0, 0, 0]
-                    self.node("Slice", [padded,
-                                        self.const("starts", np.array([du, dv], np.int64)),
-                                        self.const("ends", np.array([du + stride_h * (out_h - 1) + 3,
-                                                                     dv + stride_w * (wide - 1) + 3], np.int64)),
-                                        self.const("axes", np.array([2, 3], np.int64)),
-                                        self.const("steps", np.array([1, 1], np.int64))], [window])
+                    self.slice(padded, [du, dv],
+                               [du + stride_h * (out_h - 1) + 3, dv + stride_w * (wide - 1) + 3],
+                               [2, 3], [1, 1], window)
                 inputs = [window, self.const("W", block)]
                 if bias is not None and not parts:
                     inputs.append(self.const("B", bias))
@@ -237,10 +245,7 @@ class Converter:
             self.node("Sum", parts, [raw])
         if wide > out_w:
             cut = self.fresh("cut")
-            self.node("Slice", [raw, self.const("starts", np.array([0], np.int64)),
-                                self.const("ends", np.array([out_w], np.int64)),
-                                self.const("axes", np.array([3], np.int64)),
-                                self.const("steps", np.array([1], np.int64))], [cut])
+            self.slice(raw, [0], [out_w], [3], [1], cut)
             raw = cut
         return raw
 
@@ -293,8 +298,7 @@ class Converter:
                 a = NHWC_TO_NCHW_AXIS[axis]
                 onnx_pads[a], onnx_pads[4 + a] = int(pads[axis][0]), int(pads[axis][1])
             out = self.out_name(o)
-            self.node("Pad", [self.names[op.inputs[0]], self.const("pads", np.array(onnx_pads, np.int64)),
-                              self.const("value", np.array(0, np.float32))], [out], mode="constant")
+            self.pad(self.names[op.inputs[0]], onnx_pads, out)
             self.names[o] = out
             return
         if op.name == "MAX_POOL_2D":
@@ -399,11 +403,7 @@ class Converter:
                 axes.append(NHWC_TO_NCHW_AXIS[axis] if rank == 4 else axis)
                 steps.append(strides[axis])
             out = self.out_name(o)
-            self.node("Slice", [self.names[op.inputs[0]],
-                                self.const("starts", np.array(starts, np.int64)),
-                                self.const("ends", np.array(ends, np.int64)),
-                                self.const("axes", np.array(axes, np.int64)),
-                                self.const("steps", np.array(steps, np.int64))], [out])
+            self.slice(self.names[op.inputs[0]], starts, ends, axes, steps, out)
             self.names[o] = out
             return
         raise NotImplementedError("TFLite op %s" % op.name)
