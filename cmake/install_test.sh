@@ -170,7 +170,7 @@ if [ -s "$deb" ]; then
   check '[ "$(dpkg-deb -f "$deb" Package)" = arco ] && [ "$(dpkg-deb -f "$deb" Architecture)" = amd64 ]' \
     "package arco, architecture amd64"
   depends=$(dpkg-deb -f "$deb" Depends)
-  for lib in libc6 libstdc++6 libopencv-dnn libavcodec libsndfile1 libfftw3 libcpp-httplib; do
+  for lib in libc6 libstdc++6 libopencv-dnn libxnnpack0 libavcodec libsndfile1 libfftw3 libcpp-httplib; do
     check 'grep -q "$lib" <<<"$depends"' "Depends (dpkg-shlibdeps) names $lib: $depends"
   done
 fi

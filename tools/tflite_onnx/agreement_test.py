@@ -1,6 +1,8 @@
 #!/usr/bin/python3
-"""The converter's test: cv::dnn on each converted ONNX model against the numpy reference
-executor of its TFLite graph (reference.py), on real image crops.
+"""The converter's test: arco's runtimes (XNNPACK where fetch.py says it runs the model,
+and cv::dnn on every model) on each converted ONNX model against the numpy reference
+executor of its TFLite graph (reference.py), on real image crops. arco's default runtime
+choice ("auto") must pick the runtime fetch.py converted the model for.
 
 Crops come from ../shared/data/spd/example.jpg (a real cellist) and, when opencv-doc is
 installed, its messi5.jpg; the C++ helper detect_run_model cuts them (python here has no
@@ -21,6 +23,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from reference import Reference  # noqa: E402
+from fetch import MODELS as FETCHED, OPENCV, XNNPACK  # noqa: E402
 from to_onnx import convert_file  # noqa: E402
 
 # max |cv::dnn - reference| / max |reference| per output; measured worst 8.0e-6 on these
@@ -80,36 +83,56 @@ def main():
 
     env = dict(os.environ, ARCO_MODELS_DIR=args.models)  # the runner reads this folder
     failures = 0
-    worst = 0.0
     with tempfile.TemporaryDirectory() as tmp:
         for name, (size, value_range, outputs) in MODELS.items():
             reference = Reference(os.path.join(args.models, "tflite", name + ".tflite"))
-            for label, image, cx, cy, side, angle in crops_for(name, args.data):
+            intended = FETCHED[name][3]
+            runtimes = [XNNPACK, OPENCV] if intended == XNNPACK else [OPENCV]
+            for k, (label, image, cx, cy, side, angle) in enumerate(crops_for(name, args.data)):
                 crop = os.path.join(tmp, "input.npy")
                 subprocess.run([args.runner, "crop", image, str(cx), str(cy), str(side),
                                 str(angle), str(size), value_range, crop], check=True)
-                subprocess.run([args.runner, name, crop, tmp, "2"], check=True, env=env)
                 expected = list(reference.run(np.load(crop)).values())
-                parts = []
-                for out_name, want in zip(outputs, expected):
-                    got = np.load(os.path.join(tmp, out_name + ".npy"))
-                    if got.shape != want.shape:
-                        print("FAIL %s %s %s: shape %s, reference %s"
-                              % (name, label, out_name, got.shape, want.shape))
+                if k == 0:
+                    subprocess.run([args.runner, name, crop, tmp, "1", "auto"], check=True, env=env)
+                    with open(os.path.join(tmp, "runtime.txt")) as f:
+                        chosen = f.read().strip()
+                    if chosen != intended:
+                        print("FAIL %s: arco runs it with %s, converted for %s"
+                              % (name, chosen, intended))
                         failures += 1
-                        continue
-                    scale = max(float(np.abs(want).max()), 1e-6)
-                    error = float(np.abs(got.astype(np.float64) - want).max()) / scale
-                    worst = max(worst, error)
-                    if not error <= TOLERANCE:
-                        failures += 1
-                        parts.append("%s %.1e FAIL" % (out_name, error))
-                    else:
-                        parts.append("%s %.1e" % (out_name, error))
-                print("%-20s %-18s %s" % (name, label, "  ".join(parts)))
+                for runtime in runtimes:
+                    subprocess.run([args.runner, name, crop, tmp, "2", runtime], check=True, env=env)
+                    failures += compare(name, "%s %s" % (label, runtime), outputs, expected, tmp)
         failures += unread_heads_refused(args, tmp)
-    print("worst relative error %.2e (tolerance %.0e); %d failure(s)" % (worst, TOLERANCE, failures))
+    print("worst relative error %.2e (tolerance %.0e); %d failure(s)" % (WORST[0], TOLERANCE, failures))
     return 1 if failures else 0
+
+
+WORST = [0.0]
+
+
+def compare(name, label, outputs, expected, tmp):
+    """Prints the runner's outputs in `tmp` against `expected`; returns the failures."""
+    failures = 0
+    parts = []
+    for out_name, want in zip(outputs, expected):
+        got = np.load(os.path.join(tmp, out_name + ".npy"))
+        if got.shape != want.shape:
+            print("FAIL %s %s %s: shape %s, reference %s"
+                  % (name, label, out_name, got.shape, want.shape))
+            failures += 1
+            continue
+        scale = max(float(np.abs(want).max()), 1e-6)
+        error = float(np.abs(got.astype(np.float64) - want).max()) / scale
+        WORST[0] = max(WORST[0], error)
+        if not error <= TOLERANCE:
+            failures += 1
+            parts.append("%s %.1e FAIL" % (out_name, error))
+        else:
+            parts.append("%s %.1e" % (out_name, error))
+    print("%-20s %-26s %s" % (name, label, "  ".join(parts)))
+    return failures
 
 
 def unread_heads_refused(args, tmp):
@@ -120,17 +143,21 @@ def unread_heads_refused(args, tmp):
     stale = os.path.join(tmp, "stale")
     os.makedirs(stale, exist_ok=True)
     convert_file(os.path.join(args.models, "tflite", name + ".tflite"),
-                 os.path.join(stale, name + ".onnx"), name)
+                 os.path.join(stale, name + ".onnx"), name, for_opencv=False)
     crop = os.path.join(tmp, "input.npy")
-    run = subprocess.run([args.runner, name, crop, tmp, "1"], capture_output=True, text=True,
-                         env=dict(os.environ, ARCO_MODELS_DIR=stale))
     wanted = ("the model computes outputs arco does not read ('Identity_2', 'Identity_3', "
               "'Identity_4'); run scripts/setup to convert it again")
-    if run.returncode == 0 or wanted not in run.stderr:
-        print("FAIL %s with every head: exit %d, stderr %r" % (name, run.returncode, run.stderr))
-        return 1
-    print("%-20s %-18s refused: %s" % (name, "with every head", wanted))
-    return 0
+    failures = 0
+    for runtime in (XNNPACK, OPENCV):
+        run = subprocess.run([args.runner, name, crop, tmp, "1", runtime], capture_output=True,
+                             text=True, env=dict(os.environ, ARCO_MODELS_DIR=stale))
+        if run.returncode == 0 or wanted not in run.stderr:
+            print("FAIL %s with every head, %s: exit %d, stderr %r"
+                  % (name, runtime, run.returncode, run.stderr))
+            failures += 1
+        else:
+            print("%-20s %-26s refused: %s" % (name, "with every head " + runtime, wanted))
+    return failures
 
 
 if __name__ == "__main__":

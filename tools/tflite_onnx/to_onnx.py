@@ -12,9 +12,11 @@ Our own converter, written from the op semantics of TensorFlow Lite and ONNX
 - OpenCV 4.6's ONNX dialect: Clip with min/max attributes (opset-6 style, although the
   model says opset 11, which cv::dnn needs for Resize's half_pixel mode), Slice listing
   only the sliced axes.
-- Depthwise 5 x 5 layers, and 3 x 3 ones too narrow for it, are rewritten for cv::dnn's
-  vectorised 3 x 3 depthwise path (depthwise_on_fast_path): the same products summed in
-  another order, about 0.8x the time of a landmark model's forward pass on one thread.
+- For the models cv::dnn runs (`for_opencv`; arco runs the others with XNNPACK, which has
+  5 x 5 depthwise kernels of its own), depthwise 5 x 5 layers, and 3 x 3 ones too narrow
+  for it, are rewritten for cv::dnn's vectorised 3 x 3 depthwise path
+  (depthwise_on_fast_path): the same products summed in another order, about 0.8x the
+  time of a landmark model's forward pass on one thread.
 - Only the outputs arco reads are kept (`keep_outputs`), with the nodes and constants they
   need: cv::dnn runs every layer up to the last requested output in node order, so a head
   nobody reads (pose_landmark's segmentation mask and heatmaps) would cost its time on
@@ -65,8 +67,9 @@ def constant_value(model, producers, index):
 
 
 class Converter:
-    def __init__(self, model):
+    def __init__(self, model, for_opencv=True):
         self.model = model
+        self.for_opencv = for_opencv
         self.producers = {}
         for op in model.operators:
             for o in op.outputs:
@@ -156,7 +159,7 @@ class Converter:
         if len(op.inputs) > 2 and op.inputs[2] >= 0:
             bias = self.cval(op.inputs[2]).astype(np.float32)
         out_w = (in_shape[2] + left + right - kw) // stride_w + 1
-        if (depthwise and kh == kw and dil_h == 1 and dil_w == 1 and weight.shape[0] == group and
+        if (self.for_opencv and depthwise and kh == kw and dil_h == 1 and dil_w == 1 and weight.shape[0] == group and
                 stride_h == stride_w and self.fast_path_pays(kh, stride_w, out_w, left + right)):
             raw = self.depthwise_on_fast_path(self.names[x], in_shape, weight.astype(np.float32),
                                               bias, (top, left, bottom, right), (stride_h, stride_w))
@@ -456,8 +459,8 @@ class Converter:
         return model
 
 
-def convert_file(tflite_path, onnx_path, graph_name, keep_outputs=None):
-    model = Converter(TfliteModel(tflite_path)).convert(graph_name, keep_outputs)
+def convert_file(tflite_path, onnx_path, graph_name, keep_outputs=None, for_opencv=True):
+    model = Converter(TfliteModel(tflite_path), for_opencv).convert(graph_name, keep_outputs)
     with open(onnx_path, "wb") as f:
         f.write(model.SerializeToString())
 

@@ -52,6 +52,7 @@ Json SummaryJson(const detect::WholeBodySummary& s) {
   for (const auto& m : s.models) {
     if (m.runs == 0) continue;
     models.push_back({{"model", GetModelInfo(m.model).name},
+                      {"runtime", m.runtime},
                       {"runs", m.runs},
                       {"inference_ms_per_run", 1e3 * m.inference_s / m.runs}});
   }
@@ -113,6 +114,7 @@ Status DetectStageOptions::Validate() const {
 Json ToJson(const DetectStageOptions& o) {
   return Json{{"pose_model", detect::PoseModelName(o.detector.pose_model)},
               {"hand_model", detect::HandModelName(o.detector.hand_model)},
+              {"inference", detect::InferenceRuntimeName(o.detector.runtime)},
               {"min_detection_score", o.detector.min_detection_score},
               {"nms_min_iou", o.detector.nms_min_iou},
               {"min_pose_presence", o.detector.min_pose_presence},
@@ -479,6 +481,11 @@ StatusOr<DetectStageSummary> RunDetectStage(const DetectStageOptions& options, P
   report_summary.erase("decode_wait_s");
   report_summary.erase("wall_s");
   report_summary["hands"].erase("wall_s");
+  // Which runtime ran each model (network.h) is kept: it decides the keypoints' last bits.
+  Json runtimes = Json::object();
+  for (const Json& m : report_summary["total"]["models"])
+    runtimes[m["model"].get<std::string>()] = m["runtime"];
+  report_summary["runtimes"] = runtimes;
   for (Json* j : {&report_summary["total"]}) {
     j->erase("models");
     j->erase("inference_s");

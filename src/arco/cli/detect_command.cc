@@ -30,6 +30,7 @@ struct DetectArgs {
   capture::DetectStageOptions o;
   std::string model = "full";
   std::string hand_model = "full";
+  std::string inference = "auto";
   std::string frames;  // FIRST:LAST
   bool no_hand_recrop = false;
   bool no_decode_ahead = false;
@@ -44,6 +45,9 @@ void ApplyAndValidate(DetectArgs& a) {
   auto hands = detect::ParseHandModel(a.hand_model);
   ThrowIfInvalid(hands.status());
   a.o.detector.hand_model = *hands;
+  auto runtime = detect::ParseInferenceRuntime(a.inference);
+  ThrowIfInvalid(runtime.status());
+  a.o.detector.runtime = *runtime;
   a.o.detector.hand_recrop = !a.no_hand_recrop;
   a.o.decode_ahead = !a.no_decode_ahead;
   a.o.hands.enabled = !a.no_hand_check;
@@ -127,6 +131,12 @@ std::function<int()> SetupDetect(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--hand-model", a->hand_model, "Hand landmark model: lite or full")
       ->check(CLI::IsMember({"lite", "full"}))
+      ->capture_default_str();
+  sub->add_option("--inference",
+                  a->inference,
+                  "Runtime of the models: auto (XNNPACK where a model translates, else "
+                  "OpenCV's cv::dnn), xnnpack or opencv (docs/detect.md)")
+      ->check(CLI::IsMember({"auto", "xnnpack", "opencv"}))
       ->capture_default_str();
   sub->add_option("--frames",
                   a->frames,

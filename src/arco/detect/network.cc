@@ -1,5 +1,6 @@
 #include "arco/detect/network.h"
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <opencv2/core.hpp>
@@ -7,14 +8,36 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "arco/detect/xnnpack_graph.h"
+
 namespace arco::detect {
 
 struct Network::Impl {
+  std::unique_ptr<XnnpackGraph> xnnpack;  // set: XNNPACK runs the network, else cv::dnn
   cv::dnn::Net net;
   std::vector<cv::String> onnx_names;
   cv::Mat blob;  // 1 x 3 x H x W input, allocated once
   std::vector<cv::Mat> results;
 };
+
+StatusOr<InferenceRuntime> ParseInferenceRuntime(const std::string& name) {
+  if (name == "auto") return InferenceRuntime::kAuto;
+  if (name == "xnnpack") return InferenceRuntime::kXnnpack;
+  if (name == "opencv") return InferenceRuntime::kOpenCv;
+  return Status::Error("unknown inference runtime '" + name + "' (auto, xnnpack or opencv)");
+}
+
+const char* InferenceRuntimeName(InferenceRuntime runtime) {
+  switch (runtime) {
+    case InferenceRuntime::kXnnpack:
+      return "xnnpack";
+    case InferenceRuntime::kOpenCv:
+      return "opencv";
+    case InferenceRuntime::kAuto:
+      break;
+  }
+  return "auto";
+}
 
 Status NetworkOptions::Validate() const {
   if (num_threads < 1) {
@@ -23,6 +46,38 @@ Status NetworkOptions::Validate() const {
   }
   return Status::Ok();
 }
+
+namespace {
+
+// The graph computes every output arco reads and no other. A graph with heads arco does not
+// read (a conversion before tools/tflite_onnx kept only the read outputs) computes them on
+// every frame: cv::dnn runs every layer up to the last requested one. Refused, so a stale
+// models folder is converted again, not silently slow.
+Status CheckOutputs(const std::string& path,
+                    const ModelInfo& info,
+                    const std::vector<std::string>& graph_outputs) {
+  for (const ModelOutput& output : info.outputs) {
+    if (std::find(graph_outputs.begin(), graph_outputs.end(), output.onnx_name) ==
+        graph_outputs.end()) {
+      return Status::Error(path + ": the model has no output '" + output.onnx_name + "' (" +
+                           info.name + "'s " + output.name +
+                           "); run scripts/setup to convert it again");
+    }
+  }
+  std::string extra;
+  for (const std::string& name : graph_outputs) {
+    bool read = false;
+    for (const ModelOutput& output : info.outputs) read = read || name == output.onnx_name;
+    if (!read) extra += (extra.empty() ? "'" : ", '") + name + "'";
+  }
+  if (!extra.empty()) {
+    return Status::Error(path + ": the model computes outputs arco does not read (" + extra +
+                         "); run scripts/setup to convert it again");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
 
 StatusOr<Network> Network::Load(ModelId id,
                                 const std::string& models_dir,
@@ -42,6 +97,27 @@ StatusOr<Network> Network::LoadFile(ModelId id,
                          "convert the models (docs/detect.md)");
   }
   auto impl = std::make_unique<Impl>();
+  for (const ModelOutput& output : info.outputs) impl->onnx_names.push_back(output.onnx_name);
+  if (options.runtime != InferenceRuntime::kOpenCv) {
+    const std::vector<std::string> names(impl->onnx_names.begin(), impl->onnx_names.end());
+    Status outputs = Status::Ok();
+    StatusOr<std::unique_ptr<XnnpackGraph>> graph =
+        XnnpackGraph::Load(path,
+                           names,
+                           info.input_height,
+                           info.input_width,
+                           options.num_threads,
+                           [&](const std::vector<std::string>& graph_outputs) {
+                             outputs = CheckOutputs(path, info, graph_outputs);
+                             return outputs;
+                           });
+    ARCO_RETURN_IF_ERROR(outputs);
+    if (graph.ok()) {
+      impl->xnnpack = std::move(graph).value();
+      return Network(info, path, options, std::move(impl));
+    }
+    if (options.runtime == InferenceRuntime::kXnnpack) return graph.status();
+  }
   try {
     impl->net = cv::dnn::readNetFromONNX(path);
   } catch (const cv::Exception& e) {
@@ -53,30 +129,9 @@ StatusOr<Network> Network::LoadFile(ModelId id,
   }
   impl->net.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
   impl->net.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
-  const std::vector<cv::String> graph_outputs = impl->net.getUnconnectedOutLayersNames();
-  for (const ModelOutput& output : info.outputs) {
-    bool found = false;
-    for (const cv::String& name : graph_outputs) found = found || name == output.onnx_name;
-    if (!found) {
-      return Status::Error(path + ": the model has no output '" + output.onnx_name + "' (" +
-                           info.name + "'s " + output.name +
-                           "); run scripts/setup to convert it again");
-    }
-    impl->onnx_names.push_back(output.onnx_name);
-  }
-  // A graph with heads arco does not read (a conversion before tools/tflite_onnx kept only
-  // the read outputs) computes them on every frame: cv::dnn runs every layer up to the last
-  // requested one. Refused, so a stale models folder is converted again, not silently slow.
-  if (graph_outputs.size() != info.outputs.size()) {
-    std::string extra;
-    for (const cv::String& name : graph_outputs) {
-      bool read = false;
-      for (const ModelOutput& output : info.outputs) read = read || name == output.onnx_name;
-      if (!read) extra += (extra.empty() ? "'" : ", '") + name + "'";
-    }
-    return Status::Error(path + ": the model computes outputs arco does not read (" + extra +
-                         "); run scripts/setup to convert it again");
-  }
+  const std::vector<cv::String> cv_outputs = impl->net.getUnconnectedOutLayersNames();
+  ARCO_RETURN_IF_ERROR(
+      CheckOutputs(path, info, std::vector<std::string>(cv_outputs.begin(), cv_outputs.end())));
   const int blob_shape[] = {1, 3, info.input_height, info.input_width};
   impl->blob.create(4, blob_shape, CV_32F);
   return Network(info, path, options, std::move(impl));
@@ -109,6 +164,27 @@ Status Network::Run(const float* input, size_t input_size, TensorLayout layout) 
                                 " x " + std::to_string(width) + " floats, got " +
                                 std::to_string(input_size));
   }
+  if (impl_->xnnpack) {
+    if (layout == TensorLayout::kNhwc) {
+      ARCO_RETURN_IF_ERROR(impl_->xnnpack->Run(input).WithContext(path_));
+    } else {
+      nhwc_.resize(3 * plane);
+      for (size_t i = 0; i < plane; ++i) {
+        for (size_t c = 0; c < 3; ++c) nhwc_[3 * i + c] = input[c * plane + i];
+      }
+      ARCO_RETURN_IF_ERROR(impl_->xnnpack->Run(nhwc_.data()).WithContext(path_));
+    }
+    for (size_t k = 0; k < outputs_.size(); ++k) {
+      const std::vector<float>& result = impl_->xnnpack->outputs()[k];
+      if (result.size() != outputs_[k].data.size()) {
+        return Status::Error(path_ + ": output '" + info_->outputs[k].onnx_name + "' has " +
+                             std::to_string(result.size()) + " values, expected " +
+                             std::to_string(outputs_[k].data.size()));
+      }
+      std::memcpy(outputs_[k].data.data(), result.data(), result.size() * sizeof(float));
+    }
+    return Status::Ok();
+  }
   float* blob = impl_->blob.ptr<float>();
   if (layout == TensorLayout::kNchw) {
     std::memcpy(blob, input, 3 * plane * sizeof(float));
@@ -137,6 +213,11 @@ Status Network::Run(const float* input, size_t input_size, TensorLayout layout) 
     std::memcpy(tensor.data.data(), result.ptr<float>(), tensor.data.size() * sizeof(float));
   }
   return Status::Ok();
+}
+
+const char* Network::runtime_name() const {
+  return InferenceRuntimeName(impl_->xnnpack ? InferenceRuntime::kXnnpack
+                                             : InferenceRuntime::kOpenCv);
 }
 
 const Tensor& Network::output(const std::string& name) const {

@@ -1,4 +1,10 @@
-// One pretrained network (detect/model_registry.h) run with OpenCV's cv::dnn on the CPU.
+// One pretrained network (detect/model_registry.h) run on the CPU by XNNPACK
+// (detect/xnnpack_graph.h) or by OpenCV's cv::dnn.
+//
+// Runtime: by default (kAuto) a graph XNNPACK can run is run by XNNPACK, which is about
+// twice as fast on MediaPipe's landmarkers (docs/detect.md, "XNNPACK"); a graph with an
+// operator it lacks (hand_recrop's and the detectors' Slice, Resize, Concat) by cv::dnn.
+// runtime_name() says which.
 //
 // Load once (reading and preparing the graph is the expensive part), then Run per crop;
 // Run writes into output tensors owned by the Network, so the per-crop call allocates
@@ -19,8 +25,19 @@
 
 namespace arco::detect {
 
+enum class InferenceRuntime {
+  kAuto,     // XNNPACK where the graph translates, else cv::dnn
+  kXnnpack,  // XNNPACK only: a graph it cannot run is an error
+  kOpenCv,   // cv::dnn only
+};
+
+// "auto", "xnnpack", "opencv" (arco detect's --inference).
+StatusOr<InferenceRuntime> ParseInferenceRuntime(const std::string& name);
+const char* InferenceRuntimeName(InferenceRuntime runtime);
+
 struct NetworkOptions {
-  int num_threads = 1;  // OpenCV threads during Run (process-wide, see above); >= 1
+  int num_threads = 1;  // threads of one forward pass (cv::dnn's: process-wide); >= 1
+  InferenceRuntime runtime = InferenceRuntime::kAuto;
   Status Validate() const;
 };
 
@@ -53,6 +70,8 @@ class Network {
 
   const ModelInfo& info() const { return *info_; }
   const std::string& path() const { return path_; }
+  // "xnnpack" or "opencv": the runtime that runs this network.
+  const char* runtime_name() const;
 
   // Runs one crop: 3 * input_height * input_width floats in `layout`, values already in
   // info().range. Throws std::invalid_argument on a wrong size; a failure inside
@@ -76,6 +95,7 @@ class Network {
   NetworkOptions options_;
   std::unique_ptr<Impl> impl_;
   std::vector<Tensor> outputs_;
+  std::vector<float> nhwc_;  // an NCHW input reordered for XNNPACK
 };
 
 }  // namespace arco::detect

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -38,6 +39,52 @@ TEST(NetworkLoad, CorruptFileNamesIt) {
   EXPECT_EQ(network.status().message().rfind(path + ": cannot read the ONNX model", 0), 0u)
       << network.status().message();
   EXPECT_NE(network.status().message().find("scripts/setup"), std::string::npos);
+}
+
+TEST(NetworkLoad, CorruptFileNamesItWithEitherRuntime) {
+  const arco::testing::TempDir temp;
+  const std::string path = temp.path() + "/hand_landmark_full.onnx";
+  std::ofstream(path) << "not an onnx model";
+  for (InferenceRuntime runtime : {InferenceRuntime::kXnnpack, InferenceRuntime::kOpenCv}) {
+    NetworkOptions options;
+    options.runtime = runtime;
+    StatusOr<Network> network = Network::Load(ModelId::kHandLandmarkFull, temp.path(), options);
+    ASSERT_FALSE(network.ok());
+    EXPECT_EQ(network.status().message().rfind(path + ": cannot read the ONNX model", 0), 0u)
+        << network.status().message();
+    EXPECT_NE(network.status().message().find("scripts/setup"), std::string::npos);
+  }
+}
+
+// pose_detection is converted for cv::dnn (tools/tflite_onnx/fetch.py): asked for XNNPACK
+// it is an error naming the file and the operator; by default cv::dnn runs it.
+TEST(NetworkLoad, AGraphXnnpackCannotRunNamesTheOperatorOrFallsBack) {
+  ARCO_REQUIRE_MODELS();
+  NetworkOptions options;
+  options.runtime = InferenceRuntime::kXnnpack;
+  StatusOr<Network> strict = Network::Load(ModelId::kPoseDetection, DefaultModelsDir(), options);
+  ASSERT_FALSE(strict.ok());
+  const std::string& message = strict.status().message();
+  EXPECT_EQ(message.rfind(ModelPath(ModelId::kPoseDetection, DefaultModelsDir()) + ": ", 0), 0u)
+      << message;
+  EXPECT_NE(message.find("Slice '"), std::string::npos) << message;
+  StatusOr<Network> automatic = Network::Load(ModelId::kPoseDetection, DefaultModelsDir());
+  ASSERT_TRUE(automatic.ok()) << automatic.status().message();
+  EXPECT_STREQ(automatic->runtime_name(), "opencv");
+  StatusOr<Network> landmarks = Network::Load(ModelId::kHandLandmarkFull, DefaultModelsDir());
+  ASSERT_TRUE(landmarks.ok()) << landmarks.status().message();
+  EXPECT_STREQ(landmarks->runtime_name(), "xnnpack");
+}
+
+TEST(InferenceRuntime, NamesParse) {
+  for (InferenceRuntime r :
+       {InferenceRuntime::kAuto, InferenceRuntime::kXnnpack, InferenceRuntime::kOpenCv}) {
+    StatusOr<InferenceRuntime> parsed = ParseInferenceRuntime(InferenceRuntimeName(r));
+    ASSERT_TRUE(parsed.ok());
+    EXPECT_EQ(*parsed, r);
+  }
+  EXPECT_EQ(ParseInferenceRuntime("tflite").status().message(),
+            "unknown inference runtime 'tflite' (auto, xnnpack or opencv)");
 }
 
 TEST(NetworkOptions, RejectsZeroThreads) {
@@ -306,34 +353,65 @@ TEST(NetworkRealImage, CellistPoseAndLeftHand) {
   EXPECT_LT(hand_net->output("presence").data[0], 0.5);
 }
 
-// Same outputs, bit for bit, for 1 and 2 threads, and for NHWC and NCHW input.
+// Same outputs, bit for bit, for 1, 2 and 3 threads (XNNPACK) or 1 and 2 (cv::dnn: with 3
+// its hand_landmark_full differs in the last bits), and for NHWC and NCHW input; and the
+// two runtimes agree with each other (both also agree with the TFLite reference:
+// tools/tflite_onnx/agreement_test.py).
 TEST(NetworkRun, DeterministicAcrossThreadsAndLayouts) {
   ARCO_REQUIRE_MODELS();
   const cv::Mat image = ReadRgb(ARCO_SHARED_DATA_DIR "/spd/example.jpg");
   ASSERT_FALSE(image.empty());
-  const Crop body = MakeCrop({1150, 1350}, {0, -1}, 2200, 256);
-  const std::vector<float> input = CutCrop(image, body, ValueRange::kZeroToOne);
-  std::vector<float> nchw(input.size());
-  const size_t plane = 256 * 256;
-  for (size_t i = 0; i < plane; ++i) {
-    for (size_t c = 0; c < 3; ++c) nchw[c * plane + i] = input[3 * i + c];
-  }
-  std::vector<std::vector<Tensor>> results;
-  for (int threads : {1, 2}) {
-    NetworkOptions options;
-    options.num_threads = threads;
-    StatusOr<Network> network =
-        Network::Load(ModelId::kPoseLandmarkLite, DefaultModelsDir(), options);
-    ASSERT_TRUE(network.ok()) << network.status().message();
-    ASSERT_TRUE(network->Run(input.data(), input.size()).ok());
-    results.push_back(network->outputs());
-    ASSERT_TRUE(network->Run(nchw.data(), nchw.size(), TensorLayout::kNchw).ok());
-    results.push_back(network->outputs());
-    EXPECT_THROW((void)network->Run(input.data(), input.size() - 1), std::invalid_argument);
-  }
-  for (size_t r = 1; r < results.size(); ++r) {
-    for (size_t k = 0; k < results[0].size(); ++k) {
-      EXPECT_EQ(results[r][k].data, results[0][k].data) << "run " << r << " output " << k;
+  struct Case {
+    ModelId model;
+    Crop crop;
+  };
+  const Case cases[] = {{ModelId::kPoseLandmarkLite, MakeCrop({1150, 1350}, {0, -1}, 2200, 256)},
+                        {ModelId::kHandLandmarkFull, MakeCrop({1150, 1350}, {0, -1}, 2200, 224)}};
+  for (const Case& c : cases) {
+    const ModelInfo& info = GetModelInfo(c.model);
+    const std::vector<float> input = CutCrop(image, c.crop, info.range);
+    std::vector<float> nchw(input.size());
+    const size_t plane = static_cast<size_t>(info.input_width) * info.input_height;
+    for (size_t i = 0; i < plane; ++i) {
+      for (size_t ch = 0; ch < 3; ++ch) nchw[ch * plane + i] = input[3 * i + ch];
+    }
+    std::vector<std::vector<Tensor>> by_runtime;
+    for (InferenceRuntime runtime : {InferenceRuntime::kXnnpack, InferenceRuntime::kOpenCv}) {
+      std::vector<std::vector<Tensor>> results;
+      for (int threads : {1, 2, 3}) {
+        if (runtime == InferenceRuntime::kOpenCv && threads == 3) continue;
+        NetworkOptions options;
+        options.num_threads = threads;
+        options.runtime = runtime;
+        StatusOr<Network> network = Network::Load(c.model, DefaultModelsDir(), options);
+        ASSERT_TRUE(network.ok()) << network.status().message();
+        EXPECT_STREQ(network->runtime_name(), InferenceRuntimeName(runtime));
+        ASSERT_TRUE(network->Run(input.data(), input.size()).ok());
+        results.push_back(network->outputs());
+        ASSERT_TRUE(network->Run(nchw.data(), nchw.size(), TensorLayout::kNchw).ok());
+        results.push_back(network->outputs());
+        EXPECT_THROW((void)network->Run(input.data(), input.size() - 1), std::invalid_argument);
+      }
+      for (size_t r = 1; r < results.size(); ++r) {
+        for (size_t k = 0; k < results[0].size(); ++k) {
+          EXPECT_EQ(results[r][k].data, results[0][k].data)
+              << info.name << " " << InferenceRuntimeName(runtime) << " run " << r << " output "
+              << k;
+        }
+      }
+      by_runtime.push_back(results[0]);
+    }
+    for (size_t k = 0; k < by_runtime[0].size(); ++k) {
+      const std::vector<float>& a = by_runtime[0][k].data;
+      const std::vector<float>& b = by_runtime[1][k].data;
+      ASSERT_EQ(a.size(), b.size());
+      float scale = 1e-6f, worst = 0;
+      for (size_t i = 0; i < a.size(); ++i) {
+        scale = std::max(scale, std::abs(b[i]));
+        worst = std::max(worst, std::abs(a[i] - b[i]));
+      }
+      // The agreement test's tolerance against the TFLite reference (docs/detect.md).
+      EXPECT_LE(worst / scale, 2e-4f) << info.name << " output " << k;
     }
   }
 }

@@ -1,9 +1,11 @@
 // Test helper for tools/tflite_onnx/agreement_test.py, which compares cv::dnn with the
 // numpy reference executor of the TFLite graph (the python side has no image decoder):
 //
-// detect_run_model MODEL INPUT.npy OUT_DIR [THREADS]
+// detect_run_model MODEL INPUT.npy OUT_DIR [THREADS [RUNTIME]]
 //   runs one registry model's ONNX file (models folder: $ARCO_MODELS_DIR or the default)
-//   on an NHWC float32 input of shape (1, H, W, 3); writes OUT_DIR/<output name>.npy.
+//   on an NHWC float32 input of shape (1, H, W, 3) with RUNTIME (auto, xnnpack, opencv;
+//   default auto); writes OUT_DIR/<output name>.npy and OUT_DIR/runtime.txt (the runtime
+//   that ran it).
 // detect_run_model crop IMAGE CX CY SIDE_PX ANGLE_DEG SIZE RANGE OUT.npy [OUT.png]
 //   writes the square crop of side SIDE_PX centred on (CX, CY), rotated by ANGLE_DEG
 //   (counter-clockwise, so the crop's up is the image's direction rotated by it), resized
@@ -86,8 +88,8 @@ int Crop(int argc, char** argv) {
 int main(int argc, char** argv) {
   using namespace arco;
   if (argc >= 2 && std::string(argv[1]) == "crop") return Crop(argc, argv);
-  if (argc < 4 || argc > 5) {
-    std::fprintf(stderr, "usage: detect_run_model MODEL INPUT.npy OUT_DIR [THREADS]\n");
+  if (argc < 4 || argc > 6) {
+    std::fprintf(stderr, "usage: detect_run_model MODEL INPUT.npy OUT_DIR [THREADS [RUNTIME]]\n");
     return 2;
   }
   auto fail = [](const Status& status) {
@@ -97,7 +99,12 @@ int main(int argc, char** argv) {
   StatusOr<detect::ModelId> id = detect::ParseModelName(argv[1]);
   if (!id.ok()) return fail(id.status());
   detect::NetworkOptions options;
-  if (argc == 5) options.num_threads = std::stoi(argv[4]);
+  if (argc >= 5) options.num_threads = std::stoi(argv[4]);
+  if (argc == 6) {
+    StatusOr<detect::InferenceRuntime> runtime = detect::ParseInferenceRuntime(argv[5]);
+    if (!runtime.ok()) return fail(runtime.status());
+    options.runtime = *runtime;
+  }
   StatusOr<detect::Network> network =
       detect::Network::Load(*id, detect::DefaultModelsDir(), options);
   if (!network.ok()) return fail(network.status());
@@ -119,5 +126,9 @@ int main(int argc, char** argv) {
     Status written = WriteNpy(std::string(argv[3]) + "/" + info.outputs[k].name + ".npy", out);
     if (!written.ok()) return fail(written);
   }
+  std::FILE* f = std::fopen((std::string(argv[3]) + "/runtime.txt").c_str(), "w");
+  if (f == nullptr) return fail(Status::Error(std::string(argv[3]) + "/runtime.txt: cannot write"));
+  std::fprintf(f, "%s\n", network->runtime_name());
+  std::fclose(f);
   return 0;
 }

@@ -137,6 +137,10 @@ void WholeBodySummary::Merge(const WholeBodySummary& other) {
   hands_tracked += other.hands_tracked;
   hands_reused += other.hands_reused;
   for (size_t k = 0; k < models.size(); ++k) {
+    if (*models[k].runtime == '\0') {  // a summary that has loaded nothing yet (a total)
+      models[k].model = other.models[k].model;
+      models[k].runtime = other.models[k].runtime;
+    }
     models[k].runs += other.models[k].runs;
     models[k].inference_s += other.models[k].inference_s;
   }
@@ -446,6 +450,7 @@ StatusOr<WholeBodyTracker> WholeBodyTracker::Create(const WholeBodyOptions& opti
   const std::string dir = options.models_dir.empty() ? DefaultModelsDir() : options.models_dir;
   NetworkOptions network_options;
   network_options.num_threads = options.num_threads;
+  network_options.runtime = options.runtime;
   const std::array<ModelId, 4> ids = {ModelId::kPoseDetection,
                                       PoseLandmarkModel(options.pose_model),
                                       ModelId::kHandRecrop,
@@ -456,6 +461,7 @@ StatusOr<WholeBodyTracker> WholeBodyTracker::Create(const WholeBodyOptions& opti
     ARCO_ASSIGN_OR_RETURN(Network network, Network::Load(ids[k], dir, network_options));
     impl->networks[k].emplace(std::move(network));
     const Network* net = &*impl->networks[k];
+    impl->summary.models[k].runtime = net->runtime_name();
     impl->inputs[k].assign(
         3 * static_cast<size_t>(net->info().input_width) * net->info().input_height, 0.0f);
   }

@@ -45,6 +45,7 @@
 #include <string>
 
 #include "arco/detect/model_registry.h"
+#include "arco/detect/network.h"
 #include "arco/detect/roi.h"
 #include "arco/media/image.h"
 #include "arco/registry/keypoint_layout.h"
@@ -117,7 +118,9 @@ struct WholeBodyOptions {
   // moving is seen. The reference crop stays the one last landmarked, so slow drift
   // adds up until it is run again. 0: always run the landmarker.
   double hand_reuse_max_change = 0;
-  int num_threads = 1;  // cv::dnn threads (network.h)
+  int num_threads = 1;  // threads of one forward pass (network.h)
+  // Which runtime runs the models (network.h): XNNPACK where a model's graph translates.
+  InferenceRuntime runtime = InferenceRuntime::kAuto;
   // Every number inside its declared range; messages name the field.
   Status Validate() const;
 };
@@ -163,6 +166,7 @@ struct WholeBodySummary {
   // (postprocess). Not deterministic; never part of the output.
   struct ModelTime {
     ModelId model = ModelId::kPoseDetection;
+    const char* runtime = "";  // Network::runtime_name(); "" when not loaded
     int64_t runs = 0;
     double inference_s = 0;
   };
