@@ -1,8 +1,8 @@
 #!/usr/bin/python3
-"""The converter's test: arco's runtimes (XNNPACK where fetch.py says it runs the model,
-and cv::dnn on every model) on each converted ONNX model against the numpy reference
-executor of its TFLite graph (reference.py), on real image crops. arco's default runtime
-choice ("auto") must pick the runtime fetch.py converted the model for.
+"""The converter's test: arco's two runtimes (XNNPACK, its default, and cv::dnn) on each
+converted ONNX model against the numpy reference executor of its TFLite graph
+(reference.py), on real image crops. arco's default choice ("auto") must run every model
+with XNNPACK.
 
 Crops come from ../shared/data/spd/example.jpg (a real cellist) and, when opencv-doc is
 installed, its messi5.jpg; the C++ helper detect_run_model cuts them (python here has no
@@ -23,13 +23,14 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from reference import Reference  # noqa: E402
-from fetch import MODELS as FETCHED, OPENCV, XNNPACK  # noqa: E402
 from to_onnx import convert_file  # noqa: E402
 
-# max |cv::dnn - reference| / max |reference| per output; measured worst 8.0e-6 on these
-# crops (pose_landmark_heavy's landmarks), docs/detect.md. Set when the pose models still
+# max |arco's runtime - reference| / max |reference| per output; measured worst 8.0e-6 on
+# these crops (pose_landmark_heavy's landmarks), docs/detect.md. Set when the pose models still
 # kept their segmentation logits (6.7e-5 here, 1.8e-4 on uniform noise).
 TOLERANCE = 2e-4
+
+XNNPACK, OPENCV = "xnnpack", "opencv"  # detect_run_model's runtime names
 
 MODELS = {  # name: (input size, value range, output names in registry order)
     "pose_detection": (224, "-1,1", ["boxes", "scores"]),
@@ -86,8 +87,6 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         for name, (size, value_range, outputs) in MODELS.items():
             reference = Reference(os.path.join(args.models, "tflite", name + ".tflite"))
-            intended = FETCHED[name][3]
-            runtimes = [XNNPACK, OPENCV] if intended == XNNPACK else [OPENCV]
             for k, (label, image, cx, cy, side, angle) in enumerate(crops_for(name, args.data)):
                 crop = os.path.join(tmp, "input.npy")
                 subprocess.run([args.runner, "crop", image, str(cx), str(cy), str(side),
@@ -97,11 +96,10 @@ def main():
                     subprocess.run([args.runner, name, crop, tmp, "1", "auto"], check=True, env=env)
                     with open(os.path.join(tmp, "runtime.txt")) as f:
                         chosen = f.read().strip()
-                    if chosen != intended:
-                        print("FAIL %s: arco runs it with %s, converted for %s"
-                              % (name, chosen, intended))
+                    if chosen != XNNPACK:
+                        print("FAIL %s: arco runs it with %s, not %s" % (name, chosen, XNNPACK))
                         failures += 1
-                for runtime in runtimes:
+                for runtime in (XNNPACK, OPENCV):
                     subprocess.run([args.runner, name, crop, tmp, "2", runtime], check=True, env=env)
                     failures += compare(name, "%s %s" % (label, runtime), outputs, expected, tmp)
         failures += unread_heads_refused(args, tmp)
@@ -143,7 +141,7 @@ def unread_heads_refused(args, tmp):
     stale = os.path.join(tmp, "stale")
     os.makedirs(stale, exist_ok=True)
     convert_file(os.path.join(args.models, "tflite", name + ".tflite"),
-                 os.path.join(stale, name + ".onnx"), name, for_opencv=False)
+                 os.path.join(stale, name + ".onnx"), name)
     crop = os.path.join(tmp, "input.npy")
     wanted = ("the model computes outputs arco does not read ('Identity_2', 'Identity_3', "
               "'Identity_4'); run scripts/setup to convert it again")

@@ -24,26 +24,19 @@ HANDS = "mediapipe-hands-0.4.1675469240.tgz"
 # The landmark models' outputs arco reads (src/arco/detect/model_registry.cc): the landmarks
 # and the presence score. The pose models' segmentation mask and heatmaps and the hand
 # models' handedness and world landmarks are dropped with the layers only they need
-# (to_onnx.py), so cv::dnn does not compute them on every frame.
+# (to_onnx.py), so they are not computed on every frame.
 LANDMARKS_AND_PRESENCE = ["Identity", "Identity_1"]
 
-# Which runtime runs a model (src/arco/detect/network.h): XNNPACK runs the landmarkers and
-# hand_recrop; cv::dnn the models with an operator the XNNPACK translation lacks (Resize,
-# Concat), which are converted with cv::dnn's depthwise rewrite (to_onnx.py).
-XNNPACK, OPENCV = "xnnpack", "opencv"
-
-# name: (tarball, where: "file" or the packed-assets stem, outputs kept: None for all,
-#        the runtime that runs it)
+# name: (tarball, where: "file" or the packed-assets stem, outputs kept: None for all)
 MODELS = {
-    "pose_detection": (HOLISTIC, "holistic_solution_packed_assets", None, OPENCV),
-    "pose_landmark_lite": (HOLISTIC, "file", LANDMARKS_AND_PRESENCE, XNNPACK),
-    "pose_landmark_full": (HOLISTIC, "file", LANDMARKS_AND_PRESENCE, XNNPACK),
-    "pose_landmark_heavy": (HOLISTIC, "file", LANDMARKS_AND_PRESENCE, OPENCV),
-    "hand_landmark_full": (HOLISTIC, "holistic_solution_packed_assets", LANDMARKS_AND_PRESENCE,
-                           XNNPACK),
-    "hand_recrop": (HOLISTIC, "holistic_solution_packed_assets", None, XNNPACK),
-    "palm_detection_full": (HOLISTIC, "holistic_solution_packed_assets", None, OPENCV),
-    "hand_landmark_lite": (HANDS, "file", LANDMARKS_AND_PRESENCE, XNNPACK),
+    "pose_detection": (HOLISTIC, "holistic_solution_packed_assets", None),
+    "pose_landmark_lite": (HOLISTIC, "file", LANDMARKS_AND_PRESENCE),
+    "pose_landmark_full": (HOLISTIC, "file", LANDMARKS_AND_PRESENCE),
+    "pose_landmark_heavy": (HOLISTIC, "file", LANDMARKS_AND_PRESENCE),
+    "hand_landmark_full": (HOLISTIC, "holistic_solution_packed_assets", LANDMARKS_AND_PRESENCE),
+    "hand_recrop": (HOLISTIC, "holistic_solution_packed_assets", None),
+    "palm_detection_full": (HOLISTIC, "holistic_solution_packed_assets", None),
+    "hand_landmark_lite": (HANDS, "file", LANDMARKS_AND_PRESENCE),
 }
 
 
@@ -82,7 +75,7 @@ def main():
     os.makedirs(os.path.join(out_dir, "tflite"), exist_ok=True)
     tars = {}
     packed = {}
-    for name, (tarball, where, keep, runtime) in sorted(MODELS.items()):
+    for name, (tarball, where, keep) in sorted(MODELS.items()):
         if tarball not in tars:
             tars[tarball] = tarfile.open(os.path.join(package_dir, tarball))
         tar = tars[tarball]
@@ -103,8 +96,7 @@ def main():
                              % (rel, digest, expected.get(rel)))
         with open(os.path.join(out_dir, rel), "wb") as f:
             f.write(data)
-        convert_file(os.path.join(out_dir, rel), os.path.join(out_dir, name + ".onnx"), name, keep,
-                     for_opencv=runtime == OPENCV)
+        convert_file(os.path.join(out_dir, rel), os.path.join(out_dir, name + ".onnx"), name, keep)
 
 
 if __name__ == "__main__":

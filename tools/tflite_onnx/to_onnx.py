@@ -1,4 +1,4 @@
-"""Converts a MediaPipe TFLite graph to an ONNX graph that OpenCV 4.6's cv::dnn reads.
+"""Converts a MediaPipe TFLite graph to an ONNX graph that arco runs (XNNPACK or cv::dnn).
 
 Our own converter, written from the op semantics of TensorFlow Lite and ONNX
 (docs/detect.md). Choices:
@@ -12,11 +12,10 @@ Our own converter, written from the op semantics of TensorFlow Lite and ONNX
 - OpenCV 4.6's ONNX dialect: Clip with min/max attributes (opset-6 style, although the
   model says opset 11, which cv::dnn needs for Resize's half_pixel mode), Slice listing
   only the sliced axes.
-- For the models cv::dnn runs (`for_opencv`; arco runs the others with XNNPACK, which has
-  5 x 5 depthwise kernels of its own), depthwise 5 x 5 layers, and 3 x 3 ones too narrow
-  for it, are rewritten for cv::dnn's vectorised 3 x 3 depthwise path
-  (depthwise_on_fast_path): the same products summed in another order, about 0.8x the
-  time of a landmark model's forward pass on one thread.
+- The graph is what the TFLite graph computes, layer for layer: arco runs it with
+  XNNPACK (src/arco/detect/xnnpack_graph.h), which has kernels for every layer, or with
+  cv::dnn. (A rewrite of the 5 x 5 depthwise layers for cv::dnn's 3 x 3 fast path, 6d4a031,
+  was dropped with XNNPACK: docs/detect.md.)
 - Only the outputs arco reads are kept (`keep_outputs`), with the nodes and constants they
   need: cv::dnn runs every layer up to the last requested output in node order, so a head
   nobody reads (pose_landmark's segmentation mask and heatmaps) would cost its time on
@@ -34,9 +33,6 @@ OPSET = 11
 # fused_activation_function values (schema.fbs ActivationFunctionType).
 ACT_NONE, ACT_RELU, ACT_RELU6 = 0, 1, 3
 PAD_SAME, PAD_VALID = 0, 1
-# OpenCV 4.6's vectorised 3 x 3 depthwise convolution takes outputs at least this wide;
-# narrower ones run the generic path (measured: docs/detect.md).
-FAST_DEPTHWISE_MIN_WIDTH = 16
 NHWC_TO_NCHW_AXIS = {0: 0, 1: 2, 2: 3, 3: 1}
 
 
@@ -67,9 +63,8 @@ def constant_value(model, producers, index):
 
 
 class Converter:
-    def __init__(self, model, for_opencv=True):
+    def __init__(self, model):
         self.model = model
-        self.for_opencv = for_opencv
         self.producers = {}
         for op in model.operators:
             for o in op.outputs:
@@ -158,12 +153,6 @@ class Converter:
         bias = None
         if len(op.inputs) > 2 and op.inputs[2] >= 0:
             bias = self.cval(op.inputs[2]).astype(np.float32)
-        out_w = (in_shape[2] + left + right - kw) // stride_w + 1
-        if (self.for_opencv and depthwise and kh == kw and dil_h == 1 and dil_w == 1 and weight.shape[0] == group and
-                stride_h == stride_w and self.fast_path_pays(kh, stride_w, out_w, left + right)):
-            raw = self.depthwise_on_fast_path(self.names[x], in_shape, weight.astype(np.float32),
-                                              bias, (top, left, bottom, right), (stride_h, stride_w))
-            return self.activation(op, act, op.outputs[0], raw)
         inputs = [self.names[x], self.const("W", weight.astype(np.float32))]
         if bias is not None:
             inputs.append(self.const("B", bias))
@@ -171,86 +160,6 @@ class Converter:
         self.node("Conv", inputs, [raw], kernel_shape=[kh, kw], strides=[stride_h, stride_w],
                   dilations=[dil_h, dil_w], pads=[top, left, bottom, right], group=group)
         self.activation(op, act, op.outputs[0], raw)
-
-    @staticmethod
-    def fast_path_pays(kernel, stride, out_w, pads_w):
-        """Whether depthwise_on_fast_path is faster than cv::dnn on the layer as it is, from
-        single-layer timings (docs/detect.md). Stride 1: a 3 x 3 layer that cv::dnn does
-        not already vectorise (its output, less its padding, narrower than
-        FAST_DEPTHWISE_MIN_WIDTH) and at least 7 wide; a 5 x 5 layer at least 10 wide
-        (narrower, the blocks' overhead outweighs what they save). Stride 2: a 5 x 5 layer
-        at least 28 wide (cv::dnn's own stride-2 path is faster below)."""
-        if stride == 1 and kernel == 3:
-            return out_w >= 7 and out_w - pads_w < FAST_DEPTHWISE_MIN_WIDTH
-        if stride == 1 and kernel == 5:
-            return out_w >= 10
-        return stride == 2 and kernel == 5 and out_w >= 28
-
-    def depthwise_on_fast_path(self, x, in_shape, weight, bias, pads, strides):
-        """A 3 x 3 or 5 x 5 depthwise convolution as OpenCV's fast path runs it; returns the
-        result's name.
-
-        OpenCV 4.6's cv::dnn vectorises a depthwise convolution only with a 3 x 3 kernel and
-        an output wide enough (FAST_DEPTHWISE_MIN_WIDTH); anything else runs its generic
-        path, 5-30x slower per multiply-add here (docs/detect.md), and MediaPipe's landmark
-        models are mostly 5 x 5 depthwise layers. So:
-        - a narrow output is widened to 16 by padding the input on the right, the extra
-          columns cut off the result at the end;
-        - a 5 x 5 kernel is cut into its 3 x 3 blocks at row and column offsets 0 and 2
-          (the shared row and column counted once, in the first block), and the four
-          blocks' convolutions are summed: the same sum of products in another order. A
-          block at offset (du, dv) reads the input du rows and dv columns further on, so it
-          is the 3 x 3 convolution padded du less at the top and dv less at the left, and as
-          much more at the bottom and the right (stride 1, pads of 2: 'SAME'). Otherwise
-          the input is padded once and each block convolves its window of it.
-        """
-        top, left, bottom, right = pads
-        stride_h, stride_w = strides
-        channels, _, k, _ = weight.shape
-        out_h = (in_shape[1] + top + bottom - k) // stride_h + 1
-        out_w = (in_shape[2] + left + right - k) // stride_w + 1
-        wide = max(out_w, FAST_DEPTHWISE_MIN_WIDTH)
-        right += max(0, stride_w * (wide - 1) + k - (in_shape[2] + left + right))
-        direct = k == 5 and min(top, left, bottom, right) >= 2
-        padded = x
-        if not direct and (top or left or bottom or right):
-            padded = self.fresh("pad_dw")
-            self.pad(x, [0, 0, top, left, 0, 0, bottom, right], padded)
-        offsets = (0,) if k == 3 else (0, 2)
-        parts = []
-        for du in offsets:
-            for dv in offsets:
-                block = weight[:, :, du:du + 3, dv:dv + 3].copy()
-                if du == 2:
-                    block[:, :, 0, :] = 0  # row 2 belongs to the du = 0 blocks
-                if dv == 2:
-                    block[:, :, :, 0] = 0  # column 2 belongs to the dv = 0 blocks
-                if k == 3:
-                    window, block_pads = padded, [0, 0, 0, 0]
-                elif direct:
-                    window = x
-                    block_pads = [top - du, left - dv, bottom - 2 + du, right - 2 + dv]
-                else:
-                    window, block_pads = self.fresh("window"), [0, 0, 0, 0]
-                    self.slice(padded, [du, dv],
-                               [du + stride_h * (out_h - 1) + 3, dv + stride_w * (wide - 1) + 3],
-                               [2, 3], [1, 1], window)
-                inputs = [window, self.const("W", block)]
-                if bias is not None and not parts:
-                    inputs.append(self.const("B", bias))
-                part = self.fresh("conv3")
-                self.node("Conv", inputs, [part], kernel_shape=[3, 3], strides=[stride_h, stride_w],
-                          dilations=[1, 1], pads=block_pads, group=channels)
-                parts.append(part)
-        raw = parts[0]
-        if len(parts) > 1:
-            raw = self.fresh("sum")
-            self.node("Sum", parts, [raw])
-        if wide > out_w:
-            cut = self.fresh("cut")
-            self.slice(raw, [0], [out_w], [3], [1], cut)
-            raw = cut
-        return raw
 
     def to_nhwc(self, index):
         """The ONNX name of tensor `index` in TFLite's layout (transposed if 4-D)."""
@@ -459,8 +368,8 @@ class Converter:
         return model
 
 
-def convert_file(tflite_path, onnx_path, graph_name, keep_outputs=None, for_opencv=True):
-    model = Converter(TfliteModel(tflite_path), for_opencv).convert(graph_name, keep_outputs)
+def convert_file(tflite_path, onnx_path, graph_name, keep_outputs=None):
+    model = Converter(TfliteModel(tflite_path)).convert(graph_name, keep_outputs)
     with open(onnx_path, "wb") as f:
         f.write(model.SerializeToString())
 

@@ -1,9 +1,9 @@
 // One pretrained network (detect/model_registry.h) run on the CPU by XNNPACK
 // (detect/xnnpack_graph.h) or by OpenCV's cv::dnn.
 //
-// Runtime: by default (kAuto) a graph XNNPACK can run is run by XNNPACK, which is about
-// twice as fast on MediaPipe's landmarkers (docs/detect.md, "XNNPACK"); a graph with an
-// operator it lacks (hand_recrop's and the detectors' Slice, Resize, Concat) by cv::dnn.
+// Runtime: by default (kAuto) a graph XNNPACK can run (every model arco converts) is run
+// by XNNPACK, faster than cv::dnn and bit-exact for any thread count (docs/detect.md,
+// "XNNPACK runs the models"); a graph with an operator the translation lacks by cv::dnn.
 // runtime_name() says which.
 //
 // Load once (reading and preparing the graph is the expensive part), then Run per crop;

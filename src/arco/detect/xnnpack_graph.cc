@@ -46,27 +46,56 @@ class Builder {
     for (const onnx::TensorProto& t : graph.initializer()) initializers_[t.name()] = &t;
   }
 
-  Status Build(xnn_subgraph_t subgraph,
-               const std::vector<std::string>& output_names,
-               int input_height,
-               int input_width,
-               std::vector<std::vector<size_t>>* output_dims) {
-    subgraph_ = subgraph;
-    // What each output name is an alias of (Identity, and the Transpose to NHWC that the
-    // converter puts before a graph output or a Reshape), so the value that is really
-    // computed is the one declared external.
-    std::map<std::string, std::string> alias;
+  // The external values: each output is one value XNNPACK computes, or, for an output a
+  // Concat computes (the detectors' anchors of each scale, Debian 12's XNNPACK has no
+  // concatenation), the Concat's inputs, copied one after the other when run. Sets
+  // (*parts)[k] to output k's external value ids; returns how many there are.
+  StatusOr<uint32_t> Plan(const std::vector<std::string>& output_names,
+                          std::vector<std::vector<uint32_t>>* parts) {
+    // What each name is an alias of (Identity, and the Transpose to NHWC that the converter
+    // puts before a graph output or a Reshape), so the value that is really computed is the
+    // one declared external.
+    std::map<std::string, const onnx::NodeProto*> producer;
     for (const onnx::NodeProto& node : graph_.node()) {
       if ((node.op_type() == "Identity" || node.op_type() == "Transpose") &&
           node.input_size() == 1 && node.output_size() == 1) {
-        alias[node.output(0)] = node.input(0);
+        alias_[node.output(0)] = node.input(0);
+      }
+      for (const std::string& out : node.output()) producer[out] = &node;
+    }
+    const auto resolve = [&](std::string name) {
+      while (alias_.count(name)) name = alias_[name];
+      return name;
+    };
+    uint32_t next = 1;  // 0 is the input
+    parts->assign(output_names.size(), {});
+    for (size_t k = 0; k < output_names.size(); ++k) {
+      const std::string name = resolve(output_names[k]);
+      auto p = producer.find(name);
+      if (p != producer.end() && p->second->op_type() == "Concat") {
+        concat_outputs_.insert(name);
+        for (const std::string& in : p->second->input()) {
+          const std::string part = resolve(in);
+          if (external_outputs_.count(part)) return Error("'" + part + "' feeds two outputs");
+          external_outputs_[part] = next;
+          part_names_.push_back(part);
+          (*parts)[k].push_back(next++);
+        }
+      } else {
+        external_outputs_[name] = next;
+        part_names_.push_back(name);
+        (*parts)[k].push_back(next++);
       }
     }
-    for (size_t k = 0; k < output_names.size(); ++k) {
-      std::string name = output_names[k];
-      while (alias.count(name)) name = alias[name];
-      external_outputs_[name] = static_cast<uint32_t>(k + 1);
-    }
+    return next - 1;
+  }
+
+  // Translates the graph; (*part_sizes)[i] is the element count of external value i + 1.
+  Status Build(xnn_subgraph_t subgraph,
+               int input_height,
+               int input_width,
+               std::vector<size_t>* part_sizes) {
+    subgraph_ = subgraph;
     if (graph_.input_size() != 1)
       return Error("the graph has " + std::to_string(graph_.input_size()) + " inputs, not 1");
     Value input;
@@ -75,13 +104,14 @@ class Builder {
     ARCO_RETURN_IF_ERROR(Define(&input, 0, XNN_VALUE_FLAG_EXTERNAL_INPUT));
     values_[graph_.input(0).name()] = input;
     for (const onnx::NodeProto& node : graph_.node()) ARCO_RETURN_IF_ERROR(Translate(node));
-    for (size_t k = 0; k < output_names.size(); ++k) {
-      auto it = values_.find(output_names[k]);
-      if (it == values_.end())
-        return Error("no node computes the output '" + output_names[k] + "'");
-      if (it->second.id != k + 1)
-        return Error("the output '" + output_names[k] + "' is not computed by a node of its own");
-      output_dims->push_back(XnnDims(it->second));
+    for (size_t i = 0; i < part_names_.size(); ++i) {
+      auto it = values_.find(part_names_[i]);
+      if (it == values_.end()) return Error("no node computes '" + part_names_[i] + "'");
+      if (it->second.id != i + 1)
+        return Error("the output '" + part_names_[i] + "' is not computed by a node of its own");
+      size_t count = 1;
+      for (size_t d : it->second.onnx_shape) count *= d;
+      part_sizes->push_back(count);
     }
     return Status::Ok();
   }
@@ -235,7 +265,7 @@ class Builder {
       ARCO_ASSIGN_OR_RETURN(Value y, Output(node, x.onnx_shape, x.nchw));
       return Check(xnn_define_clamp(subgraph_, lo, hi, x.id, y.id, 0), node);
     }
-    if (op == "Add" || op == "Sum") return Add(node, where);
+    if (op == "Add") return Add(node, where);
     if (op == "Pad") {
       ARCO_ASSIGN_OR_RETURN(Value x, In(node, 0));
       if (node.input_size() < 2 || x.onnx_shape.size() != 4)
@@ -391,6 +421,72 @@ class Builder {
       return Check(xnn_define_prelu(subgraph_, x.id, sid, y.id, 0), node);
     }
     if (op == "Slice") return ChannelSlice(node, where);
+    if (op == "Concat") {
+      // Only a Concat computing an output (Plan): its inputs are external values, laid one
+      // after the other, which is the concatenation when every axis before it is 1.
+      if (!concat_outputs_.count(node.output(0)))
+        return Error(where + ": only a Concat computing an output");
+      int64_t axis = Int(node, "axis", 0);
+      std::vector<size_t> first;
+      for (int k = 0; k < node.input_size(); ++k) {
+        ARCO_ASSIGN_OR_RETURN(Value v, In(node, k));
+        const int64_t rank = static_cast<int64_t>(v.onnx_shape.size());
+        const int64_t a = axis < 0 ? axis + rank : axis;
+        if (v.nchw || a < 0 || a >= rank)
+          return Error(where + ": an axis or layout it cannot lay out");
+        for (int64_t d = 0; d < a; ++d) {
+          if (v.onnx_shape[d] != 1) return Error(where + ": a dimension before the axis is not 1");
+        }
+        std::vector<size_t> rest(v.onnx_shape.begin() + a + 1, v.onnx_shape.end());
+        if (k == 0) first = rest;
+        if (rest != first) return Error(where + ": inputs of different shapes");
+      }
+      return Status::Ok();
+    }
+    if (op == "Resize") {
+      ARCO_ASSIGN_OR_RETURN(Value x, In(node, 0));
+      const onnx::AttributeProto* mode = Attr(node, "mode");
+      const onnx::AttributeProto* transform = Attr(node, "coordinate_transformation_mode");
+      if (!x.nchw || !mode || mode->s() != "linear" || node.input_size() < 4) {
+        return Error(where + ": only a bilinear Resize to constant sizes");
+      }
+      // TFLite's RESIZE_BILINEAR: half_pixel_centers is ONNX's half_pixel, XNNPACK's default;
+      // without it, ONNX's asymmetric, XNNPACK's TensorFlow legacy mode.
+      uint32_t flags = 0;
+      const std::string t = transform ? transform->s() : "half_pixel";
+      if (t == "asymmetric") {
+        flags = XNN_FLAG_TENSORFLOW_LEGACY_MODE;
+      } else if (t != "half_pixel") {
+        return Error(where + ": coordinate_transformation_mode " + t);
+      }
+      ARCO_ASSIGN_OR_RETURN(std::vector<float> sizes, Constant(node.input(3)));
+      if (sizes.size() != 4 || sizes[0] != x.onnx_shape[0] || sizes[1] != x.onnx_shape[1]) {
+        return Error(where + ": only a resize of height and width");
+      }
+      const size_t h = static_cast<size_t>(sizes[2]), w = static_cast<size_t>(sizes[3]);
+      ARCO_ASSIGN_OR_RETURN(Value y, Output(node, {x.onnx_shape[0], x.onnx_shape[1], h, w}, true));
+      return Check(xnn_define_static_resize_bilinear_2d(subgraph_, h, w, x.id, y.id, flags), node);
+    }
+    if (op == "DepthToSpace") {
+      ARCO_ASSIGN_OR_RETURN(Value x, In(node, 0));
+      const onnx::AttributeProto* mode = Attr(node, "mode");
+      const int64_t block = Int(node, "blocksize", 0);
+      // TFLite's (NHWC) depth_to_space is ONNX's DCR mode, which is XNNPACK's.
+      if (!x.nchw || block < 1 || (mode && mode->s() != "DCR") ||
+          x.onnx_shape[1] % static_cast<size_t>(block * block) != 0) {
+        return Error(where + ": only DCR mode");
+      }
+      const size_t b = static_cast<size_t>(block);
+      const std::vector<size_t>& sh = x.onnx_shape;
+      ARCO_ASSIGN_OR_RETURN(Value y,
+                            Output(node, {sh[0], sh[1] / (b * b), sh[2] * b, sh[3] * b}, true));
+      return Check(xnn_define_depth_to_space(subgraph_, x.id, y.id, static_cast<uint32_t>(b), 0),
+                   node);
+    }
+    if ((op == "Identity" || op == "Transpose") && concat_outputs_.count(node.input(0))) {
+      concat_outputs_.insert(node.output(0));  // the output's name for a concatenation
+      return Status::Ok();
+    }
     if (op == "Identity") {
       ARCO_ASSIGN_OR_RETURN(Value x, In(node, 0));
       values_[node.output(0)] = x;
@@ -566,9 +662,9 @@ class Builder {
                  node);
   }
 
-  // Add (two inputs, NumPy broadcasting as XNNPACK has it) and Sum (a chain of them).
+  // Add (NumPy broadcasting, as XNNPACK has it), of values or of a constant.
   Status Add(const onnx::NodeProto& node, const std::string& where) {
-    if (node.input_size() < 2) return Error(where + ": fewer than two inputs");
+    if (node.input_size() != 2) return Error(where + ": not two inputs");
     std::vector<Value> in;
     for (int k = 0; k < node.input_size(); ++k) {
       if (initializers_.count(node.input(k))) {
@@ -590,31 +686,14 @@ class Builder {
         in.push_back(v);
       }
     }
-    for (size_t k = 1; k < in.size(); ++k) {
-      if (in[k].nchw != in[0].nchw || in[k].onnx_shape.size() != in[0].onnx_shape.size()) {
-        return Error(where + ": inputs of different layouts");
-      }
+    if (in[1].nchw != in[0].nchw || in[1].onnx_shape.size() != in[0].onnx_shape.size()) {
+      return Error(where + ": inputs of different layouts");
     }
     std::vector<size_t> shape = in[0].onnx_shape;
-    for (size_t k = 1; k < in.size(); ++k)
-      for (size_t a = 0; a < shape.size(); ++a) shape[a] = std::max(shape[a], in[k].onnx_shape[a]);
-    Value acc = in[0];
-    const float lo = -std::numeric_limits<float>::infinity(),
-                hi = std::numeric_limits<float>::infinity();
-    for (size_t k = 1; k < in.size(); ++k) {
-      Value y;
-      if (k + 1 == in.size()) {
-        ARCO_ASSIGN_OR_RETURN(y, Output(node, shape, in[0].nchw));
-      } else {
-        y.onnx_shape = shape;
-        y.nchw = in[0].nchw;
-        ARCO_RETURN_IF_ERROR(Define(&y, XNN_INVALID_VALUE_ID, 0));
-      }
-      ARCO_RETURN_IF_ERROR(
-          Check(xnn_define_add2(subgraph_, lo, hi, acc.id, in[k].id, y.id, 0), node));
-      acc = y;
-    }
-    return Status::Ok();
+    for (size_t a = 0; a < shape.size(); ++a) shape[a] = std::max(shape[a], in[1].onnx_shape[a]);
+    ARCO_ASSIGN_OR_RETURN(Value y, Output(node, shape, in[0].nchw));
+    const float inf = std::numeric_limits<float>::infinity();
+    return Check(xnn_define_add2(subgraph_, -inf, inf, in[0].id, in[1].id, y.id, 0), node);
   }
 
   const onnx::GraphProto& graph_;
@@ -622,6 +701,9 @@ class Builder {
   std::map<std::string, const onnx::TensorProto*> initializers_;
   std::map<std::string, Value> values_;
   std::map<std::string, uint32_t> external_outputs_;
+  std::map<std::string, std::string> alias_;
+  std::set<std::string> concat_outputs_;
+  std::vector<std::string> part_names_;  // external value i + 1
   xnn_subgraph_t subgraph_ = nullptr;
 };
 
@@ -633,6 +715,12 @@ struct XnnpackGraph::Impl {
   xnn_runtime_t runtime = nullptr;
   std::vector<float> input;  // H x W x 3, with XNNPACK's extra bytes
   std::vector<xnn_external_value> externals;
+  // The parts of an output a Concat computes, and where each goes.
+  struct Copy {
+    size_t part, output, offset;
+  };
+  std::vector<std::vector<float>> parts;
+  std::vector<Copy> copies;
   ~Impl() {
     if (runtime) xnn_delete_runtime(runtime);
     if (pool) pthreadpool_destroy(pool);
@@ -668,16 +756,21 @@ StatusOr<std::unique_ptr<XnnpackGraph>> XnnpackGraph::Load(
     graph->impl_->pool = pthreadpool_create(static_cast<size_t>(num_threads));
     if (!graph->impl_->pool) return Status::Error(onnx_path + ": cannot start XNNPACK's threads");
   }
+  Builder builder(model.graph(), &graph->impl_->constants);
+  std::vector<std::vector<uint32_t>> parts;
+  StatusOr<uint32_t> externals = builder.Plan(output_names, &parts);
+  if (!externals.ok()) return Status::Error(onnx_path + ": " + externals.status().message());
   xnn_subgraph_t subgraph = nullptr;
-  if (xnn_create_subgraph(static_cast<uint32_t>(output_names.size() + 1), 0, &subgraph) !=
-      xnn_status_success) {
+  if (xnn_create_subgraph(*externals + 1, 0, &subgraph) != xnn_status_success) {
     return Status::Error(onnx_path + ": XNNPACK cannot create a subgraph");
   }
-  std::vector<std::vector<size_t>> output_dims;
-  Builder builder(model.graph(), &graph->impl_->constants);
-  Status built = builder.Build(subgraph, output_names, input_height, input_width, &output_dims);
+  std::vector<size_t> part_sizes;
+  Status built = builder.Build(subgraph, input_height, input_width, &part_sizes);
   if (built.ok()) {
-    if (xnn_create_runtime_v2(subgraph, graph->impl_->pool, 0, &graph->impl_->runtime) !=
+    // The pool's threads yield after each pass instead of spinning for the next: a tracker
+    // crops and decodes between passes, and spinning threads would take its cores.
+    if (xnn_create_runtime_v2(
+            subgraph, graph->impl_->pool, XNN_FLAG_YIELD_WORKERS, &graph->impl_->runtime) !=
         xnn_status_success) {
       built = Status::Error("XNNPACK cannot create the runtime");
     }
@@ -688,13 +781,24 @@ StatusOr<std::unique_ptr<XnnpackGraph>> XnnpackGraph::Load(
   impl.input.assign(
       static_cast<size_t>(input_height) * input_width * 3 + XNN_EXTRA_BYTES / sizeof(float), 0.0f);
   impl.externals.push_back({0, impl.input.data()});
-  for (size_t k = 0; k < output_dims.size(); ++k) {
-    size_t count = 1;
-    for (size_t d : output_dims[k]) count *= d;
+  impl.parts.resize(part_sizes.size());
+  for (size_t k = 0; k < parts.size(); ++k) {
+    size_t count = 0;
+    for (uint32_t id : parts[k]) count += part_sizes[id - 1];
     graph->outputs_.emplace_back(count, 0.0f);
   }
-  for (size_t k = 0; k < output_dims.size(); ++k) {
-    impl.externals.push_back({static_cast<uint32_t>(k + 1), graph->outputs_[k].data()});
+  for (size_t k = 0; k < parts.size(); ++k) {
+    size_t offset = 0;
+    for (uint32_t id : parts[k]) {
+      float* data = graph->outputs_[k].data();
+      if (parts[k].size() > 1) {  // written apart, then laid one after the other
+        impl.parts[id - 1].assign(part_sizes[id - 1], 0.0f);
+        impl.copies.push_back({id - 1, k, offset});
+        data = impl.parts[id - 1].data();
+      }
+      impl.externals.push_back({id, data});
+      offset += part_sizes[id - 1];
+    }
   }
   if (xnn_setup_runtime(impl.runtime, impl.externals.size(), impl.externals.data()) !=
       xnn_status_success) {
@@ -708,6 +812,10 @@ Status XnnpackGraph::Run(const float* input_nhwc) {
   std::memcpy(impl_->input.data(), input_nhwc, count * sizeof(float));
   if (xnn_invoke_runtime(impl_->runtime) != xnn_status_success) {
     return Status::Error("XNNPACK failed to run the graph");
+  }
+  for (const Impl::Copy& c : impl_->copies) {
+    const std::vector<float>& part = impl_->parts[c.part];
+    std::memcpy(outputs_[c.output].data() + c.offset, part.data(), part.size() * sizeof(float));
   }
   return Status::Ok();
 }

@@ -3,16 +3,17 @@
 //
 // Why: OpenCV 4.6's cv::dnn vectorises a depthwise convolution only with a 3 x 3 kernel
 // and a wide output, and MediaPipe's landmarkers are mostly 5 x 5 depthwise layers;
-// XNNPACK has kernels for every layer these models use (docs/detect.md, "XNNPACK").
+// XNNPACK has kernels for every layer these models use (docs/detect.md, "XNNPACK runs the
+// models").
 //
 // The ONNX graph is NCHW (ONNX's order); XNNPACK is NHWC. Each 4-D value is defined in
 // XNNPACK as NHWC and the weights are reordered on load; a Transpose to NHWC (which the
 // converter puts before a Reshape or at a 4-D output) becomes a no-op on that memory.
-// Only the operators the converter emits for the landmarkers translate (Conv: dense or
-// depthwise; Clip, Add, Sum, Pad, MaxPool, GlobalAveragePool, Flatten, Gemm, Sigmoid,
-// PRelu, Identity, Transpose to NHWC, Reshape, and a Slice of the first channels); any other is an
-// error naming it, and detect::Network then runs the model with cv::dnn (tools/tflite_onnx/fetch.py
-// says which models are converted for which runtime).
+// Only the operators the converter emits for the eight models translate (Conv: dense or
+// depthwise; Clip, Add, Pad, MaxPool, GlobalAveragePool, Flatten, Gemm, Sigmoid, PRelu,
+// Resize (bilinear), DepthToSpace, Identity, Transpose to NHWC, Reshape, a Slice of the
+// first channels, and a Concat computing an output); any other is an error naming it, and
+// detect::Network then runs the model with cv::dnn.
 //
 // Threads: with num_threads 1 a forward pass runs on the calling thread only (arco detect
 // parallelises over views and frames); more use a pool of the graph's own. XNNPACK
