@@ -411,6 +411,8 @@ Json EvalReport::ToJson(const EvalOptions& options) const {
       mj["double_stop_frames"] = m.double_stop_frames;
       mj["double_stop_string_accuracy"] = JsonFromDouble(m.double_stop_string_accuracy);
       mj["double_stop_finger_accuracy"] = JsonFromDouble(m.double_stop_finger_accuracy);
+      mj["false_double_stop_frames"] =
+          m.false_double_stop_frames >= 0 ? Json(m.false_double_stop_frames) : Json(nullptr);
     }
     j["methods"][m.method] = mj;
   }

@@ -304,7 +304,9 @@ void ScoreBowing(const std::vector<refine::BowingFrame>& truth,
     const refine::BowingFrame& m = method[f];
     if (t.string <= 0) continue;
     ++sounding;
-    const bool same_string = m.string == t.string || m.second_string == t.string;
+    // A string the truth's bow is on (a double stop's bow is on two) is under the method's.
+    const auto bowed = [&t](int s) { return s > 0 && (s == t.string || s == t.second_string); };
+    const bool same_string = bowed(m.string) || bowed(m.second_string);
     string_right += same_string;
     if (t.direction != refine::BowDirection::kNone) {
       ++moving;
@@ -327,10 +329,13 @@ void ScoreDoubleStops(const std::vector<FrameVoices>& truth,
     throw std::invalid_argument("double stops: " + std::to_string(method->size()) +
                                 " frames but the truth has " + std::to_string(truth.size()));
   }
-  int frames = 0, string_hits = 0, finger_hits = 0;
+  int frames = 0, string_hits = 0, finger_hits = 0, false_frames = 0;
   for (size_t f = 0; f < truth.size(); ++f) {
     const FrameVoices& t = truth[f];
-    if (!t.DoubleStop()) continue;
+    if (!t.DoubleStop()) {
+      false_frames += method && (*method)[f].DoubleStop();
+      continue;
+    }
     ++frames;
     if (!method) continue;
     const FrameVoices& m = (*method)[f];
@@ -343,6 +348,7 @@ void ScoreDoubleStops(const std::vector<FrameVoices>& truth,
   }
   metrics->double_stop_truth = frames > 0;
   metrics->double_stop_frames = frames;
+  if (method) metrics->false_double_stop_frames = false_frames;
   if (method && frames > 0) {
     metrics->double_stop_string_accuracy = static_cast<double>(string_hits) / frames;
     metrics->double_stop_finger_accuracy = static_cast<double>(finger_hits) / frames;

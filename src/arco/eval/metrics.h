@@ -119,6 +119,9 @@ struct MethodMetrics {
   int double_stop_frames = 0;
   double double_stop_string_accuracy = NAN;
   double double_stop_finger_accuracy = NAN;
+  // Frames the method sounds two voices where the truth has one note or none (-1: the
+  // method gives no second note).
+  int false_double_stop_frames = -1;
   // Per frame (NaN where not measured): wrist-aligned left-hand error and
   // contact deviation, for plots.
   std::vector<double> frame_hand_mm, frame_contact_mm;
@@ -153,7 +156,8 @@ struct FrameVoices {
 // Double-stop metrics over the truth's frames with two voices: a string hit when the
 // method's two strings are the truth's two, a finger hit when its two (string, finger)
 // pairs are the truth's two, in either order (a method may call either voice its first).
-// `method` null: the method gives no second note (accuracies stay NaN). Sets
+// `method` null: the method gives no second note (accuracies stay NaN). Also counts the
+// method's double stops on the truth's other frames (false_double_stop_frames). Sets
 // double_stop_truth when the truth has a double-stop frame. Throws std::invalid_argument
 // when the frame counts differ.
 void ScoreDoubleStops(const std::vector<FrameVoices>& truth,

@@ -207,12 +207,21 @@ TEST(ScoreDoubleStops, BothNotesInEitherVoiceOrderOverDoubleStopFramesOnly) {
   EXPECT_EQ(m.double_stop_frames, 4);
   EXPECT_DOUBLE_EQ(m.double_stop_string_accuracy, 3.0 / 4);
   EXPECT_DOUBLE_EQ(m.double_stop_finger_accuracy, 2.0 / 4);
+  EXPECT_EQ(m.false_double_stop_frames, 0);  // frame 0: one voice, if the wrong one
+  // A second voice where the truth has one note is a false double stop.
+  std::vector<FrameVoices> extra = method;
+  extra[0] = voices(2, 2, 1, 1);
+  MethodMetrics e;
+  ScoreDoubleStops(truth, &extra, &e);
+  EXPECT_EQ(e.false_double_stop_frames, 1);
+  EXPECT_DOUBLE_EQ(e.double_stop_string_accuracy, 3.0 / 4);
   // No second voice from the method: NaN, never 0; no double stops in the truth: unset.
   MethodMetrics none;
   ScoreDoubleStops(truth, nullptr, &none);
   EXPECT_TRUE(none.double_stop_truth);
   EXPECT_TRUE(std::isnan(none.double_stop_string_accuracy));
   EXPECT_TRUE(std::isnan(none.double_stop_finger_accuracy));
+  EXPECT_EQ(none.false_double_stop_frames, -1);
   MethodMetrics single;
   const std::vector<FrameVoices> single_truth = {voices(4, 1, 0, 0)};
   const std::vector<FrameVoices> single_method = {voices(4, 1, 0, 0)};

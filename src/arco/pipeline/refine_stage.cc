@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -293,8 +294,20 @@ StatusOr<MethodRecord> RefineMethod(const RefineInputs& inputs,
   const refine::DoubleStopRefineOptions double_stop_options;
   refine::DoubleStopRefineSummary double_stop_summary;
   if (options.mode == refine::RefineMode::kArco && !inputs.upper_f0_hz.empty()) {
-    refine::DoubleStopRefineResult ds =
-        refine::RefineSecondVoice(inputs.input, r, inputs.upper_f0_hz, double_stop_options);
+    // The bow's inclination while it is on the strings (step 00 of double_stop_refine.h):
+    // it does not depend on the notes, so the first voice's result serves.
+    std::vector<double> bow_inclination_deg;
+    {
+      ARCO_ASSIGN_OR_RETURN(const refine::BowingResult bow, AnalyzeBow(inputs, r, bowing));
+      if (bow.frames.size() == r.contacts.size()) {
+        for (const refine::BowingFrame& bf : bow.frames) {
+          bow_inclination_deg.push_back(bf.string > 0 ? bf.inclination_deg
+                                                      : std::numeric_limits<double>::quiet_NaN());
+        }
+      }
+    }
+    refine::DoubleStopRefineResult ds = refine::RefineSecondVoice(
+        inputs.input, r, inputs.upper_f0_hz, double_stop_options, bow_inclination_deg);
     r.hand = std::move(ds.hand);
     // The pair of fingers may have given first-voice notes another finger: their rows of
     // fingering.csv follow.

@@ -28,7 +28,7 @@ constexpr char kReprojectionRmsFile[] = "reprojection_rms_px.npy";
 constexpr char kInlierCountFile[] = "inlier_count.npy";
 constexpr char kViewCountFile[] = "view_count.npy";
 constexpr char kInlierMaskFile[] = "inlier_mask.npy";
-constexpr char kDepthSourceFile[] = "depth_source.npy";  // one camera only
+constexpr char kDepthSourceFile[] = "depth_source.npy";   // one camera only
 constexpr char kDepthSigmaFile[] = "depth_sigma_mm.npy";  // one camera only
 constexpr char kStringsFile[] = "strings.npy";
 constexpr char kKeypointsFile[] = "keypoints.npy";
@@ -848,9 +848,11 @@ Status ResultFolder::WriteMethod(const MethodRecord& r) const {
                                {"fill_notes", o.fill_notes},
                                {"tie_chords", o.tie_chords},
                                {"chord_gap_s", o.chord_gap_s},
-                               {"chord_lower_max_s", o.chord_lower_max_s}}},
+                               {"chord_lower_max_s", o.chord_lower_max_s},
+                               {"bow_gate", o.bow_gate}}},
                              {"summary",
                               {{"frames", d.frames},
+                               {"bow_one_string", d.bow_one_string},
                                {"pressed", d.pressed},
                                {"open_string", d.open_string},
                                {"one_finger_fifths", d.one_finger_fifths},

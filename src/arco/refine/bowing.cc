@@ -59,8 +59,7 @@ void LineToSegment(const Eigen::Vector3d& p,
 
 // The upper median of the finite values (NaN when there are none).
 double FiniteMedian(std::vector<double> v) {
-  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }),
-          v.end());
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
   return v.empty() ? kNaN : UpperMedian(std::move(v));
 }
 
@@ -141,7 +140,8 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
     const int string = best + 1;
     // The neighbour on the inclination's side: a double stop when near the midpoint.
     const double own = inclination_rad[static_cast<size_t>(best)];
-    const int neighbour = incl > own ? string - 1 : string + 1;  // higher inclination: higher string
+    const int neighbour =
+        incl > own ? string - 1 : string + 1;  // higher inclination: higher string
     int second = 0;
     if (neighbour >= 1 && neighbour <= num_strings) {
       const double mid = 0.5 * (own + inclination_rad[static_cast<size_t>(neighbour - 1)]);
@@ -150,13 +150,25 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
     const StringSegment& seg = strings[static_cast<size_t>(best)];
     double a = 0, b = 0, distance = 0;
     LineToSegment(frog, u, seg.bridge, seg.nut, &a, &b, &distance);
+    double sounding_mm = b * (seg.nut - seg.bridge).norm();
+    if (second > 0) {
+      // A double stop's bow touches both strings: its contact is between them. Measured on
+      // the nearer string alone, the place on the bow would jump by the strings' spacing
+      // whenever the nearer one changes (a bow at the midpoint), read as speed.
+      const StringSegment& other = strings[static_cast<size_t>(second - 1)];
+      double a2 = 0, b2 = 0, distance2 = 0;
+      LineToSegment(frog, u, other.bridge, other.nut, &a2, &b2, &distance2);
+      a = 0.5 * (a + a2);
+      sounding_mm = 0.5 * (sounding_mm + b2 * (other.nut - other.bridge).norm());
+      distance = std::min(distance, distance2);
+    }
     bf.lift_mm = distance;
     bf.bow_position = a / length;
     along_mm[f] = a;
     if (distance <= options.max_lift_mm) {
       bf.string = string;
       bf.second_string = second;
-      bf.sounding_point_mm = b * (seg.nut - seg.bridge).norm();
+      bf.sounding_point_mm = sounding_mm;
     }
   }
 
@@ -184,8 +196,8 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
     if (seen(f) && out.frames[f].string > 0) on.push_back(f);
   }
   const double step = options.min_stroke_mm;
-  int first_direction = 0;           // +1 down, -1 up; 0 until the bow has moved `step`
-  std::vector<size_t> turns;         // frames of the turning points
+  int first_direction = 0;    // +1 down, -1 up; 0 until the bow has moved `step`
+  std::vector<size_t> turns;  // frames of the turning points
   {
     int dir = 0;
     size_t lo = 0, hi = 0, ext = 0;  // indices into `on`
@@ -214,7 +226,8 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
   auto time = [&](size_t f) { return out.frames[f].time_s; };
   for (size_t k : turns) {
     std::vector<std::pair<double, double>> before, after;
-    for (size_t j = k >= 3 ? k - 3 : 0; j < k; ++j) before.emplace_back(time(on[j]), along_mm[on[j]]);
+    for (size_t j = k >= 3 ? k - 3 : 0; j < k; ++j)
+      before.emplace_back(time(on[j]), along_mm[on[j]]);
     for (size_t j = k + 1; j < std::min(on.size(), k + 4); ++j) {
       after.emplace_back(time(on[j]), along_mm[on[j]]);
     }
@@ -234,7 +247,8 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
     int dir = first_direction;
     for (size_t f : on) {
       BowingFrame& bf = out.frames[f];
-      while (next_change < out.change_times_s.size() && bf.time_s >= out.change_times_s[next_change]) {
+      while (next_change < out.change_times_s.size() &&
+             bf.time_s >= out.change_times_s[next_change]) {
         ++next_change;
         dir = -dir;
         bf.bow_change = true;
@@ -243,7 +257,8 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
                           std::abs(bf.bow_speed_mm_per_s) >= options.min_speed_mm_per_s;
       bool near_change = false;
       for (size_t c = next_change > 0 ? next_change - 1 : 0;
-           c < std::min(out.change_times_s.size(), next_change + 1); ++c) {
+           c < std::min(out.change_times_s.size(), next_change + 1);
+           ++c) {
         near_change = near_change || std::abs(bf.time_s - out.change_times_s[c]) * input.fps <= 1.5;
       }
       if (moving || near_change) bf.direction = dir > 0 ? BowDirection::kDown : BowDirection::kUp;
@@ -282,9 +297,9 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
         note.bow_second_string = key.second;
       }
     }
-    note.strings_agree = nf.string == 0 || note.bow_string == 0 ||
-                         nf.string == note.bow_string || nf.string == note.bow_second_string;
-    note.direction = down > up ? BowDirection::kDown
+    note.strings_agree = nf.string == 0 || note.bow_string == 0 || nf.string == note.bow_string ||
+                         nf.string == note.bow_second_string;
+    note.direction = down > up   ? BowDirection::kDown
                      : up > down ? BowDirection::kUp
                                  : BowDirection::kNone;
     if (!speeds.empty()) {
@@ -295,7 +310,8 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
     note.sounding_point_mm = FiniteMedian(sounding);
     for (double t : out.change_times_s) {
       const double dt = t - nf.onset_s;
-      if (!std::isfinite(note.change_to_onset_s) || std::abs(dt) < std::abs(note.change_to_onset_s)) {
+      if (!std::isfinite(note.change_to_onset_s) ||
+          std::abs(dt) < std::abs(note.change_to_onset_s)) {
         note.change_to_onset_s = dt;
       }
     }
@@ -353,11 +369,10 @@ Status WriteBowingCsv(const std::string& path, const std::vector<BowingFrame>& f
     for (size_t f = 0; f < frames.size(); ++f) {
       const BowingFrame& b = frames[f];
       out << f << ',' << FormatCsvDouble(b.time_s) << ',' << b.string << ',' << b.second_string
-          << ',' << FormatCsvDouble(b.inclination_deg) << ',' << FormatCsvDouble(b.skew_deg)
-          << ',' << FormatCsvDouble(b.lift_mm) << ',' << FormatCsvDouble(b.sounding_point_mm)
-          << ',' << FormatCsvDouble(b.bow_position) << ','
-          << FormatCsvDouble(b.bow_speed_mm_per_s) << ',' << BowDirectionName(b.direction)
-          << ',' << (b.bow_change ? 1 : 0) << '\n';
+          << ',' << FormatCsvDouble(b.inclination_deg) << ',' << FormatCsvDouble(b.skew_deg) << ','
+          << FormatCsvDouble(b.lift_mm) << ',' << FormatCsvDouble(b.sounding_point_mm) << ','
+          << FormatCsvDouble(b.bow_position) << ',' << FormatCsvDouble(b.bow_speed_mm_per_s) << ','
+          << BowDirectionName(b.direction) << ',' << (b.bow_change ? 1 : 0) << '\n';
     }
     return Status::Ok();
   });
@@ -379,9 +394,8 @@ Status WriteBowingNotesCsv(const std::string& path, const std::vector<BowingNote
 }
 
 StatusOr<std::vector<BowingFrame>> ReadBowingCsv(const std::string& path) {
-  ARCO_ASSIGN_OR_RETURN(
-      const CsvTable table,
-      ReadCsvTable(path, {"frame", "string", "direction", "sounding_point_mm"}));
+  ARCO_ASSIGN_OR_RETURN(const CsvTable table,
+                        ReadCsvTable(path, {"frame", "string", "direction", "sounding_point_mm"}));
   std::vector<BowingFrame> frames;
   for (const CsvTable::Row& row : table.rows) {
     const std::string where = table.Where(row);
@@ -433,8 +447,9 @@ StatusOr<std::vector<BowingFrame>> ReadBowingCsv(const std::string& path) {
 }
 
 StatusOr<std::vector<BowingNote>> ReadBowingNotesCsv(const std::string& path) {
-  ARCO_ASSIGN_OR_RETURN(const CsvTable table,
-                        ReadCsvTable(path, SplitCsvLine(kBowingNotesCsvHeader), kBowingNotesCsvHeader));
+  ARCO_ASSIGN_OR_RETURN(
+      const CsvTable table,
+      ReadCsvTable(path, SplitCsvLine(kBowingNotesCsvHeader), kBowingNotesCsvHeader));
   std::vector<BowingNote> notes;
   for (const CsvTable::Row& row : table.rows) {
     const std::string where = table.Where(row);
@@ -443,8 +458,10 @@ StatusOr<std::vector<BowingNote>> ReadBowingNotesCsv(const std::string& path) {
     };
     BowingNote n;
     int64_t note = 0, fingered = 0, bow = 0, second = 0, agree = 0;
-    if (!ParseCsvInt(cell("note"), &note) || note < 0 || !ParseCsvInt(cell("fingered_string"), &fingered) ||
-        !ParseCsvInt(cell("bow_string"), &bow) || !ParseCsvInt(cell("bow_second_string"), &second) ||
+    if (!ParseCsvInt(cell("note"), &note) || note < 0 ||
+        !ParseCsvInt(cell("fingered_string"), &fingered) ||
+        !ParseCsvInt(cell("bow_string"), &bow) ||
+        !ParseCsvInt(cell("bow_second_string"), &second) ||
         !ParseCsvInt(cell("strings_agree"), &agree) || fingered < 0 || fingered > 6 || bow < 0 ||
         bow > 6 || second < 0 || second > 6 || (agree != 0 && agree != 1)) {
       return Status::Error(where + "note, the strings and strings_agree must be small integers");

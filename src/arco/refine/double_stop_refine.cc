@@ -14,6 +14,8 @@
 namespace arco::refine {
 namespace {
 
+constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
+
 // Semitones of f0_hz above the open pitch of `string`.
 double SemitonesAboveOpen(const InstrumentModel& model, int string, double f0_hz) {
   return 12.0 * std::log2(f0_hz / model.open_hz(string));
@@ -285,15 +287,32 @@ Status DoubleStopRefineOptions::Validate() const {
   return Status::Ok();
 }
 
+bool BowOnOneString(const InstrumentModel& model, int string, double inclination_deg) {
+  const int n = model.num_strings();
+  if (string < 1 || string > n || n < 2 || !std::isfinite(inclination_deg)) return false;
+  // The pair the second voice would need: `string` and the next higher one; on the highest
+  // string (no string above it) the top two.
+  const int upper = std::max(1, string - 1);
+  const double incl = inclination_deg * kRadPerDeg;
+  const double mid = 0.5 * (model.BowInclinationRad(upper) + model.BowInclinationRad(upper + 1));
+  const double to_pair = std::abs(incl - mid);
+  for (int s = 1; s <= n; ++s) {
+    if (std::abs(incl - model.BowInclinationRad(s)) < to_pair) return true;
+  }
+  return false;
+}
+
 DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
                                          const RefineResult& first,
                                          const std::vector<double>& upper_f0_hz,
-                                         const DoubleStopRefineOptions& options) {
+                                         const DoubleStopRefineOptions& options,
+                                         const std::vector<double>& bow_inclination_deg) {
   const Status status = options.Validate();
   if (!status.ok()) throw std::invalid_argument("RefineSecondVoice: " + status.message());
   const size_t frames = input.pitch.size();
   if (first.contacts.size() != frames || first.hand.size() != frames ||
-      upper_f0_hz.size() != frames || input.strings_in_world_mm.size() != frames) {
+      upper_f0_hz.size() != frames || input.strings_in_world_mm.size() != frames ||
+      (!bow_inclination_deg.empty() && bow_inclination_deg.size() != frames)) {
     throw std::invalid_argument("RefineSecondVoice: per-frame inputs differ in length");
   }
   const InstrumentModel& model = *input.instrument;
@@ -311,13 +330,21 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
   // A note of the first voice whose frames mostly have an upper note keeps it on the rest
   // of its frames (the polyphonic tracker's window holds two notes only well inside a
   // double stop): its median upper f0, where that lies above the frame's own pitch.
+  // Step 00: frames whose bow is on one string have no second voice (and give none to
+  // their note's other frames).
+  std::vector<bool> one_string(frames, false);
+  if (options.bow_gate && !bow_inclination_deg.empty()) {
+    for (size_t f = 0; f < frames; ++f) {
+      one_string[f] = BowOnOneString(model, first.contacts[f].string, bow_inclination_deg[f]);
+    }
+  }
   std::map<int, std::vector<double>> note_upper;
   std::map<int, int> note_frames;
   for (size_t f = 0; f < frames; ++f) {
     const int note = first.contacts[f].note;
     if (note < 0) continue;
     ++note_frames[note];
-    if (upper_f0_hz[f] > 0) note_upper[note].push_back(upper_f0_hz[f]);
+    if (upper_f0_hz[f] > 0 && !one_string[f]) note_upper[note].push_back(upper_f0_hz[f]);
   }
   std::map<int, double> note_median;
   for (auto& [note, values] : note_upper) {
@@ -340,6 +367,10 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
     const bool sounding =
         c1.state == ContactState::kPressed || c1.state == ContactState::kOpenString;
     if (!(upper > 0) || !sounding || c1.string < 1) continue;
+    if (one_string[f]) {
+      ++out.summary.bow_one_string;
+      continue;
+    }
     ++out.summary.frames;
     FrameContact& c2 = out.second[f];
     c2.f0_hz = upper;

@@ -32,6 +32,13 @@
 //      max_tip_distance_mm of their contacts on average over the frames, or the pair is not taken.
 //      No such pair: the first voice's finger and the nearest other fingertip. A second finger
 //      farther than max_tip_distance_mm from its contact: uncertain.
+//  00. The bow (bow_gate): a double stop is bowed on both its strings at once, so a frame whose
+//      bow is seen on the strings and lies nearer one string's inclination than the two
+//      strings' midpoint (refine/bowing.h: InstrumentModel::BowInclinationRad per string)
+//      has no second voice, whatever the tracker heard: on a real cello the 2nd partial and
+//      the previous note still ringing are heard as a second note on half the frames
+//      (docs/accuracy.md, "Double stops"). An unseen or lifted bow leaves the frame to the
+//      sound alone.
 //   0. A first-voice note (FrameContact::note) with an upper note on at least half its
 //      frames gets their median on its frames without one, where it lies above the frame's
 //      pitch (fill_notes).
@@ -81,11 +88,14 @@ struct DoubleStopRefineOptions {
   bool tie_chords = true;
   double chord_gap_s = 0.2;
   double chord_lower_max_s = 0.5;
+  // Step 00: no second voice where the bow is seen on one string.
+  bool bow_gate = true;
   Status Validate() const;
 };
 
 struct DoubleStopRefineSummary {
   int frames = 0;                    // frames with an upper note and a first voice
+  int bow_one_string = 0;            // frames whose upper note the bow ruled out (step 00)
   int pressed = 0, open_string = 0;  // second voices assigned
   int one_finger_fifths = 0;         // pressed by the first voice's finger
   int first_fingers_changed = 0;     // first-voice frames given another finger (step 4)
@@ -101,11 +111,20 @@ struct DoubleStopRefineResult {
   DoubleStopRefineSummary summary;
 };
 
-// `first` is Refine(input, ...)'s result; upper_f0_hz one per frame (0 = none). Throws
-// std::invalid_argument on sizes that differ or invalid options.
+// `first` is Refine(input, ...)'s result; upper_f0_hz one per frame (0 = none);
+// bow_inclination_deg the bow's inclination across the strings per frame while it is on
+// them (refine/bowing.h's BowingFrame::inclination_deg), NaN where it is not seen or is
+// lifted, or empty when the take has no bow. Throws std::invalid_argument on sizes that
+// differ or invalid options.
 DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
                                          const RefineResult& first,
                                          const std::vector<double>& upper_f0_hz,
-                                         const DoubleStopRefineOptions& options);
+                                         const DoubleStopRefineOptions& options,
+                                         const std::vector<double>& bow_inclination_deg = {});
+
+// Step 00's test: whether a bow inclined `inclination_deg` across the strings lies nearer
+// one string's inclination than the midpoint of `string` and `string - 1` (1 = highest; on
+// the highest string, of the top two). False for an unknown inclination.
+bool BowOnOneString(const InstrumentModel& model, int string, double inclination_deg);
 
 }  // namespace arco::refine

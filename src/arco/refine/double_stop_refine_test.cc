@@ -159,6 +159,59 @@ TEST(TranscribeSecondVoice, OneRowPerFirstVoiceNoteWithASecondVoice) {
       TranscribeSecondVoice(*fx.scene.model, fx.first.fingering, few.second, 440.0).empty());
 }
 
+// Step 00: the bow says whether two strings sound. The sixth of the first test, heard on
+// frames 5-14; the bow rests on the A and E strings together on frames 5-9 (the chord of the
+// arch through both: the mean of their inclinations), on the A string alone on 10-14.
+TEST(RefineSecondVoice, ABowOnOneStringRulesOutTheSecondVoice) {
+  const Fixture fx;
+  const InstrumentModel& model = *fx.scene.model;
+  const size_t n = fx.scene.input.pitch.size();
+  constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
+  const double a_deg = model.BowInclinationRad(2) * kDegPerRad;
+  const double e_deg = model.BowInclinationRad(1) * kDegPerRad;
+  const double both_deg = 0.5 * (a_deg + e_deg);
+  // The test itself: the midpoint plays both; each string's own inclination, or a bow a
+  // third of the way from the A string's toward the midpoint, plays one.
+  EXPECT_FALSE(BowOnOneString(model, 2, both_deg));
+  EXPECT_FALSE(BowOnOneString(model, 2, both_deg + 0.2 * (e_deg - both_deg)));
+  EXPECT_TRUE(BowOnOneString(model, 2, a_deg));
+  EXPECT_TRUE(BowOnOneString(model, 2, a_deg + 0.33 * (both_deg - a_deg)));
+  EXPECT_TRUE(BowOnOneString(model, 1, e_deg));          // the top string: pair E + A
+  EXPECT_FALSE(BowOnOneString(model, 2, std::nan("")));  // no bow: the sound decides
+  std::vector<double> upper(n, 0.0);
+  for (size_t f = 5; f < 15; ++f) upper[f] = fx.UpperHz(4);
+  std::vector<double> bow(n, std::nan(""));
+  for (size_t f = 5; f < 10; ++f) bow[f] = both_deg;
+  for (size_t f = 10; f < 15; ++f) bow[f] = a_deg;
+  bow[12] = std::nan("");  // a lifted or unseen bow leaves the frame to the sound
+  DoubleStopRefineOptions per_frame;
+  per_frame.fill_notes = false;
+  const DoubleStopRefineResult r =
+      RefineSecondVoice(fx.scene.input, fx.first, upper, per_frame, bow);
+  for (size_t f = 5; f < 10; ++f) EXPECT_TRUE(r.second[f].pressed()) << f;
+  for (size_t f : {10, 11, 13, 14}) EXPECT_EQ(r.second[f].state, ContactState::kRest) << f;
+  EXPECT_TRUE(r.second[12].pressed());
+  EXPECT_EQ(r.summary.bow_one_string, 4);
+  EXPECT_EQ(r.summary.frames, 6);
+  // The note's other frames are not filled from the frames the bow ruled out.
+  DoubleStopRefineOptions filled;
+  std::vector<double> heard_where_single(n, 0.0);
+  for (size_t f = 0; f < n; ++f) heard_where_single[f] = f % 4 == 0 ? 0.0 : fx.UpperHz(4);
+  const std::vector<double> on_a(n, a_deg);
+  const DoubleStopRefineResult none =
+      RefineSecondVoice(fx.scene.input, fx.first, heard_where_single, filled, on_a);
+  for (size_t f = 0; f < n; ++f) EXPECT_FALSE(none.second[f].pressed()) << f;
+  // Turned off, the bow is not read.
+  DoubleStopRefineOptions off = per_frame;
+  off.bow_gate = false;
+  const DoubleStopRefineResult heard = RefineSecondVoice(fx.scene.input, fx.first, upper, off, bow);
+  for (size_t f = 5; f < 15; ++f) EXPECT_TRUE(heard.second[f].pressed()) << f;
+  EXPECT_EQ(heard.summary.bow_one_string, 0);
+  // A bow track of another length is a caller's bug.
+  EXPECT_THROW(RefineSecondVoice(fx.scene.input, fx.first, upper, per_frame, {1.0}),
+               std::invalid_argument);
+}
+
 TEST(RefineSecondVoice, NoHigherStringOrAnUnplayableSpanIsUncertain) {
   const Fixture fx;
   const size_t n = fx.scene.input.pitch.size();

@@ -116,38 +116,62 @@ double BowAnimator::BowFractionAt(double t) const {
   return s;
 }
 
+BowAnimator::Rest BowAnimator::RestOn(size_t note) const {
+  const int n_strings = instrument_.num_strings();
+  const NoteFingering& fingering = perf_.notes[note].fingering;
+  Rest rest;
+  rest.string = n_strings - fingering.string_index;
+  rest.tilt_rad = TiltRad(rest.string);
+  if (fingering.IsDoubleStop()) {
+    // A double stop is bowed on both strings at once: the bow line is the chord through
+    // the two strings' tops on the bridge's arch, whose inclination is the mean of the
+    // two tangents' (refine/bowing.h reads it back as a double stop), and it crosses the
+    // strings' plane between them.
+    rest.second_string = n_strings - fingering.second_string_index;
+    rest.tilt_rad = 0.5 * (rest.tilt_rad + TiltRad(rest.second_string));
+  }
+  return rest;
+}
+
+Eigen::Vector3d BowAnimator::ContactOn(const Rest& rest, double fraction) const {
+  const Eigen::Vector3d c =
+      tmpl_.strings_mm[static_cast<size_t>(rest.string - 1)].PointAtFraction(fraction);
+  if (rest.second_string == 0) return c;
+  return 0.5 * (c + tmpl_.strings_mm[static_cast<size_t>(rest.second_string - 1)].PointAtFraction(
+                        fraction));
+}
+
 BowFrame BowAnimator::At(double t) const {
   BowFrame out;
-  const int n_strings = instrument_.num_strings();
   const auto& notes = perf_.notes;
   // String: the sounding note's, else the next note's, else the last.
   int idx = perf_.NoteIndexAt(t);
-  int string = 0, prev_string = 0;
   double crossing_u = 1;
   size_t next = 0;
   while (next < notes.size() && notes[next].note.onset_s <= t) ++next;
   const size_t cur =
       idx >= 0 ? static_cast<size_t>(idx) : (next < notes.size() ? next : notes.size() - 1);
-  string = n_strings - notes[cur].fingering.string_index;
-  prev_string = cur > 0 ? n_strings - notes[cur - 1].fingering.string_index : string;
+  const Rest rest = RestOn(cur);
+  Rest prev_rest = cur > 0 ? RestOn(cur - 1) : rest;
   if (idx < 0 && next < notes.size()) {
     // In a gap before note `next`: cross towards its string as it approaches.
-    prev_string = next > 0 ? n_strings - notes[next - 1].fingering.string_index : string;
+    prev_rest = next > 0 ? RestOn(next - 1) : rest;
     const double start = notes[next].note.onset_s - options_.crossing_s;
     crossing_u = options_.crossing_s > 0 ? SmoothStep((t - start) / options_.crossing_s) : 1;
   } else if (idx >= 0 && options_.crossing_s > 0) {
     crossing_u =
         SmoothStep((t - notes[cur].note.onset_s + options_.crossing_s) / options_.crossing_s);
   }
-  const double tilt = TiltRad(prev_string) + (TiltRad(string) - TiltRad(prev_string)) * crossing_u;
+  const int string = rest.string;
+  const double tilt = prev_rest.tilt_rad + (rest.tilt_rad - prev_rest.tilt_rad) * crossing_u;
   out.string = idx >= 0 ? string : 0;
+  out.second_string = idx >= 0 ? rest.second_string : 0;
   const double lift = idx >= 0 ? 0.0 : options_.lift_mm;
 
   // Contact on the string (interpolated across strings while crossing).
   const double f = ContactFraction(cur);
-  const Eigen::Vector3d c0 =
-      tmpl_.strings_mm[static_cast<size_t>(prev_string - 1)].PointAtFraction(f);
-  const Eigen::Vector3d c1 = tmpl_.strings_mm[static_cast<size_t>(string - 1)].PointAtFraction(f);
+  const Eigen::Vector3d c0 = ContactOn(prev_rest, f);
+  const Eigen::Vector3d c1 = ContactOn(rest, f);
   if (idx >= 0) {
     const StringSegment& sounding = tmpl_.strings_mm[static_cast<size_t>(string - 1)];
     out.sounding_point_mm = f * (sounding.nut - sounding.bridge).norm();

@@ -165,6 +165,7 @@ StatusOr<SyntheticCapture> Generate(const Rig& rig, const SynthOptions& options)
     bow_truth.time_s = t;
     bow_truth.seen = true;
     bow_truth.string = bf.string;
+    bow_truth.second_string = bf.second_string;
     bow_truth.direction = static_cast<refine::BowDirection>(bf.direction);
     bow_truth.sounding_point_mm = bf.string > 0 ? bf.sounding_point_mm : NAN;
     bow_truth.bow_position = bf.bow_position;
