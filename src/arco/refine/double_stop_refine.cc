@@ -287,19 +287,28 @@ Status DoubleStopRefineOptions::Validate() const {
   return Status::Ok();
 }
 
-bool BowOnOneString(const InstrumentModel& model, int string, double inclination_deg) {
+BowRest BowRestOf(const InstrumentModel& model, double inclination_deg) {
+  BowRest rest;
   const int n = model.num_strings();
-  if (string < 1 || string > n || n < 2 || !std::isfinite(inclination_deg)) return false;
-  // The pair the second voice would need: `string` and the next higher one; on the highest
-  // string (no string above it) the top two.
-  const int upper = std::max(1, string - 1);
+  if (!std::isfinite(inclination_deg) || n < 1) return rest;
   const double incl = inclination_deg * kRadPerDeg;
-  const double mid = 0.5 * (model.BowInclinationRad(upper) + model.BowInclinationRad(upper + 1));
-  const double to_pair = std::abs(incl - mid);
-  for (int s = 1; s <= n; ++s) {
-    if (std::abs(incl - model.BowInclinationRad(s)) < to_pair) return true;
+  double best = std::numeric_limits<double>::infinity();
+  for (int s = 1; s <= n; ++s) {  // one string: its own inclination
+    const double d = std::abs(incl - model.BowInclinationRad(s));
+    if (d < best) {
+      best = d;
+      rest = {s, 0};
+    }
   }
-  return false;
+  for (int s = 2; s <= n; ++s) {  // two: the chord of the arch through both, the mean
+    const double d =
+        std::abs(incl - 0.5 * (model.BowInclinationRad(s) + model.BowInclinationRad(s - 1)));
+    if (d < best) {
+      best = d;
+      rest = {s, s - 1};
+    }
+  }
+  return rest;
 }
 
 DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
@@ -327,29 +336,45 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
   ik.seed_levels = 0;
   ik.restarts = 0;
   ik.max_iterations = options.max_iterations;
+  // Step 00: frames whose bow is on one string have no second voice (and give none to
+  // their note's other frames); frames whose bow is on the first voice's string and the
+  // next higher one together (on_pair) may get an octave (step 0c).
+  std::vector<bool> one_string(frames, false), on_pair(frames, false);
+  if (!bow_inclination_deg.empty()) {
+    for (size_t f = 0; f < frames; ++f) {
+      const BowRest rest = BowRestOf(model, bow_inclination_deg[f]);
+      const int string = first.contacts[f].string;
+      one_string[f] = options.bow_gate && rest.string > 0 && rest.second_string == 0;
+      on_pair[f] = string >= 2 && rest.string == string && rest.second_string == string - 1;
+    }
+  }
   // A note of the first voice whose frames mostly have an upper note keeps it on the rest
   // of its frames (the polyphonic tracker's window holds two notes only well inside a
   // double stop): its median upper f0, where that lies above the frame's own pitch.
-  // Step 00: frames whose bow is on one string have no second voice (and give none to
-  // their note's other frames).
-  std::vector<bool> one_string(frames, false);
-  if (options.bow_gate && !bow_inclination_deg.empty()) {
-    for (size_t f = 0; f < frames; ++f) {
-      one_string[f] = BowOnOneString(model, first.contacts[f].string, bow_inclination_deg[f]);
-    }
-  }
   std::map<int, std::vector<double>> note_upper;
-  std::map<int, int> note_frames;
+  std::map<int, int> note_frames, note_on_pair;
   for (size_t f = 0; f < frames; ++f) {
     const int note = first.contacts[f].note;
     if (note < 0) continue;
     ++note_frames[note];
+    note_on_pair[note] += on_pair[f];
     if (upper_f0_hz[f] > 0 && !one_string[f]) note_upper[note].push_back(upper_f0_hz[f]);
   }
   std::map<int, double> note_median;
   for (auto& [note, values] : note_upper) {
     if (2 * static_cast<int>(values.size()) < note_frames[note]) continue;
     note_median[note] = UpperMedian(values);
+  }
+  // Step 0c: a note bowed on two strings on most of its frames that the tracker heard as
+  // one note is an octave: the upper note's partials are all the lower's even ones, so
+  // the spectrum cannot show it (docs/accuracy.md, "Double stops"), but the bow does.
+  std::map<int, bool> bow_octave_note;
+  if (options.bow_octaves) {
+    for (const auto& [note, count] : note_on_pair) {
+      if (2 * count >= note_frames[note] && count > 0 && note_median.count(note) == 0) {
+        bow_octave_note[note] = true;
+      }
+    }
   }
   // Chords: the lower pair on the strings its upper pair leaves it.
   if (options.tie_chords) {
@@ -363,6 +388,10 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
     if (!(upper > 0) && options.fill_notes) {
       const auto it = note_median.find(c1.note);
       if (it != note_median.end() && it->second > 1.03 * c1.f0_hz) upper = it->second;
+    }
+    if (!(upper > 0) && on_pair[f] && bow_octave_note.count(c1.note) > 0 && c1.f0_hz > 0) {
+      upper = 2.0 * c1.f0_hz;
+      ++out.summary.bow_octaves;
     }
     const bool sounding =
         c1.state == ContactState::kPressed || c1.state == ContactState::kOpenString;

@@ -33,10 +33,11 @@
 //      No such pair: the first voice's finger and the nearest other fingertip. A second finger
 //      farther than max_tip_distance_mm from its contact: uncertain.
 //  00. The bow (bow_gate): a double stop is bowed on both its strings at once, so a frame whose
-//      bow is seen on the strings and lies nearer one string's inclination than the two
-//      strings' midpoint (refine/bowing.h: InstrumentModel::BowInclinationRad per string)
-//      has no second voice, whatever the tracker heard: on a real cello the 2nd partial and
-//      the previous note still ringing are heard as a second note on half the frames
+//      bow is seen on the strings and rests on one string (BowRestOf: its inclination
+//      nearer one string's than any two adjacent strings'; refine/bowing.h) has no second
+//      voice, whatever the tracker heard (whichever string the first voice was decoded on:
+//      a chord's lower pair may be on other strings until step 0b): on a real cello the 2nd partial
+//      and the previous note still ringing are heard as a second note on half the frames
 //      (docs/accuracy.md, "Double stops"). An unseen or lifted bow leaves the frame to the
 //      sound alone.
 //   0. A first-voice note (FrameContact::note) with an upper note on at least half its
@@ -48,6 +49,11 @@
 //      the two pairs share that note (one finger holds it on one string), or two below when
 //      the four notes differ: the string (open within open_tolerance_cents, else the
 //      fingertip nearest the new contact, by IK) where both of its notes are playable.
+//  0c. Octaves (bow_octaves), with step 0 in pass 1: a first-voice note heard as one note
+//      (no upper note on half its frames) whose bow rests on its string and the next higher one on
+//      at least half its frames gets the octave above the frame's pitch on those frames. An
+//      octave's upper partials are all the lower note's even partials, so the sound alone hears one
+//      note (docs/accuracy.md, "Double stops"); a bow on two strings says two sound.
 //   5. IK: that finger's tip to the contact by the hand layer's bounded IK (MCP, PIP, DIP
 //      within the joint limits, regularised toward the refined pose); a fifth's finger is
 //      left where the first voice put it (its pad covers both strings).
@@ -90,12 +96,16 @@ struct DoubleStopRefineOptions {
   double chord_lower_max_s = 0.5;
   // Step 00: no second voice where the bow is seen on one string.
   bool bow_gate = true;
+  // Step 0c: an octave above the first voice on the frames of a note heard as one note but
+  // bowed on two strings on at least half its frames.
+  bool bow_octaves = true;
   Status Validate() const;
 };
 
 struct DoubleStopRefineSummary {
   int frames = 0;                    // frames with an upper note and a first voice
   int bow_one_string = 0;            // frames whose upper note the bow ruled out (step 00)
+  int bow_octaves = 0;               // frames given an octave the bow plays (step 0c)
   int pressed = 0, open_string = 0;  // second voices assigned
   int one_finger_fifths = 0;         // pressed by the first voice's finger
   int first_fingers_changed = 0;     // first-voice frames given another finger (step 4)
@@ -122,9 +132,14 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
                                          const DoubleStopRefineOptions& options,
                                          const std::vector<double>& bow_inclination_deg = {});
 
-// Step 00's test: whether a bow inclined `inclination_deg` across the strings lies nearer
-// one string's inclination than the midpoint of `string` and `string - 1` (1 = highest; on
-// the highest string, of the top two). False for an unknown inclination.
-bool BowOnOneString(const InstrumentModel& model, int string, double inclination_deg);
+// Where a bow inclined `inclination_deg` across the strings rests (steps 00 and 0c): on the
+// string or the pair of adjacent strings whose inclination is nearest (a pair's is the mean
+// of its two strings', InstrumentModel::BowInclinationRad: the chord of the bridge's arch
+// through both). {0, 0} for an unknown inclination.
+struct BowRest {
+  int string = 0;         // 1 = highest; the lower of a pair
+  int second_string = 0;  // the pair's upper string (string - 1); 0 on one string
+};
+BowRest BowRestOf(const InstrumentModel& model, double inclination_deg);
 
 }  // namespace arco::refine

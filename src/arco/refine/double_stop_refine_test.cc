@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 #include "arco/refine/test_scene.h"
 #include "arco/refine/transcription.h"
@@ -170,14 +171,20 @@ TEST(RefineSecondVoice, ABowOnOneStringRulesOutTheSecondVoice) {
   const double a_deg = model.BowInclinationRad(2) * kDegPerRad;
   const double e_deg = model.BowInclinationRad(1) * kDegPerRad;
   const double both_deg = 0.5 * (a_deg + e_deg);
-  // The test itself: the midpoint plays both; each string's own inclination, or a bow a
+  // Where the bow rests: the midpoint plays both; each string's own inclination, or a bow a
   // third of the way from the A string's toward the midpoint, plays one.
-  EXPECT_FALSE(BowOnOneString(model, 2, both_deg));
-  EXPECT_FALSE(BowOnOneString(model, 2, both_deg + 0.2 * (e_deg - both_deg)));
-  EXPECT_TRUE(BowOnOneString(model, 2, a_deg));
-  EXPECT_TRUE(BowOnOneString(model, 2, a_deg + 0.33 * (both_deg - a_deg)));
-  EXPECT_TRUE(BowOnOneString(model, 1, e_deg));          // the top string: pair E + A
-  EXPECT_FALSE(BowOnOneString(model, 2, std::nan("")));  // no bow: the sound decides
+  const auto rest = [&](double deg) {
+    const BowRest r = BowRestOf(model, deg);
+    return std::make_pair(r.string, r.second_string);
+  };
+  EXPECT_EQ(rest(both_deg), std::make_pair(2, 1));
+  EXPECT_EQ(rest(both_deg + 0.2 * (e_deg - both_deg)), std::make_pair(2, 1));
+  EXPECT_EQ(rest(a_deg), std::make_pair(2, 0));
+  EXPECT_EQ(rest(a_deg + 0.33 * (both_deg - a_deg)), std::make_pair(2, 0));
+  EXPECT_EQ(rest(e_deg), std::make_pair(1, 0));
+  const double d_deg = model.BowInclinationRad(3) * kDegPerRad;
+  EXPECT_EQ(rest(0.5 * (a_deg + d_deg)), std::make_pair(3, 2));  // the D and A strings
+  EXPECT_EQ(rest(std::nan("")), std::make_pair(0, 0));           // no bow: the sound decides
   std::vector<double> upper(n, 0.0);
   for (size_t f = 5; f < 15; ++f) upper[f] = fx.UpperHz(4);
   std::vector<double> bow(n, std::nan(""));
@@ -210,6 +217,50 @@ TEST(RefineSecondVoice, ABowOnOneStringRulesOutTheSecondVoice) {
   // A bow track of another length is a caller's bug.
   EXPECT_THROW(RefineSecondVoice(fx.scene.input, fx.first, upper, per_frame, {1.0}),
                std::invalid_argument);
+}
+
+// Step 0c: an octave is heard as one note (its partials are the lower note's even ones);
+// a bow on both strings through most of the note says two sound. B4 on the A string, the
+// bow on the A and E strings on frames 0-14 of its 20, on the A string alone after.
+TEST(RefineSecondVoice, ANoteBowedOnTwoStringsGetsItsOctave) {
+  const Fixture fx;
+  const InstrumentModel& model = *fx.scene.model;
+  const size_t n = fx.scene.input.pitch.size();
+  constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
+  const double a_deg = model.BowInclinationRad(2) * kDegPerRad;
+  const double both_deg = 0.5 * (a_deg + model.BowInclinationRad(1) * kDegPerRad);
+  const std::vector<double> heard_one(n, 0.0);
+  std::vector<double> bow(n, a_deg);
+  for (size_t f = 0; f < 15; ++f) bow[f] = both_deg;
+  const DoubleStopRefineResult r = RefineSecondVoice(fx.scene.input, fx.first, heard_one, {}, bow);
+  int octaves = 0;
+  for (size_t f = 0; f < n; ++f) {
+    const FrameContact& c1 = fx.first.contacts[f];
+    const FrameContact& c2 = r.second[f];
+    if (f >= 15 || !c1.pressed()) {
+      EXPECT_EQ(c2.state, ContactState::kRest) << f;
+      continue;
+    }
+    ASSERT_TRUE(c2.pressed()) << f;
+    EXPECT_EQ(c2.string, 1);
+    EXPECT_DOUBLE_EQ(c2.f0_hz, 2 * c1.f0_hz);  // the octave of the frame's own pitch
+    ++octaves;
+  }
+  EXPECT_GE(octaves, 10);
+  EXPECT_EQ(r.summary.bow_octaves, octaves);
+  // Bowed on two strings on fewer than half its frames (a crossing): one note.
+  std::vector<double> crossing(n, a_deg);
+  for (size_t f = 0; f < 4; ++f) crossing[f] = both_deg;
+  const DoubleStopRefineResult one =
+      RefineSecondVoice(fx.scene.input, fx.first, heard_one, {}, crossing);
+  for (size_t f = 0; f < n; ++f) EXPECT_EQ(one.second[f].state, ContactState::kRest) << f;
+  // Turned off: the sound alone.
+  DoubleStopRefineOptions off;
+  off.bow_octaves = false;
+  const DoubleStopRefineResult none =
+      RefineSecondVoice(fx.scene.input, fx.first, heard_one, off, bow);
+  EXPECT_EQ(none.summary.bow_octaves, 0);
+  for (size_t f = 0; f < n; ++f) EXPECT_EQ(none.second[f].state, ContactState::kRest) << f;
 }
 
 TEST(RefineSecondVoice, NoHigherStringOrAnUnplayableSpanIsUncertain) {
