@@ -29,6 +29,12 @@ struct Fixture {
   double UpperHz(double semitones_on_e) const {
     return scene.model->open_hz(1) * std::exp2(semitones_on_e / 12.0);
   }
+  // A bow's inclination (degrees) resting on `string` alone, or on it and string - 1 (the
+  // chord of the bridge's arch through both: the mean of their inclinations).
+  double BowDeg(int string) const {
+    return scene.model->BowInclinationRad(string) * 180.0 / 3.14159265358979323846;
+  }
+  double BowOnPairDeg(int string) const { return 0.5 * (BowDeg(string) + BowDeg(string - 1)); }
 };
 
 TEST(RefineSecondVoice, SixthFifthAndOpenStringOnTheNextHigherString) {
@@ -167,10 +173,7 @@ TEST(RefineSecondVoice, ABowOnOneStringRulesOutTheSecondVoice) {
   const Fixture fx;
   const InstrumentModel& model = *fx.scene.model;
   const size_t n = fx.scene.input.pitch.size();
-  constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
-  const double a_deg = model.BowInclinationRad(2) * kDegPerRad;
-  const double e_deg = model.BowInclinationRad(1) * kDegPerRad;
-  const double both_deg = 0.5 * (a_deg + e_deg);
+  const double a_deg = fx.BowDeg(2), e_deg = fx.BowDeg(1), both_deg = fx.BowOnPairDeg(2);
   // Where the bow rests: the midpoint plays both; each string's own inclination, or a bow a
   // third of the way from the A string's toward the midpoint, plays one.
   const auto rest = [&](double deg) {
@@ -182,9 +185,8 @@ TEST(RefineSecondVoice, ABowOnOneStringRulesOutTheSecondVoice) {
   EXPECT_EQ(rest(a_deg), std::make_pair(2, 0));
   EXPECT_EQ(rest(a_deg + 0.33 * (both_deg - a_deg)), std::make_pair(2, 0));
   EXPECT_EQ(rest(e_deg), std::make_pair(1, 0));
-  const double d_deg = model.BowInclinationRad(3) * kDegPerRad;
-  EXPECT_EQ(rest(0.5 * (a_deg + d_deg)), std::make_pair(3, 2));  // the D and A strings
-  EXPECT_EQ(rest(std::nan("")), std::make_pair(0, 0));           // no bow: the sound decides
+  EXPECT_EQ(rest(fx.BowOnPairDeg(3)), std::make_pair(3, 2));  // the D and A strings
+  EXPECT_EQ(rest(std::nan("")), std::make_pair(0, 0));        // no bow: the sound decides
   std::vector<double> upper(n, 0.0);
   for (size_t f = 5; f < 15; ++f) upper[f] = fx.UpperHz(4);
   std::vector<double> bow(n, std::nan(""));
@@ -224,11 +226,8 @@ TEST(RefineSecondVoice, ABowOnOneStringRulesOutTheSecondVoice) {
 // bow on the A and E strings on frames 0-14 of its 20, on the A string alone after.
 TEST(RefineSecondVoice, ANoteBowedOnTwoStringsGetsItsOctave) {
   const Fixture fx;
-  const InstrumentModel& model = *fx.scene.model;
   const size_t n = fx.scene.input.pitch.size();
-  constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
-  const double a_deg = model.BowInclinationRad(2) * kDegPerRad;
-  const double both_deg = 0.5 * (a_deg + model.BowInclinationRad(1) * kDegPerRad);
+  const double a_deg = fx.BowDeg(2), both_deg = fx.BowOnPairDeg(2);
   const std::vector<double> heard_one(n, 0.0);
   std::vector<double> bow(n, a_deg);
   for (size_t f = 0; f < 15; ++f) bow[f] = both_deg;
