@@ -389,10 +389,9 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
       const auto it = note_median.find(c1.note);
       if (it != note_median.end() && it->second > 1.03 * c1.f0_hz) upper = it->second;
     }
-    if (!(upper > 0) && on_pair[f] && bow_octave_note.count(c1.note) > 0 && c1.f0_hz > 0) {
-      upper = 2.0 * c1.f0_hz;
-      ++out.summary.bow_octaves;
-    }
+    const bool octave =
+        !(upper > 0) && on_pair[f] && bow_octave_note.count(c1.note) > 0 && c1.f0_hz > 0;
+    if (octave) upper = 2.0 * c1.f0_hz;
     const bool sounding =
         c1.state == ContactState::kPressed || c1.state == ContactState::kOpenString;
     if (!(upper > 0) || !sounding || c1.string < 1) continue;
@@ -401,6 +400,7 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
       continue;
     }
     ++out.summary.frames;
+    out.summary.bow_octaves += octave;
     FrameContact& c2 = out.second[f];
     c2.f0_hz = upper;
     c2.confidence = c1.confidence;
