@@ -143,24 +143,31 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
     const int neighbour =
         incl > own ? string - 1 : string + 1;  // higher inclination: higher string
     int second = 0;
+    // The neighbour's share of the contact: 1/2 (midway between the two strings) within
+    // the margin of the midpoint, none beyond twice the margin, linear between. A contact
+    // that switched from the nearer string to the midpoint at the margin would jump by half
+    // the strings' spacing along the bow whenever a noisy inclination crossed it (a double
+    // stop's, a crossing's), and the jump would read as speed.
+    double share = 0;
+    const double margin = options.double_stop_margin_deg * kDeg;
     if (neighbour >= 1 && neighbour <= num_strings) {
       const double mid = 0.5 * (own + inclination_rad[static_cast<size_t>(neighbour - 1)]);
-      if (std::abs(incl - mid) <= options.double_stop_margin_deg * kDeg) second = neighbour;
+      const double off = std::abs(incl - mid);
+      if (off <= margin) second = neighbour;
+      share = margin > 0 ? 0.5 * std::clamp((2 * margin - off) / margin, 0.0, 1.0)
+                         : (second > 0 ? 0.5 : 0.0);
     }
     const StringSegment& seg = strings[static_cast<size_t>(best)];
     double a = 0, b = 0, distance = 0;
     LineToSegment(frog, u, seg.bridge, seg.nut, &a, &b, &distance);
     double sounding_mm = b * (seg.nut - seg.bridge).norm();
-    if (second > 0) {
-      // A double stop's bow touches both strings: its contact is between them. Measured on
-      // the nearer string alone, the place on the bow would jump by the strings' spacing
-      // whenever the nearer one changes (a bow at the midpoint), read as speed.
-      const StringSegment& other = strings[static_cast<size_t>(second - 1)];
+    if (share > 0) {
+      const StringSegment& other = strings[static_cast<size_t>(neighbour - 1)];
       double a2 = 0, b2 = 0, distance2 = 0;
       LineToSegment(frog, u, other.bridge, other.nut, &a2, &b2, &distance2);
-      a = 0.5 * (a + a2);
-      sounding_mm = 0.5 * (sounding_mm + b2 * (other.nut - other.bridge).norm());
-      distance = std::min(distance, distance2);
+      a += share * (a2 - a);
+      sounding_mm += share * (b2 * (other.nut - other.bridge).norm() - sounding_mm);
+      if (second > 0) distance = std::min(distance, distance2);  // it touches both
     }
     bf.lift_mm = distance;
     bf.bow_position = a / length;
