@@ -6,6 +6,8 @@
 #include <cmath>
 #include <ctime>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "arco/audio/sample_stream.h"
 #include "arco/registry/instruments.h"
@@ -35,6 +37,17 @@ constexpr double kPartialFifthRatio = 0.1;
 // Auto window: periods of the lowest f0, so that the partials of a third on the lowest
 // strings (4 Hz apart at the double bass's 40 Hz) are at least a Hann main lobe apart.
 constexpr double kAutoWindowPeriods = 8.0;
+
+// PairOnStrings: the candidates of the string taken first that are tried (the loudest
+// few: a pair's partials and ghosts rank among them, its notes too).
+constexpr int kPairFirstCandidates = 3;
+// PairOnStrings: the highest stop of either note (semitones above its open string), just
+// below the octave. Without a bound every pair of strings holds every high pair, a note
+// and its 2nd partial among them; at the octave itself an open string's 2nd and 3rd
+// partials are a pair on its string and the next (the cello's open C2 + C3 heard as C3 +
+// G3 at 12 semitones on the C and G strings). A double stop higher up the bowed strings
+// is taken for a pair below the bound: a limit of this reading (docs/audio.md).
+constexpr double kPairMaxStopSemitones = 11.5;
 
 double Weight(double f_hz, int m) { return (f_hz + kAlphaHz) / (m * f_hz + kBetaHz); }
 
@@ -335,8 +348,11 @@ int DoubleStopAnalyzer::PartialFifth(int low, int high) const {
   return heard > 0 && unique >= kPartialFifthRatio * heard ? below : -1;
 }
 
-int DoubleStopAnalyzer::Analyze(const float* x, std::array<PolyNote, 2>* notes) {
+int DoubleStopAnalyzer::Analyze(const float* x,
+                                std::array<PolyNote, 2>* notes,
+                                std::array<std::array<PolyNote, 2>, kStringPairs>* on_strings) {
   *notes = {};
+  if (on_strings != nullptr) *on_strings = {};
   double mean = 0;
   for (int j = 0; j < window_; ++j) mean += x[j];
   mean /= window_;
@@ -352,6 +368,24 @@ int DoubleStopAnalyzer::Analyze(const float* x, std::array<PolyNote, 2>* notes) 
   const auto* spectrum = static_cast<const fftw_complex*>(spectrum_);
   for (int k = 0; k <= fft_size_ / 2; ++k)
     magnitude_[k] = std::hypot(spectrum[k][0], spectrum[k][1]);
+  const int count = FreePair(notes);
+  if (on_strings != nullptr && has_strings_) {
+    // on_strings[s - 1] holds strings s + 1 and s (1 = highest): the pair whose lower
+    // string is open_midi_[q] (low to high) is s = kStringPairs - q.
+    // The free pair where it can be played on those strings (its checks are the finer:
+    // the search on every frame lost the cello's and the double bass's double stops,
+    // 0.942 -> 0.790 and 0.870 -> 0.583 of their frames' strings); the search on the
+    // strings where it cannot.
+    for (int q = 0; q < kStringPairs; ++q) {
+      (*on_strings)[kStringPairs - 1 - q] =
+          count == 2 && OnStrings(*notes, q) ? *notes : PairOnStrings(q);
+    }
+  }
+  return count;
+}
+
+// The free analysis of Analyze (the header's steps (1)-(5)) on magnitude_.
+int DoubleStopAnalyzer::FreePair(std::array<PolyNote, 2>* notes) {
   const Best first = Search(magnitude_, -1);
   if (first.index < 0) return 0;
   PolyNote one{Refine(first.index, magnitude_), first.salience};
@@ -389,6 +423,127 @@ int DoubleStopAnalyzer::Analyze(const float* x, std::array<PolyNote, 2>* notes) 
   (*notes)[0] = one;
   (*notes)[1] = two;
   return 2;
+}
+
+// What Cancel(c) would take from `spectrum`, unweighted: per partial m, its main lobe's
+// magnitudes times the share min(A_m, sqrt(A_{m-1} A_{m+1})) / A_m that is this note's.
+// Unlike the salience (eq. 3 weighs a high note's partials more), it compares pairs of
+// different notes on one scale: the spectrum each pair accounts for.
+double DoubleStopAnalyzer::Explained(int c, const std::vector<double>& spectrum) const {
+  const int harmonics = options_.harmonics;
+  std::array<double, 64> amplitude{};
+  std::array<int, 64> at{};
+  int count = 0;
+  for (int m = 1; m <= harmonics && m + 1 < static_cast<int>(amplitude.size()); ++m) {
+    const double a = BandMax(c, m, spectrum, &at[m]);
+    if (a < 0) break;
+    amplitude[m] = a;
+    count = m;
+  }
+  double explained = 0;
+  for (int m = 1; m <= count; ++m) {
+    if (!(amplitude[m] > 0)) continue;
+    double own = amplitude[m];
+    if (m > 1) {
+      const double next = m < count ? amplitude[m + 1] : amplitude[m - 1];
+      own = std::min(own, std::sqrt(amplitude[m - 1] * next));
+    }
+    const int lo = std::max(0, at[m] - lobe_bins_), hi = std::min(fft_size_ / 2, at[m] + lobe_bins_);
+    double lobe = 0;
+    for (int k = lo; k <= hi; ++k) lobe += spectrum[k];
+    explained += own / amplitude[m] * lobe;
+  }
+  return explained;
+}
+
+// True when the lower note of `pair` can be stopped on the string open_midi_[q] and the
+// upper on open_midi_[q + 1] (PairOnStrings' bounds: from the nut to
+// kPairMaxStopSemitones, the two stops within max_span_semitones).
+bool DoubleStopAnalyzer::OnStrings(const std::array<PolyNote, 2>& pair, int q) const {
+  const double low = 69.0 + 12.0 * std::log2(pair[0].f0_hz / options_.a4_hz) - open_midi_[q];
+  const double high = 69.0 + 12.0 * std::log2(pair[1].f0_hz / options_.a4_hz) - open_midi_[q + 1];
+  return low >= -0.5 && low <= kPairMaxStopSemitones && high >= -0.5 &&
+         high <= kPairMaxStopSemitones && std::abs(high - low) <= options_.max_span_semitones;
+}
+
+// The pair with one note on each of two adjacent strings (open_midi_[q] below,
+// open_midi_[q + 1] above) that explains most of the spectrum: for each string taken
+// first, its kPairFirstCandidates most salient candidates (at least kMinIntervalSemitones
+// apart, their fundamentals present), each cancelled from the spectrum and joined by the
+// candidate of the other string that explains most of the residual and makes a playable
+// pair with it (its fundamental present on the residual, but for an octave above, whose
+// fundamental is the lower note's 2nd partial); the pair that explains most in all
+// (Explained, unweighted: with the salience's weights the cello's C3 + G3 on its C and G
+// strings outscored the open C2 + C3 whose partials they are). Greedy free analysis
+// (FreePair) takes the loudest candidate anywhere first, so a partial of the pair or a
+// ghost an octave away is often its first note; here every note is where the strings put
+// it (the double bass's D2 + B2 freely heard as B1 + D2, the viola's E3 + E4 as E4 + B4).
+// Stops from the nut up to kPairMaxStopSemitones.
+std::array<PolyNote, 2> DoubleStopAnalyzer::PairOnStrings(int q) {
+  const std::array<double, 2> open = {open_midi_[q], open_midi_[q + 1]};
+  const double peak = *std::max_element(magnitude_.begin(), magnitude_.end());
+  const double min_fundamental = options_.min_fundamental_ratio * peak;
+  const int n = static_cast<int>(candidates_hz_.size());
+  double best_score = 0;
+  int best_first = -1, best_second = -1;
+  for (int first_string = 0; first_string < 2; ++first_string) {
+    const double open_first = open[first_string], open_second = open[1 - first_string];
+    // The first string's most salient candidates, one per semitone's neighbourhood.
+    std::vector<std::pair<double, int>> ranked;
+    for (int c = 0; c < n; ++c) {
+      const double stop = candidates_midi_[c] - open_first;
+      if (stop < -0.5 || stop > kPairMaxStopSemitones) continue;
+      if (Fundamental(c, magnitude_) < min_fundamental) continue;
+      ranked.push_back({Salience(c, magnitude_), c});
+    }
+    std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
+      return a.first > b.first || (a.first == b.first && a.second < b.second);
+    });
+    std::vector<int> firsts;
+    for (const auto& [salience, c] : ranked) {
+      if (static_cast<int>(firsts.size()) == kPairFirstCandidates) break;
+      bool near = false;
+      for (const int f : firsts) {
+        near |= std::abs(candidates_midi_[f] - candidates_midi_[c]) < kMinIntervalSemitones;
+      }
+      if (!near) firsts.push_back(c);
+    }
+    for (const int c1 : firsts) {
+      residual_ = magnitude_;
+      const double own = Explained(c1, magnitude_);
+      Cancel(c1);
+      const double stop_first = candidates_midi_[c1] - open_first;
+      double best_s2 = 0;
+      int c2_best = -1;
+      for (int c2 = 0; c2 < n; ++c2) {
+        const double m2 = candidates_midi_[c2];
+        if (m2 < open_second - 0.5 || m2 - open_second > kPairMaxStopSemitones) continue;
+        if (std::abs(m2 - candidates_midi_[c1]) < kMinIntervalSemitones) continue;
+        // The lower string's note must be the lower note.
+        if ((first_string == 0) != (candidates_midi_[c1] < m2)) continue;
+        if (std::abs((m2 - open_second) - stop_first) > options_.max_span_semitones) continue;
+        const bool octave_above = first_string == 0 &&
+                                  std::abs(m2 - candidates_midi_[c1] - 12.0) < kPartialCents / 100.0;
+        if (!octave_above && Fundamental(c2, residual_) < min_fundamental) continue;
+        const double s2 = Explained(c2, residual_);
+        if (s2 > best_s2) {
+          best_s2 = s2;
+          c2_best = c2;
+        }
+      }
+      if (c2_best < 0 || own + best_s2 <= best_score) continue;
+      best_score = own + best_s2;
+      best_first = c1;
+      best_second = c2_best;
+    }
+  }
+  if (best_first < 0) return {};
+  residual_ = magnitude_;
+  Cancel(best_first);
+  PolyNote one{Refine(best_first, magnitude_), Salience(best_first, magnitude_)};
+  PolyNote two{Refine(best_second, residual_), Salience(best_second, residual_)};
+  if (two.f0_hz < one.f0_hz) std::swap(one, two);
+  return {one, two};
 }
 
 namespace {
@@ -525,7 +680,7 @@ StatusOr<std::vector<PolyPitchFrame>> TrackDoubleStops(std::unique_ptr<AudioRead
     PolyPitchFrame f;
     f.frame = i;
     f.time_s = time_s;
-    f.count = analyzer.Analyze(buffer.data(), &f.notes);
+    f.count = analyzer.Analyze(buffer.data(), &f.notes, &f.on_strings);
     frames.push_back(f);
   }
   ConsistentDoubleStops(static_cast<int>(std::llround(options.consistency_s * options.fps)),

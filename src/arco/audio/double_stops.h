@@ -83,11 +83,20 @@ struct PolyNote {
   double salience = 0;  // s(f) of eq. 3 (on the residual for the second note)
 };
 
+// Pairs of adjacent strings of a four-string instrument (PolyPitchFrame::on_strings).
+inline constexpr int kStringPairs = 3;
+
 struct PolyPitchFrame {
   int64_t frame = 0;
   double time_s = 0;
   int count = 0;                  // notes found: 0, 1 or 2
   std::array<PolyNote, 2> notes;  // the first `count`, lower f0 first
+  // The pair heard as played on strings s + 1 and s (1 = highest), lower f0 first, at
+  // on_strings[s - 1] (DoubleStopAnalyzer::Analyze: `notes` when they can be played there,
+  // else the best joint explanation with one note on each string); f0 0 where none is
+  // playable or the window is silent. The bow
+  // says which strings sound (refine/double_stop_refine.h, bow_pairs).
+  std::array<std::array<PolyNote, 2>, kStringPairs> on_strings{};
 };
 
 struct DoubleStopSummary {
@@ -124,8 +133,12 @@ class DoubleStopAnalyzer {
   DoubleStopAnalyzer& operator=(const DoubleStopAnalyzer&) = delete;
 
   int window_length() const { return window_; }
-  // Notes of x[0..window_length()), lower f0 first; returns their count.
-  int Analyze(const float* x, std::array<PolyNote, 2>* notes);
+  // Notes of x[0..window_length()), lower f0 first; returns their count. With on_strings,
+  // also the pair on each pair of adjacent strings (PairOnStrings; zero without the
+  // instrument's strings or in silence).
+  int Analyze(const float* x,
+              std::array<PolyNote, 2>* notes,
+              std::array<std::array<PolyNote, 2>, kStringPairs>* on_strings = nullptr);
 
  private:
   struct Best {
@@ -142,6 +155,10 @@ class DoubleStopAnalyzer {
   double Cancel(int candidate);
   int LostFundamental(int note, int partner);
   int PartialFifth(int low, int high) const;
+  int FreePair(std::array<PolyNote, 2>* notes);
+  std::array<PolyNote, 2> PairOnStrings(int lower_string_low_to_high);
+  bool OnStrings(const std::array<PolyNote, 2>& pair, int lower_string_low_to_high) const;
+  double Explained(int candidate, const std::vector<double>& spectrum) const;
 
   DoubleStopOptions options_;
   int window_ = 0, fft_size_ = 0, lobe_bins_ = 0;

@@ -4,8 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 
 #include "arco/audio/double_stop_music.h"
 #include "arco/audio/double_stops_csv.h"
@@ -132,6 +134,50 @@ TEST(DoubleStopAnalyzer, FindsALowerNoteWhoseFundamentalIsWeak) {
   ASSERT_EQ(analyzer.Analyze(x.data(), &notes), 2);
   EXPECT_LT(std::abs(Cents(notes[0].f0_hz, hi)), 10) << notes[0].f0_hz;
   EXPECT_LT(std::abs(Cents(notes[1].f0_hz, 2 * lo)), 10) << notes[1].f0_hz;
+}
+
+// The pair heard on the strings a bow rests on (PolyPitchFrame::on_strings): the cello's
+// open C2 with C3 on the G string, an octave whose upper partials are all the lower note's
+// even ones. The free analysis may hear one note; on the C and G strings the pair is the
+// octave, and every pair of strings holds only notes its strings can stop (at or above
+// their open pitch, below the octave position).
+TEST(DoubleStopAnalyzer, HearsThePairOnTheStringsAskedFor) {
+  const auto o = Options("cello");
+  DoubleStopAnalyzer analyzer(o);
+  const int rate = o.range.analysis_rate_hz, n = analyzer.window_length();
+  const std::array<double, 4> open_midi = {36, 43, 50, 57};  // C2 G2 D3 A3
+  const auto midi = [](double hz) { return 69.0 + 12.0 * std::log2(hz / 440.0); };
+  for (auto [lo, hi, upper_string] : std::vector<std::tuple<double, double, int>>{
+           {65.41, 130.81, 3},     // open C2 + C3: an octave on the C and G strings
+           {98.0, 164.81, 2},      // open G2 + E3: a sixth on the G and D strings
+           {146.83, 220.0, 1}}) {  // D3 + A3 open: a fifth on the D and A strings
+    std::array<PolyNote, 2> notes;
+    std::array<std::array<PolyNote, 2>, kStringPairs> on;
+    analyzer.Analyze(Chord({lo, hi}, rate, n).data(), &notes, &on);
+    const auto& pair = on[static_cast<size_t>(upper_string - 1)];
+    EXPECT_LT(std::abs(Cents(pair[0].f0_hz, lo)), 10) << lo << " " << pair[0].f0_hz;
+    EXPECT_LT(std::abs(Cents(pair[1].f0_hz, hi)), 10) << hi << " " << pair[1].f0_hz;
+    for (int s = 1; s <= kStringPairs; ++s) {
+      const auto& p = on[static_cast<size_t>(s - 1)];
+      if (p[0].f0_hz == 0) {
+        EXPECT_EQ(p[1].f0_hz, 0) << s;
+        continue;
+      }
+      // Strings s + 1 (below) and s: open_midi low to high at 4 - (s + 1) and 4 - s.
+      const double low_stop = midi(p[0].f0_hz) - open_midi[static_cast<size_t>(3 - s)];
+      const double high_stop = midi(p[1].f0_hz) - open_midi[static_cast<size_t>(4 - s)];
+      EXPECT_GE(low_stop, -0.5) << s;
+      EXPECT_LE(low_stop, 12.0) << s;
+      EXPECT_GE(high_stop, -0.5) << s;
+      EXPECT_LE(high_stop, 12.0) << s;
+    }
+  }
+  // Silence: no pair anywhere.
+  std::array<PolyNote, 2> notes;
+  std::array<std::array<PolyNote, 2>, kStringPairs> on;
+  on[0][0].f0_hz = 1;
+  EXPECT_EQ(analyzer.Analyze(Chord({}, rate, n).data(), &notes, &on), 0);
+  for (const auto& p : on) EXPECT_EQ(p[0].f0_hz, 0);
 }
 
 PolyPitchFrame Pair(double low_hz, double high_hz) {
@@ -285,6 +331,8 @@ TEST(DoubleStopsCsv, RoundTripsTheFramesTheRefinementUsesAndRejectsBadRows) {
   for (int i = 0; i < 3; ++i) frames[i].frame = i, frames[i].time_s = 0.5 + i / 30.0;
   frames[1].count = 1, frames[1].notes[0] = {220.01234, 3.0};
   frames[2].count = 2, frames[2].notes = {PolyNote{246.94165, 2.0}, PolyNote{415.30469, 1.0}};
+  frames[2].on_strings[1] = {PolyNote{246.94165, 2.0}, PolyNote{415.30469, 1.0}};
+  frames[1].on_strings[2] = {PolyNote{110.00004, 1.0}, PolyNote{220.01234, 1.0}};
   const std::string text = FormatDoubleStopsCsv(frames);
   EXPECT_EQ(text.substr(0, text.find('\n')), kDoubleStopsCsvHeader);
   auto read = ParseDoubleStopsCsv(text, "double_stops.csv");
@@ -297,7 +345,16 @@ TEST(DoubleStopsCsv, RoundTripsTheFramesTheRefinementUsesAndRejectsBadRows) {
   EXPECT_EQ((*read)[2].notes[0].f0_hz, 246.9417);
   EXPECT_EQ((*read)[2].notes[1].f0_hz, 415.3047);
   EXPECT_NEAR((*read)[2].time_s, 0.5 + 2 / 30.0, 1e-6);
+  EXPECT_EQ((*read)[2].on_strings[1][1].f0_hz, 415.3047);
+  EXPECT_EQ((*read)[1].on_strings[2][0].f0_hz, 110.0);
+  EXPECT_EQ((*read)[0].on_strings[0][0].f0_hz, 0.0);
   EXPECT_EQ(FormatDoubleStopsCsv(*read), text);  // what is read writes the same text
+  // A file from before the on_ columns reads with those pairs 0.
+  const auto old = ParseDoubleStopsCsv(
+      "frame,time_s,notes,f0_low_hz,f0_high_hz\n0,0.5,2,246.9417,415.3047\n", "old.csv");
+  ASSERT_TRUE(old.ok()) << old.status().message();
+  EXPECT_EQ((*old)[0].notes[1].f0_hz, 415.3047);
+  for (const auto& p : (*old)[0].on_strings) EXPECT_EQ(p[1].f0_hz, 0.0);
   // Bad rows name the file and say what is wrong.
   const auto error = [&](const std::string& from, const std::string& to) {
     std::string bad = text;
@@ -310,6 +367,7 @@ TEST(DoubleStopsCsv, RoundTripsTheFramesTheRefinementUsesAndRejectsBadRows) {
   EXPECT_NE(error("\n2,", "\n7,").find("out of order"), std::string::npos);
   EXPECT_NE(error(",1,220.0123", ",3,220.0123").find("notes must be 0, 1 or 2"), std::string::npos);
   EXPECT_NE(error("220.0123", "nan").find("double_stops.csv"), std::string::npos);
+  EXPECT_NE(error("110.0000", "330.0000").find("on_3_low_hz"), std::string::npos);
   EXPECT_FALSE(ParseDoubleStopsCsv("frame,time_s,notes\n0,0,0\n", "x.csv").ok());
 }
 

@@ -131,7 +131,9 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
                            std::to_string(double_stops.size()) + " rows for " +
                            std::to_string(inputs.input.pitch.size()) + " frames");
     }
-    if (!double_stops.empty()) AddDoubleStops(double_stops, &inputs);
+    if (!double_stops.empty()) {
+      AddDoubleStops(double_stops, &inputs, refine::DoubleStopRefineOptions().bow_pairs);
+    }
   }
   return inputs;
 }
@@ -253,13 +255,46 @@ StatusOr<RefineInputs> MakeRefineInputs(const std::string& result_dir,
   return out;
 }
 
-void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly, RefineInputs* inputs) {
+void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
+                    RefineInputs* inputs,
+                    bool bow_pairs) {
   std::vector<refine::FramePitch>& pitch = inputs->input.pitch;
   if (poly.size() > pitch.size()) {
     throw std::invalid_argument("AddDoubleStops: more polyphonic frames than video frames");
   }
   inputs->upper_f0_hz.assign(pitch.size(), 0.0);
+  inputs->bow_pair_frames = 0;
+  // Where the bow rests per frame; none when the layout has no bow or its frames differ.
+  std::vector<refine::BowRest> rest;
+  if (bow_pairs && inputs->instrument != nullptr) {
+    const StatusOr<refine::BowingResult> bow =
+        AnalyzeBow(*inputs, refine::RefineResult(), refine::BowingOptions());
+    if (bow.ok() && bow->frames.size() == pitch.size()) {
+      for (const refine::BowingFrame& bf : bow->frames) {
+        rest.push_back(bf.string > 0 ? refine::BowRestOf(*inputs->instrument, bf.inclination_deg)
+                                     : refine::BowRest());
+      }
+    }
+  }
   for (size_t f = 0; f < poly.size(); ++f) {
+    const refine::BowRest r = f < rest.size() ? rest[f] : refine::BowRest();
+    // BowRest: `string` the lower string of the pair, second_string = string - 1 the upper;
+    // on_strings[s - 1] holds strings s + 1 and s.
+    if (r.second_string >= 1 && r.second_string <= audio::kStringPairs) {
+      const std::array<audio::PolyNote, 2>& on = poly[f].on_strings[r.second_string - 1];
+      // An octave where the free analysis heard one note is left to the note's own rule
+      // (bow_octaves, double_stop_refine.h step 0c): a single note's 2nd partial is that
+      // octave, and a bow crossing between two strings rests on both for a few frames.
+      const bool lone_octave =
+          poly[f].count != 2 && on[0].f0_hz > 0 &&
+          std::abs(12.0 * std::log2(on[1].f0_hz / on[0].f0_hz) - 12.0) < 0.5;
+      if (on[0].f0_hz > 0 && on[1].f0_hz > 0 && !lone_octave) {
+        pitch[f] = {on[0].f0_hz, 1.0};
+        inputs->upper_f0_hz[f] = on[1].f0_hz;
+        ++inputs->bow_pair_frames;
+        continue;
+      }
+    }
     if (poly[f].count != 2) continue;
     pitch[f] = {poly[f].notes[0].f0_hz, 1.0};
     inputs->upper_f0_hz[f] = poly[f].notes[1].f0_hz;
@@ -318,6 +353,7 @@ StatusOr<MethodRecord> RefineMethod(const RefineInputs& inputs,
     }
     second = std::move(ds.second);
     double_stop_summary = ds.summary;
+    double_stop_summary.bow_pairs = inputs.bow_pair_frames;
   }
   MethodRecord out;
   out.method = refine::RefineModeName(options.mode);

@@ -35,14 +35,25 @@ struct RefineInputs {
   // per frame (0 = none), input.pitch then holding the lower one on those frames (see
   // AddDoubleStops). Empty: off, and arco writes no contacts_2.csv.
   std::vector<double> upper_f0_hz;
+  // Frames whose two notes AddDoubleStops took from the pair heard on the strings the bow
+  // rests on (DoubleStopRefineSummary::bow_pairs).
+  int bow_pair_frames = 0;
 };
 
 // Puts a polyphonic tracker's two notes (audio/double_stops.h, one frame per video frame;
 // the pitch stage's double_stops.csv, read back by LoadRefineInputs) into the inputs: on
 // each frame with two notes, the lower becomes the frame's pitch (confidence 1: both notes
-// were found) and the upper goes to upper_f0_hz. Throws std::invalid_argument when the
-// frame counts differ.
-void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly, RefineInputs* inputs);
+// were found) and the upper goes to upper_f0_hz. With bow_pairs, a frame whose bow (the
+// triangulated frog and tip against the strings, refine/bowing.h with its default options)
+// rests on two adjacent strings s and s + 1 (refine::BowRestOf) takes the pair the tracker
+// heard as played on those strings (PolyPitchFrame::on_strings), where it heard one,
+// whatever the free analysis found: the bow says which strings sound, the free analysis
+// often hears a pair's partial or a ghost an octave away as one of its notes
+// (docs/accuracy.md, "Double stops"). Throws std::invalid_argument when the frame counts
+// differ.
+void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
+                    RefineInputs* inputs,
+                    bool bow_pairs = true);
 // Errors name the file: no hand or instrument stage, shapes that disagree, a
 // double_stops.csv with more rows than frames. With double_stops.csv, AddDoubleStops.
 StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir);

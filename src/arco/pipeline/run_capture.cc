@@ -361,7 +361,9 @@ StatusOr<std::vector<MethodRecord>> RunRefineMethods(
         audio::ParseDoubleStopsCsv(audio::FormatDoubleStopsCsv(pitch.double_stops), pitch_path));
   }
   ARCO_ASSIGN_OR_RETURN(RefineInputs inputs, MakeRefineInputs(options.result_dir, stages));
-  if (!double_stops_as_written.empty()) AddDoubleStops(double_stops_as_written, &inputs);
+  if (!double_stops_as_written.empty()) {
+    AddDoubleStops(double_stops_as_written, &inputs, refine::DoubleStopRefineOptions().bow_pairs);
+  }
   std::vector<refine::RefineMode> modes = {refine::RefineMode::kVision};
   if (inputs.has_pitch) {
     modes.push_back(refine::RefineMode::kPaper);

@@ -99,6 +99,9 @@ struct DoubleStopRefineOptions {
   // Step 0c: an octave above the first voice on the frames of a note heard as one note but
   // bowed on two strings on at least half its frames.
   bool bow_octaves = true;
+  // Before the refinement (pipeline/refine_stage.h, AddDoubleStops): a frame whose bow rests
+  // on two strings takes the pair the tracker heard as played on them.
+  bool bow_pairs = true;
   Status Validate() const;
 };
 
@@ -106,6 +109,9 @@ struct DoubleStopRefineSummary {
   int frames = 0;                    // frames with an upper note and a first voice
   int bow_one_string = 0;            // frames whose upper note the bow ruled out (step 00)
   int bow_octaves = 0;               // frames given an octave the bow plays (step 0c)
+  // Frames whose two notes are the pair heard on the strings the bow rests on (set by the
+  // pipeline, pipeline/refine_stage.h AddDoubleStops, before the refinement).
+  int bow_pairs = 0;
   int pressed = 0, open_string = 0;  // second voices assigned
   int one_finger_fifths = 0;         // pressed by the first voice's finger
   int first_fingers_changed = 0;     // first-voice frames given another finger (step 4)
