@@ -41,6 +41,8 @@ constexpr double kAutoWindowPeriods = 8.0;
 // PairOnStrings: the candidates of the string taken first that are tried (the loudest
 // few: a pair's partials and ghosts rank among them, its notes too).
 constexpr int kPairFirstCandidates = 3;
+// PairOnStrings: the share of the free analysis's bar a fundamental must reach.
+constexpr double kPairFundamentalShare = 0.5;
 // PairOnStrings: the highest stop of either note (semitones above its open string), just
 // below the octave. Without a bound every pair of strings holds every high pair, a note
 // and its 2nd partial among them; at the octave itself an open string's 2nd and 3rd
@@ -378,7 +380,7 @@ int DoubleStopAnalyzer::Analyze(const float* x,
     // strings where it cannot.
     for (int q = 0; q < kStringPairs; ++q) {
       (*on_strings)[kStringPairs - 1 - q] =
-          count == 2 && OnStrings(*notes, q) ? *notes : PairOnStrings(q);
+          count == 2 && FitsStrings(*notes, kStringPairs - q) ? *notes : PairOnStrings(q);
     }
   }
   return count;
@@ -456,10 +458,10 @@ double DoubleStopAnalyzer::Explained(int c, const std::vector<double>& spectrum)
   return explained;
 }
 
-// True when the lower note of `pair` can be stopped on the string open_midi_[q] and the
-// upper on open_midi_[q + 1] (PairOnStrings' bounds: from the nut to
-// kPairMaxStopSemitones, the two stops within max_span_semitones).
-bool DoubleStopAnalyzer::OnStrings(const std::array<PolyNote, 2>& pair, int q) const {
+bool DoubleStopAnalyzer::FitsStrings(const std::array<PolyNote, 2>& pair, int upper_string) const {
+  if (!has_strings_ || upper_string < 1 || upper_string > kStringPairs) return false;
+  if (!(pair[0].f0_hz > 0 && pair[1].f0_hz > 0)) return false;
+  const int q = kStringPairs - upper_string;  // the lower string, low to high
   const double low = 69.0 + 12.0 * std::log2(pair[0].f0_hz / options_.a4_hz) - open_midi_[q];
   const double high = 69.0 + 12.0 * std::log2(pair[1].f0_hz / options_.a4_hz) - open_midi_[q + 1];
   return low >= -0.5 && low <= kPairMaxStopSemitones && high >= -0.5 &&
@@ -482,7 +484,7 @@ bool DoubleStopAnalyzer::OnStrings(const std::array<PolyNote, 2>& pair, int q) c
 std::array<PolyNote, 2> DoubleStopAnalyzer::PairOnStrings(int q) {
   const std::array<double, 2> open = {open_midi_[q], open_midi_[q + 1]};
   const double peak = *std::max_element(magnitude_.begin(), magnitude_.end());
-  const double min_fundamental = options_.min_fundamental_ratio * peak;
+  const double min_fundamental = kPairFundamentalShare * options_.min_fundamental_ratio * peak;
   const int n = static_cast<int>(candidates_hz_.size());
   double best_score = 0;
   int best_first = -1, best_second = -1;
@@ -685,6 +687,14 @@ StatusOr<std::vector<PolyPitchFrame>> TrackDoubleStops(std::unique_ptr<AudioRead
   }
   ConsistentDoubleStops(static_cast<int>(std::llround(options.consistency_s * options.fps)),
                         &frames);
+  // The free pair made consistent over time is the pair on any strings it fits, as the
+  // frame's own free pair was (Analyze): a frame alone heard the double bass's E1 + C#2 as
+  // C#2 + E2 and G#1 + D#2 as D#2 + G#2, which its neighbours' pair explains.
+  for (PolyPitchFrame& f : frames) {
+    for (int s = 0; s < kStringPairs; ++s) {
+      if (f.count == 2 && analyzer.FitsStrings(f.notes, s + 1)) f.on_strings[s] = f.notes;
+    }
+  }
   if (summary != nullptr) {
     *summary = DoubleStopSummary();
     summary->frames = static_cast<int64_t>(frames.size());

@@ -133,6 +133,11 @@ class DoubleStopAnalyzer {
   DoubleStopAnalyzer& operator=(const DoubleStopAnalyzer&) = delete;
 
   int window_length() const { return window_; }
+  // True when `pair` (lower f0 first) can be played on strings upper_string + 1 and
+  // upper_string (1 = highest): the lower note from the nut to kPairMaxStopSemitones up the
+  // lower string, the upper likewise on the upper one, the stops within max_span_semitones.
+  // False without the instrument's strings or for a string outside 1..kStringPairs.
+  bool FitsStrings(const std::array<PolyNote, 2>& pair, int upper_string) const;
   // Notes of x[0..window_length()), lower f0 first; returns their count. With on_strings,
   // also the pair on each pair of adjacent strings (PairOnStrings; zero without the
   // instrument's strings or in silence).
@@ -157,7 +162,6 @@ class DoubleStopAnalyzer {
   int PartialFifth(int low, int high) const;
   int FreePair(std::array<PolyNote, 2>* notes);
   std::array<PolyNote, 2> PairOnStrings(int lower_string_low_to_high);
-  bool OnStrings(const std::array<PolyNote, 2>& pair, int lower_string_low_to_high) const;
   double Explained(int candidate, const std::vector<double>& spectrum) const;
 
   DoubleStopOptions options_;

@@ -264,6 +264,7 @@ void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
   }
   inputs->upper_f0_hz.assign(pitch.size(), 0.0);
   inputs->bow_pair_frames = 0;
+  inputs->input.bowed_pair_lower_string.clear();
   // Where the bow rests per frame; none when the layout has no bow or its frames differ.
   std::vector<refine::BowRest> rest;
   if (bow_pairs && inputs->instrument != nullptr) {
@@ -292,6 +293,8 @@ void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
         pitch[f] = {on[0].f0_hz, 1.0};
         inputs->upper_f0_hz[f] = on[1].f0_hz;
         ++inputs->bow_pair_frames;
+        inputs->input.bowed_pair_lower_string.resize(pitch.size(), 0);
+        inputs->input.bowed_pair_lower_string[f] = r.string;
         continue;
       }
     }

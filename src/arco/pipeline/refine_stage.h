@@ -47,7 +47,8 @@ struct RefineInputs {
 // triangulated frog and tip against the strings, refine/bowing.h with its default options)
 // rests on two adjacent strings s and s + 1 (refine::BowRestOf) takes the pair the tracker
 // heard as played on those strings (PolyPitchFrame::on_strings), where it heard one,
-// whatever the free analysis found: the bow says which strings sound, the free analysis
+// whatever the free analysis found, and input.bowed_pair_lower_string the pair's lower
+// string (the first voice's): the bow says which strings sound, the free analysis
 // often hears a pair's partial or a ghost an octave away as one of its notes
 // (docs/accuracy.md, "Double stops"). Throws std::invalid_argument when the frame counts
 // differ.

@@ -1,6 +1,7 @@
 #include "arco/refine/arco_decode.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -59,6 +60,23 @@ std::vector<State> NoteStates(const DecodeContext& context,
   const InstrumentModel& model = *context.input->instrument;
   std::vector<State> states;
   std::vector<double> distances, orders;
+  // The string the bow's pair puts the note on (RefineInput::bowed_pair_lower_string), when
+  // most of its trusted frames have one and agree.
+  int bowed = 0;
+  if (options.bowed_pair_string && !context.input->bowed_pair_lower_string.empty()) {
+    std::array<int, 9> votes{};
+    int trusted = 0;
+    for (int64_t f = note.first_frame; f <= note.last_frame; ++f) {
+      const size_t i = static_cast<size_t>(f);
+      if (context.analysis->frame_state[i] != FrameAudioState::kNote) continue;
+      ++trusted;
+      const int b = context.input->bowed_pair_lower_string[i];
+      if (b > 0 && b < static_cast<int>(votes.size())) ++votes[static_cast<size_t>(b)];
+    }
+    for (int b = 1; b < static_cast<int>(votes.size()); ++b) {
+      if (2 * votes[static_cast<size_t>(b)] > trusted) bowed = b;
+    }
+  }
   for (int s = 1; s <= model.num_strings(); ++s) {
     const Contact median_contact = ContactPoint(model, s, note.f0_hz, pitch_options.contact);
     if (median_contact.kind == ContactKind::kOpenString) {
@@ -113,6 +131,15 @@ std::vector<State> NoteStates(const DecodeContext& context,
       }
       states.push_back(st);
     }
+  }
+  // On the bowed pair's lower string only, where the note can be played there.
+  if (bowed > 0 && std::any_of(states.begin(), states.end(), [&](const State& st) {
+        return st.string == bowed;
+      })) {
+    states.erase(std::remove_if(states.begin(),
+                                states.end(),
+                                [&](const State& st) { return st.string != bowed; }),
+                 states.end());
   }
   return states;
 }

@@ -341,10 +341,32 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
   // next higher one together (on_pair) may get an octave (step 0c).
   std::vector<bool> one_string(frames, false), on_pair(frames, false);
   if (!bow_inclination_deg.empty()) {
+    // A note bowed on two strings on most of its frames is a double stop on all of them: a
+    // noisy inclination at its start (the violin's fifth G3 + D4 read on the D string
+    // alone for its first 6 of 23 frames) does not take its second voice away.
+    // Not after the note's last frame on two strings: a double stop's release rings on
+    // while the bow leaves the strings or moves to one.
+    std::map<int, int> frames_of_note, pair_frames_of_note;
+    std::map<int, size_t> last_pair_frame;
+    std::vector<BowRest> rests(frames);
     for (size_t f = 0; f < frames; ++f) {
-      const BowRest rest = BowRestOf(model, bow_inclination_deg[f]);
+      rests[f] = BowRestOf(model, bow_inclination_deg[f]);
+      const int note = first.contacts[f].note;
+      if (note < 0) continue;
+      ++frames_of_note[note];
+      if (rests[f].second_string > 0) {
+        ++pair_frames_of_note[note];
+        last_pair_frame[note] = f;
+      }
+    }
+    for (size_t f = 0; f < frames; ++f) {
+      const BowRest& rest = rests[f];
       const int string = first.contacts[f].string;
-      one_string[f] = options.bow_gate && rest.string > 0 && rest.second_string == 0;
+      const int note = first.contacts[f].note;
+      const bool paired_note = note >= 0 && 2 * pair_frames_of_note[note] > frames_of_note[note] &&
+                               f < last_pair_frame[note];
+      one_string[f] =
+          options.bow_gate && rest.string > 0 && rest.second_string == 0 && !paired_note;
       on_pair[f] = string >= 2 && rest.string == string && rest.second_string == string - 1;
     }
   }

@@ -35,7 +35,10 @@
 //  00. The bow (bow_gate): a double stop is bowed on both its strings at once, so a frame whose
 //      bow is seen on the strings and rests on one string (BowRestOf: its inclination
 //      nearer one string's than any two adjacent strings'; refine/bowing.h) has no second
-//      voice, whatever the tracker heard (whichever string the first voice was decoded on:
+//      voice, whatever the tracker heard, unless its first-voice note is bowed on two
+//      strings on most of its frames and the frame comes before the note's last such frame
+//      (a noisy inclination at a double stop's start; its release rings on while the bow
+//      leaves) (whichever string the first voice was decoded on:
 //      a chord's lower pair may be on other strings until step 0b): on a real cello the 2nd partial
 //      and the previous note still ringing are heard as a second note on half the frames
 //      (docs/accuracy.md, "Double stops"). An unseen or lifted bow leaves the frame to the

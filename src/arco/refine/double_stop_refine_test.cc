@@ -169,6 +169,37 @@ TEST(TranscribeSecondVoice, OneRowPerFirstVoiceNoteWithASecondVoice) {
 // Step 00: the bow says whether two strings sound. The sixth of the first test, heard on
 // frames 5-14; the bow rests on the A and E strings together on frames 5-9 (the chord of the
 // arch through both: the mean of their inclinations), on the A string alone on 10-14.
+// A note bowed on two strings on most of its frames keeps its second voice where the bow's
+// inclination reads one string before its last frame on two (a double stop's start
+// tracked noisily), but not after it (the release, where the bow leaves the pair).
+TEST(RefineSecondVoice, ANoteBowedOnTwoStringsKeepsItsStartButNotItsRelease) {
+  const Fixture fx;
+  const size_t n = fx.scene.input.pitch.size();  // one note of 20 frames
+  const double a_deg = fx.BowDeg(2), both_deg = fx.BowOnPairDeg(2);
+  ASSERT_EQ(fx.first.contacts[0].note, fx.first.contacts[n - 1].note);
+  const std::vector<double> upper(n, fx.UpperHz(4));
+  std::vector<double> bow(n, both_deg);
+  for (size_t f = 0; f < 4; ++f) bow[f] = a_deg;      // the start, on the A string alone
+  for (size_t f = n - 3; f < n; ++f) bow[f] = a_deg;  // the release
+  DoubleStopRefineOptions per_frame;
+  per_frame.fill_notes = false;
+  const DoubleStopRefineResult r =
+      RefineSecondVoice(fx.scene.input, fx.first, upper, per_frame, bow);
+  for (size_t f = 0; f < n - 3; ++f) {
+    if (!fx.first.contacts[f].pressed()) continue;
+    EXPECT_TRUE(r.second[f].pressed()) << f;
+  }
+  for (size_t f = n - 3; f < n; ++f) EXPECT_EQ(r.second[f].state, ContactState::kRest) << f;
+  EXPECT_EQ(r.summary.bow_one_string, 3);
+  // A note bowed on two strings on fewer than half its frames is gated frame by frame.
+  for (size_t f = 0; f < n; ++f) bow[f] = f % 3 == 0 ? both_deg : a_deg;
+  const DoubleStopRefineResult gated =
+      RefineSecondVoice(fx.scene.input, fx.first, upper, per_frame, bow);
+  for (size_t f = 0; f < n; ++f) {
+    if (f % 3 != 0) EXPECT_EQ(gated.second[f].state, ContactState::kRest) << f;
+  }
+}
+
 TEST(RefineSecondVoice, ABowOnOneStringRulesOutTheSecondVoice) {
   const Fixture fx;
   const InstrumentModel& model = *fx.scene.model;

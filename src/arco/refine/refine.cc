@@ -111,6 +111,16 @@ Status RefineInput::Validate() const {
     return Status::Error("refine input: " + std::to_string(detected_left_hand.size()) +
                          " detected hand frames for " + std::to_string(n) + " frames");
   }
+  if (!bowed_pair_lower_string.empty() && bowed_pair_lower_string.size() != n) {
+    return Status::Error("refine input: " + std::to_string(bowed_pair_lower_string.size()) +
+                         " bowed-pair frames for " + std::to_string(n) + " frames");
+  }
+  for (const int b : bowed_pair_lower_string) {
+    if (b < 0 || b > instrument->num_strings()) {
+      return Status::Error("refine input: a bowed pair's lower string " + std::to_string(b) +
+                           " is not 0 or a string of the " + instrument->name());
+    }
+  }
   if (!(fps > 0 && Finite(fps))) return Status::Error("refine input: fps must be > 0");
   if (!(a4_hz > 0 && Finite(a4_hz))) return Status::Error("refine input: a4_hz must be > 0");
   if (!Finite(start_s)) return Status::Error("refine input: start_s must be finite");
@@ -343,6 +353,7 @@ Json ToJson(const RefineOptions& o) {
             {"glide_frames", o.decode.glide_frames},
             {"audio_onsets", o.decode.audio_onsets},
             {"one_view_along_rays", o.decode.one_view_along_rays},
+            {"bowed_pair_string", o.decode.bowed_pair_string},
             {"boundaries",
              {{"onset_tolerance_s", o.decode.boundaries.onset_tolerance_s},
               {"match_cents", o.decode.boundaries.match_cents},

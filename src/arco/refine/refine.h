@@ -63,6 +63,12 @@ struct RefineInput {
   // (hand/one_view_depth.h, a median over the frames around), and decoded again. Empty:
   // several cameras, whose hand stays where they put it.
   std::optional<Eigen::Vector3d> one_view_camera_centre_mm;
+  // Per frame (empty, or one per frame): double stops whose two notes are the pair heard on
+  // the two strings the bow rests on (pipeline/refine_stage.h, AddDoubleStops) give the
+  // lower of those strings (the higher number, 1 = highest) here, 0 elsewhere. A double
+  // stop's lower note is on it: arco's decoding keeps a note whose frames mostly have one
+  // on that string (ArcoDecodeOptions::bowed_pair_string). Empty: no such frames.
+  std::vector<int> bowed_pair_lower_string;
 
   // Errors: no instrument, a right-hand model, sizes that differ, fps <= 0, a strings entry
   // with a wrong string count or non-finite ends.
@@ -121,6 +127,12 @@ struct ArcoDecodeOptions {
   double rest_gap_s = 0.4;          // a gap this long between notes frees the hand ...
   double rest_factor = 0.3;         // ... and scales the transition costs by this
   double infeasible_cost = 1000.0;  // candidate beyond the lift distance; open with vibrato
+  // A note most of whose trusted frames have RefineInput::bowed_pair_lower_string b keeps to
+  // string b: its states on other strings are dropped where it can be played on b. The
+  // cameras and the pitch alone decide a double stop's lower note like a single note (a
+  // double bass's open A1 as the E string's fourth finger, under a bow on the A and D
+  // strings).
+  bool bowed_pair_string = true;
   // Up to this many untrusted frames (rest, low confidence, ...) right before a stopped
   // note's first trusted frame are pressed too, with the note's first pitch: the finger
   // lands before the bow speaks and the tracker locks on a frame or two late.

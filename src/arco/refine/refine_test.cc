@@ -284,6 +284,40 @@ TEST(Refine, HighOnTheCelloAFingerSpansMoreThanASemitone) {
   EXPECT_EQ(finger_of_the_lost_note(2, false), 4);
 }
 
+// A double stop's lower note where the bow rests on two strings (RefineInput::
+// bowed_pair_lower_string, set by the pipeline where the tracker's pair on those strings is
+// taken): the scene's D3 is stopped by the G string's fourth finger, which the cameras see;
+// a bow on the D and A strings says the lower note is the open D string (the double bass's
+// open A1 decoded as the E string's fourth finger under a bow on the A and D strings).
+TEST(Refine, ABowOnTwoStringsKeepsTheLowerNoteOnTheLowerString) {
+  const std::vector<SceneNote> notes = {{3, 1, 2, 20}, {3, 4, 7, 30}, {3, 1, 2, 20}};
+  testing::Scene scene = Cello(notes);
+  const auto [first, last] = NoteFrames(notes, 1);
+  const auto middle = [&](const RefineResult& r) {
+    return r.contacts[static_cast<size_t>(first + 10)];
+  };
+  const RefineResult seen = Refine(scene.input, Options(RefineMode::kArco));
+  ASSERT_TRUE(middle(seen).pressed());  // the cameras: the G string's fourth finger
+  ASSERT_EQ(middle(seen).string, 3);
+  scene.input.bowed_pair_lower_string.assign(scene.input.pitch.size(), 0);
+  for (int f = first; f <= last; ++f) {
+    scene.input.bowed_pair_lower_string[static_cast<size_t>(f)] = 2;
+  }
+  const RefineResult bowed = Refine(scene.input, Options(RefineMode::kArco));
+  EXPECT_EQ(middle(bowed).state, ContactState::kOpenString)
+      << ContactStateName(middle(bowed).state) << " " << ContactReasonName(middle(bowed).reason);
+  EXPECT_EQ(middle(bowed).string, 2);
+  EXPECT_EQ(bowed.contacts[static_cast<size_t>(first - 5)].string, 3);  // the notes around stay
+  RefineOptions off = Options(RefineMode::kArco);
+  off.decode.bowed_pair_string = false;
+  EXPECT_EQ(middle(Refine(scene.input, off)).string, 3);
+  // Bad hints are errors of the input.
+  scene.input.bowed_pair_lower_string[5] = 5;
+  EXPECT_FALSE(scene.input.Validate().ok());
+  scene.input.bowed_pair_lower_string.pop_back();
+  EXPECT_FALSE(scene.input.Validate().ok());
+}
+
 TEST(Refine, AnOpenStringPitchThatVibratesIsStopped) {
   // E5 on the violin: the open E string, or the A string's fourth finger in first position.
   // Without vibrato arco takes the open string; an open string cannot vibrate.
