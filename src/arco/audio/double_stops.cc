@@ -445,6 +445,13 @@ double DoubleStopAnalyzer::Explained(int c, const std::vector<double>& spectrum)
   double explained = 0;
   for (int m = 1; m <= count; ++m) {
     if (!(amplitude[m] > 0)) continue;
+    // Only a partial that is there: the band's maximum a peak, not the slope of a
+    // neighbour's (whose lobe it would count as its own: a semitone above the cello's
+    // C2, C#2's bands lie on C2's partials' slopes).
+    const int k = at[m];
+    const bool peak = (k == 0 || spectrum[k - 1] <= spectrum[k]) &&
+                      (k + 1 >= static_cast<int>(spectrum.size()) || spectrum[k + 1] <= spectrum[k]);
+    if (!peak) continue;
     double own = amplitude[m];
     if (m > 1) {
       const double next = m < count ? amplitude[m + 1] : amplitude[m - 1];
@@ -542,8 +549,18 @@ std::array<PolyNote, 2> DoubleStopAnalyzer::PairOnStrings(int q) {
   if (best_first < 0) return {};
   residual_ = magnitude_;
   Cancel(best_first);
-  PolyNote one{Refine(best_first, magnitude_), Salience(best_first, magnitude_)};
-  PolyNote two{Refine(best_second, residual_), Salience(best_second, residual_)};
+  // The f0 refined from the partials, where it stays within the candidate's partial band:
+  // an octave's lower note shares every even partial with the upper one, and its fit was
+  // pulled a semitone off (the cello's open C2 under C3 refined to 69.5 Hz on 5 of 23
+  // frames), which a single note's fit never is.
+  const auto refined = [&](int c, const std::vector<double>& spectrum) {
+    const double f0 = Refine(c, spectrum);
+    return std::abs(1200.0 * std::log2(f0 / candidates_hz_[c])) <= kPartialCents
+               ? f0
+               : candidates_hz_[c];
+  };
+  PolyNote one{refined(best_first, magnitude_), Salience(best_first, magnitude_)};
+  PolyNote two{refined(best_second, residual_), Salience(best_second, residual_)};
   if (two.f0_hz < one.f0_hz) std::swap(one, two);
   return {one, two};
 }
