@@ -26,6 +26,11 @@
 //   (5) before (4), a pair a fifth apart whose octave below has a present fundamental and
 //       strong partials prime to 6 (neither heard note's) is that one note, heard as its
 //       2nd and 3rd partials.
+// Besides, per pair of adjacent strings, the pair heard as played on them
+// (PolyPitchFrame::on_strings): the free pair where it can be played there, else the pair
+// with one note on each string that explains most of the spectrum (PairOnStrings). The
+// refinement takes the pair of the strings the bow rests on (docs/audio.md, "The pair on
+// the bowed strings").
 #pragma once
 
 #include <array>
