@@ -292,7 +292,8 @@ TEST(Refine, HighOnTheCelloAFingerSpansMoreThanASemitone) {
 TEST(Refine, ABowOnTwoStringsKeepsTheLowerNoteOnTheLowerString) {
   const std::vector<SceneNote> notes = {{3, 1, 2, 20}, {3, 4, 7, 30}, {3, 1, 2, 20}};
   testing::Scene scene = Cello(notes);
-  const auto [first, last] = NoteFrames(notes, 1);
+  const std::pair<int, int> frames = NoteFrames(notes, 1);
+  const int first = frames.first, last = frames.second;  // a lambda below captures them
   const auto middle = [&](const RefineResult& r) {
     return r.contacts[static_cast<size_t>(first + 10)];
   };
