@@ -2,9 +2,11 @@
 // YIN's O(W * tau_max) difference function; ours uses one FFT pair per frame.
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <cmath>
 #include <vector>
 
+#include "arco/audio/double_stops.h"
 #include "arco/audio/pitch_hmm.h"
 #include "arco/audio/pitch_tracker.h"
 #include "arco/audio/resampler.h"
@@ -107,6 +109,38 @@ void BM_TrackPitchSixtySeconds(benchmark::State& state) {
       benchmark::Counter(60.0 * state.iterations(), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_TrackPitchSixtySeconds)->Unit(benchmark::kMillisecond);
+
+// Double stops (docs/audio.md, "Double stops"): one cello window holding the sixth G2 +
+// E3, the free analysis with the pairs heard on each pair of strings, against the free
+// analysis alone (what one frame cost before the pairs on the strings).
+std::vector<float> CelloSixth(int rate, int n) {
+  testing::ToneOptions tone;
+  tone.sample_rate_hz = rate;
+  tone.harmonics = 15;
+  tone.amplitude = 0.2;
+  std::vector<float> x(static_cast<size_t>(n), 0.0f);
+  for (const double f : {98.0, 164.81}) {
+    const auto y = testing::RenderTone([f](double) { return f; }, 1.0 * n / rate, tone);
+    for (int j = 0; j < n && j < static_cast<int>(y.size()); ++j) x[static_cast<size_t>(j)] += y[j];
+  }
+  return x;
+}
+
+void DoubleStopFrame(benchmark::State& state, bool on_strings) {
+  DoubleStopOptions o;
+  o.range = *InstrumentRangeByName("cello");
+  DoubleStopAnalyzer analyzer(o);
+  const auto x = CelloSixth(o.range.analysis_rate_hz, analyzer.window_length());
+  std::array<PolyNote, 2> notes;
+  std::array<std::array<PolyNote, 2>, kStringPairs> pairs;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(analyzer.Analyze(x.data(), &notes, on_strings ? &pairs : nullptr));
+  }
+}
+void BM_DoubleStopFrameWithStringPairs(benchmark::State& state) { DoubleStopFrame(state, true); }
+BENCHMARK(BM_DoubleStopFrameWithStringPairs);
+void BM_BaselineDoubleStopFrameFreeOnly(benchmark::State& state) { DoubleStopFrame(state, false); }
+BENCHMARK(BM_BaselineDoubleStopFrameFreeOnly);
 
 }  // namespace
 
