@@ -53,6 +53,15 @@ constexpr double kPairMaxStopSemitones = 11.5;
 
 double Weight(double f_hz, int m) { return (f_hz + kAlphaHz) / (m * f_hz + kBetaHz); }
 
+// Partial m's amplitude that is its note's after the spectral-smoothness rule (Klapuri
+// 2003): min(A_m, sqrt(A_{m-1} A_{m+1})), the last partial against its one neighbour;
+// amplitude[1..count].
+double OwnAmplitude(const double* amplitude, int m, int count) {
+  if (m == 1) return amplitude[1];
+  const double next = m < count ? amplitude[m + 1] : amplitude[m - 1];
+  return std::min(amplitude[m], std::sqrt(amplitude[m - 1] * next));
+}
+
 }  // namespace
 
 Status DoubleStopOptions::Validate() const {
@@ -279,11 +288,7 @@ double DoubleStopAnalyzer::Cancel(int c) {
   }
   double own_salience = 0;
   for (int m = 1; m <= count; ++m) {
-    double own = amplitude[m];
-    if (m > 1) {
-      const double next = m < count ? amplitude[m + 1] : amplitude[m - 1];
-      own = std::min(own, std::sqrt(amplitude[m - 1] * next));
-    }
+    const double own = OwnAmplitude(amplitude.data(), m, count);
     own_salience += Weight(candidates_hz_[c], m) * own;
     const double keep = amplitude[m] > 0 ? 1.0 - own / amplitude[m] : 0.0;
     const int lo = std::max(0, at[m] - lobe_bins_),
@@ -452,11 +457,7 @@ double DoubleStopAnalyzer::Explained(int c, const std::vector<double>& spectrum)
     const bool peak = (k == 0 || spectrum[k - 1] <= spectrum[k]) &&
                       (k + 1 >= static_cast<int>(spectrum.size()) || spectrum[k + 1] <= spectrum[k]);
     if (!peak) continue;
-    double own = amplitude[m];
-    if (m > 1) {
-      const double next = m < count ? amplitude[m + 1] : amplitude[m - 1];
-      own = std::min(own, std::sqrt(amplitude[m - 1] * next));
-    }
+    const double own = OwnAmplitude(amplitude.data(), m, count);
     const int lo = std::max(0, at[m] - lobe_bins_), hi = std::min(fft_size_ / 2, at[m] + lobe_bins_);
     double lobe = 0;
     for (int k = lo; k <= hi; ++k) lobe += spectrum[k];
