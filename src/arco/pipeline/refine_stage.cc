@@ -255,6 +255,58 @@ StatusOr<RefineInputs> MakeRefineInputs(const std::string& result_dir,
   return out;
 }
 
+namespace {
+
+// Within half a semitone (audio/double_stops.h's notes are each within a few cents of the
+// single-note tracker's reading of the same note).
+bool SameNote(double a_hz, double b_hz) {
+  return a_hz > 0 && b_hz > 0 && std::abs(12.0 * std::log2(a_hz / b_hz)) < 0.5;
+}
+
+}  // namespace
+
+FrameVoices VoicesOfFrame(const audio::PolyPitchFrame& poly,
+                          const refine::FramePitch& heard,
+                          const refine::BowRest& rest) {
+  FrameVoices out;
+  out.first = heard;
+  // BowRest: `string` the lower string of the pair, second_string = string - 1 the upper;
+  // on_strings[s - 1] holds strings s + 1 and s.
+  if (rest.second_string >= 1 && rest.second_string <= audio::kStringPairs) {
+    const std::array<audio::PolyNote, 2>& on = poly.on_strings[rest.second_string - 1];
+    // An octave where the free analysis heard one note is left to the note's own rule
+    // (bow_octaves, double_stop_refine.h step 0c): a single note's 2nd partial is that
+    // octave, and a bow crossing between two strings rests on both for a few frames. Not
+    // where that one note is neither of the pair's (the double bass's open E1 with E2 on
+    // the A string heard as E3, a partial of both).
+    const bool lone_octave =
+        poly.count != 2 && on[0].f0_hz > 0 &&
+        std::abs(12.0 * std::log2(on[1].f0_hz / on[0].f0_hz) - 12.0) < 0.5 &&
+        !(poly.count == 1 && !SameNote(poly.notes[0].f0_hz, on[0].f0_hz) &&
+          !SameNote(poly.notes[0].f0_hz, on[1].f0_hz));
+    if (on[0].f0_hz > 0 && on[1].f0_hz > 0 && !lone_octave) {
+      out.first = {on[0].f0_hz, 1.0};
+      out.upper_f0_hz = on[1].f0_hz;
+      out.bowed_pair_lower_string = rest.string;
+      return out;
+    }
+  }
+  if (poly.count != 2) return out;
+  // The bow clearly on one string: one note sounds, so a pair the free analysis heard there
+  // holds a ghost (an attack's transient, a partial of the note, a rest's noise; the ghost
+  // below a cello's B2 flipped the first voice every few frames, and the pitch model took
+  // the stretch for a tracker torn between notes and dropped the double stop after it).
+  // Unless the single-note tracker hears the pair's lower note, its own reading stays the
+  // first voice and there is no second.
+  if (rest.string > 0 && rest.second_string == 0 && rest.off_deg <= kOneStringRestDeg &&
+      !SameNote(heard.f0_hz, poly.notes[0].f0_hz)) {
+    return out;
+  }
+  out.first = {poly.notes[0].f0_hz, 1.0};
+  out.upper_f0_hz = poly.notes[1].f0_hz;
+  return out;
+}
+
 void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
                     RefineInputs* inputs,
                     bool bow_pairs) {
@@ -278,29 +330,15 @@ void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
     }
   }
   for (size_t f = 0; f < poly.size(); ++f) {
-    const refine::BowRest r = f < rest.size() ? rest[f] : refine::BowRest();
-    // BowRest: `string` the lower string of the pair, second_string = string - 1 the upper;
-    // on_strings[s - 1] holds strings s + 1 and s.
-    if (r.second_string >= 1 && r.second_string <= audio::kStringPairs) {
-      const std::array<audio::PolyNote, 2>& on = poly[f].on_strings[r.second_string - 1];
-      // An octave where the free analysis heard one note is left to the note's own rule
-      // (bow_octaves, double_stop_refine.h step 0c): a single note's 2nd partial is that
-      // octave, and a bow crossing between two strings rests on both for a few frames.
-      const bool lone_octave =
-          poly[f].count != 2 && on[0].f0_hz > 0 &&
-          std::abs(12.0 * std::log2(on[1].f0_hz / on[0].f0_hz) - 12.0) < 0.5;
-      if (on[0].f0_hz > 0 && on[1].f0_hz > 0 && !lone_octave) {
-        pitch[f] = {on[0].f0_hz, 1.0};
-        inputs->upper_f0_hz[f] = on[1].f0_hz;
-        ++inputs->bow_pair_frames;
-        inputs->input.bowed_pair_lower_string.resize(pitch.size(), 0);
-        inputs->input.bowed_pair_lower_string[f] = r.string;
-        continue;
-      }
+    const FrameVoices v =
+        VoicesOfFrame(poly[f], pitch[f], f < rest.size() ? rest[f] : refine::BowRest());
+    pitch[f] = v.first;
+    inputs->upper_f0_hz[f] = v.upper_f0_hz;
+    if (v.bowed_pair_lower_string > 0) {
+      ++inputs->bow_pair_frames;
+      inputs->input.bowed_pair_lower_string.resize(pitch.size(), 0);
+      inputs->input.bowed_pair_lower_string[f] = v.bowed_pair_lower_string;
     }
-    if (poly[f].count != 2) continue;
-    pitch[f] = {poly[f].notes[0].f0_hz, 1.0};
-    inputs->upper_f0_hz[f] = poly[f].notes[1].f0_hz;
   }
 }
 

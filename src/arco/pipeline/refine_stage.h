@@ -11,6 +11,7 @@
 #include "arco/instrument/instrument_model.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/refine/bowing.h"
+#include "arco/refine/double_stop_refine.h"
 #include "arco/refine/method_result.h"
 #include "arco/refine/refine.h"
 #include "arco/util/status.h"
@@ -50,11 +51,33 @@ struct RefineInputs {
 // whatever the free analysis found, and input.bowed_pair_lower_string the pair's lower
 // string (the first voice's): the bow says which strings sound, the free analysis
 // often hears a pair's partial or a ghost an octave away as one of its notes
-// (docs/accuracy.md, "Double stops"). Throws std::invalid_argument when the frame counts
+// (docs/accuracy.md, "Double stops"); a frame whose bow clearly rests on one string keeps
+// the single-note tracker's reading unless it is the free pair's lower note
+// (VoicesOfFrame). Throws std::invalid_argument when the frame counts
 // differ.
 void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
                     RefineInputs* inputs,
                     bool bow_pairs = true);
+
+// One frame of AddDoubleStops: the voices from the polyphonic frame, the single-note
+// tracker's reading `heard` and where the bow rests (refine::BowRestOf; a default BowRest
+// when unknown). On two strings: their pair (on_strings), except a lone octave. Otherwise,
+// two notes from the free analysis: the lower is the first voice (confidence 1) and the
+// upper the second, except with the bow clearly on one string (within kOneStringRestDeg of
+// its inclination) where the tracker does not hear the lower note: `heard` stays, alone.
+struct FrameVoices {
+  refine::FramePitch first;
+  double upper_f0_hz = 0;           // 0: no second voice
+  int bowed_pair_lower_string = 0;  // > 0: the pair came from the bowed strings
+};
+// A bow within this of one string's inclination rests on that string alone. The pair
+// beside it is about 10 degrees away on every instrument's arch, but the measured
+// inclination scatters by 0.8 (double bass) to 2.3 degrees (violin) sd on the synthetic
+// takes, and a violin's double stop was measured 2.3 degrees from one string (2.5 lost it).
+constexpr double kOneStringRestDeg = 1.5;
+FrameVoices VoicesOfFrame(const audio::PolyPitchFrame& poly,
+                          const refine::FramePitch& heard,
+                          const refine::BowRest& rest);
 // Errors name the file: no hand or instrument stage, shapes that disagree, a
 // double_stops.csv with more rows than frames. With double_stops.csv, AddDoubleStops.
 StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir);

@@ -308,6 +308,7 @@ BowRest BowRestOf(const InstrumentModel& model, double inclination_deg) {
       rest = {s, s - 1};
     }
   }
+  rest.off_deg = best / kRadPerDeg;
   return rest;
 }
 

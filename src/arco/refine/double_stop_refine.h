@@ -65,6 +65,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -148,6 +149,9 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
 struct BowRest {
   int string = 0;         // 1 = highest; the lower of a pair
   int second_string = 0;  // the pair's upper string (string - 1); 0 on one string
+  // How far the bow's inclination lies from that rest's own (degrees): a string and the
+  // pairs beside it are about 10 degrees apart, so a small value is a clear rest.
+  double off_deg = std::numeric_limits<double>::quiet_NaN();
 };
 BowRest BowRestOf(const InstrumentModel& model, double inclination_deg);
 

@@ -218,6 +218,11 @@ TEST(RefineSecondVoice, ABowOnOneStringRulesOutTheSecondVoice) {
   EXPECT_EQ(rest(e_deg), std::make_pair(1, 0));
   EXPECT_EQ(rest(fx.BowOnPairDeg(3)), std::make_pair(3, 2));  // the D and A strings
   EXPECT_EQ(rest(std::nan("")), std::make_pair(0, 0));        // no bow: the sound decides
+  // How far from its rest's own inclination: 0 on it, a third of the way to the pair.
+  EXPECT_NEAR(BowRestOf(model, a_deg).off_deg, 0.0, 1e-9);
+  EXPECT_NEAR(BowRestOf(model, a_deg + 0.33 * (both_deg - a_deg)).off_deg,
+              0.33 * std::abs(both_deg - a_deg), 1e-9);
+  EXPECT_TRUE(std::isnan(BowRestOf(model, std::nan("")).off_deg));
   std::vector<double> upper(n, 0.0);
   for (size_t f = 5; f < 15; ++f) upper[f] = fx.UpperHz(4);
   std::vector<double> bow(n, std::nan(""));
