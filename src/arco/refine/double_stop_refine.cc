@@ -15,6 +15,8 @@ namespace arco::refine {
 namespace {
 
 constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
+// Upper notes within this of each other are the same note (step 0a).
+constexpr double kSameUpperSemitones = 0.5;
 
 // Semitones of f0_hz above the open pitch of `string`.
 double SemitonesAboveOpen(const InstrumentModel& model, int string, double f0_hz) {
@@ -282,6 +284,7 @@ Status DoubleStopRefineOptions::Validate() const {
       CheckInRange("max_tip_distance_mm", max_tip_distance_mm, kTipDistanceRangeMm));
   ARCO_RETURN_IF_ERROR(CheckInRange("chord_gap_s", chord_gap_s, kChordWindowRangeS));
   ARCO_RETURN_IF_ERROR(CheckInRange("chord_lower_max_s", chord_lower_max_s, kChordWindowRangeS));
+  ARCO_RETURN_IF_ERROR(CheckInRange("attack_s", attack_s, kAttackRangeS));
   if (max_iterations < 1 || max_iterations > 1000)
     return Status::Error("max_iterations must be in [1, 1000]");
   return Status::Ok();
@@ -384,10 +387,21 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
     if (upper_f0_hz[f] > 0 && !one_string[f]) note_upper[note].push_back(upper_f0_hz[f]);
   }
   std::map<int, double> note_median;
+  std::map<int, bool> note_agrees;  // two thirds of its upper notes at the median (step 0a)
   for (auto& [note, values] : note_upper) {
     if (2 * static_cast<int>(values.size()) < note_frames[note]) continue;
-    note_median[note] = UpperMedian(values);
+    const double median = UpperMedian(values);
+    note_median[note] = median;
+    const auto near = std::count_if(values.begin(), values.end(), [median](double hz) {
+      return std::abs(12.0 * std::log2(hz / median)) <= kSameUpperSemitones;
+    });
+    note_agrees[note] = 3 * near >= 2 * static_cast<int64_t>(values.size());
   }
+  std::map<int, size_t> note_first_frame;
+  for (size_t f = frames; f-- > 0;) {
+    if (first.contacts[f].note >= 0) note_first_frame[first.contacts[f].note] = f;
+  }
+  const double attack_frames = options.attack_s * input.fps;
   // Step 0c: a note bowed on two strings on most of its frames that the tracker heard as
   // one note is an octave: the upper note's partials are all the lower's even ones, so
   // the spectrum cannot show it (docs/accuracy.md, "Double stops"), but the bow does.
@@ -411,6 +425,15 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
     if (!(upper > 0) && options.fill_notes) {
       const auto it = note_median.find(c1.note);
       if (it != note_median.end() && it->second > 1.03 * c1.f0_hz) upper = it->second;
+    }
+    if (upper > 0 && c1.note >= 0 && note_agrees[c1.note] && !one_string[f] &&
+        static_cast<double>(f - note_first_frame[c1.note]) < attack_frames) {
+      const double median = note_median[c1.note];
+      if (std::abs(12.0 * std::log2(upper / median)) > kSameUpperSemitones &&
+          median > 1.03 * c1.f0_hz) {
+        upper = median;
+        ++out.summary.attack_frames;
+      }
     }
     const bool octave =
         !(upper > 0) && on_pair[f] && bow_octave_note.count(c1.note) > 0 && c1.f0_hz > 0;

@@ -46,6 +46,9 @@
 //   0. A first-voice note (FrameContact::note) with an upper note on at least half its
 //      frames gets their median on its frames without one, where it lies above the frame's
 //      pitch (fill_notes).
+//  0a. Attacks (attack_s): in such a note whose upper notes agree on two thirds of them, a
+//      frame within attack_s of the note's first frame whose upper note is more than half
+//      a semitone from the median gets the median.
 //  0b. Chords (tie_chords): a rolled chord reaches the refinement as a short lower pair
 //      right before its held upper pair, and the first voice of each was decoded alone. The
 //      lower pair's first voice moves to the string below the upper pair's lower note when
@@ -81,6 +84,7 @@ inline constexpr NumberRange kOpenToleranceRangeCents = Closed(0, 100);
 inline constexpr NumberRange kSpanRangeSemitones = Closed(0, 24);
 inline constexpr NumberRange kTipDistanceRangeMm = Closed(0, 500);
 inline constexpr NumberRange kChordWindowRangeS = Closed(0, 2);
+inline constexpr NumberRange kAttackRangeS = Closed(0, 1);
 
 struct DoubleStopRefineOptions {
   double open_tolerance_cents = 40.0;  // an upper note this near its open string is open
@@ -91,6 +95,13 @@ struct DoubleStopRefineOptions {
   // A first-voice note with an upper note on at least half its frames keeps the median of
   // them on its other frames (the tracker's window misses the second note near the ends).
   bool fill_notes = true;
+  // Step 0a: a first-voice note whose upper notes mostly agree (two thirds within half a
+  // semitone of their median) gives that median to the frames of its first attack_s that
+  // heard another (0: off). A bowed string's new note takes 50-150 ms to settle into its
+  // periodic motion and the tracker's window (up to 0.2 s on the double bass) straddles
+  // the onset: there the upper note of an octave or a sixth is heard a tone off or as the
+  // lower note's own partial (docs/accuracy.md, "A double stop's attack").
+  double attack_s = 0.25;
   // A rolled chord's lower pair (a double-stop note of at most chord_lower_max_s, ending at
   // most chord_gap_s before the next longer double-stop note, its upper pair) is put on the
   // strings its upper pair leaves it (step 0b): below the shared note's string, or the two
@@ -113,6 +124,7 @@ struct DoubleStopRefineSummary {
   int frames = 0;                    // frames with an upper note and a first voice
   int bow_one_string = 0;            // frames whose upper note the bow ruled out (step 00)
   int bow_octaves = 0;               // frames given an octave the bow plays (step 0c)
+  int attack_frames = 0;             // upper notes replaced by their note's (step 0a)
   // Frames whose two notes are the pair heard on the strings the bow rests on (set by the
   // pipeline, pipeline/refine_stage.h AddDoubleStops, before the refinement).
   int bow_pairs = 0;

@@ -257,6 +257,43 @@ TEST(RefineSecondVoice, ABowOnOneStringRulesOutTheSecondVoice) {
                std::invalid_argument);
 }
 
+// Step 0a: a double stop's first frames hear its upper note a semitone off (the attack);
+// the note's own upper note replaces them within attack_s of its first frame, not later,
+// and not in a note whose upper notes disagree (a moving upper voice).
+TEST(RefineSecondVoice, ADoubleStopsAttackTakesItsNotesUpperNote) {
+  const Fixture fx;
+  const size_t n = fx.scene.input.pitch.size();
+  size_t start = 0;
+  while (start < n && fx.first.contacts[start].note < 0) ++start;
+  ASSERT_LT(start + 18, n + 1);
+  ASSERT_EQ(fx.scene.input.fps, 30.0);
+  std::vector<double> upper(n, 0.0);
+  for (size_t f = start; f < n; ++f) upper[f] = fx.UpperHz(4);
+  for (size_t f = start; f < start + 3; ++f) upper[f] = fx.UpperHz(3);  // the attack
+  upper[start + 12] = fx.UpperHz(3);  // 0.4 s into the note: not its attack
+  const DoubleStopRefineResult r = RefineSecondVoice(fx.scene.input, fx.first, upper, {});
+  EXPECT_EQ(r.summary.attack_frames, 3);
+  for (size_t f = start; f < start + 3; ++f) {
+    ASSERT_TRUE(r.second[f].pressed()) << f;
+    EXPECT_NEAR(r.second[f].f0_hz, fx.UpperHz(4), 1e-9) << f;
+    EXPECT_EQ(r.second[f].finger, 2) << f;
+  }
+  EXPECT_NEAR(r.second[start + 12].f0_hz, fx.UpperHz(3), 1e-9);
+  DoubleStopRefineOptions off;
+  off.attack_s = 0;
+  const DoubleStopRefineResult kept = RefineSecondVoice(fx.scene.input, fx.first, upper, off);
+  EXPECT_EQ(kept.summary.attack_frames, 0);
+  EXPECT_NEAR(kept.second[start].f0_hz, fx.UpperHz(3), 1e-9);
+  // Half the upper notes a semitone lower: no note's upper note to give.
+  for (size_t f = start; f < start + 9; ++f) upper[f] = fx.UpperHz(3);
+  const DoubleStopRefineResult moving = RefineSecondVoice(fx.scene.input, fx.first, upper, {});
+  EXPECT_EQ(moving.summary.attack_frames, 0);
+  EXPECT_NEAR(moving.second[start].f0_hz, fx.UpperHz(3), 1e-9);
+  DoubleStopRefineOptions bad;
+  bad.attack_s = -0.1;
+  EXPECT_FALSE(bad.Validate().ok());
+}
+
 // Step 0c: an octave is heard as one note (its partials are the lower note's even ones);
 // a bow on both strings through most of the note says two sound. B4 on the A string, the
 // bow on the A and E strings on frames 0-14 of its 20, on the A string alone after.
