@@ -174,6 +174,40 @@ TEST(AnalyzeBowing, DirectionsAndBowChangesOfStraightStrokes) {
   EXPECT_EQ(r.summary.bow_changes, 4);
 }
 
+// A slow down-bow (75 mm/s) whose tracked place on the bow jitters by +-1.5 mm in a
+// 4-frame pattern: one frame's central difference reads 30 mm/s on half the frames, under
+// the 50 mm/s of a still bow, but the bow moves; then the bow stops, with the same jitter,
+// and has no direction.
+TEST(AnalyzeBowing, ASlowBowsJitterIsNoStop) {
+  const Scene scene(InstrumentKind::kCello);
+  const double fps = 30;
+  const Eigen::Vector3d contact = scene.ArchTop(2, 60);
+  const double incl = scene.model.BowInclinationRad(2);
+  const Eigen::Vector3d d(0, -std::cos(incl), -std::sin(incl));  // frog -> tip
+  BowingInput in;
+  in.fps = fps;
+  const int moving = 30, n = 46;
+  for (int f = 0; f < n; ++f) {
+    const double jitter = (f / 2) % 2 == 0 ? 1.5 : -1.5;
+    const double along = 200 + 75.0 / fps * std::min(f, moving) + jitter;
+    in.frog_in_world_mm.push_back(scene.World(contact - along * d));
+    in.tip_in_world_mm.push_back(scene.World(contact + (640 - along) * d));
+    in.strings_in_world_mm.push_back(scene.strings);
+  }
+  const BowingResult r = AnalyzeBowing(scene.model, in, {}).value();
+  EXPECT_TRUE(r.change_times_s.empty());
+  int slow_frames = 0;
+  for (int f = 2; f < moving - 1; ++f) {  // frame 1's window holds two slow readings
+    const BowingFrame& bf = r.frames[static_cast<size_t>(f)];
+    slow_frames += bf.bow_speed_mm_per_s < 50;
+    EXPECT_EQ(bf.direction, BowDirection::kDown) << f << " at " << bf.bow_speed_mm_per_s;
+  }
+  EXPECT_GE(slow_frames, 10);  // the frames whose own speed reads still
+  for (int f = moving + 2; f < n; ++f) {
+    EXPECT_EQ(r.frames[static_cast<size_t>(f)].direction, BowDirection::kNone) << f;
+  }
+}
+
 // Notes: the bow's string against the fingered one, and changes against the onsets.
 TEST(AnalyzeBowing, NotesFlagABowOnAnotherStringThanTheFingeredOne) {
   const Scene scene(InstrumentKind::kCello);
