@@ -377,7 +377,7 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
   // A note of the first voice whose frames mostly have an upper note keeps it on the rest
   // of its frames (the polyphonic tracker's window holds two notes only well inside a
   // double stop): its median upper f0, where that lies above the frame's own pitch.
-  std::map<int, std::vector<double>> note_upper;
+  std::map<int, std::vector<double>> note_upper, note_unheard_octave;
   std::map<int, int> note_frames, note_on_pair;
   for (size_t f = 0; f < frames; ++f) {
     const int note = first.contacts[f].note;
@@ -385,11 +385,30 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
     ++note_frames[note];
     note_on_pair[note] += on_pair[f];
     if (upper_f0_hz[f] > 0 && !one_string[f]) note_upper[note].push_back(upper_f0_hz[f]);
+    // Bowed on two strings with one note heard: an octave the spectrum cannot show (0c).
+    if (!(upper_f0_hz[f] > 0) && on_pair[f] && first.contacts[f].f0_hz > 0) {
+      note_unheard_octave[note].push_back(2.0 * first.contacts[f].f0_hz);
+    }
   }
   std::map<int, double> note_median;
   std::map<int, bool> note_agrees;  // two thirds of its upper notes at the median (step 0a)
   for (auto& [note, values] : note_upper) {
     if (2 * static_cast<int>(values.size()) < note_frames[note]) continue;
+    // Step 0c in a note heard as two notes: where the frames heard at the octave and the
+    // bowed frames heard as one note together put the median at the octave, the octave is
+    // the note's upper note (the double bass's A1 + A2, whose A2 the spectrum shows on a
+    // third of the frames and a ghost G2 on another third, seed 4).
+    const auto unheard = note_unheard_octave.find(note);
+    if (options.bow_octaves && unheard != note_unheard_octave.end() &&
+        2 * note_on_pair[note] >= note_frames[note]) {
+      std::vector<double> with_octaves = values;
+      with_octaves.insert(with_octaves.end(), unheard->second.begin(), unheard->second.end());
+      const double octave = UpperMedian(unheard->second);
+      if (std::abs(12.0 * std::log2(UpperMedian(with_octaves) / octave)) <= kSameUpperSemitones) {
+        values = std::move(with_octaves);
+        out.summary.bow_octaves += static_cast<int>(unheard->second.size());
+      }
+    }
     const double median = UpperMedian(values);
     note_median[note] = median;
     const auto near = std::count_if(values.begin(), values.end(), [median](double hz) {

@@ -335,6 +335,42 @@ TEST(RefineSecondVoice, ANoteBowedOnTwoStringsGetsItsOctave) {
   for (size_t f = 0; f < n; ++f) EXPECT_EQ(none.second[f].state, ContactState::kRest) << f;
 }
 
+// Step 0c in a note heard as two notes: the double bass's A1 + A2 (seed 4), A2 heard on a
+// few frames, a ghost a tone below it on a few, one note on the rest. Here B4 + B5 bowed on
+// the A and E strings throughout: a ghost A5 on the first 6 frames, B5 on the next 4, one
+// note after. The heard median is the ghost; with the bow's unheard octaves it is B5, and
+// the ghost frames lie in the note's attack (step 0a).
+TEST(RefineSecondVoice, ANoteHeardAsTwoNotesTakesTheOctaveTheBowPlays) {
+  const Fixture fx;
+  const size_t n = fx.scene.input.pitch.size();
+  size_t start = 0;
+  while (start < n && fx.first.contacts[start].note < 0) ++start;
+  ASSERT_LT(start + 10, n);
+  const std::vector<double> bow(n, fx.BowOnPairDeg(2));
+  std::vector<double> upper(n, 0.0);
+  for (size_t f = start; f < start + 6; ++f) upper[f] = fx.UpperHz(5);
+  for (size_t f = start + 6; f < start + 10; ++f) upper[f] = fx.UpperHz(7);
+  const DoubleStopRefineResult r = RefineSecondVoice(fx.scene.input, fx.first, upper, {}, bow);
+  int octaves = 0;
+  for (size_t f = start; f < n; ++f) {
+    const FrameContact& c1 = fx.first.contacts[f];
+    if (!c1.pressed()) continue;
+    const FrameContact& c2 = r.second[f];
+    ASSERT_TRUE(c2.pressed()) << f;
+    EXPECT_EQ(c2.string, 1) << f;
+    EXPECT_NEAR(c2.f0_hz, 2 * c1.f0_hz, 0.005 * c1.f0_hz) << f;
+    ++octaves;
+  }
+  EXPECT_GE(octaves, 15);
+  EXPECT_EQ(r.summary.attack_frames, 6);
+  EXPECT_EQ(r.summary.bow_octaves, static_cast<int>(n - start) - 10);
+  // Without the bow's octaves the note's upper note is the ghost the tracker heard most.
+  DoubleStopRefineOptions off;
+  off.bow_octaves = false;
+  const DoubleStopRefineResult ghost = RefineSecondVoice(fx.scene.input, fx.first, upper, off, bow);
+  EXPECT_NEAR(ghost.second[start + 12].f0_hz, fx.UpperHz(5), 1e-9);
+}
+
 TEST(RefineSecondVoice, NoHigherStringOrAnUnplayableSpanIsUncertain) {
   const Fixture fx;
   const size_t n = fx.scene.input.pitch.size();
