@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -44,9 +45,9 @@ StatusOr<NpyArray<double>> FitBody(const RefineInputs& inputs, int num_threads) 
   return std::move(fit.points_mm);
 }
 
-// The bow arm from the triangulated frog and tip and the placed strings.
+// The bow arm from the triangulated frog and tip and the placed strings, without notes
+// (refine::AnalyzeBowStrokes; refine::AddBowingNotes adds the refinement's).
 StatusOr<refine::BowingResult> AnalyzeBow(const RefineInputs& inputs,
-                                          const refine::RefineResult& r,
                                           const refine::BowingOptions& options) {
   const InstrumentModel& m = *inputs.instrument;
   const std::vector<std::string>& names = m.keypoint_names();
@@ -68,10 +69,9 @@ StatusOr<refine::BowingResult> AnalyzeBow(const RefineInputs& inputs,
     in.tip_in_world_mm.push_back(point(tip_index));
   }
   in.strings_in_world_mm = inputs.input.strings_in_world_mm;
-  in.notes = r.fingering;
   in.fps = inputs.input.fps;
   in.start_s = inputs.input.start_s;
-  return refine::AnalyzeBowing(m, in, options);
+  return refine::AnalyzeBowStrokes(m, in, options);
 }
 
 }  // namespace
@@ -321,7 +321,7 @@ void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
   std::vector<refine::BowRest> rest;
   if (bow_pairs && inputs->instrument != nullptr) {
     const StatusOr<refine::BowingResult> bow =
-        AnalyzeBow(*inputs, refine::RefineResult(), refine::BowingOptions());
+        AnalyzeBow(*inputs, refine::BowingOptions());
     if (bow.ok() && bow->frames.size() == pitch.size()) {
       for (const refine::BowingFrame& bf : bow->frames) {
         rest.push_back(bf.string > 0 ? refine::BowRestOf(*inputs->instrument, bf.inclination_deg)
@@ -365,21 +365,23 @@ StatusOr<MethodRecord> RefineMethod(const RefineInputs& inputs,
                                 " needs the pitch stage's inputs");
   }
   refine::RefineResult r = refine::Refine(inputs.input, options);
+  // arco's bow arm, analysed once: its frames do not depend on the notes (bowing.csv gets
+  // the final notes below; the double stops' bow gate, step 00, reads the inclinations).
+  std::optional<refine::BowingResult> bow;
+  if (options.mode == refine::RefineMode::kArco) {
+    ARCO_ASSIGN_OR_RETURN(bow, AnalyzeBow(inputs, bowing));
+  }
   // arco with double stops: the upper notes' strings, fingers and the second finger's IK.
   std::vector<refine::FrameContact> second;
   const refine::DoubleStopRefineOptions double_stop_options;
   refine::DoubleStopRefineSummary double_stop_summary;
   if (options.mode == refine::RefineMode::kArco && !inputs.upper_f0_hz.empty()) {
-    // The bow's inclination while it is on the strings (step 00 of double_stop_refine.h):
-    // it does not depend on the notes, so the first voice's result serves.
+    // The bow's inclination while it is on the strings (step 00 of double_stop_refine.h).
     std::vector<double> bow_inclination_deg;
-    {
-      ARCO_ASSIGN_OR_RETURN(const refine::BowingResult bow, AnalyzeBow(inputs, r, bowing));
-      if (bow.frames.size() == r.contacts.size()) {
-        for (const refine::BowingFrame& bf : bow.frames) {
-          bow_inclination_deg.push_back(bf.string > 0 ? bf.inclination_deg
-                                                      : std::numeric_limits<double>::quiet_NaN());
-        }
+    if (bow->frames.size() == r.contacts.size()) {
+      for (const refine::BowingFrame& bf : bow->frames) {
+        bow_inclination_deg.push_back(bf.string > 0 ? bf.inclination_deg
+                                                    : std::numeric_limits<double>::quiet_NaN());
       }
     }
     refine::DoubleStopRefineResult ds = refine::RefineSecondVoice(
@@ -426,8 +428,8 @@ StatusOr<MethodRecord> RefineMethod(const RefineInputs& inputs,
   out.options = options;
   if (inputs.input.audio_notes.empty()) out.options.decode.audio_onsets = false;
   out.summary = r.summary;
-  if (options.mode == refine::RefineMode::kArco) {
-    ARCO_ASSIGN_OR_RETURN(refine::BowingResult bow, AnalyzeBow(inputs, r, bowing));
+  if (bow) {
+    refine::AddBowingNotes(r.fingering, bowing, &*bow);
     out.bowing = std::move(bow);
     out.bowing_options = bowing;
   }

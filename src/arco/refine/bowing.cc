@@ -92,6 +92,14 @@ Status BowingOptions::Validate() const {
 StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
                                      const BowingInput& input,
                                      const BowingOptions& options) {
+  ARCO_ASSIGN_OR_RETURN(BowingResult out, AnalyzeBowStrokes(instrument, input, options));
+  AddBowingNotes(input.notes, options, &out);
+  return out;
+}
+
+StatusOr<BowingResult> AnalyzeBowStrokes(const InstrumentModel& instrument,
+                                         const BowingInput& input,
+                                         const BowingOptions& options) {
   ARCO_RETURN_IF_ERROR(options.Validate());
   const size_t n = input.frog_in_world_mm.size();
   if (input.tip_in_world_mm.size() != n || input.strings_in_world_mm.size() != n) {
@@ -294,9 +302,32 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
     }
   }
 
-  // Notes: the refinement's, with their frames' bowing.
   BowingSummary& sum = out.summary;
-  for (const NoteFingering& nf : input.notes) {
+  sum.frames = static_cast<int>(n);
+  sum.bow_changes = static_cast<int>(out.change_times_s.size());
+  std::vector<double> sounding, speeds;
+  for (const BowingFrame& bf : out.frames) {
+    sum.frames_seen += bf.seen;
+    sum.frames_on_string += bf.string > 0;
+    if (bf.string > 0) sounding.push_back(bf.sounding_point_mm);
+    if (bf.direction != BowDirection::kNone) speeds.push_back(std::abs(bf.bow_speed_mm_per_s));
+  }
+  sum.median_sounding_point_mm = FiniteMedian(sounding);
+  sum.median_speed_mm_per_s = FiniteMedian(speeds);
+  return out;
+}
+
+void AddBowingNotes(const std::vector<NoteFingering>& notes,
+                    const BowingOptions& options,
+                    BowingResult* result) {
+  BowingResult& out = *result;
+  const size_t n = out.frames.size();
+  BowingSummary& sum = out.summary;
+  out.notes.clear();
+  sum.notes_string_disagree = 0;
+  sum.bow_changes_at_onsets = 0;
+  // Notes: the refinement's, with their frames' bowing.
+  for (const NoteFingering& nf : notes) {
     BowingNote note;
     note.note = nf.note;
     note.onset_s = nf.onset_s;
@@ -348,27 +379,15 @@ StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
     out.notes.push_back(note);
   }
 
-  sum.frames = static_cast<int>(n);
   sum.notes = static_cast<int>(out.notes.size());
-  sum.bow_changes = static_cast<int>(out.change_times_s.size());
-  std::vector<double> sounding, speeds;
-  for (const BowingFrame& bf : out.frames) {
-    sum.frames_seen += bf.seen;
-    sum.frames_on_string += bf.string > 0;
-    if (bf.string > 0) sounding.push_back(bf.sounding_point_mm);
-    if (bf.direction != BowDirection::kNone) speeds.push_back(std::abs(bf.bow_speed_mm_per_s));
-  }
   for (double t : out.change_times_s) {
-    for (const NoteFingering& nf : input.notes) {
+    for (const NoteFingering& nf : notes) {
       if (std::abs(t - nf.onset_s) <= options.onset_tolerance_s) {
         ++sum.bow_changes_at_onsets;
         break;
       }
     }
   }
-  sum.median_sounding_point_mm = FiniteMedian(sounding);
-  sum.median_speed_mm_per_s = FiniteMedian(speeds);
-  return out;
 }
 
 Json ToJson(const BowingSummary& s) {

@@ -116,9 +116,21 @@ struct BowingInput {
 };
 
 // Throws nothing; an invalid `options` or mismatched input sizes are an error status.
+// AnalyzeBowStrokes then AddBowingNotes with input.notes.
 StatusOr<BowingResult> AnalyzeBowing(const InstrumentModel& instrument,
                                      const BowingInput& input,
                                      const BowingOptions& options);
+// The per-frame part, which does not depend on the notes: frames, changes and the summary
+// but for its notes, notes_string_disagree and bow_changes_at_onsets (0); input.notes is
+// not read. A refinement that needs the bow before its notes are final analyses it once.
+StatusOr<BowingResult> AnalyzeBowStrokes(const InstrumentModel& instrument,
+                                         const BowingInput& input,
+                                         const BowingOptions& options);
+// The per-note part on `result` (AnalyzeBowStrokes'): its notes and their counts in the
+// summary, replacing any from an earlier call.
+void AddBowingNotes(const std::vector<NoteFingering>& notes,
+                    const BowingOptions& options,
+                    BowingResult* result);
 
 Json ToJson(const BowingSummary& summary);
 Json ToJson(const BowingOptions& options);

@@ -235,6 +235,19 @@ TEST(AnalyzeBowing, NotesFlagABowOnAnotherStringThanTheFingeredOne) {
   EXPECT_NEAR(r.notes[0].mean_speed_mm_per_s, 600, 1e-6);
   EXPECT_EQ(r.summary.notes_string_disagree, 1);
   EXPECT_EQ(r.summary.bow_changes, 0);
+  // The same in two parts: the frames once, the notes added (again: replaced, not doubled).
+  BowingResult parts = AnalyzeBowStrokes(scene.model, in, {}).value();
+  EXPECT_TRUE(parts.notes.empty());
+  EXPECT_EQ(parts.summary.notes, 0);
+  EXPECT_EQ(parts.summary.frames_on_string, r.summary.frames_on_string);
+  AddBowingNotes({agree}, {}, &parts);
+  AddBowingNotes(in.notes, {}, &parts);
+  ASSERT_EQ(parts.notes.size(), 2u);
+  EXPECT_EQ(parts.notes[1].bow_string, 2);
+  EXPECT_FALSE(parts.notes[1].strings_agree);
+  EXPECT_EQ(parts.summary.notes, 2);
+  EXPECT_EQ(parts.summary.notes_string_disagree, 1);
+  EXPECT_EQ(parts.summary.bow_changes_at_onsets, r.summary.bow_changes_at_onsets);
 }
 
 TEST(AnalyzeBowing, OffTheStringsUnseenAndBadInput) {
