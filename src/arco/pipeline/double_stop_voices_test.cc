@@ -87,5 +87,47 @@ TEST(VoicesOfFrame, ABowOnTwoStringsTakesTheirPairUnlessALoneOctaveIsHeard) {
   EXPECT_EQ(sixth.bowed_pair_lower_string, 4);
 }
 
+FrameVoices Bowed(double low_midi, double high_midi, int lower_string) {
+  FrameVoices v;
+  v.first = {Hz(low_midi), 1.0};
+  v.upper_f0_hz = Hz(high_midi);
+  v.bowed_pair_lower_string = lower_string;
+  return v;
+}
+
+// The viola chord's lower pair D3 + A3 on the C and G strings (chords, seed 3), heard on
+// every other frame as F#3 + A3: each ghost frame lies between frames of the pair and takes
+// it; the pair's first frame (no frame of it before) and a frame off the bow's pair stay.
+TEST(ConsistentBowedPairs, AGhostBetweenFramesOfThePairTakesThePair) {
+  std::vector<FrameVoices> v = {Bowed(54.2, 57, 4), Bowed(50, 57, 4), Bowed(54.3, 57, 4),
+                                Bowed(50, 57, 4),   Bowed(50, 57, 4), Bowed(54.3, 57, 4),
+                                Bowed(50, 57, 4)};
+  v.push_back(Bowed(54.3, 57, 0));  // the pair of the free analysis, the bow unknown
+  ConsistentBowedPairs(5, &v);
+  EXPECT_NEAR(v[0].first.f0_hz, Hz(54.2), 1e-9);  // no frame of D3 + A3 before it
+  for (size_t f = 1; f < 7; ++f) EXPECT_NEAR(v[f].first.f0_hz, Hz(50), 1e-9) << f;
+  EXPECT_NEAR(v[7].first.f0_hz, Hz(54.3), 1e-9);  // not from the bowed strings
+  EXPECT_EQ(v[2].bowed_pair_lower_string, 4);
+}
+
+// A change of notes under one bow (sixths up the same two strings) is kept: each pair has
+// frames on one side only of the change; the window 0 leaves everything.
+TEST(ConsistentBowedPairs, AChangeOfNotesOnTheSameStringsIsKept) {
+  std::vector<FrameVoices> v;
+  for (int f = 0; f < 6; ++f) v.push_back(Bowed(50, 59, 4));
+  for (int f = 0; f < 6; ++f) v.push_back(Bowed(52, 60, 4));
+  const std::vector<FrameVoices> before = v;
+  ConsistentBowedPairs(5, &v);
+  for (size_t f = 0; f < v.size(); ++f) {
+    EXPECT_EQ(v[f].first.f0_hz, before[f].first.f0_hz) << f;
+    EXPECT_EQ(v[f].upper_f0_hz, before[f].upper_f0_hz) << f;
+  }
+  std::vector<FrameVoices> ghost = {Bowed(50, 57, 4), Bowed(54, 57, 4), Bowed(50, 57, 4)};
+  ConsistentBowedPairs(0, &ghost);
+  EXPECT_NEAR(ghost[1].first.f0_hz, Hz(54), 1e-9);
+  ConsistentBowedPairs(1, &ghost);
+  EXPECT_NEAR(ghost[1].first.f0_hz, Hz(50), 1e-9);
+}
+
 }  // namespace
 }  // namespace arco::pipeline

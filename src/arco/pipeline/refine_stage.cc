@@ -1,8 +1,10 @@
 #include "arco/pipeline/refine_stage.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <vector>
@@ -259,6 +261,8 @@ namespace {
 
 // Within half a semitone (audio/double_stops.h's notes are each within a few cents of the
 // single-note tracker's reading of the same note).
+double MidiOf(double f0_hz) { return 69.0 + 12.0 * std::log2(f0_hz / 440.0); }
+
 bool SameNote(double a_hz, double b_hz) {
   return a_hz > 0 && b_hz > 0 && std::abs(12.0 * std::log2(a_hz / b_hz)) < 0.5;
 }
@@ -307,6 +311,53 @@ FrameVoices VoicesOfFrame(const audio::PolyPitchFrame& poly,
   return out;
 }
 
+void ConsistentBowedPairs(int window_frames, std::vector<FrameVoices>* voices) {
+  if (window_frames <= 0) return;
+  const std::vector<FrameVoices> heard = *voices;
+  const int64_t n = static_cast<int64_t>(heard.size());
+  auto key = [&](int64_t j) {
+    return std::array<int64_t, 2>{std::llround(MidiOf(heard[j].first.f0_hz)),
+                                  std::llround(MidiOf(heard[j].upper_f0_hz))};
+  };
+  for (int64_t i = 0; i < n; ++i) {
+    const int strings = heard[i].bowed_pair_lower_string;
+    if (strings <= 0) continue;
+    const int64_t lo = std::max<int64_t>(0, i - window_frames);
+    const int64_t hi = std::min<int64_t>(n - 1, i + window_frames);
+    // The window's pairs on the same two strings: frames per pair, and on which sides.
+    std::map<std::array<int64_t, 2>, std::array<int, 3>> support;  // frames, before, after
+    for (int64_t k = lo; k <= hi; ++k) {
+      if (heard[k].bowed_pair_lower_string != strings) continue;
+      std::array<int, 3>& s = support[key(k)];
+      ++s[0];
+      s[1] += k < i;
+      s[2] += k > i;
+    }
+    const auto own = key(i);
+    const int own_support = support[own][0];
+    std::array<int64_t, 2> best{};
+    int best_support = 0;
+    for (const auto& [k, s] : support) {
+      if (k == own || s[1] == 0 || s[2] == 0 || s[0] <= own_support) continue;
+      if (s[0] > best_support) best = k, best_support = s[0];
+    }
+    if (best_support == 0) continue;
+    for (int64_t d = 1; d <= window_frames; ++d) {  // its nearest frame, the earlier first
+      const int64_t j = i - d >= lo && heard[i - d].bowed_pair_lower_string == strings &&
+                                key(i - d) == best
+                            ? i - d
+                        : i + d <= hi && heard[i + d].bowed_pair_lower_string == strings &&
+                                key(i + d) == best
+                            ? i + d
+                            : -1;
+      if (j >= 0) {
+        (*voices)[i] = heard[j];
+        break;
+      }
+    }
+  }
+}
+
 void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
                     RefineInputs* inputs,
                     bool bow_pairs) {
@@ -329,9 +380,14 @@ void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
       }
     }
   }
+  std::vector<FrameVoices> voices(poly.size());
   for (size_t f = 0; f < poly.size(); ++f) {
-    const FrameVoices v =
-        VoicesOfFrame(poly[f], pitch[f], f < rest.size() ? rest[f] : refine::BowRest());
+    voices[f] = VoicesOfFrame(poly[f], pitch[f], f < rest.size() ? rest[f] : refine::BowRest());
+  }
+  ConsistentBowedPairs(static_cast<int>(std::lround(kBowedPairConsistencyS * inputs->input.fps)),
+                       &voices);
+  for (size_t f = 0; f < poly.size(); ++f) {
+    const FrameVoices& v = voices[f];
     pitch[f] = v.first;
     inputs->upper_f0_hz[f] = v.upper_f0_hz;
     if (v.bowed_pair_lower_string > 0) {

@@ -78,6 +78,19 @@ constexpr double kOneStringRestDeg = 1.5;
 FrameVoices VoicesOfFrame(const audio::PolyPitchFrame& poly,
                           const refine::FramePitch& heard,
                           const refine::BowRest& rest);
+// The pairs taken from the bowed strings, made consistent over time (after VoicesOfFrame,
+// before the refinement): the tracker's search on two strings sometimes takes a ghost for
+// one note of the pair (a viola chord's D3 + A3 on its C and G strings heard as F#3 + A3 on
+// every other frame, F#3 the subharmonic of the F#4 still ringing), and the first voice
+// then jumps so often that the pitch model drops the stretch. A frame's pair (its notes to
+// the nearest semitone) bowed on strings s and s - 1 takes the pair found on more frames
+// bowed on the same strings within window_frames of it, on both sides of it (so a change
+// of notes under one bow is kept), from that pair's nearest frame (the earlier on a tie).
+// Decisions are made on the input, so the order of frames plays no part. 0: unchanged.
+void ConsistentBowedPairs(int window_frames, std::vector<FrameVoices>* voices);
+// Its window each side (rounded to frames at the video's fps): audio/double_stops.h's
+// consistency_s for the free pairs.
+constexpr double kBowedPairConsistencyS = 0.17;
 // Errors name the file: no hand or instrument stage, shapes that disagree, a
 // double_stops.csv with more rows than frames. With double_stops.csv, AddDoubleStops.
 StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir);
