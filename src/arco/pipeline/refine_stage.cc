@@ -261,11 +261,12 @@ namespace {
 
 // Within half a semitone (audio/double_stops.h's notes are each within a few cents of the
 // single-note tracker's reading of the same note).
-double MidiOf(double f0_hz) { return 69.0 + 12.0 * std::log2(f0_hz / 440.0); }
-
 bool SameNote(double a_hz, double b_hz) {
-  return a_hz > 0 && b_hz > 0 && std::abs(12.0 * std::log2(a_hz / b_hz)) < 0.5;
+  return a_hz > 0 && b_hz > 0 && std::abs(CentsBetween(b_hz, a_hz)) < 50.0;
 }
+
+// A note to the nearest semitone (a key: only equality matters, so A4 = 440 Hz will do).
+int64_t Semitone(double f0_hz) { return std::llround(CentsBetween(440.0, f0_hz) / 100.0); }
 
 }  // namespace
 
@@ -316,8 +317,7 @@ void ConsistentBowedPairs(int window_frames, std::vector<FrameVoices>* voices) {
   const std::vector<FrameVoices> heard = *voices;
   const int64_t n = static_cast<int64_t>(heard.size());
   auto key = [&](int64_t j) {
-    return std::array<int64_t, 2>{std::llround(MidiOf(heard[j].first.f0_hz)),
-                                  std::llround(MidiOf(heard[j].upper_f0_hz))};
+    return std::array<int64_t, 2>{Semitone(heard[j].first.f0_hz), Semitone(heard[j].upper_f0_hz)};
   };
   for (int64_t i = 0; i < n; ++i) {
     const int strings = heard[i].bowed_pair_lower_string;
@@ -342,14 +342,11 @@ void ConsistentBowedPairs(int window_frames, std::vector<FrameVoices>* voices) {
       if (s[0] > best_support) best = k, best_support = s[0];
     }
     if (best_support == 0) continue;
+    auto holds_best = [&](int64_t j) {
+      return j >= lo && j <= hi && heard[j].bowed_pair_lower_string == strings && key(j) == best;
+    };
     for (int64_t d = 1; d <= window_frames; ++d) {  // its nearest frame, the earlier first
-      const int64_t j = i - d >= lo && heard[i - d].bowed_pair_lower_string == strings &&
-                                key(i - d) == best
-                            ? i - d
-                        : i + d <= hi && heard[i + d].bowed_pair_lower_string == strings &&
-                                key(i + d) == best
-                            ? i + d
-                            : -1;
+      const int64_t j = holds_best(i - d) ? i - d : holds_best(i + d) ? i + d : -1;
       if (j >= 0) {
         (*voices)[i] = heard[j];
         break;
@@ -384,8 +381,9 @@ void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
   for (size_t f = 0; f < poly.size(); ++f) {
     voices[f] = VoicesOfFrame(poly[f], pitch[f], f < rest.size() ? rest[f] : refine::BowRest());
   }
-  ConsistentBowedPairs(static_cast<int>(std::lround(kBowedPairConsistencyS * inputs->input.fps)),
-                       &voices);
+  ConsistentBowedPairs(
+      static_cast<int>(std::lround(audio::DoubleStopOptions().consistency_s * inputs->input.fps)),
+      &voices);
   for (size_t f = 0; f < poly.size(); ++f) {
     const FrameVoices& v = voices[f];
     pitch[f] = v.first;

@@ -87,10 +87,9 @@ FrameVoices VoicesOfFrame(const audio::PolyPitchFrame& poly,
 // bowed on the same strings within window_frames of it, on both sides of it (so a change
 // of notes under one bow is kept), from that pair's nearest frame (the earlier on a tie).
 // Decisions are made on the input, so the order of frames plays no part. 0: unchanged.
+// AddDoubleStops' window each side is the free pairs' (audio::DoubleStopOptions'
+// default consistency_s, rounded to frames at the video's fps).
 void ConsistentBowedPairs(int window_frames, std::vector<FrameVoices>* voices);
-// Its window each side (rounded to frames at the video's fps): audio/double_stops.h's
-// consistency_s for the free pairs.
-constexpr double kBowedPairConsistencyS = 0.17;
 // Errors name the file: no hand or instrument stage, shapes that disagree, a
 // double_stops.csv with more rows than frames. With double_stops.csv, AddDoubleStops.
 StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir);

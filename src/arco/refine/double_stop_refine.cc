@@ -15,8 +15,8 @@ namespace arco::refine {
 namespace {
 
 constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
-// Upper notes within this of each other are the same note (step 0a).
-constexpr double kSameUpperSemitones = 0.5;
+// Upper notes within half a semitone of each other are the same note (steps 0a, 0c).
+bool SameUpper(double a_hz, double b_hz) { return std::abs(CentsBetween(b_hz, a_hz)) <= 50.0; }
 
 // Semitones of f0_hz above the open pitch of `string`.
 double SemitonesAboveOpen(const InstrumentModel& model, int string, double f0_hz) {
@@ -379,9 +379,11 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
   // double stop): its median upper f0, where that lies above the frame's own pitch.
   std::map<int, std::vector<double>> note_upper, note_unheard_octave;
   std::map<int, int> note_frames, note_on_pair;
+  std::map<int, size_t> note_first_frame;
   for (size_t f = 0; f < frames; ++f) {
     const int note = first.contacts[f].note;
     if (note < 0) continue;
+    note_first_frame.emplace(note, f);
     ++note_frames[note];
     note_on_pair[note] += on_pair[f];
     if (upper_f0_hz[f] > 0 && !one_string[f]) note_upper[note].push_back(upper_f0_hz[f]);
@@ -404,21 +406,16 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
       std::vector<double> with_octaves = values;
       with_octaves.insert(with_octaves.end(), unheard->second.begin(), unheard->second.end());
       const double octave = UpperMedian(unheard->second);
-      if (std::abs(12.0 * std::log2(UpperMedian(with_octaves) / octave)) <= kSameUpperSemitones) {
+      if (SameUpper(UpperMedian(with_octaves), octave)) {
         values = std::move(with_octaves);
         out.summary.bow_octaves += static_cast<int>(unheard->second.size());
       }
     }
     const double median = UpperMedian(values);
     note_median[note] = median;
-    const auto near = std::count_if(values.begin(), values.end(), [median](double hz) {
-      return std::abs(12.0 * std::log2(hz / median)) <= kSameUpperSemitones;
-    });
+    const auto near = std::count_if(values.begin(), values.end(),
+                                    [median](double hz) { return SameUpper(hz, median); });
     note_agrees[note] = 3 * near >= 2 * static_cast<int64_t>(values.size());
-  }
-  std::map<int, size_t> note_first_frame;
-  for (size_t f = frames; f-- > 0;) {
-    if (first.contacts[f].note >= 0) note_first_frame[first.contacts[f].note] = f;
   }
   const double attack_frames = options.attack_s * input.fps;
   // Step 0c: a note bowed on two strings on most of its frames that the tracker heard as
@@ -448,8 +445,7 @@ DoubleStopRefineResult RefineSecondVoice(const RefineInput& input,
     if (upper > 0 && c1.note >= 0 && note_agrees[c1.note] && !one_string[f] &&
         static_cast<double>(f - note_first_frame[c1.note]) < attack_frames) {
       const double median = note_median[c1.note];
-      if (std::abs(12.0 * std::log2(upper / median)) > kSameUpperSemitones &&
-          median > 1.03 * c1.f0_hz) {
+      if (!SameUpper(upper, median) && median > 1.03 * c1.f0_hz) {
         upper = median;
         ++out.summary.attack_frames;
       }
