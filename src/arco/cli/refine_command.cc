@@ -123,6 +123,11 @@ std::function<int()> SetupRefine(CLI::App& app) {
                 r.decode.hand_frame_in_mm,
                 "arco decoding: the hand frame's finger spacing in semitones on every "
                 "instrument (the former rule), not in mm on the cello and the double bass");
+  sub->add_flag("!--no-gap-bridging",
+                r.decode.bridge_short_gaps,
+                "arco decoding: frames of a short gap between two notes on one string join "
+                "the next note only where the fitted fingertip is near its contact (the former "
+                "rule), not wherever they hear that note, however unsurely");
   sub->add_flag("!--whole-hand-shift",
                 r.ik.detected_hand_shift,
                 "arco: move the whole hand by all of the offset its finger cannot reach (the "

@@ -7,12 +7,16 @@
 #include <cstdlib>
 #include <limits>
 
+#include "arco/instrument/instrument_model.h"
 #include "arco/util/parallel.h"
 #include "arco/util/stats.h"
 #include "arco/util/viterbi.h"
 
 namespace arco::refine {
 namespace {
+
+// A pitch within half a semitone of a note is that note (the nearest-note rounding).
+constexpr double kHalfSemitoneCents = 50.0;
 
 // One camera (RefineInput::one_view_camera_centre_mm): the lifted hand's depth is what the
 // view lacks, so a candidate is compared with the hand scaled about the camera's centre
@@ -359,6 +363,21 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
         break;
       }
     }
+    // A gap of untrusted frames no longer than onset_lead_frames after a stopped frame on
+    // this note's string (header comment): its frames that hear the note skip the
+    // fitted-tip test.
+    bool bridged = false;
+    if (options.bridge_short_gaps) {
+      int64_t g = note.first_frame - 1;
+      while (g >= 0 && g >= note.first_frame - options.onset_lead_frames &&
+             !out[static_cast<size_t>(g)].pressed() &&
+             out[static_cast<size_t>(g)].state != ContactState::kOpenString) {
+        --g;
+      }
+      const FrameContact* before = g >= 0 ? &out[static_cast<size_t>(g)] : nullptr;
+      bridged = before && g < note.first_frame - 1 && before->pressed() && before->finger > 0 &&
+                before->string == st.string;
+    }
     for (int64_t f = note.first_frame - 1;
          f >= 0 && f >= note.first_frame - options.onset_lead_frames;
          --f) {
@@ -383,8 +402,15 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
       AssignFrame(
           context, options, st.string, st.finger, onset_hz, pitch_options, lift_max_mm, f, &lead);
       // Only where the fitted finger is already near its contact (not still on its way),
-      // and nearer than to the previous note's contact.
-      if (!lead.pressed() || !(lead.tip_distance_vision_mm <= lead_max_mm)) break;
+      // and nearer than to the previous note's contact; in a short gap that hears the note
+      // whatever the fitted hand says (header comment).
+      if (!lead.pressed()) break;
+      // The tracker hears this note there, if not confidently (half a semitone).
+      const bool hears_note =
+          input.pitch[i].f0_hz > 0 &&
+          std::abs(CentsBetween(onset_hz, input.pitch[i].f0_hz)) <= kHalfSemitoneCents;
+      const bool bridge = bridged && untrusted && hears_note;
+      if (!bridge && !(lead.tip_distance_vision_mm <= lead_max_mm)) break;
       const double margin = untrusted ? 0.0 : options.handover_margin_mm;
       if (out[i].pressed() &&
           !(lead.tip_distance_vision_mm < out[i].tip_distance_vision_mm - margin)) {

@@ -35,7 +35,14 @@
 // frame get the note's contact too (kBeforeOnset): the finger lands before the sound.
 // With the audio's onsets, frames still with the previous note are not handed over.
 // Only where the fitted tip is no more than onset_lead_margin_mm farther from the contact
-// than its median over the note (the hand is already in place).
+// than its median over the note (the hand is already in place), except in a short gap
+// (bridge_short_gaps): when every frame between a stopped frame on the note's string and
+// the note is untrusted and there are at most onset_lead_frames of them, those whose own
+// pitch, however unsure, is within half a semitone of the note's first trusted frame join
+// the note whatever the fitted hand says. The tracker hears the note coming; a poorly
+// fitted hand (the real take's harsh detector errors) would otherwise leave them
+// uncertain. A gap that is unvoiced, or hears another note (a short note the tracker
+// missed, on another string), keeps the fitted-tip test.
 // Glides: a transition frame (kNoteBoundary, kBeforeOnset) with a frame of another note on
 // either side within glide_frames (the nearest non-transition pressed frames, both on its
 // string) is where the stopping point moves from one note's place to the other's: its

@@ -349,6 +349,7 @@ Json ToJson(const RefineOptions& o) {
             {"infeasible_cost", o.decode.infeasible_cost},
             {"onset_lead_frames", o.decode.onset_lead_frames},
             {"onset_lead_margin_mm", o.decode.onset_lead_margin_mm},
+            {"bridge_short_gaps", o.decode.bridge_short_gaps},
             {"handover_margin_mm", JsonFromDouble(o.decode.handover_margin_mm)},  // inf: off
             {"glide_frames", o.decode.glide_frames},
             {"audio_onsets", o.decode.audio_onsets},

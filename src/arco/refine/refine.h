@@ -140,6 +140,11 @@ struct ArcoDecodeOptions {
   // contact than its median over the note (the finger is already there, not on its way).
   int onset_lead_frames = 3;
   double onset_lead_margin_mm = 10.0;
+  // A gap of at most onset_lead_frames untrusted frames between a stopped frame on a note's
+  // string and the note: its frames that hear the note (within half a semitone, at any
+  // confidence) join it without the fitted-tip test (arco_decode.h); false: the test
+  // everywhere, the former rule.
+  bool bridge_short_gaps = true;
   // The previous note's last (trusted) frame is handed over to the next note when the
   // next finger's fitted tip is nearer its contact by more than this (the sound lags the
   // hand by up to a frame); infinity disables it.

@@ -404,6 +404,45 @@ TEST(Refine, TheFingerLandsBeforeTheTrackerLocksOn) {
   }
 }
 
+TEST(Refine, AShortGapThatHearsTheNextNoteKeepsTheStringStopped) {
+  // Two notes on the D string; the tracker hears the second one's first three frames only
+  // faintly, and the fitted hand on them is 35 mm off (a poor fit), so the fitted-tip test
+  // would leave them uncertain.
+  const std::vector<SceneNote> notes = {{2, 1, 2, 20}, {2, 3, 4, 20}};
+  for (const bool hears_the_note : {true, false}) {
+    testing::Scene scene = Cello(notes);
+    for (int f = 20; f < 23; ++f) {
+      FramePitch& p = scene.input.pitch[static_cast<size_t>(f)];
+      // Otherwise it hears a note a fifth above (a short note the tracker missed).
+      if (!hears_the_note) p.f0_hz *= std::exp2(7.0 / 12.0);
+      p.confidence = 0.1;
+      scene.input.vision_hand[static_cast<size_t>(f)]->world_from_wrist.translation +=
+          Eigen::Vector3d(0, 35, 0);
+    }
+    for (const bool bridge : {true, false}) {
+      RefineOptions options = Options(RefineMode::kArco);
+      options.decode.bridge_short_gaps = bridge;
+      const RefineResult r = Refine(scene.input, options);
+      for (int f = 20; f < 23; ++f) {
+        const FrameContact& c = r.contacts[static_cast<size_t>(f)];
+        if (bridge && hears_the_note) {
+          EXPECT_TRUE(c.pressed()) << "frame " << f;
+          // The contact is kept; the hand so far off may not reach it (kept unreachable).
+          EXPECT_TRUE(c.reason == ContactReason::kBeforeOnset ||
+                      c.reason == ContactReason::kOutOfReach)
+              << ContactReasonName(c.reason);
+          EXPECT_EQ(c.string, 2);
+          EXPECT_EQ(c.finger, 3);
+          EXPECT_LT((c.point_in_world_mm - scene.truth_contact[static_cast<size_t>(f)]).norm(),
+                    1e-6);
+        } else {
+          EXPECT_EQ(c.state, ContactState::kUncertain) << "frame " << f << " bridge " << bridge;
+        }
+      }
+    }
+  }
+}
+
 TEST(Refine, UnplayablePitchAndMissingStringsGiveNoContact) {
   const std::vector<SceneNote> notes = {{2, 1, 2, 20}, {2, 2, 3, 20}};
   testing::Scene scene = Cello(notes);
