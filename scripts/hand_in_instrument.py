@@ -11,12 +11,16 @@ Prints per method: the median over frames of the 21 joints' mean error (mm), the
 of all frames within 15 mm, and the fraction of frames with a hand; then where that error
 lies: the wrist's median signed offset along the strings (+: toward the nut), across them
 and off the top, and the median error left once each frame's mean offset (the hand's
-translation) is taken away (the hand's orientation and shape). As a module:
+translation) is taken away (the hand's orientation and shape); then (paper, arco) the
+contact point against SPD's, each in its own instrument's frame (the truth folder's
+contact.csv beside TRUTH_POINTS3D). As a module:
 left_hand_in_instrument(result_dir, truth_points3d, method) -> those three numbers;
 left_hand_error_parts(result_dir, truth_points3d, method) -> (wrist offset x, y, z,
-error without the translation).
+error without the translation); contact_in_instrument(result_dir, truth_points3d, method)
+-> (mean, median, fraction within 5 mm, frames).
 """
 import json
+import os
 import sys
 
 import numpy as np
@@ -74,6 +78,34 @@ def left_hand_in_instrument(result_dir, truth_points3d, method):
             float(fitted.mean()))
 
 
+def contact_in_instrument(result_dir, truth_points3d, method):
+    """The method's contact point against SPD's, each in its own instrument's frame, over
+    the frames both call pressed: (mean, median, fraction within 5 mm, frames)."""
+    import csv
+    names = json.load(open(result_dir + "/result.json"))["keypoint_names"]
+    col = names.index
+    ours = np.load("%s/%s/points3d.npy" % (result_dir, method))
+    truth = np.load(truth_points3d)
+    ours_frame, truth_frame = _frame(ours, col), _frame(truth, col)
+    got_rows = list(csv.DictReader(open("%s/%s/contacts.csv" % (result_dir, method))))
+    want_rows = list(csv.DictReader(open(os.path.join(os.path.dirname(truth_points3d),
+                                                      "contact.csv"))))
+    point = lambda r: np.array([float(r["contact_%s_mm" % c]) for c in "xyz"])
+    errors = []
+    for f, (got, want) in enumerate(zip(got_rows, want_rows)):
+        if got["state"] != "pressed" or want["state"] != "pressed":
+            continue
+        g = ours_frame[1][f] @ (point(got) - ours_frame[0][f])
+        w = truth_frame[1][f] @ (point(want) - truth_frame[0][f])
+        if np.isfinite(g).all() and np.isfinite(w).all():
+            errors.append(np.linalg.norm(g - w))
+    if not errors:
+        return float("nan"), float("nan"), 0.0, 0
+    errors = np.array(errors)
+    return (float(errors.mean()), float(np.median(errors)), float(np.mean(errors <= 5)),
+            len(errors))
+
+
 if __name__ == "__main__":
     for m in sys.argv[3:] or ["vision", "paper", "arco"]:
         median, within, fitted = left_hand_in_instrument(sys.argv[1], sys.argv[2], m)
@@ -83,3 +115,8 @@ if __name__ == "__main__":
         print("%-6s wrist off by %+.1f / %+.1f / %+.1f mm (along toward the nut / across / off "
               "the top), %.1f mm once each frame's translation is taken away"
               % (m, x, y, z, shape))
+        if os.path.exists("%s/%s/contacts.csv" % (sys.argv[1], m)) and m != "vision":
+            mean, median, within, n = contact_in_instrument(sys.argv[1], sys.argv[2], m)
+            print("%-6s contact %.2f mm from SPD's in the instrument's frame (median %.2f), "
+                  "within 5 mm on %.3f of the %d frames both call pressed"
+                  % (m, mean, median, within, n))

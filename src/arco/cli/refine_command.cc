@@ -214,6 +214,13 @@ std::function<int()> SetupRefine(CLI::App& app) {
             "arco decoding: cost per semitone of hand-position change between notes (mm)",
             refine::kCostWeightRange)
       ->capture_default_str();
+  AddNumber(sub,
+            "--one-view-max-shift-factor",
+            r.decode.one_view_max_shift_factor,
+            "arco decoding, one camera: the shift cost times 1 / sin^2 of the angle between the "
+            "strings and the camera's ray, at most this (1: as with several cameras)",
+            refine::kCostWeightRange)
+      ->capture_default_str();
   sub->parse_complete_callback([a] { ApplyAndValidate(*a); });
   return [a]() { return RunRefine(*a); };
 }

@@ -148,6 +148,32 @@ std::vector<State> NoteStates(const DecodeContext& context,
   return states;
 }
 
+// One camera (header comment, "One camera"): 1 / sin^2 of the angle between the strings and
+// the camera's ray to their middle (the median over the frames with strings), at most
+// one_view_max_shift_factor; 1 with several cameras.
+double OneViewShiftFactor(const DecodeContext& context, const ArcoDecodeOptions& options) {
+  const auto& centre = context.input->one_view_camera_centre_mm;
+  if (!centre || !(options.one_view_max_shift_factor > 1)) return 1.0;
+  std::vector<double> sines;
+  for (int f = 0; f < context.num_frames(); ++f) {
+    if (!context.has_strings[static_cast<size_t>(f)]) continue;
+    Eigen::Vector3d nut = Eigen::Vector3d::Zero(), bridge = Eigen::Vector3d::Zero();
+    for (const StringSegment& s : context.strings(f)) {
+      nut += s.nut;
+      bridge += s.bridge;
+    }
+    const Eigen::Vector3d along = (nut - bridge).normalized();
+    const Eigen::Vector3d ray =
+        (0.5 * (nut + bridge) / static_cast<double>(context.strings(f).size()) - *centre)
+            .normalized();
+    const double sine = along.cross(ray).norm();
+    if (std::isfinite(sine)) sines.push_back(sine);
+  }
+  if (sines.empty()) return 1.0;
+  const double sine = Median(sines);
+  return std::clamp(1.0 / (sine * sine), 1.0, options.one_view_max_shift_factor);
+}
+
 double TransitionCost(const NoteSpan& from_note,
                       const NoteSpan& to_note,
                       const State& a,
@@ -299,13 +325,20 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
   auto note_at = [&](size_t c) -> const NoteSpan& {
     return notes[static_cast<size_t>(usable[static_cast<size_t>(chain[c])])];
   };
+  // One camera: the hand's shifts cost more, the more the view foreshortens the strings.
+  ArcoDecodeOptions transition_options = options;
+  transition_options.shift_cost_per_semitone *= OneViewShiftFactor(context, options);
   const std::vector<int> chosen =
       DecodeViterbi(
           num_states,
           [&](size_t c, int k) { return state_at(c, k).cost; },
           [&](size_t c, int j, int k) {
-            return TransitionCost(
-                note_at(c - 1), note_at(c), state_at(c - 1, j), state_at(c, k), options, input.fps);
+            return TransitionCost(note_at(c - 1),
+                                  note_at(c),
+                                  state_at(c - 1, j),
+                                  state_at(c, k),
+                                  transition_options,
+                                  input.fps);
           })
           .states;
 

@@ -51,6 +51,12 @@
 // note's contact stays (an untrusted pitch says nothing; the finger may have landed). On
 // a real take (SPD cello01) the note's pitch put such frames 14-18 mm from SPD's contact
 // (docs/refine.md).
+// One camera (RefineInput::one_view_camera_centre_mm): candidates are compared along the
+// camera's rays (ArcoDecodeOptions::one_view_along_rays), and the shift cost is multiplied
+// by 1 / sin^2 of the angle between the strings and the camera's ray to their middle (the
+// median over the frames), at most one_view_max_shift_factor: a move along the strings is
+// foreshortened by sin theta in the view, so the view tells sin^2 theta of what several do
+// about the hand's place along the string, and the prior that the hand stays weighs more.
 #pragma once
 
 #include <array>

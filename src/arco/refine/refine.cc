@@ -166,7 +166,8 @@ Status ArcoDecodeOptions::Validate() const {
       {"rest_gap_s", rest_gap_s},
       {"rest_factor", rest_factor},
       {"infeasible_cost", infeasible_cost},
-      {"onset_lead_margin_mm", onset_lead_margin_mm}};
+      {"onset_lead_margin_mm", onset_lead_margin_mm},
+      {"one_view_max_shift_factor", one_view_max_shift_factor}};
   for (const auto& [name, value] : values) {
     ARCO_RETURN_IF_ERROR(
         CheckInRange(name, value, kCostWeightRange).WithContext("arco decode options"));
@@ -354,6 +355,7 @@ Json ToJson(const RefineOptions& o) {
             {"glide_frames", o.decode.glide_frames},
             {"audio_onsets", o.decode.audio_onsets},
             {"one_view_along_rays", o.decode.one_view_along_rays},
+            {"one_view_max_shift_factor", o.decode.one_view_max_shift_factor},
             {"bowed_pair_string", o.decode.bowed_pair_string},
             {"boundaries",
              {{"onset_tolerance_s", o.decode.boundaries.onset_tolerance_s},

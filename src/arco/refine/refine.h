@@ -162,6 +162,10 @@ struct ArcoDecodeOptions {
   // candidate's): one view tells where a fingertip is across its ray, not along it.
   // false: the lifted hand as it is (the former rule). No effect with several cameras.
   bool one_view_along_rays = true;
+  // One camera: shift_cost_per_semitone times 1 / sin^2 of the angle between the strings
+  // and the camera's ray to them, at most this (arco_decode.h, "One camera"); 1: the
+  // cameras' cost. No effect with several cameras.
+  double one_view_max_shift_factor = 8.0;
   // Note boundaries from the audio's onsets (note_boundaries.h), when the input has them.
   bool audio_onsets = true;
   NoteBoundaryOptions boundaries;
