@@ -47,10 +47,10 @@ StatusOr<NpyArray<double>> FitBody(const RefineInputs& inputs, int num_threads) 
   return std::move(fit.points_mm);
 }
 
-// The bow arm from the triangulated frog and tip and the placed strings, without notes
-// (refine::AnalyzeBowStrokes; refine::AddBowingNotes adds the refinement's).
-StatusOr<refine::BowingResult> AnalyzeBow(const RefineInputs& inputs,
-                                          const refine::BowingOptions& options) {
+}  // namespace
+
+Status AnalyzeBowArm(const refine::BowingOptions& options, RefineInputs* inputs_out) {
+  const RefineInputs& inputs = *inputs_out;
   const InstrumentModel& m = *inputs.instrument;
   const std::vector<std::string>& names = m.keypoint_names();
   const auto frog = std::find(names.begin(), names.end(), "frog");
@@ -73,10 +73,11 @@ StatusOr<refine::BowingResult> AnalyzeBow(const RefineInputs& inputs,
   in.strings_in_world_mm = inputs.input.strings_in_world_mm;
   in.fps = inputs.input.fps;
   in.start_s = inputs.input.start_s;
-  return refine::AnalyzeBowStrokes(m, in, options);
+  ARCO_ASSIGN_OR_RETURN(refine::BowingResult bow, refine::AnalyzeBowStrokes(m, in, options));
+  inputs_out->bow = std::move(bow);
+  inputs_out->bowing_options = options;
+  return Status::Ok();
 }
-
-}  // namespace
 
 Status RefineStageOptions::Validate() const {
   if (result_dir.empty()) return Status::Error("result_dir is empty");
@@ -84,7 +85,8 @@ Status RefineStageOptions::Validate() const {
   return refine.Validate();
 }
 
-StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
+StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir,
+                                        const refine::BowingOptions& bowing) {
   const ResultFolder result(result_dir);
   ARCO_ASSIGN_OR_RETURN(const bool has_hand, result.HasStage(kHandStage));
   if (!has_hand) {
@@ -126,6 +128,7 @@ StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir) {
   ARCO_ASSIGN_OR_RETURN(RefineInputs inputs, MakeRefineInputs(result_dir, records));
   // double_stops.csv (`arco run --double-stops`): the two voices the run refined.
   if (has_pitch) {
+    ARCO_RETURN_IF_ERROR(AnalyzeBowArm(bowing, &inputs));
     ARCO_ASSIGN_OR_RETURN(const std::vector<audio::PolyPitchFrame> double_stops,
                           result.ReadDoubleStops());
     if (double_stops.size() > inputs.input.pitch.size()) {
@@ -367,10 +370,9 @@ void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
   inputs->input.bowed_pair_lower_string.clear();
   // Where the bow rests per frame; none when the layout has no bow or its frames differ.
   std::vector<refine::BowRest> rest;
-  if (bow_pairs && inputs->instrument != nullptr) {
-    const StatusOr<refine::BowingResult> bow =
-        AnalyzeBow(*inputs, refine::BowingOptions());
-    if (bow.ok() && bow->frames.size() == pitch.size()) {
+  if (bow_pairs && inputs->instrument != nullptr && inputs->bow) {
+    const std::optional<refine::BowingResult>& bow = inputs->bow;
+    if (bow->frames.size() == pitch.size()) {
       for (const refine::BowingFrame& bf : bow->frames) {
         rest.push_back(bf.string > 0 ? refine::BowRestOf(*inputs->instrument, bf.inclination_deg)
                                      : refine::BowRest());
@@ -398,32 +400,34 @@ void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
 
 StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
                                                const RefineInputs& inputs,
-                                               const refine::RefineOptions& options,
-                                               const refine::BowingOptions& bowing) {
+                                               const refine::RefineOptions& options) {
   const ResultFolder result(result_dir);
   if (options.mode != refine::RefineMode::kVision && !inputs.has_pitch) {
     return Status::Error(result.ManifestPath() +
                          ": no pitch stage (the capture has no audio); only vision can be written");
   }
-  ARCO_ASSIGN_OR_RETURN(const MethodRecord record, RefineMethod(inputs, options, bowing));
+  ARCO_ASSIGN_OR_RETURN(const MethodRecord record, RefineMethod(inputs, options));
   ARCO_RETURN_IF_ERROR(result.WriteMethod(record));
   return record.summary;
 }
 
 StatusOr<MethodRecord> RefineMethod(const RefineInputs& inputs,
-                                    const refine::RefineOptions& options,
-                                    const refine::BowingOptions& bowing) {
+                                    const refine::RefineOptions& options) {
   if (options.mode != refine::RefineMode::kVision && !inputs.has_pitch) {
     throw std::invalid_argument(std::string("RefineMethod: ") +
                                 refine::RefineModeName(options.mode) +
                                 " needs the pitch stage's inputs");
   }
   refine::RefineResult r = refine::Refine(inputs.input, options);
-  // arco's bow arm, analysed once: its frames do not depend on the notes (bowing.csv gets
-  // the final notes below; the double stops' bow gate, step 00, reads the inclinations).
+  // arco's bow arm, analysed once (AnalyzeBowArm): its frames do not depend on the notes
+  // (bowing.csv gets the final notes below; the double stops' bow gate, step 00, reads the
+  // inclinations).
   std::optional<refine::BowingResult> bow;
   if (options.mode == refine::RefineMode::kArco) {
-    ARCO_ASSIGN_OR_RETURN(bow, AnalyzeBow(inputs, bowing));
+    if (!inputs.bow) {
+      throw std::invalid_argument("RefineMethod: arco needs the bow arm (AnalyzeBowArm)");
+    }
+    bow = inputs.bow;
   }
   // arco with double stops: the upper notes' strings, fingers and the second finger's IK.
   std::vector<refine::FrameContact> second;
@@ -483,9 +487,9 @@ StatusOr<MethodRecord> RefineMethod(const RefineInputs& inputs,
   if (inputs.input.audio_notes.empty()) out.options.decode.audio_onsets = false;
   out.summary = r.summary;
   if (bow) {
-    refine::AddBowingNotes(r.fingering, bowing, &*bow);
+    refine::AddBowingNotes(r.fingering, inputs.bowing_options, &*bow);
     out.bowing = std::move(bow);
-    out.bowing_options = bowing;
+    out.bowing_options = inputs.bowing_options;
   }
   return out;
 }
@@ -497,8 +501,9 @@ StatusOr<refine::RefineSummary> RunRefineStage(const RefineStageOptions& options
 }
 
 StatusOr<refine::RefineSummary> RunRefineStage(const Validated<RefineStageOptions>& options) {
-  ARCO_ASSIGN_OR_RETURN(RefineInputs inputs, LoadRefineInputs(options->result_dir));
-  return RefineAndWrite(options->result_dir, inputs, options->refine, options->bowing);
+  ARCO_ASSIGN_OR_RETURN(RefineInputs inputs,
+                        LoadRefineInputs(options->result_dir, options->bowing));
+  return RefineAndWrite(options->result_dir, inputs, options->refine);
 }
 
 }  // namespace arco::pipeline

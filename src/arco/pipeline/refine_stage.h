@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "arco/audio/double_stops.h"
@@ -39,22 +40,30 @@ struct RefineInputs {
   // Frames whose two notes AddDoubleStops took from the pair heard on the strings the bow
   // rests on (DoubleStopRefineSummary::bow_pairs).
   int bow_pair_frames = 0;
+  // arco's bow arm (refine/bowing.h: strokes, without notes), analysed once by
+  // AnalyzeBowArm with bowing_options: AddDoubleStops' bow gate and arco's bowing.csv read
+  // it. Empty until then (vision and paper need none).
+  std::optional<refine::BowingResult> bow;
+  refine::BowingOptions bowing_options;
 };
+
+// Analyses the bow arm from the triangulated frog and tip and the placed strings
+// (refine::AnalyzeBowStrokes) into inputs->bow, with these options. Errors: the
+// instrument's layout has no frog and tip.
+Status AnalyzeBowArm(const refine::BowingOptions& options, RefineInputs* inputs);
 
 // Puts a polyphonic tracker's two notes (audio/double_stops.h, one frame per video frame;
 // the pitch stage's double_stops.csv, read back by LoadRefineInputs) into the inputs: on
 // each frame with two notes, the lower becomes the frame's pitch (confidence 1: both notes
-// were found) and the upper goes to upper_f0_hz. With bow_pairs, a frame whose bow (the
-// triangulated frog and tip against the strings, refine/bowing.h with its default options)
-// rests on two adjacent strings s and s + 1 (refine::BowRestOf) takes the pair the tracker
-// heard as played on those strings (PolyPitchFrame::on_strings), where it heard one,
-// whatever the free analysis found, and input.bowed_pair_lower_string the pair's lower
-// string (the first voice's): the bow says which strings sound, the free analysis
-// often hears a pair's partial or a ghost an octave away as one of its notes
-// (docs/accuracy.md, "Double stops"); a frame whose bow clearly rests on one string keeps
-// the single-note tracker's reading unless it is the free pair's lower note
-// (VoicesOfFrame). Throws std::invalid_argument when the frame counts
-// differ.
+// were found) and the upper goes to upper_f0_hz. With bow_pairs and inputs->bow
+// (AnalyzeBowArm), a frame whose bow rests on two adjacent strings s and s + 1
+// (refine::BowRestOf) takes the pair the tracker heard as played on those strings
+// (PolyPitchFrame::on_strings), where it heard one, whatever the free analysis found, and
+// input.bowed_pair_lower_string the pair's lower string (the first voice's): the bow says
+// which strings sound, the free analysis often hears a pair's partial or a ghost an octave
+// away as one of its notes (docs/accuracy.md, "Double stops"); a frame whose bow clearly
+// rests on one string keeps the single-note tracker's reading unless it is the free pair's
+// lower note (VoicesOfFrame). Throws std::invalid_argument when the frame counts differ.
 void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
                     RefineInputs* inputs,
                     bool bow_pairs = true);
@@ -91,8 +100,10 @@ FrameVoices VoicesOfFrame(const audio::PolyPitchFrame& poly,
 // default consistency_s, rounded to frames at the video's fps).
 void ConsistentBowedPairs(int window_frames, std::vector<FrameVoices>* voices);
 // Errors name the file: no hand or instrument stage, shapes that disagree, a
-// double_stops.csv with more rows than frames. With double_stops.csv, AddDoubleStops.
-StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir);
+// double_stops.csv with more rows than frames. With a pitch stage, AnalyzeBowArm (with
+// `bowing`); with double_stops.csv, AddDoubleStops.
+StatusOr<RefineInputs> LoadRefineInputs(const std::string& result_dir,
+                                        const refine::BowingOptions& bowing = {});
 
 // What the refinement reads of stages 1-4, as their files hold it: `arco run` passes
 // the records it made (hands, pitch and notes through their files' encodings, in
@@ -113,22 +124,21 @@ struct StageRecords {
 // `result_dir` names the files in messages (shapes that disagree).
 StatusOr<RefineInputs> MakeRefineInputs(const std::string& result_dir, const StageRecords& records);
 
-// Refines one method (options.mode); arco's also gets the bow arm (refine/bowing.h:
-// bowing.csv, bowing_notes.csv). Writes nothing: the record is what
+// Refines one method (options.mode); arco's also gets the bow arm (inputs.bow with the
+// final notes, refine/bowing.h: bowing.csv, bowing_notes.csv; arco without inputs.bow is
+// a caller bug, std::invalid_argument). Writes nothing: the record is what
 // ResultFolder::WriteMethod writes into RESULT_DIR/<method>/ (record.summary: the method's
 // summary). A method that needs audio on inputs without pitch is a caller bug
 // (std::invalid_argument): RefineAndWrite checks it first. Precondition: the options are
 // valid (RefineStageOptions::Validate: RunCapture and RunRefineStage check them once at
 // their entry); not checked here.
 StatusOr<MethodRecord> RefineMethod(const RefineInputs& inputs,
-                                    const refine::RefineOptions& options,
-                                    const refine::BowingOptions& bowing = {});
+                                    const refine::RefineOptions& options);
 // RefineMethod into the result folder `result_dir`. Errors: a method that needs audio on
 // a result without a pitch stage.
 StatusOr<refine::RefineSummary> RefineAndWrite(const std::string& result_dir,
                                                const RefineInputs& inputs,
-                                               const refine::RefineOptions& options,
-                                               const refine::BowingOptions& bowing = {});
+                                               const refine::RefineOptions& options);
 
 // `arco refine`: the options validated once, here at the entry, then LoadRefineInputs +
 // RefineAndWrite.

@@ -361,6 +361,8 @@ StatusOr<std::vector<MethodRecord>> RunRefineMethods(
         audio::ParseDoubleStopsCsv(audio::FormatDoubleStopsCsv(pitch.double_stops), pitch_path));
   }
   ARCO_ASSIGN_OR_RETURN(RefineInputs inputs, MakeRefineInputs(options.result_dir, stages));
+  // arco's bow arm, once for the double stops' bow gate and arco's bowing.csv.
+  if (inputs.has_pitch) ARCO_RETURN_IF_ERROR(AnalyzeBowArm(refine::BowingOptions(), &inputs));
   if (!double_stops_as_written.empty()) {
     AddDoubleStops(double_stops_as_written, &inputs, refine::DoubleStopRefineOptions().bow_pairs);
   }
