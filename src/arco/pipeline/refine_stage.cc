@@ -371,9 +371,9 @@ void AddDoubleStops(const std::vector<audio::PolyPitchFrame>& poly,
   // Where the bow rests per frame; none when the layout has no bow or its frames differ.
   std::vector<refine::BowRest> rest;
   if (bow_pairs && inputs->instrument != nullptr && inputs->bow) {
-    const std::optional<refine::BowingResult>& bow = inputs->bow;
-    if (bow->frames.size() == pitch.size()) {
-      for (const refine::BowingFrame& bf : bow->frames) {
+    const refine::BowingResult& bow = *inputs->bow;
+    if (bow.frames.size() == pitch.size()) {
+      for (const refine::BowingFrame& bf : bow.frames) {
         rest.push_back(bf.string > 0 ? refine::BowRestOf(*inputs->instrument, bf.inclination_deg)
                                      : refine::BowRest());
       }

@@ -68,6 +68,18 @@ bool SamePose(const std::optional<hand::HandPose>& a, const std::optional<hand::
          a->world_from_wrist.rotation == b->world_from_wrist.rotation;
 }
 
+// The fraction of the truth's pressed frames a result presses with its string and finger.
+double RightStringAndFinger(const testing::Scene& scene, const RefineResult& r) {
+  int pressed = 0, right = 0;
+  for (size_t f = 0; f < r.contacts.size(); ++f) {
+    if (scene.truth_finger[f] == 0) continue;
+    ++pressed;
+    const FrameContact& c = r.contacts[f];
+    right += c.pressed() && c.string == scene.truth_string[f] && c.finger == scene.truth_finger[f];
+  }
+  return static_cast<double>(right) / pressed;
+}
+
 // Frames [first, last] of the scene note `index` (notes laid out back to back).
 std::pair<int, int> NoteFrames(const std::vector<SceneNote>& notes, int index) {
   int first = 0;
@@ -503,16 +515,7 @@ TEST(Refine, OneCameraComparesCandidatesAlongTheCameraRays) {
   const auto right_fraction = [&](bool along_rays) {
     RefineOptions o = Options(RefineMode::kArco);
     o.decode.one_view_along_rays = along_rays;
-    const RefineResult r = Refine(scene.input, o);
-    int pressed = 0, right = 0;
-    for (size_t f = 0; f < r.contacts.size(); ++f) {
-      if (scene.truth_finger[f] == 0) continue;
-      ++pressed;
-      const FrameContact& c = r.contacts[f];
-      right +=
-          c.pressed() && c.string == scene.truth_string[f] && c.finger == scene.truth_finger[f];
-    }
-    return static_cast<double>(right) / pressed;
+    return RightStringAndFinger(scene, Refine(scene.input, o));
   };
   const double along = right_fraction(true), lifted = right_fraction(false);
   std::printf(
@@ -552,16 +555,7 @@ TEST(Refine, OneCameraKeepsTheHandWhereItIsUnlessTheSoundShifts) {
   const auto right_fraction = [&](double factor) {
     RefineOptions o = Options(RefineMode::kArco);
     o.decode.one_view_max_shift_factor = factor;
-    const RefineResult r = Refine(scene.input, o);
-    int pressed = 0, right = 0;
-    for (size_t f = 0; f < r.contacts.size(); ++f) {
-      if (scene.truth_finger[f] == 0) continue;
-      ++pressed;
-      const FrameContact& c = r.contacts[f];
-      right +=
-          c.pressed() && c.string == scene.truth_string[f] && c.finger == scene.truth_finger[f];
-    }
-    return static_cast<double>(right) / pressed;
+    return RightStringAndFinger(scene, Refine(scene.input, o));
   };
   const double kept = right_fraction(RefineOptions().decode.one_view_max_shift_factor);
   const double cameras = right_fraction(1.0);
