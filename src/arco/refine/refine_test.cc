@@ -80,6 +80,17 @@ double RightStringAndFinger(const testing::Scene& scene, const RefineResult& r) 
   return static_cast<double>(right) / pressed;
 }
 
+// The scene as one camera at `centre` (world mm) sees it: each frame's vision hand moved
+// along its rays by `shift_mm[f]` (a one-view lift's depth error; the image unchanged).
+void SeeFromOneCamera(const Eigen::Vector3d& centre,
+                      const std::vector<double>& shift_mm,
+                      testing::Scene* scene) {
+  hand::OneViewDepthOptions move;
+  move.window_frames = 0;
+  ASSERT_TRUE(hand::MoveHandsAlongRays(centre, shift_mm, move, &scene->input.vision_hand).ok());
+  scene->input.one_view_camera_centre_mm = centre;
+}
+
 // Frames [first, last] of the scene note `index` (notes laid out back to back).
 std::pair<int, int> NoteFrames(const std::vector<SceneNote>& notes, int index) {
   int first = 0;
@@ -507,11 +518,7 @@ TEST(Refine, OneCameraComparesCandidatesAlongTheCameraRays) {
   testing::Scene scene = Cello(Piece());
   // 1.35 m from the bridge along the strings, 1 m to the side and 1.2 m in front of them.
   const Eigen::Vector3d centre = scene.world_from_instrument[0] * Eigen::Vector3d(1350, 1000, 1200);
-  hand::OneViewDepthOptions move;
-  move.window_frames = 0;
-  const std::vector<double> shift_mm(scene.input.vision_hand.size(), 70.0);
-  ASSERT_TRUE(hand::MoveHandsAlongRays(centre, shift_mm, move, &scene.input.vision_hand).ok());
-  scene.input.one_view_camera_centre_mm = centre;
+  SeeFromOneCamera(centre, std::vector<double>(scene.input.vision_hand.size(), 70.0), &scene);
   const auto right_fraction = [&](bool along_rays) {
     RefineOptions o = Options(RefineMode::kArco);
     o.decode.one_view_along_rays = along_rays;
@@ -544,14 +551,11 @@ TEST(Refine, OneCameraKeepsTheHandWhereItIsUnlessTheSoundShifts) {
                                         {1, 1, 2, 12}};
   testing::Scene scene = Cello(notes);
   const Eigen::Vector3d centre = scene.world_from_instrument[0] * Eigen::Vector3d(1600, 350, 500);
-  hand::OneViewDepthOptions move;
-  move.window_frames = 0;
   std::vector<double> shift_mm(scene.input.vision_hand.size());
   for (size_t f = 0; f < shift_mm.size(); ++f) {
     shift_mm[f] = 60.0 * std::sin(1.7 * static_cast<double>(f / 12));  // per note
   }
-  ASSERT_TRUE(hand::MoveHandsAlongRays(centre, shift_mm, move, &scene.input.vision_hand).ok());
-  scene.input.one_view_camera_centre_mm = centre;
+  SeeFromOneCamera(centre, shift_mm, &scene);
   const auto right_fraction = [&](double factor) {
     RefineOptions o = Options(RefineMode::kArco);
     o.decode.one_view_max_shift_factor = factor;
