@@ -68,20 +68,26 @@ for m in ("paper", "arco"):
 if not res["vision"][0] <= 35: bad.append("vision's left hand median %.1f mm > 35" % res["vision"][0])
 if not res["vision"][2] >= 0.9: bad.append("hand fitted on %.3f of frames" % res["vision"][2])
 if not j["paper"]["string_accuracy"] >= 0.8: bad.append("paper's strings %.3f" % j["paper"]["string_accuracy"])
-# arco's own decisions and hand (seed 1: strings 0.901, fingers 0.748, median 17.4 mm,
-# within 15 mm on 0.364 of frames, its contact 2.2 mm from SPD's in the instrument's frame
-# (median); docs/accuracy.md, "One camera: the hand stays where it is" and "... the
-# instrument's depth over seconds"; strings 0.870 and fingers 0.676 without the one-view
-# shift cost, within 15 mm 0.297 with the instrument's depth over +-15 frames): the sound
-# must keep it ahead of vision in the instrument's frame.
-if not j["arco"]["string_accuracy"] >= 0.9: bad.append("arco's strings %.3f" % j["arco"]["string_accuracy"])
-if not j["arco"]["finger_accuracy"] >= 0.65: bad.append("arco's fingers %.3f" % j["arco"]["finger_accuracy"])
-if not res["arco"][1] >= 0.33: bad.append("arco's hand within 15 mm on %.3f of frames" % res["arco"][1])
+# arco's own decisions and hand (seed 1: strings 0.992, fingers 0.859, median 20.6 mm,
+# within 15 mm on 0.230 of frames, its contact 5.1 mm (mean) and 2.2 mm (median) from
+# SPD's in the instrument's frame; docs/accuracy.md, "One camera: the instrument's real
+# shape and the image across the string"). The capture is not the one the former bounds
+# (strings 0.9, fingers 0.65, within 15 mm 0.33) were set on: `arco synth --motion` places
+# the take by the instrument's nominal shape, which is now the real cello's, and this camera
+# sees the bridge on 35 % of the frames instead of 97 %; the former code gives strings 0.179,
+# fingers 0.130, within 15 mm 0.024 on it (a frame's own PnP held on 17 of its 330 frames).
+# The sound must keep the hand ahead of vision in the instrument's frame.
+if not j["arco"]["string_accuracy"] >= 0.95: bad.append("arco's strings %.3f" % j["arco"]["string_accuracy"])
+if not j["arco"]["finger_accuracy"] >= 0.8: bad.append("arco's fingers %.3f" % j["arco"]["finger_accuracy"])
+if not res["arco"][1] >= 0.2: bad.append("arco's hand within 15 mm on %.3f of frames" % res["arco"][1])
+if not res["arco"][1] >= res["vision"][1] + 0.05:
+    bad.append("arco's hand within 15 mm on %.3f of frames, vision's %.3f" % (res["arco"][1], res["vision"][1]))
 from hand_in_instrument import contact_in_instrument
 contact = contact_in_instrument(tmp + "/res", tmp + "/cap/truth/points3d.npy", "arco")
 print("arco   contact in the instrument's frame: mean %.2f mm, median %.2f mm, within 5 mm on "
       "%.3f of %d frames" % contact)
 if not contact[1] <= 3.5: bad.append("arco's contact %.2f mm from SPD's (median)" % contact[1])
+if not contact[0] <= 7: bad.append("arco's contact %.2f mm from SPD's (mean)" % contact[0])
 if not res["arco"][0] < res["vision"][0]:
     bad.append("arco's left hand %.1f mm, not below vision's %.1f" % (res["arco"][0], res["vision"][0]))
 for b in bad: print("FAILED: " + b)

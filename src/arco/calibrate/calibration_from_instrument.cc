@@ -368,7 +368,7 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
     for (const InstrumentLabelsFile& l : options.labels)
       keypoints_file += (keypoints_file.empty() ? "" : ", ") + l.path;
   }
-  const std::vector<Eigen::Vector3d> nominal = NominalKeypointsInInstrument(model);
+  const std::vector<Eigen::Vector3d> nominal = NominalPoseKeypointsInInstrument(model);
   std::vector<std::pair<int, cv::Point3d>> rigid;  // layout column, nominal point
   for (int k : model.rigid_keypoints()) {
     const int column = layout->Find(model.keypoint_names()[k]);

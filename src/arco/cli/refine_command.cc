@@ -221,6 +221,20 @@ std::function<int()> SetupRefine(CLI::App& app) {
             "strings and the camera's ray, at most this (1: as with several cameras)",
             refine::kCostWeightRange)
       ->capture_default_str();
+  AddNumber(sub,
+            "--one-view-lateral-weight",
+            r.decode.one_view_lateral_weight,
+            "arco decoding, one camera: --lateral-weight for the candidates compared along "
+            "the camera's rays",
+            refine::kCostWeightRange)
+      ->capture_default_str();
+  AddNumber(sub,
+            "--one-view-above-margin-mm",
+            r.decode.one_view_above_margin_mm,
+            "arco decoding, one camera: a fingertip higher than this above the string plane "
+            "counts the height beyond it in full (mm)",
+            refine::kCostWeightRange)
+      ->capture_default_str();
   sub->parse_complete_callback([a] { ApplyAndValidate(*a); });
   return [a]() { return RunRefine(*a); };
 }

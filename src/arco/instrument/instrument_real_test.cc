@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <random>
 #include <string>
@@ -13,6 +14,7 @@
 #include "arco/camera/calibration_io.h"
 #include "arco/geometry/triangulation.h"
 #include "arco/instrument/contact.h"
+#include "arco/instrument/nominal_keypoints.h"
 #include "arco/instrument/strings.h"
 #include "arco/instrument/template_fit.h"
 #include "arco/util/file_io.h"
@@ -123,6 +125,38 @@ TEST(InstrumentOnRealLabels, ScaleDistancesAndStringOrder) {
   auto flipped = GeometryFromEdges(Cello(), Edges(f), behind);
   ASSERT_TRUE(flipped.ok());
   EXPECT_FALSE(flipped->order.labels_agree);
+}
+
+TEST(InstrumentOnRealLabels, TheNominalShapeIsTheRealCellos) {
+  // instrument/nominal_keypoints.h: the places the model does not give are this cello's,
+  // in its own frame (x along the strings, z to the front), on the centre line.
+  const RealFrame& f = Frame128();
+  auto g = GeometryFromEdges(Cello(), Edges(f), FrontCamera(f));
+  ASSERT_TRUE(g.ok()) << g.status().message();
+  const std::vector<Eigen::Vector3d> nominal = NominalKeypointsInInstrument(Cello());
+  for (const char* name : {"scroll_top", "tail_gut", "end_pin"}) {
+    const Eigen::Vector3d real = g->world_from_instrument.InverseMap(f.points.at(name));
+    const Eigen::Vector3d& n = nominal[static_cast<size_t>(Cello().KeypointIndex(name))];
+    std::printf("[ nominal ] %-10s real %7.1f %6.1f %7.1f, nominal %7.1f %6.1f %7.1f mm\n",
+                name,
+                real.x(),
+                real.y(),
+                real.z(),
+                n.x(),
+                n.y(),
+                n.z());
+    EXPECT_NEAR(n.x(), real.x(), 3.0) << name;
+    EXPECT_NEAR(n.z(), real.z(), 3.0) << name;  // the former guesses were 5-164 mm off
+    EXPECT_EQ(n.y(), 0.0) << name;
+    EXPECT_LT(std::abs(real.y()), 40.0) << name;  // the lean the centre line leaves out
+  }
+  // A pose from the nominal shape leaves the end pin out: its spike is the player's.
+  const std::vector<Eigen::Vector3d> pose = NominalPoseKeypointsInInstrument(Cello());
+  for (size_t k = 0; k < pose.size(); ++k) {
+    const bool end_pin = Cello().keypoint_names()[k] == "end_pin";
+    EXPECT_EQ(pose[k].allFinite(), !end_pin && nominal[k].allFinite()) << k;
+    if (!end_pin && nominal[k].allFinite()) EXPECT_EQ(pose[k], nominal[k]) << k;
+  }
 }
 
 TEST(InstrumentOnRealLabels, OctaveIsHalfWayAlongTheRealString) {

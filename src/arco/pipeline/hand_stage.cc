@@ -6,6 +6,7 @@
 #include <optional>
 #include <vector>
 
+#include "arco/hand/pose_gaps.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/registry/keypoint_layout.h"
 #include "arco/util/parallel.h"
@@ -25,6 +26,7 @@ Status HandStageOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(bones.Validate().WithContext("bones"));
   ARCO_RETURN_IF_ERROR(palm.Validate().WithContext("palm"));
   ARCO_RETURN_IF_ERROR(one_view_depth.Validate().WithContext("one_view_depth"));
+  ARCO_RETURN_IF_ERROR(gaps.Validate().WithContext("gaps"));
   if (!(one_view_bone_quantile >= 0.5 && one_view_bone_quantile < 1))
     return Status::Error("one_view_bone_quantile must be in [0.5, 1)");
   return fit.Validate().WithContext("fit");
@@ -58,6 +60,7 @@ Json ToJson(const HandStageOptions& o) {
             {"temporal_translation_weight_px_per_mm", f.temporal_translation_weight_px_per_mm},
             {"max_iterations", f.max_iterations}}},
           {"one_view_depth", {{"window_frames", o.one_view_depth.window_frames}}},
+          {"gaps", {{"max_gap_frames", o.gaps.max_gap_frames}}},
           {"one_view_bone_quantile", o.one_view_bone_quantile},
           {"chunk_frames", o.chunk_frames},
           {"num_threads", o.num_threads}};
@@ -188,6 +191,11 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
         progress.Advance(end - ci * chunk);
       },
       1);
+  // Which frames the fit placed, before the short gaps between them are filled.
+  std::vector<uint8_t> was_fitted(static_cast<size_t>(frames), 0);
+  for (int64_t f = 0; f < frames; ++f)
+    was_fitted[static_cast<size_t>(f)] = fitted[static_cast<size_t>(f)] ? 1 : 0;
+  ARCO_ASSIGN_OR_RETURN(summary.frames_interpolated, hand::FillHandPoseGaps(options.gaps, &fitted));
   if (one_view) {
     // The fingertips at the depth of the strings: the lifted fingertips' median distance
     // from the camera (the lift put the hand at one depth per frame).
@@ -218,7 +226,7 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
   // (the upper middle element when even).
   std::vector<double> res, res_median;
   for (int64_t f = 0; f < frames; ++f) {
-    if (!fitted[static_cast<size_t>(f)]) continue;
+    if (!was_fitted[static_cast<size_t>(f)]) continue;
     ++ok;
     res.push_back(residual_px[static_cast<size_t>(f)]);
     res_median.push_back(median_residual_px[static_cast<size_t>(f)]);

@@ -10,6 +10,7 @@
 #include "arco/hand/fit.h"
 #include "arco/hand/one_view_depth.h"
 #include "arco/hand/palm_shape.h"
+#include "arco/hand/pose_gaps.h"
 #include "arco/pipeline/capture_context.h"
 #include "arco/pipeline/result_folder.h"
 #include "arco/pipeline/summaries.h"
@@ -25,6 +26,7 @@ struct HandStageOptions {
   hand::PalmShapeOptions palm;  // the performer's palm (after the bone lengths)
   hand::HandFitOptions fit;
   hand::OneViewDepthOptions one_view_depth;  // a one-camera capture's hand depth
+  hand::PoseGapOptions gaps;                 // short gaps between fitted frames (hand/pose_gaps.h)
   // [0.5, 1): one camera: the bone lengths are this quantile of the lifted hand's
   // distances (bones.quantile; the lift's points are projections at the strings' depth).
   double one_view_bone_quantile = 0.75;

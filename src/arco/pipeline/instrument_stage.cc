@@ -91,7 +91,7 @@ StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& opti
   // One camera: the instrument was placed by a PnP of its nominal points, which says where
   // its front is; the performer's points were put at an assumed depth and say nothing.
   const bool one_view = capture.view_to_camera.size() == 1;
-  const std::vector<Eigen::Vector3d> nominal = NominalKeypointsInInstrument(model);
+  const std::vector<Eigen::Vector3d> nominal = NominalPoseKeypointsInInstrument(model);
   for (int64_t f = 0; f < frames; ++f) {
     Eigen::Matrix3Xd& m = keypoints[static_cast<size_t>(f)];
     m.resize(3, num_k);

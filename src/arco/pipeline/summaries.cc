@@ -15,6 +15,7 @@ Json ToJson(const InstrumentStageSummary& s) {
 Json ToJson(const HandStageSummary& s) {
   return {{"frames", s.frames},
           {"frames_fitted", s.frames_fitted},
+          {"frames_interpolated", s.frames_interpolated},
           {"median_rms_residual_px", JsonFromDouble(s.median_rms_residual_px)},
           {"median_residual_px", JsonFromDouble(s.median_residual_px)},
           {"bone_lengths_from_data", s.bone_lengths_from_data},

@@ -41,6 +41,7 @@ Json ToJson(const InstrumentStageSummary& summary);
 struct HandStageSummary {
   int64_t frames = 0;
   int frames_fitted = 0;
+  int frames_interpolated = 0;  // short gaps between fitted frames (hand/pose_gaps.h)
   // Medians over the fitted frames of the per-frame RMS reprojection residual (dominated
   // by the few outlier detections a robust fit ignores) and of the per-frame median.
   double median_rms_residual_px = 0;
@@ -52,7 +53,7 @@ struct HandStageSummary {
   int palm_bases_kept = 0;              // bases beyond max_shift_mm, left where they were
   std::vector<std::string> warnings;
 };
-// {frames, frames_fitted, median_rms_residual_px, median_residual_px,
+// {frames, frames_fitted, frames_interpolated, median_rms_residual_px, median_residual_px,
 // bone_lengths_from_data, palm_from_data, palm_frames, palm_max_shift_mm,
 // palm_bases_kept}.
 Json ToJson(const HandStageSummary& summary);

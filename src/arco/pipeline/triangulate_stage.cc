@@ -81,7 +81,7 @@ double OneViewWorldUnitsPerMm(const std::string& units) {
 // The instrument, its strings and the points lifted to them (monocular_lift.h).
 StatusOr<track::MonocularScene> OneViewScene(const CaptureContext& capture) {
   const InstrumentModel& model = *capture.instrument;
-  const std::vector<Eigen::Vector3d> nominal = NominalKeypointsInInstrument(model);
+  const std::vector<Eigen::Vector3d> nominal = NominalPoseKeypointsInInstrument(model);
   track::MonocularScene scene;
   for (int k : model.rigid_keypoints()) {
     const int column = capture.layout.Find(model.keypoint_names()[static_cast<size_t>(k)]);

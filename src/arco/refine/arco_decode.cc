@@ -62,6 +62,18 @@ std::vector<State> NoteStates(const DecodeContext& context,
                               const PitchModelOptions& pitch_options,
                               const std::array<double, 5>& lift_max_mm) {
   const InstrumentModel& model = *context.input->instrument;
+  // One camera, along the rays (ArcoDecodeOptions::one_view_lateral_weight): the image's
+  // evidence across the string in full, a tip far above the string plane not stopping it.
+  const bool along_rays =
+      context.input->one_view_camera_centre_mm.has_value() && options.one_view_along_rays;
+  ArcoDecodeOptions one_view;
+  if (along_rays) {
+    one_view = options;
+    one_view.lateral_weight = options.one_view_lateral_weight;
+  }
+  const ArcoDecodeOptions& emission = along_rays ? one_view : options;
+  const double above_margin_mm =
+      along_rays ? options.one_view_above_margin_mm : std::numeric_limits<double>::infinity();
   std::vector<State> states;
   std::vector<double> distances, orders;
   // The string the bow's pair puts the note on (RefineInput::bowed_pair_lower_string), when
@@ -115,9 +127,10 @@ std::vector<State> NoteStates(const DecodeContext& context,
             StringFrameOf(context.strings(static_cast<int>(f)), s),
             cand.point_in_world,
             k,
-            options,
+            emission,
             &d,
-            &o);
+            &o,
+            above_margin_mm);
         distances.push_back(d);
         orders.push_back(o);
       }
@@ -140,10 +153,10 @@ std::vector<State> NoteStates(const DecodeContext& context,
   if (bowed > 0 && std::any_of(states.begin(), states.end(), [&](const State& st) {
         return st.string == bowed;
       })) {
-    states.erase(std::remove_if(states.begin(),
-                                states.end(),
-                                [&](const State& st) { return st.string != bowed; }),
-                 states.end());
+    states.erase(
+        std::remove_if(
+            states.begin(), states.end(), [&](const State& st) { return st.string != bowed; }),
+        states.end());
   }
   return states;
 }
@@ -249,7 +262,8 @@ void FrameCosts(const hand::HandPointsMm& points,
                 int finger,
                 const ArcoDecodeOptions& options,
                 double* distance,
-                double* order) {
+                double* order,
+                double above_margin_mm) {
   const Eigen::Vector3d v = points[hand::TipKeypoint(static_cast<hand::Finger>(finger))] - contact;
   const double a = v.dot(sf.along);
   const double n = v.dot(sf.normal);
@@ -265,8 +279,10 @@ void FrameCosts(const hand::HandPointsMm& points,
   const double hand_across = MedianInPlace(offsets.begin(), offsets.end());
   const double wl = options.lateral_weight, wn = options.normal_weight;
   const double wh = options.hand_lateral_weight;
-  const double below = std::max(0.0, -n - options.below_margin_mm);  // n > 0: off the board
-  *distance = std::sqrt(a * a + wl * wl * l * l + wn * wn * n * n + below * below +
+  // n > 0: off the board. Beyond either margin the height counts in full.
+  const double beyond =
+      std::max(0.0, -n - options.below_margin_mm) + std::max(0.0, n - above_margin_mm);
+  *distance = std::sqrt(a * a + wl * wl * l * l + wn * wn * n * n + beyond * beyond +
                         wh * wh * hand_across * hand_across);
   double violation = 0;
   for (int j = 1; j <= 4; ++j) {
@@ -328,19 +344,18 @@ std::vector<FrameContact> DecodeArco(const DecodeContext& context,
   // One camera: the hand's shifts cost more, the more the view foreshortens the strings.
   ArcoDecodeOptions transition_options = options;
   transition_options.shift_cost_per_semitone *= OneViewShiftFactor(context, options);
-  const std::vector<int> chosen =
-      DecodeViterbi(
-          num_states,
-          [&](size_t c, int k) { return state_at(c, k).cost; },
-          [&](size_t c, int j, int k) {
-            return TransitionCost(note_at(c - 1),
-                                  note_at(c),
-                                  state_at(c - 1, j),
-                                  state_at(c, k),
-                                  transition_options,
-                                  input.fps);
-          })
-          .states;
+  const std::vector<int> chosen = DecodeViterbi(
+                                      num_states,
+                                      [&](size_t c, int k) { return state_at(c, k).cost; },
+                                      [&](size_t c, int j, int k) {
+                                        return TransitionCost(note_at(c - 1),
+                                                              note_at(c),
+                                                              state_at(c - 1, j),
+                                                              state_at(c, k),
+                                                              transition_options,
+                                                              input.fps);
+                                      })
+                                      .states;
 
   // Frames of the decoded notes.
   std::vector<uint8_t> decoded_note(notes.size(), 0);

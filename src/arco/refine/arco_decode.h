@@ -60,6 +60,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <vector>
 
 #include "arco/refine/contact_annotation.h"
@@ -78,7 +79,8 @@ void FrameCosts(const hand::HandPointsMm& points,
                 int finger,
                 const ArcoDecodeOptions& options,
                 double* distance,
-                double* order);
+                double* order,
+                double above_margin_mm = std::numeric_limits<double>::infinity());
 
 // lift_max_mm[k] for finger k = 1..4 (entry 0 unused). One FrameContact per frame (before
 // IK). Frames of a note whose contact fails the lift test come back kUncertain with

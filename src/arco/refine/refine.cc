@@ -167,7 +167,9 @@ Status ArcoDecodeOptions::Validate() const {
       {"rest_factor", rest_factor},
       {"infeasible_cost", infeasible_cost},
       {"onset_lead_margin_mm", onset_lead_margin_mm},
-      {"one_view_max_shift_factor", one_view_max_shift_factor}};
+      {"one_view_max_shift_factor", one_view_max_shift_factor},
+      {"one_view_lateral_weight", one_view_lateral_weight},
+      {"one_view_above_margin_mm", one_view_above_margin_mm}};
   for (const auto& [name, value] : values) {
     ARCO_RETURN_IF_ERROR(
         CheckInRange(name, value, kCostWeightRange).WithContext("arco decode options"));
@@ -209,8 +211,9 @@ Status ArcoIkOptions::Validate() const {
   }
   ARCO_RETURN_IF_ERROR(
       CheckInRange("pip_weight", pip_weight, kCostWeightRange).WithContext("arco IK options"));
-  ARCO_RETURN_IF_ERROR(CheckInRange("transition_dip_weight", transition_dip_weight, kCostWeightRange)
-                           .WithContext("arco IK options"));
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("transition_dip_weight", transition_dip_weight, kCostWeightRange)
+          .WithContext("arco IK options"));
   if (max_iterations < 1) return Status::Error("arco IK options: max_iterations must be >= 1");
   if (neighbour_shift_frames < 0) {
     return Status::Error("arco IK options: neighbour_shift_frames must be >= 0");
@@ -356,6 +359,8 @@ Json ToJson(const RefineOptions& o) {
             {"audio_onsets", o.decode.audio_onsets},
             {"one_view_along_rays", o.decode.one_view_along_rays},
             {"one_view_max_shift_factor", o.decode.one_view_max_shift_factor},
+            {"one_view_lateral_weight", o.decode.one_view_lateral_weight},
+            {"one_view_above_margin_mm", o.decode.one_view_above_margin_mm},
             {"bowed_pair_string", o.decode.bowed_pair_string},
             {"boundaries",
              {{"onset_tolerance_s", o.decode.boundaries.onset_tolerance_s},

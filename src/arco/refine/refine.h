@@ -166,6 +166,19 @@ struct ArcoDecodeOptions {
   // and the camera's ray to them, at most this (arco_decode.h, "One camera"); 1: the
   // cameras' cost. No effect with several cameras.
   double one_view_max_shift_factor = 8.0;
+  // One camera, along the rays: the weight of the tip-to-contact distance across the string
+  // instead of lateral_weight. After the along-ray scaling what is left of tip - contact
+  // lies across the camera's ray: across the string it is the image's evidence (the
+  // detector's error in the image), not the lifted tip's sideways drift that the cameras'
+  // 3D discounts (docs/accuracy.md, "One camera: the image's evidence across the string").
+  double one_view_lateral_weight = 1.0;
+  // One camera, along the rays: a fingertip higher than this above the string plane counts
+  // the height beyond it in full (as one deeper than below_margin_mm under it). A real
+  // playing fingertip lies within 13 mm of its contact on 95 % of SPD's frames (DOMAIN.md
+  // section 10); along the rays of a view that grazes the string plane a candidate on
+  // another string, far along the neck, leaves the tip high above its string, which the
+  // normal's discount would let cost a quarter.
+  double one_view_above_margin_mm = 15.0;
   // Note boundaries from the audio's onsets (note_boundaries.h), when the input has them.
   bool audio_onsets = true;
   NoteBoundaryOptions boundaries;
@@ -251,7 +264,7 @@ struct RefineOptions {
   ArcoDecodeOptions decode;
   ArcoIkOptions ik;
   hand::OneViewDepthOptions one_view_depth;  // RefineInput::one_view_camera_centre_mm
-  int num_threads = 0;  // 0 = all cores; results do not depend on it
+  int num_threads = 0;                       // 0 = all cores; results do not depend on it
   Status Validate() const;
 };
 

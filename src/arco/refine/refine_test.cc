@@ -573,6 +573,54 @@ TEST(Refine, OneCameraKeepsTheHandWhereItIsUnlessTheSoundShifts) {
   EXPECT_GT(kept, cameras + 0.15);
 }
 
+TEST(Refine, OneCameraWeighsTheImageAcrossTheStringInFull) {
+  // First position on the A string seen by a camera behind the string plane beyond the nut
+  // and to the low strings' side (as SPD's camera 21334207 sees the real take), the hand's
+  // depth off by up to +-120 mm from note to note. Along the rays what is left of
+  // tip - contact lies across the ray: across the string it is the image's evidence
+  // (ArcoDecodeOptions::one_view_lateral_weight), and a tip far above a candidate's string
+  // does not stop it (one_view_above_margin_mm).
+  const std::vector<SceneNote> notes = {{1, 1, 2, 12},
+                                        {1, 2, 3, 12},
+                                        {1, 4, 5, 12},
+                                        {1, 2, 3, 12},
+                                        {1, 1, 2, 12},
+                                        {1, 4, 5, 12},
+                                        {1, 1, 2, 12},
+                                        {1, 2, 3, 12},
+                                        {1, 4, 5, 12},
+                                        {1, 1, 2, 12}};
+  testing::Scene scene = Cello(notes);
+  const Eigen::Vector3d centre = scene.world_from_instrument[0] * Eigen::Vector3d(2200, 300, -400);
+  std::vector<double> shift_mm(scene.input.vision_hand.size());
+  for (size_t f = 0; f < shift_mm.size(); ++f) {
+    shift_mm[f] = 120.0 * std::sin(1.7 * static_cast<double>(f / 12));  // per note
+  }
+  SeeFromOneCamera(centre, shift_mm, &scene);
+  const auto right_fraction = [&](double lateral_weight, double above_margin_mm) {
+    RefineOptions o = Options(RefineMode::kArco);
+    o.decode.one_view_lateral_weight = lateral_weight;
+    o.decode.one_view_above_margin_mm = above_margin_mm;
+    return RightStringAndFinger(scene, Refine(scene.input, o));
+  };
+  const RefineOptions defaults;
+  const double full = right_fraction(defaults.decode.one_view_lateral_weight,
+                                     defaults.decode.one_view_above_margin_mm);
+  // The cameras' weights: the lateral discount, no margin above the strings.
+  const double cameras = right_fraction(defaults.decode.lateral_weight, 1e6);
+  const double margin_only =
+      right_fraction(defaults.decode.lateral_weight, defaults.decode.one_view_above_margin_mm);
+  std::printf(
+      "[ one camera ] string and finger right on %.3f of pressed frames, %.3f with the "
+      "cameras' weights, %.3f with only the margin above the strings\n",
+      full,
+      cameras,
+      margin_only);
+  EXPECT_GE(full, 0.95);
+  EXPECT_LT(cameras, full - 0.2);
+  EXPECT_GT(margin_only, cameras + 0.05);
+}
+
 TEST(Refine, FingeringTranscription) {
   const std::vector<SceneNote> notes = Piece();
   const testing::Scene scene = Cello(notes);

@@ -117,7 +117,10 @@ RigidMatrix3d InstrumentRestPose(InstrumentKind kind, double scale) {
   Eigen::Matrix3d r = FrameFromAxes(x, Eigen::Vector3d::UnitZ());
   r = Eigen::AngleAxisd(-8 * kDeg, r.col(0)).toRotationMatrix() * r;
   pose.rotation = r;
-  // End pin (template point (-691 s, 0, -120 s)) on the floor in front.
+  // A point on the string axis's side of the body, (-691 s, 0, -120 s), stands on the floor
+  // in front: it places the instrument against the synthetic performer, who was built
+  // around it. (It was the nominal end pin; the real cello's, nominal_keypoints.h, lies
+  // farther behind the strings' plane, where a spike angled towards the player ends.)
   const Eigen::Vector3d end_pin_template(-691 * scale, 0, -120 * scale);
   const double reach = 691 * scale + 695 * scale;  // end pin to nut along the axis
   const Eigen::Vector3d floor_point(-35, kFloorY, reach * std::cos(elevation) * std::cos(yaw) + 40);
