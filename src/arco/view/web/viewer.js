@@ -360,9 +360,24 @@
       video.currentTime = want;
     }
   }
+  // The media time of the frame the video element last presented (requestVideoFrameCallback
+  // where the browser has it): after a seek the element may still paint the frame before,
+  // and videoPixel below waits for the one that was sought.
+  let presentedTime = null, watchingFrames = false;
+  function watchPresentedFrames() {
+    if (!video || watchingFrames || !('requestVideoFrameCallback' in video)) return;
+    watchingFrames = true;
+    const onFrame = (now, meta) => {
+      presentedTime = meta.mediaTime;
+      video.requestVideoFrameCallback(onFrame);
+    };
+    video.requestVideoFrameCallback(onFrame);
+  }
   function setVideoCamera(i) {
     if (!video) return;
     const v = manifest.videos[i];
+    presentedTime = null;
+    watchPresentedFrames();
     view.videoCamera = i;
     $('videocam').value = String(i);
     $('videoname').textContent = v.camera + ' · ' + v.method + ' overlay';
@@ -679,7 +694,10 @@
   view.setVideoCamera = (name) => setVideoCamera(manifest.videos.findIndex((v) => v.camera === name));
   // The video's picture at its own pixel (x, y), once the current seek is done: [r, g, b].
   view.videoPixel = async (x, y) => {
-    for (let i = 0; video.seeking || video.readyState < 2; ++i) {
+    // The sought frame presented: its media time within one frame before currentTime.
+    const shown = () => !watchingFrames || (presentedTime !== null &&
+        presentedTime <= video.currentTime + 1e-3 && video.currentTime - presentedTime < 1 / fps());
+    for (let i = 0; video.seeking || video.readyState < 2 || !shown(); ++i) {
       if (i > 500 || video.error) throw new Error('the video does not show a frame');
       await new Promise((r) => setTimeout(r, 20));
     }
