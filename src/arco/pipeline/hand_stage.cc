@@ -191,10 +191,7 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
         progress.Advance(end - ci * chunk);
       },
       1);
-  // Which frames the fit placed, before the short gaps between them are filled.
-  std::vector<uint8_t> was_fitted(static_cast<size_t>(frames), 0);
-  for (int64_t f = 0; f < frames; ++f)
-    was_fitted[static_cast<size_t>(f)] = fitted[static_cast<size_t>(f)] ? 1 : 0;
+  // Short gaps between fitted frames (hand/pose_gaps.h); a filled frame has no residual.
   ARCO_ASSIGN_OR_RETURN(summary.frames_interpolated, hand::FillHandPoseGaps(options.gaps, &fitted));
   if (one_view) {
     // The fingertips at the depth of the strings: the lifted fingertips' median distance
@@ -226,7 +223,7 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
   // (the upper middle element when even).
   std::vector<double> res, res_median;
   for (int64_t f = 0; f < frames; ++f) {
-    if (!was_fitted[static_cast<size_t>(f)]) continue;
+    if (!std::isfinite(residual_px[static_cast<size_t>(f)])) continue;  // not fitted
     ++ok;
     res.push_back(residual_px[static_cast<size_t>(f)]);
     res_median.push_back(median_residual_px[static_cast<size_t>(f)]);

@@ -91,6 +91,31 @@ void SeeFromOneCamera(const Eigen::Vector3d& centre,
   scene->input.one_view_camera_centre_mm = centre;
 }
 
+// First position on the A string (fingers 1, 2, 4, 12 frames a note) seen by one camera at
+// `camera_in_instrument` (mm, the instrument frame of the first frame), each note's vision
+// hand moved along its rays by up to +-`depth_error_mm` (a one-view lift's depth error).
+testing::Scene FirstPositionFromOneCamera(const Eigen::Vector3d& camera_in_instrument,
+                                          double depth_error_mm) {
+  const std::vector<SceneNote> notes = {{1, 1, 2, 12},
+                                        {1, 2, 3, 12},
+                                        {1, 4, 5, 12},
+                                        {1, 2, 3, 12},
+                                        {1, 1, 2, 12},
+                                        {1, 4, 5, 12},
+                                        {1, 1, 2, 12},
+                                        {1, 2, 3, 12},
+                                        {1, 4, 5, 12},
+                                        {1, 1, 2, 12}};
+  testing::Scene scene = Cello(notes);
+  const Eigen::Vector3d centre = scene.world_from_instrument[0] * camera_in_instrument;
+  std::vector<double> shift_mm(scene.input.vision_hand.size());
+  for (size_t f = 0; f < shift_mm.size(); ++f) {
+    shift_mm[f] = depth_error_mm * std::sin(1.7 * static_cast<double>(f / 12));  // per note
+  }
+  SeeFromOneCamera(centre, shift_mm, &scene);
+  return scene;
+}
+
 // Frames [first, last] of the scene note `index` (notes laid out back to back).
 std::pair<int, int> NoteFrames(const std::vector<SceneNote>& notes, int index) {
   int first = 0;
@@ -539,23 +564,7 @@ TEST(Refine, OneCameraKeepsTheHandWhereItIsUnlessTheSoundShifts) {
   // nut (a phone looking down the neck). The one-view hand's depth errs by up to +-60 mm
   // from note to note (the lift), which, along the rays, can look like a higher position
   // on the D string: the decode must not shift there and back for it.
-  const std::vector<SceneNote> notes = {{1, 1, 2, 12},
-                                        {1, 2, 3, 12},
-                                        {1, 4, 5, 12},
-                                        {1, 2, 3, 12},
-                                        {1, 1, 2, 12},
-                                        {1, 4, 5, 12},
-                                        {1, 1, 2, 12},
-                                        {1, 2, 3, 12},
-                                        {1, 4, 5, 12},
-                                        {1, 1, 2, 12}};
-  testing::Scene scene = Cello(notes);
-  const Eigen::Vector3d centre = scene.world_from_instrument[0] * Eigen::Vector3d(1600, 350, 500);
-  std::vector<double> shift_mm(scene.input.vision_hand.size());
-  for (size_t f = 0; f < shift_mm.size(); ++f) {
-    shift_mm[f] = 60.0 * std::sin(1.7 * static_cast<double>(f / 12));  // per note
-  }
-  SeeFromOneCamera(centre, shift_mm, &scene);
+  testing::Scene scene = FirstPositionFromOneCamera(Eigen::Vector3d(1600, 350, 500), 60.0);
   const auto right_fraction = [&](double factor) {
     RefineOptions o = Options(RefineMode::kArco);
     o.decode.one_view_max_shift_factor = factor;
@@ -580,23 +589,7 @@ TEST(Refine, OneCameraWeighsTheImageAcrossTheStringInFull) {
   // tip - contact lies across the ray: across the string it is the image's evidence
   // (ArcoDecodeOptions::one_view_lateral_weight), and a tip far above a candidate's string
   // does not stop it (one_view_above_margin_mm).
-  const std::vector<SceneNote> notes = {{1, 1, 2, 12},
-                                        {1, 2, 3, 12},
-                                        {1, 4, 5, 12},
-                                        {1, 2, 3, 12},
-                                        {1, 1, 2, 12},
-                                        {1, 4, 5, 12},
-                                        {1, 1, 2, 12},
-                                        {1, 2, 3, 12},
-                                        {1, 4, 5, 12},
-                                        {1, 1, 2, 12}};
-  testing::Scene scene = Cello(notes);
-  const Eigen::Vector3d centre = scene.world_from_instrument[0] * Eigen::Vector3d(2200, 300, -400);
-  std::vector<double> shift_mm(scene.input.vision_hand.size());
-  for (size_t f = 0; f < shift_mm.size(); ++f) {
-    shift_mm[f] = 120.0 * std::sin(1.7 * static_cast<double>(f / 12));  // per note
-  }
-  SeeFromOneCamera(centre, shift_mm, &scene);
+  testing::Scene scene = FirstPositionFromOneCamera(Eigen::Vector3d(2200, 300, -400), 120.0);
   const auto right_fraction = [&](double lateral_weight, double above_margin_mm) {
     RefineOptions o = Options(RefineMode::kArco);
     o.decode.one_view_lateral_weight = lateral_weight;
