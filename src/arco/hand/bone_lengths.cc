@@ -19,6 +19,9 @@ Status BoneLengthOptions::Validate() const {
     return bad("need 0 < min_ratio <= 1 <= max_ratio");
   }
   if (!(quantile >= 0.5 && quantile < 1)) return bad("quantile must be in [0.5, 1)");
+  if (!(palm_quantile >= 0.5 && palm_quantile < 1)) return bad("palm_quantile must be in [0.5, 1)");
+  if (!(thumb_quantile >= 0.5 && thumb_quantile < 1))
+    return bad("thumb_quantile must be in [0.5, 1)");
   return Status::Ok();
 }
 
@@ -50,8 +53,10 @@ StatusOr<BoneLengthEstimate> EstimateBoneLengths(const std::vector<HandPointsMm>
       if (std::abs(d - median) <= options.mad_gate * sigma) inliers.push_back(d);
     }
     out.inliers[k] = static_cast<int>(inliers.size());
-    const double m =
-        options.quantile == 0.5 ? Median(inliers) : InterpolatedQuantile(inliers, options.quantile);
+    const bool thumb = k <= KeypointIndex(Finger::kThumb, 3);
+    const bool palm = !thumb && parent == 0;
+    const double q = thumb ? options.thumb_quantile : palm ? options.palm_quantile : options.quantile;
+    const double m = q == 0.5 ? Median(inliers) : InterpolatedQuantile(inliers, q);
     out.lengths_mm[k] = m;
     if (options.correct_noise_bias) {
       const double tau = kMadToSigma * MedianAbsDeviation(inliers, m);

@@ -42,6 +42,14 @@ struct BoneLengthOptions {
   // to the image, whole only when a bone lies parallel to it: the hand stage takes a
   // higher quantile there (HandStageOptions::one_view_bone_quantile).
   double quantile = 0.5;
+  // [0.5, 1): the quantile for the palm's bones (wrist to the four finger bases) and for the
+  // thumb's four. One camera sees a cellist's left palm turned to the neck and the thumb
+  // behind it, rarely parallel to the image, while the fingers' phalanges often are: on
+  // SPD's cellist seen by one camera the 0.75 quantile left the palm's bones 4 % short and
+  // put the thumb's 6 % long; 0.8 and 0.7 there raised fingers 0.844 -> 0.855 and the hand
+  // within 15 mm 0.244 -> 0.254 (docs/hand.md, "One camera"). 0.5 with several cameras.
+  double palm_quantile = 0.5;
+  double thumb_quantile = 0.5;
   Status Validate() const;
 };
 

@@ -124,6 +124,39 @@ TEST(EstimateBoneLengths, AHigherQuantileOfProjectedDistancesNearsTheBones) {
   EXPECT_FALSE(bad.Validate().ok());
 }
 
+// The palm's and the thumb's bones take their own quantiles (BoneLengthOptions::
+// palm_quantile, thumb_quantile); every other bone keeps `quantile`.
+TEST(EstimateBoneLengths, ThePalmAndTheThumbTakeTheirOwnQuantiles) {
+  std::mt19937 rng(7);
+  Capture c = MakeCapture(300, 1.0, rng);
+  for (HandPointsMm& p : c.frames)
+    for (auto& q : p) q.z() = 0;  // projections, as one camera's lift gives
+  const HandModel prior = HandModel::Default(HandSide::kLeft);
+  BoneLengthOptions same;
+  same.quantile = 0.75;
+  same.palm_quantile = 0.75;
+  same.thumb_quantile = 0.75;
+  BoneLengthOptions own = same;
+  own.palm_quantile = 0.9;
+  own.thumb_quantile = 0.6;
+  const StatusOr<BoneLengthEstimate> a = EstimateBoneLengths(c.frames, prior, same);
+  const StatusOr<BoneLengthEstimate> b = EstimateBoneLengths(c.frames, prior, own);
+  ASSERT_TRUE(a.ok() && b.ok());
+  for (int k = 1; k < kNumHandKeypoints; ++k) {
+    const bool thumb = k <= KeypointIndex(Finger::kThumb, 3);
+    const bool palm = !thumb && ParentKeypoint(k) == 0;
+    if (thumb) EXPECT_LT(b->lengths_mm[k], a->lengths_mm[k]) << k;
+    else if (palm) EXPECT_GT(b->lengths_mm[k], a->lengths_mm[k]) << k;
+    else EXPECT_EQ(b->lengths_mm[k], a->lengths_mm[k]) << k;
+  }
+  BoneLengthOptions bad;
+  bad.palm_quantile = 1.0;
+  EXPECT_FALSE(bad.Validate().ok());
+  bad = BoneLengthOptions{};
+  bad.thumb_quantile = 0.4;
+  EXPECT_FALSE(bad.Validate().ok());
+}
+
 TEST(EstimateBoneLengths, FillsUnseenBonesFromScaleAndClampsToAnatomy) {
   std::mt19937 rng(3);
   Capture c = MakeCapture(50, 1.0, rng);

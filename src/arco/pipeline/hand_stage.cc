@@ -29,6 +29,10 @@ Status HandStageOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(gaps.Validate().WithContext("gaps"));
   if (!(one_view_bone_quantile >= 0.5 && one_view_bone_quantile < 1))
     return Status::Error("one_view_bone_quantile must be in [0.5, 1)");
+  if (!(one_view_palm_bone_quantile >= 0.5 && one_view_palm_bone_quantile < 1))
+    return Status::Error("one_view_palm_bone_quantile must be in [0.5, 1)");
+  if (!(one_view_thumb_bone_quantile >= 0.5 && one_view_thumb_bone_quantile < 1))
+    return Status::Error("one_view_thumb_bone_quantile must be in [0.5, 1)");
   return fit.Validate().WithContext("fit");
 }
 
@@ -40,7 +44,10 @@ Json ToJson(const HandStageOptions& o) {
             {"min_mad_mm", o.bones.min_mad_mm},
             {"min_ratio", o.bones.min_ratio},
             {"max_ratio", o.bones.max_ratio},
-            {"correct_noise_bias", o.bones.correct_noise_bias}}},
+            {"correct_noise_bias", o.bones.correct_noise_bias},
+            {"quantile", o.bones.quantile},
+            {"palm_quantile", o.bones.palm_quantile},
+            {"thumb_quantile", o.bones.thumb_quantile}}},
           {"palm",
            {{"enabled", o.palm.enabled},
             {"min_frames", o.palm.min_frames},
@@ -62,6 +69,8 @@ Json ToJson(const HandStageOptions& o) {
           {"one_view_depth", {{"window_frames", o.one_view_depth.window_frames}}},
           {"gaps", {{"max_gap_frames", o.gaps.max_gap_frames}}},
           {"one_view_bone_quantile", o.one_view_bone_quantile},
+          {"one_view_palm_bone_quantile", o.one_view_palm_bone_quantile},
+          {"one_view_thumb_bone_quantile", o.one_view_thumb_bone_quantile},
           {"chunk_frames", o.chunk_frames},
           {"num_threads", o.num_threads}};
 }
@@ -116,7 +125,11 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
   // (docs/accuracy.md, "One camera").
   const bool one_view = views == 1;
   hand::BoneLengthOptions bone_options = options.bones;
-  if (one_view) bone_options.quantile = options.one_view_bone_quantile;
+  if (one_view) {
+    bone_options.quantile = options.one_view_bone_quantile;
+    bone_options.palm_quantile = options.one_view_palm_bone_quantile;
+    bone_options.thumb_quantile = options.one_view_thumb_bone_quantile;
+  }
   StatusOr<hand::BoneLengthEstimate> bones = hand::EstimateBoneLengths(left, prior, bone_options);
   if (bones.ok()) {
     StatusOr<hand::HandModel> sized = prior.WithBoneLengths(bones->lengths_mm);

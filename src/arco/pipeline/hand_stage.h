@@ -30,6 +30,10 @@ struct HandStageOptions {
   // [0.5, 1): one camera: the bone lengths are this quantile of the lifted hand's
   // distances (bones.quantile; the lift's points are projections at the strings' depth).
   double one_view_bone_quantile = 0.75;
+  // [0.5, 1): one camera: the same for the palm's bones (wrist to finger bases) and the
+  // thumb's (bones.palm_quantile, bones.thumb_quantile; hand/bone_lengths.h says why).
+  double one_view_palm_bone_quantile = 0.8;
+  double one_view_thumb_bone_quantile = 0.7;
   // The fit carries a temporal prior from frame to frame; the clip is cut into chunks of
   // this many frames that are fitted in parallel (each starts from its own 3D keypoints),
   // so results do not depend on the thread count.
