@@ -67,7 +67,9 @@ std::string FormatStageLine(const pipeline::RunSummary& summary,
                   i.frames_with_pose,
                   static_cast<double>(i.frames),
                   i.median_rms_residual_mm) +
-           Format(", scale %.4g units/mm", i.world_units_per_mm);
+           Format(", scale %.4g units/mm, poses smoothed over sigma %.0f frames",
+                  i.world_units_per_mm,
+                  i.smoothing_sigma_frames);
   }
   if (timing.name == "hands") {
     const pipeline::HandStageSummary& h = summary.hands;

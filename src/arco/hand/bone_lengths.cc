@@ -55,7 +55,9 @@ StatusOr<BoneLengthEstimate> EstimateBoneLengths(const std::vector<HandPointsMm>
     out.inliers[k] = static_cast<int>(inliers.size());
     const bool thumb = k <= KeypointIndex(Finger::kThumb, 3);
     const bool palm = !thumb && parent == 0;
-    const double q = thumb ? options.thumb_quantile : palm ? options.palm_quantile : options.quantile;
+    const double q = thumb  ? options.thumb_quantile
+                     : palm ? options.palm_quantile
+                            : options.quantile;
     const double m = q == 0.5 ? Median(inliers) : InterpolatedQuantile(inliers, q);
     out.lengths_mm[k] = m;
     if (options.correct_noise_bias) {

@@ -86,9 +86,13 @@ TEST(EstimateBoneLengths, RemovesTheUpwardBiasOfNoisyDistances) {
   };
   const auto plain = signed_and_abs(false);
   const auto corrected = signed_and_abs(true);
-  std::printf("[ bones ] 4 mm noise, phalanges: mean error %+.2f mm (abs %.2f) plain median, "
-              "%+.2f mm (abs %.2f) corrected\n",
-              plain.first, plain.second, corrected.first, corrected.second);
+  std::printf(
+      "[ bones ] 4 mm noise, phalanges: mean error %+.2f mm (abs %.2f) plain median, "
+      "%+.2f mm (abs %.2f) corrected\n",
+      plain.first,
+      plain.second,
+      corrected.first,
+      corrected.second);
   EXPECT_GT(plain.first, 0.8);
   EXPECT_LT(std::abs(corrected.first), 0.4);
   EXPECT_LT(corrected.second, 0.6 * plain.second);
@@ -145,9 +149,12 @@ TEST(EstimateBoneLengths, ThePalmAndTheThumbTakeTheirOwnQuantiles) {
   for (int k = 1; k < kNumHandKeypoints; ++k) {
     const bool thumb = k <= KeypointIndex(Finger::kThumb, 3);
     const bool palm = !thumb && ParentKeypoint(k) == 0;
-    if (thumb) EXPECT_LT(b->lengths_mm[k], a->lengths_mm[k]) << k;
-    else if (palm) EXPECT_GT(b->lengths_mm[k], a->lengths_mm[k]) << k;
-    else EXPECT_EQ(b->lengths_mm[k], a->lengths_mm[k]) << k;
+    if (thumb)
+      EXPECT_LT(b->lengths_mm[k], a->lengths_mm[k]) << k;
+    else if (palm)
+      EXPECT_GT(b->lengths_mm[k], a->lengths_mm[k]) << k;
+    else
+      EXPECT_EQ(b->lengths_mm[k], a->lengths_mm[k]) << k;
   }
   BoneLengthOptions bad;
   bad.palm_quantile = 1.0;

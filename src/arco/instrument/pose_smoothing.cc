@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 
@@ -81,6 +82,62 @@ std::vector<InstrumentFramePose> SmoothFramePoses(const std::vector<InstrumentFr
         SimMatrix3d(units, mean->normalized().toRotationMatrix(), translation / weight_sum);
   }
   return out;
+}
+
+double LeaveOneOutSigmaFrames(const std::vector<InstrumentFramePose>& frames,
+                              const std::vector<Eigen::Vector3d>& probe_points_in_instrument,
+                              const std::vector<double>& candidates_frames,
+                              int min_frames) {
+  if (candidates_frames.empty())
+    throw std::invalid_argument("LeaveOneOutSigmaFrames: no candidates");
+  for (double c : candidates_frames) {
+    if (!(c > 0) || !std::isfinite(c))
+      throw std::invalid_argument("LeaveOneOutSigmaFrames: candidates must be finite and > 0");
+  }
+  const int n = static_cast<int>(frames.size());
+  const int probes = static_cast<int>(probe_points_in_instrument.size());
+  // Each kOk frame's probes in the world, stacked (frame-major).
+  std::vector<uint8_t> ok(n, 0);
+  std::vector<Eigen::Vector3d> placed(static_cast<size_t>(n) * probes);
+  int posed = 0;
+  for (int f = 0; f < n; ++f) {
+    if (frames[f].status != FrameFitStatus::kOk) continue;
+    ok[f] = 1;
+    ++posed;
+    for (int p = 0; p < probes; ++p) {
+      placed[static_cast<size_t>(f) * probes + p] =
+          frames[f].world_from_instrument * probe_points_in_instrument[p];
+    }
+  }
+  if (posed < min_frames || probes == 0) return candidates_frames[0];
+  double best = candidates_frames[0];
+  double best_error = std::numeric_limits<double>::infinity();
+  for (double sigma : candidates_frames) {
+    const int radius = static_cast<int>(std::ceil(3.0 * sigma));
+    double sum = 0;
+    int count = 0;
+    for (int f = 0; f < n; ++f) {
+      if (!ok[f]) continue;
+      double wsum = 0;
+      std::vector<Eigen::Vector3d> mean(probes, Eigen::Vector3d::Zero());
+      for (int g = std::max(0, f - radius); g <= std::min(n - 1, f + radius); ++g) {
+        if (g == f || !ok[g]) continue;
+        const double w = std::exp(-0.5 * (g - f) * (g - f) / (sigma * sigma));
+        wsum += w;
+        for (int p = 0; p < probes; ++p) mean[p] += w * placed[static_cast<size_t>(g) * probes + p];
+      }
+      if (!(wsum > 0)) continue;
+      for (int p = 0; p < probes; ++p)
+        sum += (mean[p] / wsum - placed[static_cast<size_t>(f) * probes + p]).squaredNorm();
+      ++count;
+    }
+    const double error = count > 0 ? sum / count : std::numeric_limits<double>::infinity();
+    if (error < best_error) {
+      best_error = error;
+      best = sigma;
+    }
+  }
+  return best;
 }
 
 }  // namespace arco

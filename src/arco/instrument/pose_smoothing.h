@@ -44,4 +44,16 @@ struct PoseSmoothingOptions {
 std::vector<InstrumentFramePose> SmoothFramePoses(const std::vector<InstrumentFramePose>& frames,
                                                   const PoseSmoothingOptions& options = {});
 
+// The kernel width among `candidates_frames` whose smoothing best predicts each kOk frame's
+// `probe_points_in_instrument` (placed by that frame's own pose) from the other kOk frames
+// around it: leave-one-out cross-validation (Wahba 1990, ch. 4) of a Gaussian-weighted mean
+// of the placed points, the average over frames of the squared distance. Detector noise
+// that is independent from frame to frame counts against a narrow kernel, the
+// instrument's own motion against a wide one. `candidates_frames[0]` when fewer than
+// `min_frames` frames have a pose. Candidates must be > 0.
+double LeaveOneOutSigmaFrames(const std::vector<InstrumentFramePose>& frames,
+                              const std::vector<Eigen::Vector3d>& probe_points_in_instrument,
+                              const std::vector<double>& candidates_frames,
+                              int min_frames = 30);
+
 }  // namespace arco

@@ -312,5 +312,64 @@ TEST(SmoothFramePoses, ReducesJitterFillsGapsAndKeepsScale) {
   EXPECT_TRUE(SmoothFramePoses({}, options).empty());
 }
 
+// A pose track with known truth: the instrument translated by `amplitude_mm` * sin(2 pi f /
+// period_frames) along x and turned about z by amplitude / 700 rad, the measured poses off by
+// white noise of `noise_mm` per axis.
+std::vector<InstrumentFramePose> MovingTrack(int frames,
+                                             double amplitude_mm,
+                                             double period_frames,
+                                             double noise_mm,
+                                             unsigned seed,
+                                             std::vector<SimMatrix3d>* truth) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, noise_mm);
+  std::vector<InstrumentFramePose> out(static_cast<size_t>(frames));
+  truth->clear();
+  for (int f = 0; f < frames; ++f) {
+    const double s = std::sin(2 * M_PI * f / period_frames);
+    const Eigen::Matrix3d r =
+        Eigen::AngleAxisd(amplitude_mm / 700.0 * s, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Vector3d t(amplitude_mm * s, 0, 2000);
+    truth->push_back(SimMatrix3d(1.0, r, t));
+    const Eigen::Matrix3d rn =
+        Eigen::AngleAxisd(noise(rng) / 350.0, Eigen::Vector3d::UnitY()).toRotationMatrix() * r;
+    out[static_cast<size_t>(f)].status = FrameFitStatus::kOk;
+    out[static_cast<size_t>(f)].world_from_instrument =
+        SimMatrix3d(1.0, rn, t + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+  }
+  return out;
+}
+
+TEST(LeaveOneOutSigmaFrames, WideForAHeldInstrumentNarrowForAMovingOne) {
+  const std::vector<Eigen::Vector3d> probes = {
+      {695, 12, 0}, {695, -12, 0}, {0, 24, 0}, {0, -24, 0}};
+  const std::vector<double> candidates = {2, 3, 5, 7, 10, 15, 20};
+  std::vector<SimMatrix3d> truth;
+  // Held still, 2 mm of noise: the widest kernel, and it lands nearer the truth than sigma 2.
+  const std::vector<InstrumentFramePose> held = MovingTrack(330, 3.0, 330, 2.0, 11, &truth);
+  const double wide = LeaveOneOutSigmaFrames(held, probes, candidates);
+  std::printf("[ loo ] held instrument: sigma %.0f frames\n", wide);
+  EXPECT_GE(wide, 15);
+  const auto error = [&](double sigma) {
+    PoseSmoothingOptions o;
+    o.sigma_frames = sigma;
+    const std::vector<InstrumentFramePose> smooth = SmoothFramePoses(held, o);
+    double sum = 0;
+    for (size_t f = 0; f < smooth.size(); ++f)
+      sum += (smooth[f].world_from_instrument * probes[0] - truth[f] * probes[0]).norm();
+    return sum / static_cast<double>(smooth.size());
+  };
+  EXPECT_LT(error(wide), 0.6 * error(2));
+  // Moving 40 mm every second with 0.3 mm of noise: the narrowest.
+  const std::vector<InstrumentFramePose> moving = MovingTrack(330, 40.0, 30, 0.3, 12, &truth);
+  EXPECT_EQ(LeaveOneOutSigmaFrames(moving, probes, candidates), 2);
+  // Too few posed frames: the first candidate; frames without a pose are left out.
+  std::vector<InstrumentFramePose> few = held;
+  for (size_t f = 20; f < few.size(); ++f) few[f].status = FrameFitStatus::kTooFewPoints;
+  EXPECT_EQ(LeaveOneOutSigmaFrames(few, probes, candidates), 2);
+  EXPECT_THROW(LeaveOneOutSigmaFrames(held, probes, {}), std::invalid_argument);
+  EXPECT_THROW(LeaveOneOutSigmaFrames(held, probes, {2, 0}), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace arco

@@ -20,6 +20,10 @@ Status InstrumentStageOptions::Validate() const {
   if (result_dir.empty()) return Status::Error("result_dir is empty");
   if (num_threads < 0) return Status::Error("num_threads must be >= 0");
   ARCO_RETURN_IF_ERROR(fit.Validate().WithContext("fit"));
+  for (double c : smoothing_candidates_frames) {
+    if (!(c > 0 && c <= 300))
+      return Status::Error("smoothing_candidates_frames must each be in (0, 300]");
+  }
   return smoothing.Validate().WithContext("smoothing");
 }
 
@@ -55,6 +59,7 @@ Json ToJson(const InstrumentStageOptions& o) {
             {"radius_frames", o.smoothing.radius_frames},
             {"max_fill_gap_frames", o.smoothing.max_fill_gap_frames},
             {"replace_high_residual", o.smoothing.replace_high_residual}}},
+          {"smoothing_candidates_frames", o.smoothing_candidates_frames},
           {"num_threads", o.num_threads}};
 }
 
@@ -128,8 +133,20 @@ StatusOr<InstrumentRecord> RunInstrumentStage(const InstrumentStageOptions& opti
     return fit.status().WithContext(
         ResultFolder(options.result_dir).Points3dPath(kTriangulationStage));
   }
-  const std::vector<InstrumentFramePose> poses = SmoothFramePoses(fit->frames, options.smoothing);
+  PoseSmoothingOptions smoothing = options.smoothing;
+  if (!options.smoothing_candidates_frames.empty()) {
+    // Probes: every string's two ends, where the contacts lie.
+    std::vector<Eigen::Vector3d> probes;
+    for (const StringSegment& g : fit->instrument.strings_in_instrument) {
+      probes.push_back(g.nut);
+      probes.push_back(g.bridge);
+    }
+    smoothing.sigma_frames =
+        LeaveOneOutSigmaFrames(fit->frames, probes, options.smoothing_candidates_frames);
+  }
+  const std::vector<InstrumentFramePose> poses = SmoothFramePoses(fit->frames, smoothing);
   InstrumentStageSummary summary;
+  summary.smoothing_sigma_frames = smoothing.sigma_frames;
   for (const std::string& w : fit->summary.warnings) summary.warnings.push_back("instrument: " + w);
   if (fit->instrument.order.ambiguous) {
     summary.warnings.push_back("instrument: string order ambiguous: " +

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "arco/instrument/pose_smoothing.h"
 #include "arco/instrument/template_fit.h"
@@ -28,6 +29,14 @@ struct InstrumentStageOptions {
     o.max_fill_gap_frames = 15;
     return o;
   }();
+  // The kernel's width chosen per capture among these (frames, each > 0; empty: always
+  // smoothing.sigma_frames) by leave-one-out cross-validation of the strings' ends
+  // (LeaveOneOutSigmaFrames): a held instrument seen by few cameras is smoothed over
+  // longer, a moving one or one seen by many as before. On the real take seen by two
+  // cameras it chose 7-20 frames and the instrument came 5.2 -> 4.4 mm from SPD's, the
+  // contact 5.4 -> 4.9 mm; with 4 or 19 cameras and on arco's simulator it chose 2 (docs/
+  // accuracy.md, "The instrument held still: its smoothing chosen per capture").
+  std::vector<double> smoothing_candidates_frames = {2, 3, 5, 7, 10, 15, 20};
   int num_threads = 0;  // 0 = all cores; results do not depend on it
   Status Validate() const;
 };

@@ -9,7 +9,8 @@ Json ToJson(const InstrumentStageSummary& s) {
           {"median_rms_residual_mm", JsonFromDouble(s.median_rms_residual_mm)},
           {"front_agreement", JsonFromDouble(s.front_agreement)},
           {"string_order_ambiguous", s.string_order_ambiguous},
-          {"labels_agree", s.labels_agree}};
+          {"labels_agree", s.labels_agree},
+          {"smoothing_sigma_frames", JsonFromDouble(s.smoothing_sigma_frames)}};
 }
 
 Json ToJson(const HandStageSummary& s) {

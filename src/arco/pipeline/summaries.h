@@ -31,11 +31,12 @@ struct InstrumentStageSummary {
   double front_agreement = 0;
   bool string_order_ambiguous = false;
   bool labels_agree = false;
-  double world_units_per_mm = 0;  // the metric scale of the world
+  double world_units_per_mm = 0;      // the metric scale of the world
+  double smoothing_sigma_frames = 0;  // the pose smoothing's kernel width as chosen
   std::vector<std::string> warnings;
 };
 // {frames, frames_with_pose, frames_high_residual, median_rms_residual_mm,
-// front_agreement, string_order_ambiguous, labels_agree}.
+// front_agreement, string_order_ambiguous, labels_agree, smoothing_sigma_frames}.
 Json ToJson(const InstrumentStageSummary& summary);
 
 struct HandStageSummary {
