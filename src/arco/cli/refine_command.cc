@@ -21,6 +21,7 @@ struct RefineArgs {
   std::string joints = hand::FingerIkJointsName(refine::ArcoIkOptions{}.joints);
   bool exact_reach = false;
   bool no_audio_onsets = false;
+  bool one_view_lift_test = false;
   // The options as validated when the command line was parsed: RunRefineStage takes them
   // as they are (one validation).
   std::optional<Validated<pipeline::RefineStageOptions>> valid;
@@ -36,6 +37,7 @@ void ApplyAndValidate(RefineArgs& a) {
   if (a.joints == "mcp_flex_pip_dip") a.o.refine.ik.joints = hand::FingerIkJoints::kMcpFlexPipDip;
   a.o.refine.ik.exact_reach = a.exact_reach;
   a.o.refine.decode.audio_onsets = !a.no_audio_onsets;
+  a.o.refine.decode.one_view_keep_out_of_reach = !a.one_view_lift_test;
   StatusOr<Validated<pipeline::RefineStageOptions>> valid =
       Validated<pipeline::RefineStageOptions>::Check(a.o);
   if (!valid.ok()) {
@@ -235,6 +237,11 @@ std::function<int()> SetupRefine(CLI::App& app) {
             "counts the height beyond it in full (mm)",
             refine::kCostWeightRange)
       ->capture_default_str();
+  sub->add_flag("--one-view-lift-test",
+                a->one_view_lift_test,
+                "arco decoding, one camera: a frame whose fingertip is beyond the lift test's "
+                "reach of the decided contact becomes uncertain, as with several cameras "
+                "(default: pressed, reason out_of_reach)");
   sub->parse_complete_callback([a] { ApplyAndValidate(*a); });
   return [a]() { return RunRefine(*a); };
 }

@@ -249,8 +249,11 @@ void AssignFrame(const DecodeContext& context,
        cand.point_in_world)
           .norm();
   if (fc->tip_distance_vision_mm > lift_max_mm[static_cast<size_t>(finger)]) {
-    fc->state = ContactState::kUncertain;  // lift test: string and finger kept as info
     fc->reason = ContactReason::kOutOfReach;
+    // One camera: the decision stands (ArcoDecodeOptions::one_view_keep_out_of_reach).
+    const bool keep =
+        options.one_view_keep_out_of_reach && context.input->one_view_camera_centre_mm.has_value();
+    if (!keep) fc->state = ContactState::kUncertain;  // lift test: string and finger as info
   }
 }
 

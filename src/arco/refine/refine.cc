@@ -361,6 +361,7 @@ Json ToJson(const RefineOptions& o) {
             {"one_view_max_shift_factor", o.decode.one_view_max_shift_factor},
             {"one_view_lateral_weight", o.decode.one_view_lateral_weight},
             {"one_view_above_margin_mm", o.decode.one_view_above_margin_mm},
+            {"one_view_keep_out_of_reach", o.decode.one_view_keep_out_of_reach},
             {"bowed_pair_string", o.decode.bowed_pair_string},
             {"boundaries",
              {{"onset_tolerance_s", o.decode.boundaries.onset_tolerance_s},
