@@ -31,6 +31,7 @@ Json ToJson(const TriangulateStageOptions& o) {
                    {"pnp_gate_px", v.pnp_gate_px},
                    {"body_behind_mm", v.body_behind_mm},
                    {"depth_window_frames", v.depth_window_frames},
+                   {"end_pin_depth_window_frames", v.end_pin_depth_window_frames},
                    {"rotation_window_frames", v.rotation_window_frames},
                    {"min_ray_plane_cos", v.min_ray_plane_cos}};
   return j;
@@ -101,6 +102,8 @@ StatusOr<track::MonocularScene> OneViewScene(const CaptureContext& capture) {
                                   (1 - w) * at("bridge_l") + w * at("bridge_r"));
   }
   scene.front = Eigen::Vector3d::UnitZ();
+  scene.stands_on_end_pin =
+      model.kind() == InstrumentKind::kCello || model.kind() == InstrumentKind::kDoubleBass;
   if (const std::vector<int>* g = capture.layout.Group("left_hand")) {
     scene.string_line_columns = *g;
     // The four fingers' tips (hand-21 order: 4 points per finger after the wrist).

@@ -91,6 +91,8 @@ Status MonocularLiftOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(CheckInRange("body_behind_mm", body_behind_mm, Closed(0, 2000)));
   ARCO_RETURN_IF_ERROR(CheckInRange("depth_window_frames", depth_window_frames, Closed(0, 300)));
   ARCO_RETURN_IF_ERROR(
+      CheckInRange("end_pin_depth_window_frames", end_pin_depth_window_frames, Closed(0, 3000)));
+  ARCO_RETURN_IF_ERROR(
       CheckInRange("rotation_window_frames", rotation_window_frames, Closed(0, 300)));
   return CheckInRange("min_ray_plane_cos", min_ray_plane_cos, AboveZero(1));
 }
@@ -193,6 +195,8 @@ StatusOr<MonocularLift> LiftOneView(const Camera& camera,
       rotations[static_cast<size_t>(f)] =
           out.world_from_instrument[static_cast<size_t>(f)]->rotation;
   }
+  const int64_t depth_window =
+      scene.stands_on_end_pin ? o.end_pin_depth_window_frames : o.depth_window_frames;
   for (int64_t f = 0; f < frames && o.rotation_window_frames > 0; ++f) {
     std::optional<Rigid3d>& pose = out.world_from_instrument[static_cast<size_t>(f)];
     if (!pose) continue;
@@ -211,8 +215,8 @@ StatusOr<MonocularLift> LiftOneView(const Camera& camera,
     std::optional<Rigid3d>& pose = out.world_from_instrument[static_cast<size_t>(f)];
     if (!pose) continue;
     std::vector<double> around;
-    for (int64_t g = std::max<int64_t>(0, f - o.depth_window_frames);
-         g <= std::min(frames - 1, f + o.depth_window_frames);
+    for (int64_t g = std::max<int64_t>(0, f - depth_window);
+         g <= std::min(frames - 1, f + depth_window);
          ++g) {
       if (std::isfinite(depth[static_cast<size_t>(g)]))
         around.push_back(depth[static_cast<size_t>(g)]);
