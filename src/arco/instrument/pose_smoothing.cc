@@ -1,6 +1,7 @@
 #include "arco/instrument/pose_smoothing.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -112,17 +113,21 @@ double LeaveOneOutSigmaFrames(const std::vector<InstrumentFramePose>& frames,
   if (posed < min_frames || probes == 0) return candidates_frames[0];
   double best = candidates_frames[0];
   double best_error = std::numeric_limits<double>::infinity();
+  std::vector<Eigen::Vector3d> mean(probes);
   for (double sigma : candidates_frames) {
+    // The kernel as SmoothFramePoses builds it (radius ceil(3 sigma)).
     const int radius = static_cast<int>(std::ceil(3.0 * sigma));
+    std::vector<double> kernel(radius + 1);
+    for (int d = 0; d <= radius; ++d) kernel[d] = std::exp(-0.5 * d * d / (sigma * sigma));
     double sum = 0;
     int count = 0;
     for (int f = 0; f < n; ++f) {
       if (!ok[f]) continue;
       double wsum = 0;
-      std::vector<Eigen::Vector3d> mean(probes, Eigen::Vector3d::Zero());
+      std::fill(mean.begin(), mean.end(), Eigen::Vector3d::Zero());
       for (int g = std::max(0, f - radius); g <= std::min(n - 1, f + radius); ++g) {
         if (g == f || !ok[g]) continue;
-        const double w = std::exp(-0.5 * (g - f) * (g - f) / (sigma * sigma));
+        const double w = kernel[std::abs(g - f)];
         wsum += w;
         for (int p = 0; p < probes; ++p) mean[p] += w * placed[static_cast<size_t>(g) * probes + p];
       }
