@@ -242,6 +242,17 @@ std::function<int()> SetupRefine(CLI::App& app) {
                 "arco decoding, one camera: a frame whose fingertip is beyond the lift test's "
                 "reach of the decided contact becomes uncertain, as with several cameras "
                 "(default: pressed, reason out_of_reach)");
+  sub->add_flag("!--one-view-whole-hand-depth",
+                r.one_view_hand_frame,
+                "arco, one camera: the hand moved along its rays as a whole by the sound's "
+                "depth only (the former rule), not each keypoint by the hand frame");
+  AddNumber(sub,
+            "--one-view-frame-sigma-mm",
+            r.one_view_frame.frame_sigma_mm,
+            "arco, one camera: how far (mm) the other fingertips may lie from their places "
+            "along the string in the hand frame",
+            refine::kFrameSigmaRangeMm)
+      ->capture_default_str();
   sub->parse_complete_callback([a] { ApplyAndValidate(*a); });
   return [a]() { return RunRefine(*a); };
 }

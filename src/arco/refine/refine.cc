@@ -6,6 +6,7 @@
 #include "arco/refine/arco_decode.h"
 #include "arco/refine/decode_context.h"
 #include "arco/refine/finger_ik.h"
+#include "arco/refine/hand_frame_depth.h"
 #include "arco/refine/paper_decode.h"
 #include "arco/refine/transcription.h"
 
@@ -227,6 +228,7 @@ Status RefineOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(decode.Validate());
   ARCO_RETURN_IF_ERROR(ik.Validate());
   ARCO_RETURN_IF_ERROR(one_view_depth.Validate().WithContext("refine options: one_view_depth"));
+  ARCO_RETURN_IF_ERROR(one_view_frame.Validate().WithContext("refine options: one_view_frame"));
   if (num_threads < 0) return Status::Error("refine options: num_threads must be >= 0");
   return Status::Ok();
 }
@@ -288,6 +290,16 @@ RefineResult Refine(const RefineInput& input, const RefineOptions& options) {
                                    options.pitch,
                                    LiftMaxMm(input.hand_model, options.ik),
                                    options.num_threads);
+      // The hand frame's depth (hand_frame_depth.h), then the context the IK starts from.
+      if (options.one_view_hand_frame) {
+        PlaceHandsInTheirFrame(moved_context,
+                               result.contacts,
+                               centre,
+                               options.one_view_frame,
+                               options.num_threads,
+                               &moved.vision_hand);
+        moved_context = MakeDecodeContext(moved, result.analysis, options.num_threads);
+      }
       ik_context = &moved_context;
     }
     result.hand = SolveArcoIk(*ik_context,
@@ -315,6 +327,13 @@ Json ToJson(const RefineOptions& o) {
           {"audio_onsets", o.mode == RefineMode::kArco && o.decode.audio_onsets},
           {"num_threads", o.num_threads},
           {"one_view_depth", {{"window_frames", o.one_view_depth.window_frames}}},
+          {"one_view_hand_frame", o.one_view_hand_frame},
+          {"one_view_frame",
+           {{"tip_sigma_mm", o.one_view_frame.tip_sigma_mm},
+            {"frame_sigma_mm", o.one_view_frame.frame_sigma_mm},
+            {"bone_sigma_mm", o.one_view_frame.rays.bone_sigma_mm},
+            {"stay_sigma_mm", o.one_view_frame.rays.stay_sigma_mm},
+            {"max_iterations", o.one_view_frame.rays.max_iterations}}},
           {"pitch",
            {{"min_confidence", o.pitch.min_confidence},
             {"min_confidence_in_note", o.pitch.min_confidence_in_note},

@@ -24,6 +24,7 @@
 #include "arco/hand/ik.h"
 #include "arco/hand/kinematics.h"
 #include "arco/hand/one_view_depth.h"
+#include "arco/hand/ray_depth.h"
 #include "arco/instrument/instrument_model.h"
 #include "arco/instrument/strings.h"
 #include "arco/refine/contact_annotation.h"
@@ -267,6 +268,17 @@ struct ArcoIkOptions {
   Status Validate() const;
 };
 
+// One camera: the pressed frames' hands placed along their rays by the hand frame
+// (hand_frame_depth.h says why and how).
+inline constexpr NumberRange kFrameSigmaRangeMm = AboveZero(1000);
+struct HandFrameDepthOptions {
+  double tip_sigma_mm = 5.0;  // (0, 100]: the pressing fingertip's distance from the camera
+  double frame_sigma_mm =
+      10.0;  // kFrameSigmaRangeMm: the other fingertips' places along the string
+  hand::RayDepthOptions rays;
+  Status Validate() const;
+};
+
 struct RefineOptions {
   RefineMode mode = RefineMode::kArco;
   PitchModelOptions pitch;
@@ -274,7 +286,14 @@ struct RefineOptions {
   ArcoDecodeOptions decode;
   ArcoIkOptions ik;
   hand::OneViewDepthOptions one_view_depth;  // RefineInput::one_view_camera_centre_mm
-  int num_threads = 0;                       // 0 = all cores; results do not depend on it
+  // One camera, arco: after the decoding, each pressed frame's vision hand has its
+  // keypoints moved along their rays by the hand frame (hand_frame_depth.h: the pressing
+  // fingertip as far from the camera as the contact, the other fingertips at their places
+  // along the string), before the IK. false: the hand as the sound's depth moved it (the
+  // former rule). No effect with several cameras.
+  bool one_view_hand_frame = true;
+  HandFrameDepthOptions one_view_frame;
+  int num_threads = 0;  // 0 = all cores; results do not depend on it
   Status Validate() const;
 };
 

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 
+#include "arco/hand/fit.h"
 #include "arco/hand/kinematics.h"
 #include "arco/hand/one_view_depth.h"
 #include "arco/refine/test_scene.h"
@@ -615,6 +616,66 @@ TEST(Refine, OneCameraWeighsTheImageAcrossTheStringInFull) {
   EXPECT_GE(full, 0.95);
   EXPECT_LT(cameras, full - 0.2);
   EXPECT_GT(margin_only, cameras + 0.05);
+}
+
+TEST(Refine, OneCameraPlacesTheHandAlongItsRaysByTheHandFrame) {
+  // First position on the A string seen as SPD's camera 21334207 sees the real take, each
+  // frame's vision hand with its ring and little fingers tilted toward the camera along
+  // their rays (up to 40 mm at the tips; the image unchanged), as the real take's one-view
+  // fit has them. Once the sound has named the finger and the contact, the hand frame says
+  // where the other fingertips are along the string (hand_frame_depth.h): the refined
+  // hand's ring and little fingers come back toward the truth; the decisions stay.
+  testing::Scene scene = FirstPositionFromOneCamera(Eigen::Vector3d(2200, 300, -400), 20.0);
+  const Eigen::Vector3d centre = *scene.input.one_view_camera_centre_mm;
+  const hand::HandModel& model = scene.input.hand_model;
+  for (std::optional<hand::HandPose>& hand : scene.input.vision_hand) {
+    ASSERT_TRUE(hand.has_value());
+    hand::HandPointsMm points = hand::ForwardKinematics(model, *hand);
+    const int first = hand::KeypointIndex(hand::Finger::kRing, 0);
+    for (int k = first; k < hand::kNumHandKeypoints; ++k) {
+      const double near_mm = 40.0 * ((k - first) % 4 + 1) / 4.0;
+      points[k] -= near_mm * (points[k] - centre).normalized();
+    }
+    const hand::HandFit3dResult fit =
+        hand::FitHandToPoints3d(model, points, hand::HandFit3dOptions{}, *hand);
+    ASSERT_TRUE(fit.ok);
+    hand = fit.pose;
+  }
+  const auto run = [&](bool frame) {
+    RefineOptions o = Options(RefineMode::kArco);
+    o.one_view_hand_frame = frame;
+    return Refine(scene.input, o);
+  };
+  const RefineResult placed = run(true), whole = run(false);
+  double placed_mm = 0, whole_mm = 0;
+  int judged = 0, same = 0;
+  for (size_t f = 0; f < scene.truth_hand.size(); ++f) {
+    same += placed.contacts[f].state == whole.contacts[f].state &&
+            placed.contacts[f].string == whole.contacts[f].string &&
+            placed.contacts[f].finger == whole.contacts[f].finger;
+    if (scene.truth_finger[f] == 0 || !placed.hand[f] || !whole.hand[f]) continue;
+    const hand::HandPointsMm want = hand::ForwardKinematics(model, scene.truth_hand[f]);
+    const hand::HandPointsMm a = hand::ForwardKinematics(model, *placed.hand[f]);
+    const hand::HandPointsMm b = hand::ForwardKinematics(model, *whole.hand[f]);
+    for (int k = hand::KeypointIndex(hand::Finger::kRing, 0); k < hand::kNumHandKeypoints; ++k) {
+      placed_mm += (a[k] - want[k]).norm() / 8;
+      whole_mm += (b[k] - want[k]).norm() / 8;
+    }
+    ++judged;
+  }
+  placed_mm /= judged;
+  whole_mm /= judged;
+  std::printf(
+      "[ one camera ] ring and little fingers %.1f mm from the truth placed by the hand frame, "
+      "%.1f mm moved as a whole (%d pressed frames); decisions the same on %d of %zu frames\n",
+      placed_mm,
+      whole_mm,
+      judged,
+      same,
+      scene.truth_hand.size());
+  EXPECT_GE(judged, 100);
+  EXPECT_LT(placed_mm, 0.7 * whole_mm);
+  EXPECT_EQ(same, static_cast<int>(scene.truth_hand.size()));
 }
 
 TEST(Refine, OneCameraKeepsTheSoundsDecisionWhereTheHandIsOutOfReach) {
