@@ -239,9 +239,10 @@ std::function<int()> SetupRefine(CLI::App& app) {
       ->capture_default_str();
   sub->add_flag("--one-view-lift-test",
                 a->one_view_lift_test,
-                "arco decoding, one camera: a frame whose fingertip is beyond the lift test's "
-                "reach of the decided contact becomes uncertain, as with several cameras "
-                "(default: pressed, reason out_of_reach)");
+                "arco decoding, one camera: the lift test as with several cameras: a candidate "
+                "beyond its reach is infeasible, and a frame whose fingertip is beyond it of "
+                "the decided contact becomes uncertain (default: neither; pressed, reason "
+                "out_of_reach)");
   sub->add_flag("!--one-view-whole-hand-depth",
                 r.one_view_hand_frame,
                 "arco, one camera: the hand moved along its rays as a whole by the sound's "

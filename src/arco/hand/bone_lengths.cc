@@ -75,6 +75,22 @@ StatusOr<BoneLengthEstimate> EstimateBoneLengths(const std::vector<HandPointsMm>
         << " frames with both keypoints triangulated (" << frames.size() << " frames)";
     return Status::Error(msg.str());
   }
+  if (options.palm_as_one) {
+    // The middle two of the four palm bones' ratios (header comment); all four measured.
+    std::vector<double> palm;
+    for (int f = static_cast<int>(Finger::kIndex); f <= static_cast<int>(Finger::kLittle); ++f) {
+      const int k = KeypointIndex(static_cast<Finger>(f), 0);
+      if (out.from_data[k]) palm.push_back(out.lengths_mm[k] / prior.bone_length_mm(k));
+    }
+    if (palm.size() == 4) {
+      std::sort(palm.begin(), palm.end());
+      const double scale = 0.5 * (palm[1] + palm[2]);
+      for (int f = static_cast<int>(Finger::kIndex); f <= static_cast<int>(Finger::kLittle); ++f) {
+        const int k = KeypointIndex(static_cast<Finger>(f), 0);
+        out.lengths_mm[k] = scale * prior.bone_length_mm(k);
+      }
+    }
+  }
   out.hand_scale = Median(ratios);
   if (out.hand_scale < options.min_ratio || out.hand_scale > options.max_ratio) {
     std::ostringstream msg;

@@ -50,6 +50,15 @@ struct BoneLengthOptions {
   // within 15 mm 0.244 -> 0.254 (docs/hand.md, "One camera"). 0.5 with several cameras.
   double palm_quantile = 0.5;
   double thumb_quantile = 0.5;
+  // The palm as one rigid piece: its four bones (wrist to the finger bases) become the
+  // prior's times one scale, the mean of the middle two of their measured ratios to the
+  // prior (each measured at palm_quantile). The palm does not bend, and hands differ in its
+  // size far more than in its proportions (the prior's 88 / 87 / 84 / 80 mm; SPD's
+  // cellist 95 / 100 / 93 / 87), while one view foreshortens each of its bones by its own
+  // tilt: there the 0.8 quantile gave SPD's cellist 101 / 103 / 91 / 78 mm, one scale
+  // 98 / 97 / 94 / 89 (docs/hand.md, "One camera"). The hand stage sets it with one
+  // camera (HandStageOptions::one_view_palm_as_one); false: each bone by itself.
+  bool palm_as_one = false;
   Status Validate() const;
 };
 

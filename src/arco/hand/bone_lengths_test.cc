@@ -164,6 +164,60 @@ TEST(EstimateBoneLengths, ThePalmAndTheThumbTakeTheirOwnQuantiles) {
   EXPECT_FALSE(bad.Validate().ok());
 }
 
+TEST(EstimateBoneLengths, ThePalmAsOnePieceTakesOneScale) {
+  // A performer's palm 12 % larger than the prior's, seen with each of its bones
+  // foreshortened by its own factor (one view: the little finger's most, as the real
+  // take's camera sees the cellist's palm turned away). Each bone by itself keeps its
+  // factor's error; the palm as one piece takes one scale for all four, the mean of the
+  // middle two ratios, and keeps the prior's proportions.
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const HandModel prior = HandModel::Default(HandSide::kLeft);
+  BoneLengthsMm lengths = prior.bone_lengths_mm();
+  for (int k = 1; k < kNumHandKeypoints; ++k) lengths[k] *= 1.12;
+  const HandModel truth = prior.WithBoneLengths(lengths).value();
+  const double seen[4] = {1.0, 0.98, 0.95, 0.85};  // index, middle, ring, little
+  std::vector<HandPointsMm> frames;
+  for (int f = 0; f < 200; ++f) {
+    HandPointsMm p = ForwardKinematics(truth, testing::RandomPose(truth, rng));
+    for (int finger = 1; finger <= 4; ++finger) {
+      const int k0 = KeypointIndex(static_cast<Finger>(finger), 0);
+      const Eigen::Vector3d base =
+          p[0] + seen[finger - 1] * (p[k0] - p[0]) + 0.5 * Eigen::Vector3d(n(rng), n(rng), n(rng));
+      const Eigen::Vector3d move = base - p[k0];
+      for (int j = 0; j < 4; ++j) p[k0 + j] += move;  // the finger's own bones unchanged
+    }
+    frames.push_back(p);
+  }
+  BoneLengthOptions each;
+  BoneLengthOptions one = each;
+  one.palm_as_one = true;
+  const StatusOr<BoneLengthEstimate> a = EstimateBoneLengths(frames, prior, each);
+  const StatusOr<BoneLengthEstimate> b = EstimateBoneLengths(frames, prior, one);
+  ASSERT_TRUE(a.ok() && b.ok());
+  double worst_each = 0, worst_one = 0;
+  const int index_base = KeypointIndex(Finger::kIndex, 0);
+  for (int finger = 1; finger <= 4; ++finger) {
+    const int k = KeypointIndex(static_cast<Finger>(finger), 0);
+    const double want = truth.bone_length_mm(k);
+    worst_each = std::max(worst_each, std::abs(a->lengths_mm[k] / want - 1));
+    worst_one = std::max(worst_one, std::abs(b->lengths_mm[k] / want - 1));
+    // One scale: the prior's proportions.
+    EXPECT_NEAR(b->lengths_mm[k] / b->lengths_mm[index_base],
+                prior.bone_length_mm(k) / prior.bone_length_mm(index_base),
+                1e-9);
+  }
+  std::printf("[ palm ] worst palm bone %.1f %% off each by itself, %.1f %% as one piece\n",
+              100 * worst_each,
+              100 * worst_one);
+  EXPECT_GT(worst_each, 0.12);
+  EXPECT_LT(worst_one, 0.05);
+  for (int k = 1; k < kNumHandKeypoints; ++k) {
+    const bool thumb = k <= KeypointIndex(Finger::kThumb, 3);
+    if (thumb || ParentKeypoint(k) != 0) EXPECT_EQ(a->lengths_mm[k], b->lengths_mm[k]) << k;
+  }
+}
+
 TEST(EstimateBoneLengths, FillsUnseenBonesFromScaleAndClampsToAnatomy) {
   std::mt19937 rng(3);
   Capture c = MakeCapture(50, 1.0, rng);

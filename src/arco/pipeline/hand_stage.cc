@@ -71,6 +71,7 @@ Json ToJson(const HandStageOptions& o) {
           {"one_view_bone_quantile", o.one_view_bone_quantile},
           {"one_view_palm_bone_quantile", o.one_view_palm_bone_quantile},
           {"one_view_thumb_bone_quantile", o.one_view_thumb_bone_quantile},
+          {"one_view_palm_as_one", o.one_view_palm_as_one},
           {"chunk_frames", o.chunk_frames},
           {"num_threads", o.num_threads}};
 }
@@ -129,6 +130,7 @@ StatusOr<HandRecord> RunHandStage(const HandStageOptions& options,
     bone_options.quantile = options.one_view_bone_quantile;
     bone_options.palm_quantile = options.one_view_palm_bone_quantile;
     bone_options.thumb_quantile = options.one_view_thumb_bone_quantile;
+    bone_options.palm_as_one = options.one_view_palm_as_one;
   }
   StatusOr<hand::BoneLengthEstimate> bones = hand::EstimateBoneLengths(left, prior, bone_options);
   if (bones.ok()) {

@@ -34,6 +34,10 @@ struct HandStageOptions {
   // thumb's (bones.palm_quantile, bones.thumb_quantile; hand/bone_lengths.h says why).
   double one_view_palm_bone_quantile = 0.8;
   double one_view_thumb_bone_quantile = 0.7;
+  // One camera: the palm's bones as one rigid piece, the average palm times one scale
+  // (bones.palm_as_one, hand/bone_lengths.h says why; docs/accuracy.md, "One camera: the
+  // palm as one piece"). false: each palm bone its own quantile (the former rule).
+  bool one_view_palm_as_one = true;
   // The fit carries a temporal prior from frame to frame; the clip is cut into chunks of
   // this many frames that are fitted in parallel (each starts from its own 3D keypoints),
   // so results do not depend on the thread count.

@@ -144,7 +144,10 @@ std::vector<State> NoteStates(const DecodeContext& context,
       if (!distances.empty()) {
         const double d = Median(distances);
         st.cost = d + options.order_weight * Median(orders);
-        if (d > lift_max_mm[static_cast<size_t>(k)]) st.cost += options.infeasible_cost;
+        // One camera with the sound's decision kept: the lift test decides nothing here
+        // either (ArcoDecodeOptions::one_view_keep_out_of_reach); D itself still counts.
+        const bool gate = !(along_rays && options.one_view_keep_out_of_reach);
+        if (gate && d > lift_max_mm[static_cast<size_t>(k)]) st.cost += options.infeasible_cost;
       }
       states.push_back(st);
     }

@@ -187,8 +187,12 @@ struct ArcoDecodeOptions {
   // stretch of bad detections (tens of pixels) leaves it tens of mm away while the sound
   // still names the note: on the real take seen by one camera (30 captures) the strings
   // went 0.968 -> 0.992, the fingers 0.855 -> 0.872, the contact's median unchanged
-  // (docs/accuracy.md, "One camera: the sound's decision stands"). false: the lift test as
-  // with several cameras. No effect with several cameras.
+  // (docs/accuracy.md, "One camera: the sound's decision stands"). Nor does a candidate
+  // whose median D (compared along the rays) exceeds the lift distance cost infeasible_cost
+  // in the decoding: on the real take's `harsh` captures a poorly fitted hand had put every
+  // A-string candidate of a note beyond it and the note on the D string (fingers 0.874 ->
+  // 0.877 over 30 captures). false: the lift test as with several cameras. No effect with
+  // several cameras.
   bool one_view_keep_out_of_reach = true;
   // Note boundaries from the audio's onsets (note_boundaries.h), when the input has them.
   bool audio_onsets = true;
