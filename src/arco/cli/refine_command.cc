@@ -254,6 +254,13 @@ std::function<int()> SetupRefine(CLI::App& app) {
             "along the string in the hand frame",
             refine::kFrameSigmaRangeMm)
       ->capture_default_str();
+  AddNumber(sub,
+            "--one-view-smoothing-s",
+            r.one_view_smoothing_s,
+            "arco, one camera: hold the refined hand over this many seconds each side in the "
+            "instrument's frame (0: off)",
+            refine::kOneViewSmoothingRangeS)
+      ->capture_default_str();
   sub->parse_complete_callback([a] { ApplyAndValidate(*a); });
   return [a]() { return RunRefine(*a); };
 }

@@ -7,6 +7,7 @@
 #include "arco/refine/decode_context.h"
 #include "arco/refine/finger_ik.h"
 #include "arco/refine/hand_frame_depth.h"
+#include "arco/refine/one_view_smoothing.h"
 #include "arco/refine/paper_decode.h"
 #include "arco/refine/transcription.h"
 
@@ -229,6 +230,9 @@ Status RefineOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(ik.Validate());
   ARCO_RETURN_IF_ERROR(one_view_depth.Validate().WithContext("refine options: one_view_depth"));
   ARCO_RETURN_IF_ERROR(one_view_frame.Validate().WithContext("refine options: one_view_frame"));
+  ARCO_RETURN_IF_ERROR(
+      CheckInRange("one_view_smoothing_s", one_view_smoothing_s, kOneViewSmoothingRangeS)
+          .WithContext("refine options"));
   if (num_threads < 0) return Status::Error("refine options: num_threads must be >= 0");
   return Status::Ok();
 }
@@ -309,6 +313,11 @@ RefineResult Refine(const RefineInput& input, const RefineOptions& options) {
                               &result.contacts,
                               &ik,
                               options.num_threads);
+    if (input.one_view_camera_centre_mm && options.one_view_smoothing_s > 0) {
+      const int window = static_cast<int>(std::lround(options.one_view_smoothing_s * input.fps));
+      SmoothHandsInInstrumentFrame(
+          *ik_context, result.contacts, window, options.num_threads, &result.hand);
+    }
   }
   result.fingering =
       Transcribe(*input.instrument, result.analysis, result.contacts, input.fps, input.a4_hz);
@@ -328,6 +337,7 @@ Json ToJson(const RefineOptions& o) {
           {"num_threads", o.num_threads},
           {"one_view_depth", {{"window_frames", o.one_view_depth.window_frames}}},
           {"one_view_hand_frame", o.one_view_hand_frame},
+          {"one_view_smoothing_s", o.one_view_smoothing_s},
           {"one_view_frame",
            {{"tip_sigma_mm", o.one_view_frame.tip_sigma_mm},
             {"frame_sigma_mm", o.one_view_frame.frame_sigma_mm},

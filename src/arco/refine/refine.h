@@ -275,6 +275,7 @@ struct ArcoIkOptions {
 // One camera: the pressed frames' hands placed along their rays by the hand frame
 // (hand_frame_depth.h says why and how).
 inline constexpr NumberRange kFrameSigmaRangeMm = AboveZero(1000);
+inline constexpr NumberRange kOneViewSmoothingRangeS = Closed(0, 10);
 struct HandFrameDepthOptions {
   double tip_sigma_mm = 5.0;  // (0, 100]: the pressing fingertip's distance from the camera
   double frame_sigma_mm =
@@ -297,6 +298,12 @@ struct RefineOptions {
   // former rule). No effect with several cameras.
   bool one_view_hand_frame = true;
   HandFrameDepthOptions one_view_frame;
+  // One camera, arco: the refined hand held over this many seconds each side in the
+  // instrument's frame (one_view_smoothing.h: medians of the wrist's place and the joint
+  // angles, the average wrist rotation; a pressed frame's playing fingertip kept where
+  // the IK put it). kOneViewSmoothingRangeS; 0: off (the former rule). No effect with
+  // several cameras.
+  double one_view_smoothing_s = 0.2;
   int num_threads = 0;  // 0 = all cores; results do not depend on it
   Status Validate() const;
 };
