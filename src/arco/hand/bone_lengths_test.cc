@@ -214,7 +214,9 @@ TEST(EstimateBoneLengths, ThePalmAsOnePieceTakesOneScale) {
   EXPECT_LT(worst_one, 0.05);
   for (int k = 1; k < kNumHandKeypoints; ++k) {
     const bool thumb = k <= KeypointIndex(Finger::kThumb, 3);
-    if (thumb || ParentKeypoint(k) != 0) EXPECT_EQ(a->lengths_mm[k], b->lengths_mm[k]) << k;
+    if (thumb || ParentKeypoint(k) != 0) {
+      EXPECT_EQ(a->lengths_mm[k], b->lengths_mm[k]) << k;
+    }
   }
 }
 

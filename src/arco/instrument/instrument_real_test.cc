@@ -155,7 +155,9 @@ TEST(InstrumentOnRealLabels, TheNominalShapeIsTheRealCellos) {
   for (size_t k = 0; k < pose.size(); ++k) {
     const bool end_pin = Cello().keypoint_names()[k] == "end_pin";
     EXPECT_EQ(pose[k].allFinite(), !end_pin && nominal[k].allFinite()) << k;
-    if (!end_pin && nominal[k].allFinite()) EXPECT_EQ(pose[k], nominal[k]) << k;
+    if (!end_pin && nominal[k].allFinite()) {
+      EXPECT_EQ(pose[k], nominal[k]) << k;
+    }
   }
 }
 

@@ -244,9 +244,11 @@ TEST(FitInstrument, BadInputIsAnErrorNotACrash) {
   const Clip clip = MakeClip(20, 1.0, 1);
   EXPECT_FALSE(FitInstrument(Cello(), {}, {clip.hints[0]}).ok());
   std::vector<Eigen::Matrix3Xd> wrong(3, Eigen::Matrix3Xd::Zero(3, 7));
-  EXPECT_THROW(FitInstrument(Cello(), wrong, {clip.hints[0]}), std::invalid_argument);
+  EXPECT_THROW(static_cast<void>(FitInstrument(Cello(), wrong, {clip.hints[0]})),
+               std::invalid_argument);
   std::vector<FrontHint> two(2, clip.hints[0]);
-  EXPECT_THROW(FitInstrument(Cello(), clip.keypoints, two), std::invalid_argument);
+  EXPECT_THROW(static_cast<void>(FitInstrument(Cello(), clip.keypoints, two)),
+               std::invalid_argument);
   std::vector<Eigen::Matrix3Xd> nan(5, Eigen::Matrix3Xd::Constant(3, 9, kNaN));
   auto all_nan = FitInstrument(Cello(), nan, {clip.hints[0]});
   ASSERT_FALSE(all_nan.ok());

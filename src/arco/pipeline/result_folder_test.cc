@@ -156,7 +156,9 @@ TEST(ResultFolder, WriteMethodWritesTheFolderAndTheManifestAndReadsBack) {
     EXPECT_EQ(a.string, b.string);
     EXPECT_EQ(a.finger, b.finger);
     EXPECT_EQ(std::isnan(a.from_nut_mm), std::isnan(b.from_nut_mm));
-    if (!std::isnan(b.from_nut_mm)) EXPECT_EQ(a.from_nut_mm, b.from_nut_mm);
+    if (!std::isnan(b.from_nut_mm)) {
+      EXPECT_EQ(a.from_nut_mm, b.from_nut_mm);
+    }
     EXPECT_EQ(a.pressed_frames, b.pressed_frames);
   }
   // A damaged row names the file and line; a method without the file has no notes.

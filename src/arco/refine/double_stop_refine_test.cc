@@ -196,7 +196,9 @@ TEST(RefineSecondVoice, ANoteBowedOnTwoStringsKeepsItsStartButNotItsRelease) {
   const DoubleStopRefineResult gated =
       RefineSecondVoice(fx.scene.input, fx.first, upper, per_frame, bow);
   for (size_t f = 0; f < n; ++f) {
-    if (f % 3 != 0) EXPECT_EQ(gated.second[f].state, ContactState::kRest) << f;
+    if (f % 3 != 0) {
+      EXPECT_EQ(gated.second[f].state, ContactState::kRest) << f;
+    }
   }
 }
 
@@ -221,7 +223,8 @@ TEST(RefineSecondVoice, ABowOnOneStringRulesOutTheSecondVoice) {
   // How far from its rest's own inclination: 0 on it, a third of the way to the pair.
   EXPECT_NEAR(BowRestOf(model, a_deg).off_deg, 0.0, 1e-9);
   EXPECT_NEAR(BowRestOf(model, a_deg + 0.33 * (both_deg - a_deg)).off_deg,
-              0.33 * std::abs(both_deg - a_deg), 1e-9);
+              0.33 * std::abs(both_deg - a_deg),
+              1e-9);
   EXPECT_TRUE(std::isnan(BowRestOf(model, std::nan("")).off_deg));
   std::vector<double> upper(n, 0.0);
   for (size_t f = 5; f < 15; ++f) upper[f] = fx.UpperHz(4);
