@@ -121,11 +121,6 @@ std::optional<RayDepthResult> PlaceKeypointsAlongRays(const HandModel& model,
   RayDepthResult result;
   result.pose = fit.pose;
   result.median_move_mm = UpperMedian(moves);
-  const HandPointsMm fitted = ForwardKinematics(model, fit.pose);
-  for (const AxisTarget& a : targets) {
-    result.max_target_error_mm = std::max(
-        result.max_target_error_mm, std::abs(a.axis.dot(fitted[a.keypoint]) - a.coordinate_mm));
-  }
   return result;
 }
 

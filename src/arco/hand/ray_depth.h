@@ -44,9 +44,8 @@ struct RayDepthOptions {
 };
 
 struct RayDepthResult {
-  HandPose pose;                   // the model fitted to the moved keypoints
-  double median_move_mm = 0;       // the keypoints' median |move| along their rays
-  double max_target_error_mm = 0;  // the largest |axis . p - coordinate| after the move
+  HandPose pose;              // the model fitted to the moved keypoints
+  double median_move_mm = 0;  // the keypoints' median |move| along their rays
 };
 
 // The hand `pose` of `model` seen from `camera_centre_mm`, its keypoints moved along their

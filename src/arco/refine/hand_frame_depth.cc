@@ -1,5 +1,6 @@
 #include "arco/refine/hand_frame_depth.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "arco/registry/instruments.h"
@@ -66,9 +67,7 @@ int PlaceHandsInTheirFrame(const DecodeContext& context,
         moved[i] = 1;
       },
       16);
-  int count = 0;
-  for (uint8_t m : moved) count += m;
-  return count;
+  return static_cast<int>(std::count(moved.begin(), moved.end(), uint8_t{1}));
 }
 
 }  // namespace arco::refine

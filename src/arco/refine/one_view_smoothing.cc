@@ -1,6 +1,7 @@
 #include "arco/refine/one_view_smoothing.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 
 #include "arco/hand/fit.h"
 #include "arco/hand/ik.h"
@@ -104,9 +105,7 @@ int SmoothHandsInInstrumentFrame(const DecodeContext& context,
         changed[i] = 1;
       },
       4);
-  int count = 0;
-  for (uint8_t c : changed) count += c;
-  return count;
+  return static_cast<int>(std::count(changed.begin(), changed.end(), uint8_t{1}));
 }
 
 }  // namespace arco::refine
