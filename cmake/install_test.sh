@@ -144,6 +144,10 @@ line=$(cd "$w" && "$p/bin/arco" view result --no-serve -o page2 --no-videos 2>&1
 check '[[ "$line" == "arco: error: $p/share/arco/view/three.min.js: three.js not found"* ]]' \
   "a missing three.js is named: $line"
 
+# The installed tree is checked: its space is freed before the package is staged (the
+# staging folder and the uncompressed package are two more copies of the install).
+rm -rf "$p" "$tmp/work" "$tmp/home" "$tmp/trace" "$tmp/empty"
+
 # 4. The Debian package of the same install rules (uncompressed here: gzip of the models
 # takes 30 s; the files and the control fields are those of `make package`'s).
 if ! (cd "$tmp" && cpack -G DEB -D CPACK_DEBIAN_COMPRESSION_TYPE=none \

@@ -20,4 +20,8 @@ if [ "${ARCO_PYTHON_MODULE:-ON}" != ON ]; then
 fi
 # No __pycache__ or .pytest_cache in the source tree.
 export PYTHONDONTWRITEBYTECODE=1
-exec /usr/bin/python3 -m pytest -q -p no:cacheprovider "$1"
+# pytest's own temporary folders in one scratch folder removed on exit (its default, under
+# /tmp/pytest-of-USER, keeps the last three runs: 28 MB each here).
+base=$(mktemp -d "${TMPDIR:-/tmp}/arco_pytest.XXXXXX")
+trap 'rm -rf "$base"' EXIT
+/usr/bin/python3 -m pytest -q -p no:cacheprovider --basetemp="$base/tmp" "$1"
