@@ -235,7 +235,7 @@ Json CalibrationFromInstrumentSummary::ToJson() const {
   j["capture"] = capture_dir;
   j["output"] = output;
   j["instrument"] = instrument;
-  j["world"] = "the first camera's frame, mm";
+  j["world"] = cameras.size() == 1 ? "the camera's frame, mm" : "the first camera's frame, mm";
   j["focal_source"] = focal_source;
   j["shared_frames"] = shared_frames;
   j["reference_frame"] = reference_frame;
@@ -265,6 +265,60 @@ Json CalibrationFromInstrumentSummary::ToJson() const {
   return j;
 }
 
+namespace {
+
+// The calibration file and its report, both or neither (OutputSet).
+Status WriteCalibrationAndReport(const std::string& output,
+                                 CalibrationFormat format,
+                                 const std::string& report_file,
+                                 const CalibrationFromInstrumentSummary& summary) {
+  OutputSet outputs;
+  ARCO_ASSIGN_OR_RETURN(const std::string calibration_tmp, outputs.AddFile(output));
+  ARCO_ASSIGN_OR_RETURN(const std::string report_tmp, outputs.AddFile(report_file));
+  ARCO_RETURN_IF_ERROR(calibration::SaveCalibration(calibration_tmp, summary.rig, format));
+  {
+    std::ofstream out(report_tmp);
+    out << summary.ToJson().dump(2) << "\n";
+    if (!out) return Status::Error(report_file + ": cannot write");
+  }
+  return outputs.Commit();
+}
+
+// One phone: nothing relates it to another camera and one view measures no length, so the
+// camera's own frame is the world (the identity pose) and its intrinsics are what step 1
+// gave; the per-frame PnP (step 2) only reports how well the instrument's model fits its
+// points (`arco run` poses the instrument per frame itself: track/monocular_lift.h).
+StatusOr<CalibrationFromInstrumentSummary> OneCameraCalibration(
+    const CalibrationFromInstrumentOptions& options,
+    CalibrationFormat format,
+    const std::string& report_file,
+    const Rig& rig,
+    const std::vector<std::string>& label_warnings,
+    CalibrationFromInstrumentSummary summary) {
+  summary.rig = rig;
+  summary.shared_frames = summary.cameras[0].pnp_frames;
+  summary.string_length_initial_mm = summary.string_length_mm;
+  summary.rms_initial_px = summary.rms_px = summary.cameras[0].pnp_rms_px;
+  summary.cameras[0].focal_px = rig.cameras[0].fx;
+  summary.string_length_measured_mm = summary.string_length_spread_mm =
+      std::numeric_limits<double>::quiet_NaN();
+  summary.string_length_frames = 0;
+  summary.warnings = label_warnings;
+  summary.warnings.push_back(
+      "one camera: its frame is the world and nothing is refined or measured; the "
+      "instrument's real size will set the scale (`arco run` on one camera)");
+  if (options.focal_px == 0 && options.fov_deg == 0)
+    summary.warnings.push_back("the focal length is a phone's default (" +
+                               NumberText(kPhoneFovDeg) +
+                               " deg); give --focal-px or --fov-deg when known: one view "
+                               "does not measure it");
+  ARCO_RETURN_IF_ERROR(
+      WriteCalibrationAndReport(options.output, format, report_file, summary));
+  return summary;
+}
+
+}  // namespace
+
 StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
     const CalibrationFromInstrumentOptions& options, Progress& progress) {
   ARCO_RETURN_IF_ERROR(options.Validate());
@@ -289,11 +343,6 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
   if (manifest.keypoints2d.empty())
     return Status::Error(manifest_file + ": no keypoints2d (the instrument's 2D points)");
   const int num_views = static_cast<int>(manifest.cameras.size());
-  if (num_views < 2)
-    return Status::Error(manifest_file +
-                         ": calibrating from the instrument needs at least two cameras, the "
-                         "capture has " +
-                         std::to_string(num_views));
   ARCO_ASSIGN_OR_RETURN(const InstrumentModel model, InstrumentModel::Create(manifest.instrument));
   const KeypointLayout* layout = FindKeypointLayout(manifest.layout);
   if (layout == nullptr)
@@ -407,6 +456,9 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
                            "'s points with a score of at least " + NumberText(options.min_score) +
                            " that a PnP pose agrees with (its pose comes from them)");
   }
+
+  if (num_views == 1) return OneCameraCalibration(options, format, report_file, rig, label_warnings,
+                                                    std::move(summary));
 
   // 3. The frames every camera has a pose in; the medoid of their relative poses.
   std::vector<int64_t> shared;
@@ -544,16 +596,8 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
                                NumberText(kPhoneFovDeg) +
                                " deg); give --focal-px or --fov-deg when known");
 
-  OutputSet outputs;
-  ARCO_ASSIGN_OR_RETURN(const std::string calibration_tmp, outputs.AddFile(options.output));
-  ARCO_ASSIGN_OR_RETURN(const std::string report_tmp, outputs.AddFile(report_file));
-  ARCO_RETURN_IF_ERROR(calibration::SaveCalibration(calibration_tmp, summary.rig, format));
-  {
-    std::ofstream out(report_tmp);
-    out << summary.ToJson().dump(2) << "\n";
-    if (!out) return Status::Error(report_file + ": cannot write");
-  }
-  ARCO_RETURN_IF_ERROR(outputs.Commit());
+  ARCO_RETURN_IF_ERROR(
+      WriteCalibrationAndReport(options.output, format, report_file, summary));
   return summary;
 }
 

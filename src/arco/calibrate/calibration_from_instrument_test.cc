@@ -258,17 +258,60 @@ TEST(CalibrateFromInstrument, BadInputIsOneErrorAndNothingWritten) {
   options.focal_px = 1000;
   options.fov_deg = 60;
   EXPECT_FALSE(options.Validate().ok());
+  nothing_written();
+}
 
-  // One camera only.
+// One phone: the camera's frame is the world, its intrinsics as given, and the report says
+// how well the instrument's model fits its points; nothing is refined or measured.
+TEST(CalibrateFromInstrument, OneCameraIsItsOwnWorld) {
+  TempDir dir;
+  const std::string capture = dir / "capture";
+  WriteTwoCameraCapture(capture);
+  auto truth = calibration::LoadCalibration(capture + "/calibration.json");
+  ASSERT_TRUE(truth.ok());
+  // The first camera alone: its column of keypoints2d and its entry of capture.json.
   auto manifest = ReadCaptureManifest(capture);
   ASSERT_TRUE(manifest.ok());
+  auto keypoints = ReadCaptureKeypoints2d(capture, *manifest);
+  ASSERT_TRUE(keypoints.ok());
+  NpyArray<double> first;
+  const int64_t frames = keypoints->shape[0], points = keypoints->shape[2];
+  first.shape = {frames, 1, points, 3};
+  for (int64_t f = 0; f < frames; ++f)
+    for (int64_t p = 0; p < points; ++p)
+      for (int64_t k = 0; k < 3; ++k) first.data.push_back(keypoints->at(f, 0, p, k));
+  ASSERT_TRUE(WriteNpy(ResolveCapturePath(capture, manifest->keypoints2d), first).ok());
   manifest->cameras.resize(1);
   ASSERT_TRUE(WriteCaptureManifest(capture, *manifest).ok());
-  auto single = CalibrateFromInstrument(Options(capture, output));
-  ASSERT_FALSE(single.ok());
-  std::printf("%s\n", single.status().message().c_str());
-  EXPECT_NE(single.status().message().find("at least two cameras"), std::string::npos);
-  nothing_written();
+
+  const std::string output = dir / "one.json";
+  CalibrationFromInstrumentOptions options = Options(capture, output);
+  options.focal_px = truth->rig.cameras[0].fx;
+  auto result = CalibrateFromInstrument(options);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  auto written = calibration::LoadCalibration(output);
+  ASSERT_TRUE(written.ok());
+  ASSERT_TRUE(FileExists(RefineReportPath(output)));
+  ASSERT_EQ(written->rig.cameras.size(), 1u);
+  const Camera& cam = written->rig.cameras[0];
+  EXPECT_EQ(written->rig.units, "mm");
+  EXPECT_EQ(cam.fx, truth->rig.cameras[0].fx);
+  EXPECT_EQ(cam.width, kImageWidth);
+  EXPECT_TRUE(cam.cam_from_world.rotation.isIdentity(0));
+  EXPECT_TRUE(cam.cam_from_world.translation.isZero(0));
+  std::printf("[ from-instrument ] one camera: PnP in %d of %lld frames, rms %.2f px\n",
+              result->cameras[0].pnp_frames,
+              static_cast<long long>(frames),
+              result->rms_px);
+  // The synthetic detector's instrument points against the nominal cello's shape.
+  EXPECT_GT(result->cameras[0].pnp_frames, frames / 2);
+  EXPECT_LT(result->rms_px, 10);
+  EXPECT_FALSE(std::isfinite(result->string_length_measured_mm));
+  ASSERT_FALSE(result->warnings.empty());
+  EXPECT_NE(result->warnings[0].find("one camera: its frame is the world"), std::string::npos);
+  const Json report = Json::parse(ReadFileToString(RefineReportPath(output)).value());
+  EXPECT_EQ(report["world"], "the camera's frame, mm");
+  EXPECT_TRUE(report["string_length_measured"]["median_mm"].is_null());
 }
 
 // `--labels CAMERA=LABELS.json` (labelme, as `arco track` takes them): the instrument's

@@ -10,6 +10,7 @@
 
 #include "arco/calibration/calibration_file.h"
 #include "arco/instrument/instrument_model.h"
+#include "arco/instrument/nominal_keypoints.h"
 #include "arco/media/video_reader.h"
 #include "arco/mocap/labelme.h"
 #include "arco/track/bow_tracker.h"
@@ -293,9 +294,6 @@ StatusOr<TrackTemplates> MakeTrackTemplates(const TrackStageOptions& options,
   }
   const int64_t template_frame = t.template_frame;
   track::FrameLabels frame_labels{names, labels.labelled.at(template_frame)};
-  StatusOr<track::RigidTemplate> body = track::TriangulateTemplate(capture.cameras, frame_labels);
-  if (!body.ok()) return Status::Error(label_files + ": " + body.status().message());
-  t.body = std::move(body).value();
   // The trackers' lengths are mm (the bow's slide search, sample step and priors, its
   // minimum length): the world is scaled to mm for them; projections do not change
   // (t and X both times the scale). Outputs are pixels; track.json's 3D points are put
@@ -303,20 +301,53 @@ StatusOr<TrackTemplates> MakeTrackTemplates(const TrackStageOptions& options,
   const std::string calibration_path = ResolveCapturePath(capture.dir, manifest.calibration);
   ARCO_ASSIGN_OR_RETURN(const Calibration calibration,
                         calibration::LoadCalibration(calibration_path));
-  ARCO_ASSIGN_OR_RETURN(t.mm_per_unit,
-                        MmPerWorldUnit(calibration.rig.units,
-                                       calibration_path,
-                                       manifest.instrument,
-                                       names,
-                                       t.body.points,
-                                       label_files));
+  const bool one_view = capture.views() == 1;
+  if (one_view) {
+    // One camera: the instrument's model posed by the labels (PoseTemplateInOneView).
+    // One view measures no length, so a calibration without a metric unit is read as mm:
+    // with one camera its translation's scale changes nothing that is seen.
+    t.mm_per_unit = calibration.rig.units == "m" ? 1000.0 : 1.0;
+    if (calibration.rig.units != "m" && calibration.rig.units != "mm")
+      summary->warnings.push_back("the calibration " + calibration_path + " is in units '" +
+                                  calibration.rig.units +
+                                  "': one view measures no length, its units are taken as mm "
+                                  "(the instrument's model sets the scale)");
+    t.cameras = capture.cameras;
+    for (Camera& c : t.cameras) c.cam_from_world.translation *= t.mm_per_unit;
+    ARCO_ASSIGN_OR_RETURN(const InstrumentModel model, InstrumentModel::Create(manifest.instrument));
+    // The rigid points a one-view pose uses (no end pin: its spike is the player's).
+    const std::vector<Eigen::Vector3d> nominal = NominalPoseKeypointsInInstrument(model);
+    const std::vector<std::string>& model_names = model.keypoint_names();
+    std::vector<Eigen::Vector3d> model_points;
+    for (const std::string& n : names) {
+      const auto it = std::find(model_names.begin(), model_names.end(), n);
+      model_points.push_back(it == model_names.end() ? Eigen::Vector3d::Constant(kNaN)
+                                                     : nominal[it - model_names.begin()]);
+    }
+    StatusOr<track::RigidTemplate> body =
+        track::PoseTemplateInOneView(t.cameras[0], frame_labels, model_points);
+    if (!body.ok()) return Status::Error(label_files + ": " + body.status().message());
+    t.body = std::move(body).value();
+  } else {
+    StatusOr<track::RigidTemplate> body =
+        track::TriangulateTemplate(capture.cameras, frame_labels);
+    if (!body.ok()) return Status::Error(label_files + ": " + body.status().message());
+    t.body = std::move(body).value();
+    ARCO_ASSIGN_OR_RETURN(t.mm_per_unit,
+                          MmPerWorldUnit(calibration.rig.units,
+                                         calibration_path,
+                                         manifest.instrument,
+                                         names,
+                                         t.body.points,
+                                         label_files));
+    t.cameras = capture.cameras;
+    for (Camera& c : t.cameras) c.cam_from_world.translation *= t.mm_per_unit;
+    for (Eigen::Vector3d& x : t.body.points) x *= t.mm_per_unit;
+    t.body.plane_point *= t.mm_per_unit;
+  }
   const double mm_per_unit = t.mm_per_unit;
   summary->units = calibration.rig.units;
   summary->mm_per_unit = mm_per_unit;
-  t.cameras = capture.cameras;
-  for (Camera& c : t.cameras) c.cam_from_world.translation *= mm_per_unit;
-  for (Eigen::Vector3d& x : t.body.points) x *= mm_per_unit;
-  t.body.plane_point *= mm_per_unit;
   summary->template_frame = template_frame;
   summary->label_rms_px = t.body.rms_reprojection_px;
   for (size_t p = 0; p < names.size(); ++p) {
@@ -324,13 +355,21 @@ StatusOr<TrackTemplates> MakeTrackTemplates(const TrackStageOptions& options,
         .push_back(names[p]);
   }
   for (const auto& n : summary->untracked_points) {
-    summary->warnings.push_back("point " + n + " is labelled in fewer than two views: left NaN");
+    summary->warnings.push_back(
+        "point " + n +
+        (one_view ? " is not labelled or has no place in the model a view poses: left NaN"
+                  : " is labelled in fewer than two views: left NaN"));
   }
   // The bow: a thin rigid body from its frog and tip labelled in two views of the
   // template frame; else its slots are kept.
   if (!bow_names.empty() && !options.track_bow) {
     summary->warnings.push_back(
         "the bow is not tracked (track_bow off): its points are kept as they were");
+  } else if (!bow_names.empty() && one_view) {
+    // One view gives the bow's line in the image, not its depth (monocular_lift.h).
+    summary->warnings.push_back(
+        "the bow is not tracked from one view (its depth is unknown): its points are kept as "
+        "they were");
   } else if (!bow_names.empty()) {
     track::FrameLabels bow_frame_labels{bow_names, labels.bow_labelled.at(template_frame)};
     auto bow = track::TriangulateTemplate(t.cameras, bow_frame_labels, 10, /*thin=*/true);

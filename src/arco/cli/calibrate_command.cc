@@ -143,6 +143,28 @@ int RunFromInstrument(const calibrate::CalibrationFromInstrumentOptions& options
   bar.Finish();
   if (!result.ok())
     return PrintError(WithFlagNames(result.status().message(), kFromInstrumentFlags));
+  if (result->cameras.size() == 1) {
+    // One phone: the camera's intrinsics, and how well the instrument's model fits its
+    // points; no rig, nothing refined or measured (calibration_from_instrument.h).
+    const auto& c = result->cameras[0];
+    std::printf(
+        "calibrated 1 camera of %s: %dx%d (%s), focal %.1f px from %s; world: camera %s's "
+        "frame, mm\n"
+        "the %s's model fits its points in %d frames, reprojection rms %.2f px (median)\n",
+        options.capture_dir.c_str(),
+        c.width,
+        c.height,
+        c.size_source.c_str(),
+        c.focal_px,
+        result->focal_source.c_str(),
+        c.name.c_str(),
+        result->instrument.c_str(),
+        c.pnp_frames,
+        c.pnp_rms_px);
+    for (const auto& w : result->warnings) PrintWarning(w);
+    std::printf("wrote %s and its .report.json\n", options.output.c_str());
+    return 0;
+  }
   std::printf(
       "calibrated %zu cameras of %s from the %s: focal from %s; PnP poses in %d shared "
       "frames, initial rig from frame %lld; world: camera %s's frame, mm\n",

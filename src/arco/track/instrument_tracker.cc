@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "arco/mocap/triangulate_point.h"
+#include "arco/track/one_view_pnp.h"
 #include "arco/util/parallel.h"
 
 namespace arco::track {
@@ -349,6 +350,27 @@ Json ToJson(const InstrumentTrackerOptions& o) {
                 {"seed", o.pose.seed}}}};
 }
 
+namespace {
+
+// The plane that fits a template's points best (least squares): features get their
+// template coordinates where their ray cuts it.
+Status FitTemplatePlane(const std::vector<Eigen::Vector3d>& known, RigidTemplate* body) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& x : known) mean += x;
+  mean /= static_cast<double>(known.size());
+  Eigen::MatrixXd centred(known.size(), 3);
+  for (size_t i = 0; i < known.size(); ++i) centred.row(i) = (known[i] - mean).transpose();
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(centred, Eigen::ComputeFullV);
+  if (svd.singularValues()(1) < 1e-6 * std::max(1.0, svd.singularValues()(0))) {
+    return Status::Error("the labelled points lie on a line: no plane for the features");
+  }
+  body->plane_point = mean;
+  body->plane_normal = svd.matrixV().col(2).normalized();
+  return Status::Ok();
+}
+
+}  // namespace
+
 StatusOr<RigidTemplate> TriangulateTemplate(const std::vector<Camera>& cameras,
                                             const FrameLabels& labels,
                                             double max_label_error_px,
@@ -427,17 +449,73 @@ StatusOr<RigidTemplate> TriangulateTemplate(const std::vector<Camera>& cameras,
     body.plane_normal = normal.normalized();
     return body;
   }
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& x : known) mean += x;
-  mean /= static_cast<double>(known.size());
-  Eigen::MatrixXd centred(known.size(), 3);
-  for (size_t i = 0; i < known.size(); ++i) centred.row(i) = (known[i] - mean).transpose();
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(centred, Eigen::ComputeFullV);
-  if (svd.singularValues()(1) < 1e-6 * std::max(1.0, svd.singularValues()(0))) {
-    return Status::Error("the labelled points lie on a line: no plane for the features");
+  ARCO_RETURN_IF_ERROR(FitTemplatePlane(known, &body));
+  return body;
+}
+
+StatusOr<RigidTemplate> PoseTemplateInOneView(const Camera& camera,
+                                              const FrameLabels& labels,
+                                              const std::vector<Eigen::Vector3d>& model_points,
+                                              double max_label_error_px) {
+  if (labels.pixels.size() != 1 || model_points.size() != labels.point_names.size()) {
+    throw std::invalid_argument("PoseTemplateInOneView: one view and one model point per name");
   }
-  body.plane_point = mean;
-  body.plane_normal = svd.matrixV().col(2).normalized();
+  const std::vector<Eigen::Vector2d>& pixels = labels.pixels[0];
+  std::vector<PoseCorrespondence> c;
+  std::vector<Eigen::Vector3d> object;
+  std::vector<Eigen::Vector2d> undistorted;
+  for (size_t p = 0; p < labels.point_names.size() && p < pixels.size(); ++p) {
+    if (!std::isfinite(pixels[p].x()) || !model_points[p].allFinite()) continue;
+    c.push_back({0, model_points[p], pixels[p], 1.0});
+    object.push_back(model_points[p]);
+    undistorted.push_back(camera.UndistortPixel(pixels[p]));
+  }
+  // EPnP needs four points; a fifth makes its RANSAC choose.
+  constexpr int kMinPoints = 4;
+  if (static_cast<int>(c.size()) < kMinPoints) {
+    return Status::Error(std::to_string(c.size()) +
+                         " of the instrument's points labelled in the one view: a pose from "
+                         "one view needs at least " +
+                         std::to_string(kMinPoints));
+  }
+  Eigen::Matrix3d K;
+  K << camera.fx, camera.skew, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1;
+  const std::optional<OneViewPnp> pnp =
+      EpnpInRansac(object, undistorted, K, max_label_error_px, kMinPoints);
+  if (!pnp || !(pnp->translation.z() > 0)) {
+    return Status::Error("the labels do not fit the instrument's shape in one view (no pose "
+                         "within " +
+                         std::to_string(max_label_error_px) + " px)");
+  }
+  const Eigen::Matrix3d& Rc = camera.cam_from_world.rotation;
+  const Eigen::Vector3d& tc = camera.cam_from_world.translation;
+  const Rigid3d start(Eigen::Matrix3d(Rc.transpose() * pnp->cam_from_object.rotation),
+                      Rc.transpose() * (pnp->translation - tc));
+  PoseSolverOptions refine;
+  refine.inlier_px = max_label_error_px;
+  refine.ransac_trials = 0;  // EPnP's RANSAC chose the start; only the refinement here
+  refine.sample_size = kMinPoints;
+  const std::optional<PoseSolution> solved =
+      SolveRigidPose({camera}, c, start, refine, static_cast<int>(c.size()));
+  if (!solved) {
+    return Status::Error("the labels do not fit the instrument's shape in one view (a label "
+                         "is more than " +
+                         std::to_string(max_label_error_px) + " px off the posed model)");
+  }
+  RigidTemplate body;
+  body.point_names = labels.point_names;
+  body.points.assign(labels.point_names.size(), Eigen::Vector3d::Constant(kNaN));
+  body.label_views.assign(labels.point_names.size(), 0);
+  std::vector<Eigen::Vector3d> known;
+  for (size_t p = 0; p < labels.point_names.size(); ++p) {
+    if (p >= pixels.size() || !std::isfinite(pixels[p].x()) || !model_points[p].allFinite())
+      continue;
+    body.points[p] = solved->world_from_template * model_points[p];
+    body.label_views[p] = 1;
+    known.push_back(body.points[p]);
+  }
+  body.rms_reprojection_px = solved->rms_px;
+  ARCO_RETURN_IF_ERROR(FitTemplatePlane(known, &body));
   return body;
 }
 

@@ -55,6 +55,20 @@ StatusOr<RigidTemplate> TriangulateTemplate(const std::vector<Camera>& cameras,
                                             double max_label_error_px = 10,
                                             bool thin = false);
 
+// The template from labels in ONE view (a one-camera capture): the instrument's model
+// points (`model_points`, one per label name, its own frame in the world's units; NaN for
+// a name the model lacks) posed by a PnP of the labelled ones (EPnP in RANSAC, then
+// Levenberg-Marquardt on the camera's model with its distortion). One view fixes no
+// depth: the model's real size places the template, as `arco run` places a one-camera
+// instrument (monocular_lift.h). Points are the posed model's (label_views 1), so every
+// labelled point of the model gets a place; rms_reprojection_px is the labels' against
+// the posed model. Errors: fewer than four labelled model points, no pose within
+// max_label_error_px.
+StatusOr<RigidTemplate> PoseTemplateInOneView(const Camera& camera,
+                                              const FrameLabels& labels,
+                                              const std::vector<Eigen::Vector3d>& model_points,
+                                              double max_label_error_px = 10);
+
 struct InstrumentTrackerOptions {
   int max_features_per_view = 200;
   double min_feature_distance_px = 8;
