@@ -312,8 +312,7 @@ StatusOr<CalibrationFromInstrumentSummary> OneCameraCalibration(
                                NumberText(kPhoneFovDeg) +
                                " deg); give --focal-px or --fov-deg when known: one view "
                                "does not measure it");
-  ARCO_RETURN_IF_ERROR(
-      WriteCalibrationAndReport(options.output, format, report_file, summary));
+  ARCO_RETURN_IF_ERROR(WriteCalibrationAndReport(options.output, format, report_file, summary));
   return summary;
 }
 
@@ -457,8 +456,9 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
                            " that a PnP pose agrees with (its pose comes from them)");
   }
 
-  if (num_views == 1) return OneCameraCalibration(options, format, report_file, rig, label_warnings,
-                                                    std::move(summary));
+  if (num_views == 1)
+    return OneCameraCalibration(
+        options, format, report_file, rig, label_warnings, std::move(summary));
 
   // 3. The frames every camera has a pose in; the medoid of their relative poses.
   std::vector<int64_t> shared;
@@ -596,8 +596,7 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
                                NumberText(kPhoneFovDeg) +
                                " deg); give --focal-px or --fov-deg when known");
 
-  ARCO_RETURN_IF_ERROR(
-      WriteCalibrationAndReport(options.output, format, report_file, summary));
+  ARCO_RETURN_IF_ERROR(WriteCalibrationAndReport(options.output, format, report_file, summary));
   return summary;
 }
 

@@ -28,6 +28,11 @@
 //    fixed.
 // World frame: the first capture camera's (cam_from_world of the first camera is the
 // identity), millimetres.
+// One camera (one phone): steps 1 and 2 only. Nothing relates it to another camera and one
+// view measures no length, so its frame is the world, nothing is refined, the string
+// length is not measured (NaN, with a warning), and the report's PnP RMS says how well
+// the instrument's model fits its points (`arco run` poses the instrument per frame
+// itself: track/monocular_lift.h).
 #pragma once
 
 #include <cstdint>
@@ -121,12 +126,12 @@ struct CalibrationFromInstrumentSummary {
 // Writes options.output and OUTPUT.report.json beside it through OutputSet: nothing is
 // written on an error. Errors (one line naming the file): an unreadable capture, no
 // instrument, an image size that cannot be read, a camera that never sees min_points
-// instrument points, no frame where every camera has a pose, fewer than two cameras, and
-// RefineCalibration's; with labels, before any work: an unreadable or malformed file, an
-// unknown camera, a camera labelled twice or not at all, a labelled frame the camera did
-// not record, an image size that is not the camera's, a label outside the image, fewer
-// than min_points of the instrument's points in a file. A label that is neither a point
-// of the instrument nor the bow's is a warning and is ignored, as in `arco track`.
+// instrument points, no frame where every camera has a pose, and RefineCalibration's;
+// with labels, before any work: an unreadable or malformed file, an unknown camera, a
+// camera labelled twice or not at all, a labelled frame the camera did not record, an
+// image size that is not the camera's, a label outside the image, fewer than min_points
+// of the instrument's points in a file. A label that is neither a point of the
+// instrument nor the bow's is a warning and is ignored, as in `arco track`.
 StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
     const CalibrationFromInstrumentOptions& options, Progress& progress = NoProgress());
 

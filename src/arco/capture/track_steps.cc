@@ -314,7 +314,8 @@ StatusOr<TrackTemplates> MakeTrackTemplates(const TrackStageOptions& options,
                                   "(the instrument's model sets the scale)");
     t.cameras = capture.cameras;
     for (Camera& c : t.cameras) c.cam_from_world.translation *= t.mm_per_unit;
-    ARCO_ASSIGN_OR_RETURN(const InstrumentModel model, InstrumentModel::Create(manifest.instrument));
+    ARCO_ASSIGN_OR_RETURN(const InstrumentModel model,
+                          InstrumentModel::Create(manifest.instrument));
     // The rigid points a one-view pose uses (no end pin: its spike is the player's).
     const std::vector<Eigen::Vector3d> nominal = NominalPoseKeypointsInInstrument(model);
     const std::vector<std::string>& model_names = model.keypoint_names();
@@ -329,8 +330,7 @@ StatusOr<TrackTemplates> MakeTrackTemplates(const TrackStageOptions& options,
     if (!body.ok()) return Status::Error(label_files + ": " + body.status().message());
     t.body = std::move(body).value();
   } else {
-    StatusOr<track::RigidTemplate> body =
-        track::TriangulateTemplate(capture.cameras, frame_labels);
+    StatusOr<track::RigidTemplate> body = track::TriangulateTemplate(capture.cameras, frame_labels);
     if (!body.ok()) return Status::Error(label_files + ": " + body.status().message());
     t.body = std::move(body).value();
     ARCO_ASSIGN_OR_RETURN(t.mm_per_unit,

@@ -527,7 +527,8 @@ CommandRun SetupCalibrate(CLI::App& app) {
       "from-instrument",
       "Calibrate two or more cameras without a board, from the take itself: each camera's "
       "pose by PnP of the instrument's 2D points against its model (whose real size gives "
-      "the scale), then refined by bundle adjustment with the performer and the instrument");
+      "the scale), then refined by bundle adjustment with the performer and the instrument. "
+      "One camera: its intrinsics, its frame the world, and how well the model fits");
   from_instrument
       ->add_option("capture",
                    fi->capture_dir,

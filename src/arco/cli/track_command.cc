@@ -100,7 +100,8 @@ std::function<int()> SetupTrack(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "track",
       "The instrument's points in every camera and frame of a capture from labels of one "
-      "frame in two views (docs/track.md), into its keypoints2d.npy");
+      "frame in two views, or in its one view for a one-camera capture (docs/track.md), into "
+      "its keypoints2d.npy");
   auto a = std::make_shared<TrackArgs>();
   track::InstrumentTrackerOptions& t = a->o.tracker;
   sub->add_option("capture", a->o.capture_dir, "Capture folder made by `arco capture new`")
@@ -108,7 +109,7 @@ std::function<int()> SetupTrack(CLI::App& app) {
   sub->add_option("--labels",
                   a->labels,
                   "CAMERA=LABELME.json (labels of --labels-frame) or CAMERA@FRAME=LABELME.json; "
-                  "at least two views")
+                  "at least two views (one for a one-camera capture)")
       ->required();
   AddNumber(sub,
             "--labels-frame",

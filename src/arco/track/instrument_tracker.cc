@@ -483,9 +483,10 @@ StatusOr<RigidTemplate> PoseTemplateInOneView(const Camera& camera,
   const std::optional<OneViewPnp> pnp =
       EpnpInRansac(object, undistorted, K, max_label_error_px, kMinPoints);
   if (!pnp || !(pnp->translation.z() > 0)) {
-    return Status::Error("the labels do not fit the instrument's shape in one view (no pose "
-                         "within " +
-                         std::to_string(max_label_error_px) + " px)");
+    return Status::Error(
+        "the labels do not fit the instrument's shape in one view (no pose "
+        "within " +
+        std::to_string(max_label_error_px) + " px)");
   }
   const Eigen::Matrix3d& Rc = camera.cam_from_world.rotation;
   const Eigen::Vector3d& tc = camera.cam_from_world.translation;
@@ -498,9 +499,10 @@ StatusOr<RigidTemplate> PoseTemplateInOneView(const Camera& camera,
   const std::optional<PoseSolution> solved =
       SolveRigidPose({camera}, c, start, refine, static_cast<int>(c.size()));
   if (!solved) {
-    return Status::Error("the labels do not fit the instrument's shape in one view (a label "
-                         "is more than " +
-                         std::to_string(max_label_error_px) + " px off the posed model)");
+    return Status::Error(
+        "the labels do not fit the instrument's shape in one view (a label "
+        "is more than " +
+        std::to_string(max_label_error_px) + " px off the posed model)");
   }
   RigidTemplate body;
   body.point_names = labels.point_names;

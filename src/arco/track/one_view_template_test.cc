@@ -41,14 +41,20 @@ View MakeView(double noise_px, double scale = 1.0) {
              {-500, 0, -110},
              Eigen::Vector3d::Constant(kNaN),
              {-691, 0, -120}};
-  v.labels.point_names = {"scroll_top", "nut_l", "nut_r", "bridge_l", "bridge_r",
-                          "tail_gut", "tail_block", "bow_hair", "end_pin"};
+  v.labels.point_names = {"scroll_top",
+                          "nut_l",
+                          "nut_r",
+                          "bridge_l",
+                          "bridge_r",
+                          "tail_gut",
+                          "tail_block",
+                          "bow_hair",
+                          "end_pin"};
   // Upright and turned towards the camera's left, a little back.
-  const Eigen::Matrix3d R =
-      (Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(-1.35, Eigen::Vector3d::UnitY()) *
-       Eigen::AngleAxisd(1.5, Eigen::Vector3d::UnitX()))
-          .toRotationMatrix();
+  const Eigen::Matrix3d R = (Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()) *
+                             Eigen::AngleAxisd(-1.35, Eigen::Vector3d::UnitY()) *
+                             Eigen::AngleAxisd(1.5, Eigen::Vector3d::UnitX()))
+                                .toRotationMatrix();
   v.world_from_body = Rigid3d(R, Eigen::Vector3d(0, 0, 700));
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0, noise_px);
@@ -75,11 +81,15 @@ TEST(PoseTemplateInOneView, PlacesTheModelWhereItsLabelsAre) {
     ASSERT_TRUE(body->points[p].allFinite()) << v.labels.point_names[p];
     EXPECT_EQ(body->label_views[p], 1);
     worst_mm = std::max(worst_mm, (body->points[p] - v.world_from_body * v.model[p]).norm());
-    worst_px = std::max(worst_px, (*v.camera.Project(body->points[p]) - v.labels.pixels[0][p]).norm());
+    worst_px =
+        std::max(worst_px, (*v.camera.Project(body->points[p]) - v.labels.pixels[0][p]).norm());
   }
-  std::printf("one view, 0.5 px labels: worst point %.1f mm from the truth, %.2f px from its "
-              "label, rms %.2f px\n",
-              worst_mm, worst_px, body->rms_reprojection_px);
+  std::printf(
+      "one view, 0.5 px labels: worst point %.1f mm from the truth, %.2f px from its "
+      "label, rms %.2f px\n",
+      worst_mm,
+      worst_px,
+      body->rms_reprojection_px);
   // 2.7 m away at 1500 px: half a pixel is 0.9 mm across the ray; depth is what one view
   // measures worst.
   EXPECT_LT(worst_mm, 10);
@@ -108,7 +118,8 @@ TEST(PoseTemplateInOneView, TheModelsSizeSetsTheDepth) {
 
 TEST(PoseTemplateInOneView, TooFewLabelsOrLabelsThatFitNoPose) {
   View v = MakeView(0.5);
-  for (size_t p = 3; p < v.model.size(); ++p) v.labels.pixels[0][p] = Eigen::Vector2d::Constant(kNaN);
+  for (size_t p = 3; p < v.model.size(); ++p)
+    v.labels.pixels[0][p] = Eigen::Vector2d::Constant(kNaN);
   auto body = PoseTemplateInOneView(v.camera, v.labels, v.model);
   ASSERT_FALSE(body.ok());
   EXPECT_EQ(body.status().message(),
@@ -116,12 +127,14 @@ TEST(PoseTemplateInOneView, TooFewLabelsOrLabelsThatFitNoPose) {
             "at least 4");
   // Four labels, one of them 150 px off: no pose agrees with all of them.
   v = MakeView(0.5);
-  for (size_t p = 4; p < v.model.size(); ++p) v.labels.pixels[0][p] = Eigen::Vector2d::Constant(kNaN);
+  for (size_t p = 4; p < v.model.size(); ++p)
+    v.labels.pixels[0][p] = Eigen::Vector2d::Constant(kNaN);
   v.labels.pixels[0][1].y() += 150;
   body = PoseTemplateInOneView(v.camera, v.labels, v.model);
   ASSERT_FALSE(body.ok());
-  EXPECT_NE(body.status().message().find("the labels do not fit the instrument's shape in one view"),
-            std::string::npos)
+  EXPECT_NE(
+      body.status().message().find("the labels do not fit the instrument's shape in one view"),
+      std::string::npos)
       << body.status().message();
 }
 
