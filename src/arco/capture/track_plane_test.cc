@@ -414,6 +414,92 @@ TEST_F(TrackPlane, EveryInstrumentPointInEveryViewAndFrame) {
   EXPECT_GE(bow_mm.size(), static_cast<size_t>(2 * kFrames * 0.98));
 }
 
+// One camera (one phone): labels of frame 1 in its one view pose arco's cello model
+// (track::PoseTemplateInOneView), and that posed model is what the tracker follows. Here
+// the instrument is a photo on a flat board, so the model's 3D shape is not the board's:
+// the labels' residual against the posed model, and the wrong depth of the tracked
+// features, are what one view costs. Compared with the baseline of the test above for the
+// same view (the labelled points tracked by Lucas-Kanade in 2D).
+TEST_F(TrackPlane, OneCameraFollowsTheInstrumentWithItsModel) {
+  Scene& s = *g_scene;
+  const Camera& cam = s.scene.rig.cameras[kLabelViews[0]];
+  CaptureNewOptions c;
+  c.calibration = s.scene_dir + "/calibration.json";
+  c.instrument = "cello";
+  c.inputs.push_back({cam.name, s.scene_dir + "/videos/" + cam.name + ".mkv", false});
+  c.output_dir = s.dir / "one";
+  if (!fs::exists(c.output_dir)) {
+    auto made = CreateCapture(c);
+    ASSERT_TRUE(made.ok()) << made.status().message();
+  }
+  TrackStageOptions o;
+  o.capture_dir = c.output_dir;
+  o.labels.push_back({cam.name, -1, s.dir / LabelFile(cam.name, 0)});
+  o.num_threads = 2;
+  o.track_bow = true;
+  auto tracked = RunTrackStage(o);
+  ASSERT_TRUE(tracked.ok()) << tracked.status().message();
+  EXPECT_EQ(tracked->frames_without_pose, 0);
+  // The bow is not tracked from one view; the end pin has no place in the model a view
+  // poses.
+  EXPECT_FALSE(tracked->bow_tracked);
+  EXPECT_EQ(tracked->untracked_points, std::vector<std::string>{"end_pin"});
+  auto kp = ReadNpy<float>(c.output_dir + "/keypoints2d.npy");
+  ASSERT_TRUE(kp.ok()) << kp.status().message();
+  ASSERT_EQ(kp->shape[1], 1);
+  const std::vector<int>& slots = *FindKeypointLayout("spd_cello")->Group("instrument");
+  std::vector<double> errors_px, base_px;
+  int missing = 0;
+  media::VideoReaderOptions ro;
+  ro.format = media::PixelFormat::kGray8;
+  auto video = media::VideoReader::Open(s.scene_dir + "/videos/" + cam.name + ".mkv", ro);
+  ASSERT_TRUE(video.ok());
+  std::vector<Eigen::Vector2d> start;
+  for (const auto& tp : s.texture_px)
+    start.push_back(
+        *testing::ProjectPlanePoint(cam, s.scene.world_from_plane[0], s.scene.texture, tp));
+  track::PointTracker2d baseline(track::InstrumentTrackerOptions(), start);
+  media::Image previous, current;
+  ASSERT_TRUE(video->Read(&previous).ok());
+  std::vector<Eigen::Vector2d> base = start;
+  for (int f = 0; f < kFrames; ++f) {
+    if (f > 0) {
+      ASSERT_TRUE(*video->Read(&current));
+      base = baseline.Next(previous, current);
+      std::swap(previous, current);
+    }
+    for (size_t p = 0; p < slots.size(); ++p) {
+      if (s.names[p] == "end_pin") continue;
+      const auto truth = testing::ProjectPlanePoint(
+          cam, s.scene.world_from_plane[f], s.scene.texture, s.texture_px[p]);
+      if (!truth || !testing::InImage(cam, *truth)) continue;
+      const float* x = &kp->data[static_cast<size_t>((f * kp->shape[2] + slots[p]) * 3)];
+      if (!std::isfinite(x[0])) {
+        ++missing;
+        continue;
+      }
+      errors_px.push_back((Eigen::Vector2d(x[0], x[1]) - *truth).norm());
+      if (std::isfinite(base[p].x())) base_px.push_back((base[p] - *truth).norm());
+    }
+  }
+  ASSERT_FALSE(errors_px.empty());
+  ASSERT_FALSE(base_px.empty());
+  std::printf("| arco track, one camera (labels in its view) | %.2f | %.2f | - | - | %d |\n",
+              Median(errors_px),
+              InterpolatedQuantile(errors_px, 0.95),
+              missing);
+  std::printf("| baseline: LK in that view | %.2f | %.2f | - | - | |\n",
+              Median(base_px),
+              InterpolatedQuantile(base_px, 0.95));
+  std::printf("labels against the posed model: %.2f px\n", tracked->label_rms_px);
+  // Issue 13's bounds, as for several views. Measured 0.79 / 2.87 px (median / 95th): the
+  // model's shape against the flat board's (two views' template: 0.02 / 0.07 px; the 2D
+  // baseline 0.18 / 0.81 px, which tracks the labelled points themselves).
+  EXPECT_EQ(missing, 0);
+  EXPECT_LE(Median(errors_px), 2.0);
+  EXPECT_LE(InterpolatedQuantile(errors_px, 0.95), 6.0);
+}
+
 // Two cameras that started later than the others (phones synced by sound: capture.json's
 // cameras[].offset_s), one of them labelled: their videos hold the scene from frame
 // 1 + k on, k = 12 (a labelled view) and 5 (with a drift_ppm too). `arco track` must solve each

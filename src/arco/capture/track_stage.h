@@ -67,10 +67,13 @@ struct TrackCameraSummary {
 struct TrackStageSummary {
   std::string layout;
   int64_t first_frame = 0, last_frame = 0;
-  int64_t template_frame = 0;                 // the labelled frame the template comes from
-  std::vector<std::string> tracked_points;    // instrument points with a template point
-  std::vector<std::string> untracked_points;  // labelled in fewer than two views
-  double label_rms_px = 0;                    // the labels' triangulation residual
+  int64_t template_frame = 0;               // the labelled frame the template comes from
+  std::vector<std::string> tracked_points;  // instrument points with a template point
+  // Labelled in fewer than two views (one camera: not labelled, or no place in the model
+  // its labels pose, as the end pin).
+  std::vector<std::string> untracked_points;
+  // The labels' triangulation residual (one camera: against the posed model).
+  double label_rms_px = 0;
   // The calibration's unit and millimetres per unit: 1 for "mm", 1000 for "m"; for
   // another unit (Metashape's) the labelled nut-bridge distance against the instrument's
   // string length. The trackers work in mm.
