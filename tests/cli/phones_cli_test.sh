@@ -232,11 +232,13 @@ SNAPSHOT_DIR=$tmp/w
 bad "run before detect" "undetected/capture.json: no 2D keypoints yet" run undetected -o w/res
 
 # One phone, the guide's commands for it: the left phone alone, from its video to the
-# fingering table.
+# fingering table, without a calibration file; its focal length given once known.
 SNAPSHOT_DIR=$tmp/w
-head -3 phones.json | sed 's/},$/}]}/' >one.json
-ok "one phone: capture new" capture new --calibration one.json --video left=left.mp4 --sync audio \
-  --instrument cello -o one
+bad "two phones without a calibration" "--calibration is missing: 2 cameras need one that names them" \
+  capture new --video left=left.mp4 --video right=right.mp4 --sync audio --instrument cello -o w/two
+ok "one phone: capture new" capture new --video left=left.mp4 --sync audio --instrument cello -o one
+check 'grep -q "calibration.json made: camera left from its video: 460x528, focal 398.9 px (a phone.s default, 67 deg across the longer side), no distortion, its frame the world" "$tmp/out"' \
+  "one phone's capture: $(cat "$tmp/out")"
 ok "one phone: detect" detect one
 bad "one phone: run before track" "one/keypoints2d.npy: no frame shows the cello's nut_l, nut_r, bridge_l and bridge_r in its view" \
   run one -o w/res

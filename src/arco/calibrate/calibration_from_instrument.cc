@@ -382,9 +382,8 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
       if (view.rotate_deg == 90 || view.rotate_deg == 270) std::swap(cam.width, cam.height);
       report.size_source = "video";
     }
-    cam.fx = cam.fy = options.focal_px > 0 ? options.focal_px
-                                           : 0.5 * std::max(cam.width, cam.height) /
-                                                 std::tan(0.5 * fov_deg * M_PI / 180);
+    cam.fx = cam.fy =
+        options.focal_px > 0 ? options.focal_px : FocalPxFromFov(cam.width, cam.height, fov_deg);
     // Pixel centres at integers (camera.h): the image centre is (w - 1) / 2.
     cam.cx = 0.5 * (cam.width - 1);
     cam.cy = 0.5 * (cam.height - 1);

@@ -41,6 +41,7 @@
 #include <vector>
 
 #include "arco/calibrate/calibration_refine.h"
+#include "arco/camera/phone_camera.h"
 #include "arco/camera/rig.h"
 #include "arco/util/json_io.h"
 #include "arco/util/number_range.h"
@@ -49,7 +50,7 @@
 
 namespace arco::calibrate {
 
-inline constexpr double kPhoneFovDeg = 67.0;
+using arco::kPhoneFovDeg;  // camera/phone_camera.h
 inline constexpr NumberRange kFromInstrumentFocalRangePx = AboveZero(100000);
 inline constexpr NumberRange kFromInstrumentFovRangeDeg = Closed(10, 150);
 inline constexpr NumberRange kFromInstrumentPointsRange = Closed(4, 64);

@@ -9,6 +9,7 @@
 #include "arco/audio/align.h"
 #include "arco/audio/audio_reader.h"
 #include "arco/calibration/calibration_file.h"
+#include "arco/camera/phone_camera.h"
 #include "arco/media/audio_decoder.h"
 #include "arco/media/frame_times.h"
 #include "arco/media/video_reader.h"
@@ -182,12 +183,41 @@ StatusOr<AudioSync> SyncByAudio(const std::vector<OpenedInput>& opened,
   return sync;
 }
 
+// One camera's calibration from its video (capture_new.h, "One camera without a
+// calibration"); `what` says what it holds.
+StatusOr<Rig> OneCameraFromItsVideo(const CaptureNewOptions& o, std::string* what) {
+  const CaptureNewInput& input = o.inputs.front();
+  ARCO_ASSIGN_OR_RETURN(const media::VideoProperties p, ProbeInput(input));
+  const auto rotate = o.rotate_deg.find(input.camera);
+  const int rotate_deg = rotate != o.rotate_deg.end() ? rotate->second : p.rotation_deg;
+  const bool quarter = rotate_deg == 90 || rotate_deg == 270;
+  Camera cam;
+  cam.name = input.camera;
+  cam.width = quarter ? p.coded_height : p.coded_width;
+  cam.height = quarter ? p.coded_width : p.coded_height;
+  cam.fx = cam.fy = FocalPxFromFov(cam.width, cam.height, kPhoneFovDeg);
+  // Pixel centres at integers (camera.h): the image centre is (w - 1) / 2.
+  cam.cx = 0.5 * (cam.width - 1);
+  cam.cy = 0.5 * (cam.height - 1);
+  Rig rig;
+  rig.units = "mm";
+  rig.cameras.push_back(cam);
+  *what = "camera " + cam.name + " from its video: " + std::to_string(cam.width) + "x" +
+          std::to_string(cam.height) + ", focal " + NumberText(std::round(10 * cam.fx) / 10) +
+          " px (a phone's default, " + NumberText(kPhoneFovDeg) +
+          " deg across the longer side), no distortion, its frame the world";
+  return rig;
+}
+
 }  // namespace
 
 Status CaptureNewOptions::Validate() const {
   if (output_dir.empty()) return Status::Error("output_dir is empty");
-  if (calibration.empty()) return Status::Error("calibration is empty");
   if (inputs.empty()) return Status::Error("inputs: give at least one camera's video or images");
+  if (calibration.empty() && inputs.size() > 1)
+    return Status::Error("calibration is missing: " + std::to_string(inputs.size()) +
+                         " cameras need one that names them (two phones: docs/phones.md, step 1); "
+                         "only a single camera's is made from its video");
   std::set<std::string> cameras;
   for (const CaptureNewInput& input : inputs) {
     if (input.camera.empty()) return Status::Error("inputs: a camera name is empty");
@@ -241,7 +271,13 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
   replace.marker = kCaptureManifestName;  // only an arco capture is replaced
   replace.kind = "capture";
   ARCO_RETURN_IF_ERROR(CheckOutputFolder(o.output_dir, replace));  // before the work
-  ARCO_ASSIGN_OR_RETURN(const Calibration calibration, calibration::LoadCalibration(o.calibration));
+  Calibration calibration;
+  std::string calibration_made;
+  if (o.calibration.empty()) {
+    ARCO_ASSIGN_OR_RETURN(calibration.rig, OneCameraFromItsVideo(o, &calibration_made));
+  } else {
+    ARCO_ASSIGN_OR_RETURN(calibration, calibration::LoadCalibration(o.calibration));
+  }
   const Rig& rig = calibration.rig;
 
   // Cameras first (cheap), then the videos.
@@ -405,10 +441,13 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
   m.fps = fps;
   m.frame_first = 1;
   m.frame_count = total;
-  m.calibration = "calibration" + fs::path(o.calibration).extension().string();
+  m.calibration = o.calibration.empty()
+                      ? std::string("calibration.json")
+                      : "calibration" + fs::path(o.calibration).extension().string();
   if (!o.audio.empty()) m.audio = PathRelativeTo(o.audio, o.output_dir);
   CaptureNewSummary out;
   out.warnings = warnings;
+  out.calibration_made = calibration_made;
   if (o.sync == CaptureSync::kAudio) {
     m.audio = PathRelativeTo(sync.audio, o.output_dir);
     m.audio_offset_s = sync.audio_offset_s;
@@ -450,9 +489,14 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
 
   OutputSet outputs;
   ARCO_ASSIGN_OR_RETURN(const std::string tmp, outputs.AddFolder(o.output_dir, replace));
-  std::error_code ec;
-  fs::copy_file(o.calibration, JoinPath(tmp, m.calibration), ec);
-  if (ec) return Status::Error(o.calibration + ": cannot copy (" + ec.message() + ")");
+  if (o.calibration.empty()) {
+    ARCO_RETURN_IF_ERROR(calibration::SaveCalibration(
+        JoinPath(tmp, m.calibration), rig, CalibrationFormat::kArcoJson));
+  } else {
+    std::error_code ec;
+    fs::copy_file(o.calibration, JoinPath(tmp, m.calibration), ec);
+    if (ec) return Status::Error(o.calibration + ": cannot copy (" + ec.message() + ")");
+  }
   ARCO_RETURN_IF_ERROR(WriteCaptureManifest(tmp, m));
   ARCO_RETURN_IF_ERROR(outputs.Commit());
   return out;

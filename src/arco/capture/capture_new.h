@@ -17,6 +17,13 @@
 // recording's length, which must be the same for every camera. The capture covers the
 // whole recording: frames.first = 1, frames.count = that length.
 //
+// One camera without a calibration (one phone): the capture's calibration.json names the
+// camera, takes the image size from its video (turned by rotate_deg) and a phone's
+// default focal length (camera/phone_camera.h), principal point at the image centre, no
+// distortion, and the camera's frame as the world: what `arco calibrate from-instrument`
+// makes of one camera, which replaces it when the focal length is known. Two or more
+// cameras need a calibration (their poses cannot be guessed).
+//
 // Sync (`sync` = kAudio, docs/capture.md): the cameras' clocks are found from their
 // sound. Each video's audio track (and the recorder `audio`, when given) is aligned by
 // GCC-PHAT (audio/align.h): the clock reference is the recorder when given, else the
@@ -61,7 +68,9 @@ enum class CaptureSync {
 };
 
 struct CaptureNewOptions {
-  std::string calibration;                // any format arco reads; copied into the capture
+  // Any format arco reads; copied into the capture. Empty with one camera (one phone): its
+  // calibration is made from its video (below, "One camera without a calibration").
+  std::string calibration;
   std::vector<CaptureNewInput> inputs;    // one per camera, in the capture's view order
   std::string audio;                      // optional; referenced, not copied
   std::string instrument = "none";        // cello, violin, viola, double_bass or none
@@ -97,6 +106,9 @@ struct CaptureNewSummary {
   std::string layout;  // the layout `arco detect` will write
   std::vector<CaptureNewCamera> cameras;
   std::string sync_reference;  // sync kAudio: the recorder's or the camera's name
+  // Set when the calibration was made from the one video (no calibration given): what it
+  // holds, for the user to check.
+  std::string calibration_made;
   // A video whose timestamps jump (media/frame_times.h), one line each naming the file.
   std::vector<std::string> warnings;
 };

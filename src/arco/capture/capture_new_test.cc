@@ -107,6 +107,48 @@ TEST(CreateCapture, ReferencesTheVideosAndReadsBack) {
   EXPECT_EQ(none.message().rfind(JoinPath(o.output_dir, "capture.json") + ": ", 0), 0u);
 }
 
+// One camera without a calibration (one phone): calibration.json is made from its video,
+// turned by its rotation, with a phone's default focal length and the camera's frame as
+// the world. Two cameras need one.
+TEST(CreateCapture, OneCameraWithoutACalibrationGetsOneFromItsVideo) {
+  TempDir dir;
+  CaptureNewOptions o;
+  o.inputs = {{"phone", WriteVideo(dir, "a.mkv", 10), false}};
+  o.rotate_deg = {{"phone", 90}};
+  o.output_dir = dir / "capture";
+  const auto r = CreateCapture(o);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_NE(r->calibration_made.find("camera phone from its video: 96x128"), std::string::npos)
+      << r->calibration_made;
+  const auto m = ReadCaptureManifest(o.output_dir);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  EXPECT_EQ(m->calibration, "calibration.json");
+  const auto c = calibration::LoadCalibration(ResolveCapturePath(o.output_dir, m->calibration));
+  ASSERT_TRUE(c.ok()) << c.status().message();
+  ASSERT_EQ(c->rig.cameras.size(), 1u);
+  const Camera& cam = c->rig.cameras[0];
+  EXPECT_EQ(c->rig.units, "mm");
+  EXPECT_EQ(cam.name, "phone");
+  EXPECT_EQ(cam.width, 96);  // the 128x96 frames turned by 90 degrees
+  EXPECT_EQ(cam.height, 128);
+  // 67 degrees across the longer side: 64 / tan(33.5 deg).
+  EXPECT_NEAR(cam.fx, 64 / std::tan(33.5 * M_PI / 180), 1e-9);
+  EXPECT_EQ(cam.fx, cam.fy);
+  EXPECT_DOUBLE_EQ(cam.cx, 47.5);
+  EXPECT_DOUBLE_EQ(cam.cy, 63.5);
+  EXPECT_TRUE(cam.cam_from_world.rotation.isIdentity(0));
+  EXPECT_TRUE(cam.cam_from_world.translation.isZero(0));
+
+  CaptureNewOptions two = TwoCameras(dir);
+  two.calibration.clear();
+  two.output_dir = dir / "two";
+  const auto refused = CreateCapture(two);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().message().rfind("calibration is missing: 2 cameras need one", 0), 0u)
+      << refused.status().message();
+  EXPECT_FALSE(fs::exists(two.output_dir));
+}
+
 // Relative paths are stored relative to the capture folder, so they resolve from it.
 TEST(CreateCapture, RelativePathsResolveFromTheCapture) {
   TempDir dir;

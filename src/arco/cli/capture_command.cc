@@ -22,6 +22,7 @@ namespace {
 
 // Fields of CaptureNewOptions / ImportKeypointsOptions as their flags.
 inline constexpr FieldFlag kCaptureFlags[] = {{"inputs", "--video/--images"},
+                                              {"calibration", "--calibration"},
                                               {"rotate_deg", "--rotate"},
                                               {"dropped_frames", "--dropped-frames"},
                                               {"spd_summary", "--spd-summary"},
@@ -129,6 +130,11 @@ int RunCaptureNew(const capture::CaptureNewOptions& o) {
   if (synced) {
     std::printf("synced by sound (clock: %s)\n", r->sync_reference.c_str());
   }
+  if (!r->calibration_made.empty())
+    std::printf(
+        "calibration.json made: %s (`arco calibrate from-instrument` replaces it "
+        "when the focal length is known)\n",
+        r->calibration_made.c_str());
   for (const std::string& w : r->warnings) PrintWarning(w);
   std::printf(
       "capture of %zu cameras x %lld frames at %.6g fps -> %s (no 2D keypoints yet: run "
@@ -183,8 +189,11 @@ CommandRun SetupCapture(CLI::App& app) {
       "Create a capture folder that references each camera's video (or image folder, one "
       "image per frame in natural order), with a copy of the calibration; checks cameras, "
       "sizes, frame rates and frame counts. 2D keypoints come next: `arco detect CAPTURE`");
-  create->add_option("--calibration", n->options.calibration, "Calibration (any format; copied)")
-      ->required();
+  create->add_option("--calibration",
+                     n->options.calibration,
+                     "Calibration (any format; copied). Required for two or more cameras; "
+                     "one camera without it gets one from its video (a phone's default "
+                     "focal length, its frame the world)");
   create->add_option("--video",
                      n->videos,
                      "CAMERA=FILE: a camera's video file (or single image); CAMERA is a "
