@@ -1,6 +1,7 @@
 // `arco track CAPTURE --labels CAMERA=LABELME.json ...` (docs/track.md): the instrument's
 // points in every camera and frame of a capture made from videos, from labels of one
-// frame in at least two views. The tracking itself is track::InstrumentTracker
+// frame in at least two views (a one-camera capture: in its view, the instrument's model
+// posed by them, track::PoseTemplateInOneView). The tracking itself is track::InstrumentTracker
 // (track/instrument_tracker.h); this stage reads and checks the labels, reads the frames
 // through media::VideoReader (turned by rotate_deg), tracks forwards from the labelled
 // frame (and backwards when it is not the first) and writes the instrument slots of

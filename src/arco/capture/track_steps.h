@@ -72,9 +72,11 @@ struct TrackTemplates {
   std::vector<Camera> cameras;              // the views' cameras with the world in mm
 };
 
-// Labels -> templates: the instrument's from the template frame's labels, the world
-// scaled to mm (the calibration's units, else the labelled string length), the bow's
-// (checked for a bow's length). Sets the summary's template fields, units and warnings.
+// Labels -> templates: the instrument's from the template frame's labels (triangulated;
+// one camera: the instrument's model posed by them), the world scaled to mm (the
+// calibration's units, else the labelled string length; one camera: a unit that is not
+// metric is taken as mm, with a warning), the bow's (checked for a bow's length; not from
+// one camera). Sets the summary's template fields, units and warnings.
 StatusOr<TrackTemplates> MakeTrackTemplates(const TrackStageOptions& options,
                                             const TrackCapture& capture,
                                             const TrackLabels& labels,
