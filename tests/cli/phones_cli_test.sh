@@ -232,7 +232,8 @@ SNAPSHOT_DIR=$tmp/w
 bad "run before detect" "undetected/capture.json: no 2D keypoints yet" run undetected -o w/res
 
 # One phone, the guide's commands for it: the left phone alone, from its video to the
-# fingering table, without a calibration file; its focal length given once known.
+# fingering table without a calibration file (capture new, detect, track, run); then its
+# focal length given.
 SNAPSHOT_DIR=$tmp/w
 bad "two phones without a calibration" "--calibration is missing: 2 cameras need one that names them" \
   capture new --video left=left.mp4 --video right=right.mp4 --sync audio --instrument cello -o w/two
@@ -244,12 +245,6 @@ bad "one phone: run before track" "one/keypoints2d.npy: no frame shows the cello
   run one -o w/res
 check '[ ! -e w/res ]' "a failed run wrote its folder"
 SNAPSHOT_DIR=
-ok "one phone: calibrate" calibrate from-instrument one --labels left=left.json --labels-frame 31 \
-  --focal-px 452 -o one_rig.json
-check 'grep -q "calibrated 1 camera of one: 460x528 (video), focal 452.0 px from --focal-px; world: camera left.s frame, mm" "$tmp/out" &&
-       grep -q "the cello.s model fits its points in 240 frames" "$tmp/out"' \
-  "one phone's calibration: $(cat "$tmp/out")"
-cp one_rig.json one/calibration.json
 ok "one phone: track" track one --labels left=left.json --labels-frame 31
 check 'grep -q "tracked frames 1:240 in 1 cameras from labels of frame 31 (layout spd_cello)" "$tmp/out" &&
        grep -q "the bow is not tracked from one view" "$tmp/err"' "one phone's track: $(cat "$tmp/out" "$tmp/err")"
@@ -280,6 +275,16 @@ assert open_strings == {"C2": "4", "G2": "3", "D3": "2"}, open_strings
 source = np.load(sys.argv[1] + "/triangulation/depth_source.npy")
 assert (source[:, 133:139] == 1).all(), np.unique(source[:, 133:139])
 PY
+# The phone's focal length known: its calibration from the labels, then run again.
+ok "one phone: calibrate" calibrate from-instrument one --labels left=left.json --labels-frame 31 \
+  --focal-px 452 -o one_rig.json
+check 'grep -q "calibrated 1 camera of one: 460x528 (video), focal 452.0 px from --focal-px; world: camera left.s frame, mm" "$tmp/out" &&
+       grep -q "the cello.s model fits its points in 240 frames" "$tmp/out"' \
+  "one phone's calibration: $(cat "$tmp/out")"
+cp one_rig.json one/calibration.json
+ok "one phone: run with the focal length" run one -o one_result_focal
+check 'cmp -s <(cut -d, -f8 one_result/arco/fingering.csv) <(cut -d, -f8 one_result_focal/arco/fingering.csv)' \
+  "the focal length changed the notes: $(cut -d, -f8 one_result_focal/arco/fingering.csv | tr '\n' ' ')"
 check '[ -z "$(find "$tmp" -name ".tmp-*" -o -name ".old-*")" ]' "no temporaries left"
 echo "phones: $((SECONDS - start)) s"
 [ $fail -eq 0 ] && echo "phones CLI: all checks passed"

@@ -362,13 +362,11 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
                                                : "phone default (" + NumberText(fov_deg) +
                                                      " deg across the longer side)";
   for (const CaptureCamera& view : manifest.cameras) {
-    Camera cam;
-    cam.name = view.name;
-    cam.serial = view.serial;
     FromInstrumentCamera report;
     report.name = view.name;
+    int width = 0, height = 0;
     if (options.image_width > 0) {
-      cam.width = options.image_width, cam.height = options.image_height;
+      width = options.image_width, height = options.image_height;
       report.size_source = "--image-size";
     } else {
       if (view.video.empty())
@@ -377,16 +375,17 @@ StatusOr<CalibrationFromInstrumentSummary> CalibrateFromInstrument(
       const std::string video = ResolveCapturePath(options.capture_dir, view.video);
       auto reader = media::VideoReader::Open(video);
       if (!reader.ok()) return reader.status().WithContext("camera " + view.name);
-      cam.width = reader->properties().width;
-      cam.height = reader->properties().height;
-      if (view.rotate_deg == 90 || view.rotate_deg == 270) std::swap(cam.width, cam.height);
+      width = reader->properties().width;
+      height = reader->properties().height;
+      if (view.rotate_deg == 90 || view.rotate_deg == 270) std::swap(width, height);
       report.size_source = "video";
     }
-    cam.fx = cam.fy =
-        options.focal_px > 0 ? options.focal_px : FocalPxFromFov(cam.width, cam.height, fov_deg);
-    // Pixel centres at integers (camera.h): the image centre is (w - 1) / 2.
-    cam.cx = 0.5 * (cam.width - 1);
-    cam.cy = 0.5 * (cam.height - 1);
+    Camera cam = CentredPinhole(
+        view.name,
+        width,
+        height,
+        options.focal_px > 0 ? options.focal_px : FocalPxFromFov(width, height, fov_deg));
+    cam.serial = view.serial;
     report.initial_focal_px = cam.fx;
     report.width = cam.width, report.height = cam.height;
     rig.cameras.push_back(cam);

@@ -191,14 +191,10 @@ StatusOr<Rig> OneCameraFromItsVideo(const CaptureNewOptions& o, std::string* wha
   const auto rotate = o.rotate_deg.find(input.camera);
   const int rotate_deg = rotate != o.rotate_deg.end() ? rotate->second : p.rotation_deg;
   const bool quarter = rotate_deg == 90 || rotate_deg == 270;
-  Camera cam;
-  cam.name = input.camera;
-  cam.width = quarter ? p.coded_height : p.coded_width;
-  cam.height = quarter ? p.coded_width : p.coded_height;
-  cam.fx = cam.fy = FocalPxFromFov(cam.width, cam.height, kPhoneFovDeg);
-  // Pixel centres at integers (camera.h): the image centre is (w - 1) / 2.
-  cam.cx = 0.5 * (cam.width - 1);
-  cam.cy = 0.5 * (cam.height - 1);
+  const int width = quarter ? p.coded_height : p.coded_width;
+  const int height = quarter ? p.coded_width : p.coded_height;
+  const Camera cam =
+      CentredPinhole(input.camera, width, height, FocalPxFromFov(width, height, kPhoneFovDeg));
   Rig rig;
   rig.units = "mm";
   rig.cameras.push_back(cam);
