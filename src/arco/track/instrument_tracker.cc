@@ -11,12 +11,14 @@
 
 #include "arco/mocap/triangulate_point.h"
 #include "arco/track/one_view_pnp.h"
+#include "arco/util/number_range.h"
 #include "arco/util/parallel.h"
 
 namespace arco::track {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // A Gray8 image as a cv::Mat header (no copy).
 cv::Mat AsMat(const media::Image& image) {
@@ -464,8 +466,10 @@ StatusOr<RigidTemplate> PoseTemplateInOneView(const Camera& camera,
   std::vector<PoseCorrespondence> c;
   std::vector<Eigen::Vector3d> object;
   std::vector<Eigen::Vector2d> undistorted;
+  std::vector<size_t> label_of;  // per correspondence, its label
   for (size_t p = 0; p < labels.point_names.size() && p < pixels.size(); ++p) {
     if (!std::isfinite(pixels[p].x()) || !model_points[p].allFinite()) continue;
+    label_of.push_back(p);
     c.push_back({0, model_points[p], pixels[p], 1.0});
     object.push_back(model_points[p]);
     undistorted.push_back(camera.UndistortPixel(pixels[p]));
@@ -486,7 +490,7 @@ StatusOr<RigidTemplate> PoseTemplateInOneView(const Camera& camera,
     return Status::Error(
         "the labels do not fit the instrument's shape in one view (no pose "
         "within " +
-        std::to_string(max_label_error_px) + " px)");
+        NumberText(max_label_error_px) + " px)");
   }
   const Eigen::Matrix3d& Rc = camera.cam_from_world.rotation;
   const Eigen::Vector3d& tc = camera.cam_from_world.translation;
@@ -499,10 +503,19 @@ StatusOr<RigidTemplate> PoseTemplateInOneView(const Camera& camera,
   const std::optional<PoseSolution> solved =
       SolveRigidPose({camera}, c, start, refine, static_cast<int>(c.size()));
   if (!solved) {
-    return Status::Error(
-        "the labels do not fit the instrument's shape in one view (a label "
-        "is more than " +
-        std::to_string(max_label_error_px) + " px off the posed model)");
+    // Every label must agree, as with several views: name the one farthest from the pose
+    // the others agree on.
+    size_t worst = 0;
+    double worst_px = -1;
+    for (size_t i = 0; i < c.size(); ++i) {
+      const auto seen = camera.Project(start * c[i].point_in_template);
+      const double px = seen ? (*seen - c[i].pixel).norm() : kInfinity;
+      if (px > worst_px) worst_px = px, worst = i;
+    }
+    return Status::Error("label " + labels.point_names[label_of[worst]] +
+                         ": the labels do not fit the instrument's shape in one view (it is " +
+                         NumberText(std::round(worst_px)) + " px from where the others put it; " +
+                         NumberText(max_label_error_px) + " px at most)");
   }
   RigidTemplate body;
   body.point_names = labels.point_names;

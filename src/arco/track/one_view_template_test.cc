@@ -136,6 +136,17 @@ TEST(PoseTemplateInOneView, TooFewLabelsOrLabelsThatFitNoPose) {
       body.status().message().find("the labels do not fit the instrument's shape in one view"),
       std::string::npos)
       << body.status().message();
+  // Every label given, the right side of the nut 40 px off (a slip in labelme): the others
+  // agree on a pose, and the error names it.
+  v = MakeView(0.5);
+  v.labels.pixels[0][2].x() += 40;
+  body = PoseTemplateInOneView(v.camera, v.labels, v.model);
+  ASSERT_FALSE(body.ok());
+  EXPECT_EQ(body.status().message().rfind("label nut_r: the labels do not fit the instrument's "
+                                          "shape in one view (it is ",
+                                          0),
+            0u)
+      << body.status().message();
 }
 
 }  // namespace
