@@ -81,8 +81,9 @@ if not j["paper"]["string_accuracy"] >= 0.8: bad.append("paper's strings %.3f" %
 # The sound must keep the hand ahead of vision in the instrument's frame.
 if not j["arco"]["string_accuracy"] >= 0.95: bad.append("arco's strings %.3f" % j["arco"]["string_accuracy"])
 if not j["arco"]["finger_accuracy"] >= 0.8: bad.append("arco's fingers %.3f" % j["arco"]["finger_accuracy"])
-# (0.488 in the gcc Release build, 0.252 in the clang sanitizer build (vision 0.182), with
-# the refined hand held over +-0.2 s,
+# (0.512 in the gcc Release build with the hand blended with its other times on the same
+# note, RefineOptions::one_view_same_note_weight, 0.488 without it; 0.252 in the clang
+# sanitizer build (vision 0.182) before it; with the refined hand held over +-0.2 s,
 # RefineOptions::one_view_smoothing_s, 0.430 without it and with the palm as one piece,
 # HandStageOptions::one_view_palm_as_one, 0.376 without it and with the other fingertips at
 # their places in the hand frame, RefineOptions::one_view_hand_frame, 0.324 without either; 0.267 without in the clang

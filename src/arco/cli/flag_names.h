@@ -45,7 +45,8 @@ inline constexpr FieldFlag kRefineFlags[] = {
     {"one_view_lateral_weight", "--one-view-lateral-weight"},
     {"one_view_above_margin_mm", "--one-view-above-margin-mm"},
     {"frame_sigma_mm", "--one-view-frame-sigma-mm"},
-    {"one_view_smoothing_s", "--one-view-smoothing-s"}};
+    {"one_view_smoothing_s", "--one-view-smoothing-s"},
+    {"one_view_same_note_weight", "--one-view-same-note-weight"}};
 // Evaluation (EvaluateRequest, as set by `arco eval`).
 inline constexpr FieldFlag kEvalFlags[] = {{"truth_frames", "--truth-frame"},
                                            {"pck_thresholds_mm", "--pck-mm"},

@@ -261,6 +261,13 @@ std::function<int()> SetupRefine(CLI::App& app) {
             "instrument's frame (0: off)",
             refine::kOneViewSmoothingRangeS)
       ->capture_default_str();
+  AddNumber(sub,
+            "--one-view-same-note-weight",
+            r.one_view_same_note_weight,
+            "arco, one camera: blend a pressed frame's held hand with its median over every "
+            "frame playing the same note, finger and string (0: off)",
+            refine::kOneViewSameNoteWeightRange)
+      ->capture_default_str();
   sub->parse_complete_callback([a] { ApplyAndValidate(*a); });
   return [a]() { return RunRefine(*a); };
 }

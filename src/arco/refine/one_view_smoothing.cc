@@ -2,6 +2,9 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
+#include <map>
+#include <tuple>
 
 #include "arco/hand/fit.h"
 #include "arco/hand/ik.h"
@@ -40,11 +43,24 @@ std::optional<Frame> InstrumentFrame(const std::vector<StringSegment>& strings) 
   return f;
 }
 
+// The played note of a pressed frame (header comment): string, finger and the note's
+// equal-tempered pitch in semitones from A4 (its median f0); nullopt when not pressed.
+using PlayedNote = std::tuple<int, int, long>;
+std::optional<PlayedNote> PlayedNoteOf(const DecodeContext& context, const FrameContact& c) {
+  if (!c.pressed() || c.finger < 1 || c.finger > 4 || c.note < 0) return std::nullopt;
+  const auto& notes = context.analysis->notes;
+  if (static_cast<size_t>(c.note) >= notes.size()) return std::nullopt;
+  const double f0 = notes[static_cast<size_t>(c.note)].f0_hz;
+  if (!(f0 > 0)) return std::nullopt;
+  return PlayedNote{c.string, c.finger, std::lround(12.0 * std::log2(f0 / 440.0))};
+}
+
 }  // namespace
 
 int SmoothHandsInInstrumentFrame(const DecodeContext& context,
                                  const std::vector<FrameContact>& contacts,
                                  int window_frames,
+                                 double same_note_weight,
                                  int num_threads,
                                  std::vector<std::optional<hand::HandPose>>* hands) {
   const RefineInput& input = *context.input;
@@ -62,6 +78,31 @@ int SmoothHandsInInstrumentFrame(const DecodeContext& context,
     for (auto& q : p) q = frames[i]->rotation.transpose() * (q - frames[i]->origin);
     local[i] = p;
   }
+  // Each played note's keypoints: the median over its pressed frames (header comment).
+  std::map<PlayedNote, std::vector<size_t>> frames_of_note;
+  std::vector<std::optional<PlayedNote>> note_of_frame(static_cast<size_t>(n));
+  if (same_note_weight > 0) {
+    for (int f = 0; f < n; ++f) {
+      const size_t i = static_cast<size_t>(f);
+      if (!local[i]) continue;
+      note_of_frame[i] = PlayedNoteOf(context, contacts[i]);
+      if (note_of_frame[i]) frames_of_note[*note_of_frame[i]].push_back(i);
+    }
+  }
+  std::map<PlayedNote, hand::HandPointsMm> note_median;
+  for (const auto& [note, members] : frames_of_note) {
+    if (static_cast<int>(members.size()) < kMinSameNoteFrames) continue;
+    hand::HandPointsMm median;
+    std::vector<double> values;
+    for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
+      for (int a = 0; a < 3; ++a) {
+        values.clear();
+        for (size_t i : members) values.push_back((*local[i])[k](a));
+        median[k](a) = Median(values);
+      }
+    }
+    note_median[note] = median;
+  }
   const std::vector<std::optional<hand::HandPose>> refined = *hands;
   std::vector<uint8_t> changed(static_cast<size_t>(n), 0);
   ParallelFor(
@@ -71,6 +112,11 @@ int SmoothHandsInInstrumentFrame(const DecodeContext& context,
         const size_t i = static_cast<size_t>(f);
         if (!local[i]) return;
         hand::HandPointsMm held;
+        const hand::HandPointsMm* same_note = nullptr;
+        if (note_of_frame[i]) {
+          const auto it = note_median.find(*note_of_frame[i]);
+          if (it != note_median.end()) same_note = &it->second;
+        }
         std::vector<double> values;
         for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
           for (int a = 0; a < 3; ++a) {
@@ -83,6 +129,8 @@ int SmoothHandsInInstrumentFrame(const DecodeContext& context,
             }
             held[k](a) = Median(values);
           }
+          if (same_note)
+            held[k] = (1 - same_note_weight) * held[k] + same_note_weight * (*same_note)[k];
           held[k] = frames[i]->rotation * held[k] + frames[i]->origin;
         }
         const hand::HandFit3dResult fit =

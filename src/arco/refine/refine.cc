@@ -233,6 +233,10 @@ Status RefineOptions::Validate() const {
   ARCO_RETURN_IF_ERROR(
       CheckInRange("one_view_smoothing_s", one_view_smoothing_s, kOneViewSmoothingRangeS)
           .WithContext("refine options"));
+  ARCO_RETURN_IF_ERROR(CheckInRange("one_view_same_note_weight",
+                                    one_view_same_note_weight,
+                                    kOneViewSameNoteWeightRange)
+                           .WithContext("refine options"));
   if (num_threads < 0) return Status::Error("refine options: num_threads must be >= 0");
   return Status::Ok();
 }
@@ -315,8 +319,12 @@ RefineResult Refine(const RefineInput& input, const RefineOptions& options) {
                               options.num_threads);
     if (input.one_view_camera_centre_mm && options.one_view_smoothing_s > 0) {
       const int window = static_cast<int>(std::lround(options.one_view_smoothing_s * input.fps));
-      SmoothHandsInInstrumentFrame(
-          *ik_context, result.contacts, window, options.num_threads, &result.hand);
+      SmoothHandsInInstrumentFrame(*ik_context,
+                                   result.contacts,
+                                   window,
+                                   options.one_view_same_note_weight,
+                                   options.num_threads,
+                                   &result.hand);
     }
   }
   result.fingering =
@@ -338,6 +346,7 @@ Json ToJson(const RefineOptions& o) {
           {"one_view_depth", {{"window_frames", o.one_view_depth.window_frames}}},
           {"one_view_hand_frame", o.one_view_hand_frame},
           {"one_view_smoothing_s", o.one_view_smoothing_s},
+          {"one_view_same_note_weight", o.one_view_same_note_weight},
           {"one_view_frame",
            {{"tip_sigma_mm", o.one_view_frame.tip_sigma_mm},
             {"frame_sigma_mm", o.one_view_frame.frame_sigma_mm},

@@ -276,6 +276,7 @@ struct ArcoIkOptions {
 // (hand_frame_depth.h says why and how).
 inline constexpr NumberRange kFrameSigmaRangeMm = AboveZero(1000);
 inline constexpr NumberRange kOneViewSmoothingRangeS = Closed(0, 10);
+inline constexpr NumberRange kOneViewSameNoteWeightRange = Closed(0, 1);
 struct HandFrameDepthOptions {
   double tip_sigma_mm = 5.0;  // (0, 100]: the pressing fingertip's distance from the camera
   double frame_sigma_mm =
@@ -304,6 +305,11 @@ struct RefineOptions {
   // the IK put it). kOneViewSmoothingRangeS; 0: off (the former rule). No effect with
   // several cameras.
   double one_view_smoothing_s = 0.2;
+  // One camera, arco: with the hand held (above), a pressed frame's keypoints blended with
+  // this weight with their median over every frame of the take that plays the same note
+  // with the same finger on the same string (one_view_smoothing.h).
+  // kOneViewSameNoteWeightRange; 0: off. No effect with several cameras or without the hold.
+  double one_view_same_note_weight = 0.4;
   int num_threads = 0;  // 0 = all cores; results do not depend on it
   Status Validate() const;
 };

@@ -738,6 +738,76 @@ TEST(Refine, OneCameraHoldsTheHandOverTheFramesAround) {
   EXPECT_EQ(same, static_cast<int>(scene.truth_hand.size()));
 }
 
+TEST(Refine, OneCameraBlendsTheHandWithItsOtherTimesOnTheSameNote) {
+  // The scene above plays three notes, each three or four times. Each time (12 frames) the
+  // vision hand is turned about its fingertips' middle by its own 15 degrees (the wrist and
+  // the palm are where one view errs most; the fingertips, which decide, stay): one view's
+  // error lasts as long as a detector's error does, and it differs from one time to the
+  // next. Blending each pressed frame's held hand with its median over every frame of the
+  // same note (RefineOptions::one_view_same_note_weight) brings it nearer the truth; every
+  // playing fingertip stays where the IK put it, every decision the same.
+  testing::Scene scene = FirstPositionFromOneCamera(Eigen::Vector3d(2200, 300, -400), 0.0);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::Matrix3d turn = Eigen::Matrix3d::Identity();
+  for (size_t f = 0; f < scene.input.vision_hand.size(); ++f) {
+    if (f % 12 == 0) {
+      const Eigen::Vector3d axis(n(rng), n(rng), n(rng));
+      turn = Eigen::AngleAxisd(15.0 * M_PI / 180.0, axis.normalized()).toRotationMatrix();
+    }
+    std::optional<hand::HandPose>& hand = scene.input.vision_hand[f];
+    ASSERT_TRUE(hand.has_value());
+    const hand::HandPointsMm points = hand::ForwardKinematics(scene.input.hand_model, *hand);
+    Eigen::Vector3d tips = Eigen::Vector3d::Zero();
+    for (int finger = 1; finger <= 4; ++finger)
+      tips += points[hand::TipKeypoint(static_cast<hand::Finger>(finger))] / 4.0;
+    hand->world_from_wrist.rotation = turn * hand->world_from_wrist.rotation;
+    hand->world_from_wrist.translation = tips + turn * (hand->world_from_wrist.translation - tips);
+  }
+  const auto run = [&](double weight) {
+    RefineOptions o = Options(RefineMode::kArco);
+    o.one_view_same_note_weight = weight;
+    return Refine(scene.input, o);
+  };
+  const RefineResult blended = run(RefineOptions().one_view_same_note_weight), alone = run(0.0);
+  const hand::HandModel& model = scene.input.hand_model;
+  double blended_mm = 0, alone_mm = 0, tip_moved_mm = 0;
+  int judged = 0, same = 0;
+  for (size_t f = 0; f < scene.truth_hand.size(); ++f) {
+    const FrameContact& c = blended.contacts[f];
+    same += c.state == alone.contacts[f].state && c.string == alone.contacts[f].string &&
+            c.finger == alone.contacts[f].finger;
+    if (!blended.hand[f] || !alone.hand[f]) continue;
+    const hand::HandPointsMm want = hand::ForwardKinematics(model, scene.truth_hand[f]);
+    const hand::HandPointsMm a = hand::ForwardKinematics(model, *blended.hand[f]);
+    const hand::HandPointsMm b = hand::ForwardKinematics(model, *alone.hand[f]);
+    for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
+      blended_mm += (a[k] - want[k]).norm() / hand::kNumHandKeypoints;
+      alone_mm += (b[k] - want[k]).norm() / hand::kNumHandKeypoints;
+    }
+    if (c.pressed() && c.finger > 0) {
+      const int tip = hand::TipKeypoint(static_cast<hand::Finger>(c.finger));
+      tip_moved_mm = std::max(tip_moved_mm, (a[tip] - b[tip]).norm());
+    }
+    ++judged;
+  }
+  ASSERT_GT(judged, 0);
+  blended_mm /= judged;
+  alone_mm /= judged;
+  std::printf(
+      "[ one camera ] the hand %.1f mm from the truth blended with its other times on the "
+      "same note, %.1f mm without; playing tips moved <= %.2f mm; decisions the same on %d "
+      "of %zu frames\n",
+      blended_mm,
+      alone_mm,
+      tip_moved_mm,
+      same,
+      scene.truth_hand.size());
+  EXPECT_LT(blended_mm, 0.93 * alone_mm);
+  EXPECT_LT(tip_moved_mm, 0.5);
+  EXPECT_EQ(same, static_cast<int>(scene.truth_hand.size()));
+}
+
 TEST(Refine, OneCameraKeepsTheSoundsDecisionWhereTheHandIsOutOfReach) {
   // The scene above, and for two notes the vision hand 80 mm off across the camera's rays
   // (a stretch of bad detections moves one view's hand in its image): beyond the lift
