@@ -238,7 +238,8 @@ Json CalibrationFromInstrumentSummary::ToJson() const {
   j["world"] = cameras.size() == 1 ? "the camera's frame, mm" : "the first camera's frame, mm";
   j["focal_source"] = focal_source;
   j["shared_frames"] = shared_frames;
-  j["reference_frame"] = reference_frame;
+  // One camera chooses no frame for an initial rig: its frame is the world.
+  j["reference_frame"] = cameras.size() == 1 ? Json() : Json(reference_frame);
   j["string_length_mm"] = string_length_mm;
   j["string_length_initial_mm"] = string_length_initial_mm;
   j["string_length_error_initial_mm"] = string_length_initial_mm - string_length_mm;

@@ -106,7 +106,9 @@ struct CalibrationFromInstrumentSummary {
   std::string focal_source;  // "--focal-px", "--fov-deg", or "phone default (67 deg)"
   std::vector<FromInstrumentCamera> cameras;
   int shared_frames = 0;        // frames where every camera has a PnP pose
-  int64_t reference_frame = 0;  // the capture frame (index) the initial rig comes from
+  // The capture frame (index) the initial rig comes from; one camera: none (null in the
+  // report).
+  int64_t reference_frame = 0;
   double string_length_mm = 0;  // the model's
   // The template's nut-to-bridge distance in the initial rig's scale (before the
   // refinement holds it at the model's): how far off the PnP scale was.

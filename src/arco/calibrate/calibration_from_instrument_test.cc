@@ -312,6 +312,7 @@ TEST(CalibrateFromInstrument, OneCameraIsItsOwnWorld) {
   const Json report = Json::parse(ReadFileToString(RefineReportPath(output)).value());
   EXPECT_EQ(report["world"], "the camera's frame, mm");
   EXPECT_TRUE(report["string_length_measured"]["median_mm"].is_null());
+  EXPECT_TRUE(report["reference_frame"].is_null());  // no frame is chosen for a rig
 }
 
 // `--labels CAMERA=LABELS.json` (labelme, as `arco track` takes them): the instrument's

@@ -183,18 +183,35 @@ StatusOr<AudioSync> SyncByAudio(const std::vector<OpenedInput>& opened,
   return sync;
 }
 
+// A camera's frames as they are shown: its clockwise turn (the option's, else the
+// container's) and the size once turned.
+struct ShownSize {
+  int rotate_deg = 0;
+  bool quarter = false;  // turned by 90 or 270 degrees: width and height swap
+  int width = 0, height = 0;
+};
+ShownSize SizeAsShown(const CaptureNewOptions& o,
+                      const CaptureNewInput& input,
+                      const media::VideoProperties& p) {
+  ShownSize shown;
+  const auto rotate = o.rotate_deg.find(input.camera);
+  shown.rotate_deg = rotate != o.rotate_deg.end() ? rotate->second : p.rotation_deg;
+  shown.quarter = shown.rotate_deg == 90 || shown.rotate_deg == 270;
+  shown.width = shown.quarter ? p.coded_height : p.coded_width;
+  shown.height = shown.quarter ? p.coded_width : p.coded_height;
+  return shown;
+}
+
 // One camera's calibration from its video (capture_new.h, "One camera without a
 // calibration"); `what` says what it holds.
 StatusOr<Rig> OneCameraFromItsVideo(const CaptureNewOptions& o, std::string* what) {
   const CaptureNewInput& input = o.inputs.front();
   ARCO_ASSIGN_OR_RETURN(const media::VideoProperties p, ProbeInput(input));
-  const auto rotate = o.rotate_deg.find(input.camera);
-  const int rotate_deg = rotate != o.rotate_deg.end() ? rotate->second : p.rotation_deg;
-  const bool quarter = rotate_deg == 90 || rotate_deg == 270;
-  const int width = quarter ? p.coded_height : p.coded_width;
-  const int height = quarter ? p.coded_width : p.coded_height;
-  const Camera cam =
-      CentredPinhole(input.camera, width, height, FocalPxFromFov(width, height, kPhoneFovDeg));
+  const ShownSize shown = SizeAsShown(o, input, p);
+  const Camera cam = CentredPinhole(input.camera,
+                                    shown.width,
+                                    shown.height,
+                                    FocalPxFromFov(shown.width, shown.height, kPhoneFovDeg));
   Rig rig;
   rig.units = "mm";
   rig.cameras.push_back(cam);
@@ -314,11 +331,10 @@ StatusOr<CaptureNewSummary> CreateCapture(const CaptureNewOptions& o) {
     ARCO_ASSIGN_OR_RETURN(in.properties, ProbeInput(input));
     const media::VideoProperties& p = in.properties;
     const Camera& cam = rig.cameras[static_cast<size_t>(in.calibration_camera)];
-    const auto rotate = o.rotate_deg.find(input.camera);
-    in.rotate_deg = rotate != o.rotate_deg.end() ? rotate->second : p.rotation_deg;
-    const bool quarter = in.rotate_deg == 90 || in.rotate_deg == 270;
-    const int width = quarter ? p.coded_height : p.coded_width;
-    const int height = quarter ? p.coded_width : p.coded_height;
+    const ShownSize shown = SizeAsShown(o, input, p);
+    in.rotate_deg = shown.rotate_deg;
+    const bool quarter = shown.quarter;
+    const int width = shown.width, height = shown.height;
     if (width != cam.width || height != cam.height) {
       return Status::Error(input.path + ": " + std::to_string(p.coded_width) + "x" +
                            std::to_string(p.coded_height) + " frames" +
