@@ -680,6 +680,43 @@ TEST(Refine, OneCameraPlacesTheHandAlongItsRaysByTheHandFrame) {
   EXPECT_EQ(same, static_cast<int>(scene.truth_hand.size()));
 }
 
+// Two refinements of one scene compared against its truth hands: each one's mean
+// keypoint distance (mm, over the frames both have a hand), how far the playing
+// fingertips moved between them, and on how many frames their decisions agree.
+struct TwoRefinements {
+  double a_mm = 0, b_mm = 0, tip_moved_mm = 0;
+  int same = 0;
+};
+TwoRefinements CompareWithTruth(const testing::Scene& scene,
+                                const RefineResult& a,
+                                const RefineResult& b) {
+  const hand::HandModel& model = scene.input.hand_model;
+  TwoRefinements t;
+  int judged = 0;
+  for (size_t f = 0; f < scene.truth_hand.size(); ++f) {
+    const FrameContact& c = a.contacts[f];
+    t.same += c.state == b.contacts[f].state && c.string == b.contacts[f].string &&
+              c.finger == b.contacts[f].finger;
+    if (!a.hand[f] || !b.hand[f]) continue;
+    const hand::HandPointsMm want = hand::ForwardKinematics(model, scene.truth_hand[f]);
+    const hand::HandPointsMm pa = hand::ForwardKinematics(model, *a.hand[f]);
+    const hand::HandPointsMm pb = hand::ForwardKinematics(model, *b.hand[f]);
+    for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
+      t.a_mm += (pa[k] - want[k]).norm() / hand::kNumHandKeypoints;
+      t.b_mm += (pb[k] - want[k]).norm() / hand::kNumHandKeypoints;
+    }
+    if (c.pressed() && c.finger > 0) {
+      const int tip = hand::TipKeypoint(static_cast<hand::Finger>(c.finger));
+      t.tip_moved_mm = std::max(t.tip_moved_mm, (pa[tip] - pb[tip]).norm());
+    }
+    ++judged;
+  }
+  EXPECT_GT(judged, 0);
+  t.a_mm /= std::max(judged, 1);
+  t.b_mm /= std::max(judged, 1);
+  return t;
+}
+
 TEST(Refine, OneCameraHoldsTheHandOverTheFramesAround) {
   // The scene above, each frame's vision hand turned about its wrist by its own 6
   // degrees (one view's fit jitters from frame to frame). The refined hand held over
@@ -702,40 +739,18 @@ TEST(Refine, OneCameraHoldsTheHandOverTheFramesAround) {
     return Refine(scene.input, o);
   };
   const RefineResult held = run(RefineOptions().one_view_smoothing_s), raw = run(0.0);
-  const hand::HandModel& model = scene.input.hand_model;
-  double held_mm = 0, raw_mm = 0, tip_moved_mm = 0;
-  int judged = 0, same = 0;
-  for (size_t f = 0; f < scene.truth_hand.size(); ++f) {
-    const FrameContact& c = held.contacts[f];
-    same += c.state == raw.contacts[f].state && c.string == raw.contacts[f].string &&
-            c.finger == raw.contacts[f].finger;
-    if (!held.hand[f] || !raw.hand[f]) continue;
-    const hand::HandPointsMm want = hand::ForwardKinematics(model, scene.truth_hand[f]);
-    const hand::HandPointsMm a = hand::ForwardKinematics(model, *held.hand[f]);
-    const hand::HandPointsMm b = hand::ForwardKinematics(model, *raw.hand[f]);
-    for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
-      held_mm += (a[k] - want[k]).norm() / hand::kNumHandKeypoints;
-      raw_mm += (b[k] - want[k]).norm() / hand::kNumHandKeypoints;
-    }
-    if (c.pressed() && c.finger > 0) {
-      const int tip = hand::TipKeypoint(static_cast<hand::Finger>(c.finger));
-      tip_moved_mm = std::max(tip_moved_mm, (a[tip] - b[tip]).norm());
-    }
-    ++judged;
-  }
-  held_mm /= judged;
-  raw_mm /= judged;
+  const TwoRefinements t = CompareWithTruth(scene, held, raw);
   std::printf(
       "[ one camera ] the hand %.1f mm from the truth held over +-0.2 s, %.1f mm frame by "
       "frame; playing tips moved <= %.2f mm; decisions the same on %d of %zu frames\n",
-      held_mm,
-      raw_mm,
-      tip_moved_mm,
-      same,
+      t.a_mm,
+      t.b_mm,
+      t.tip_moved_mm,
+      t.same,
       scene.truth_hand.size());
-  EXPECT_LT(held_mm, 0.9 * raw_mm);
-  EXPECT_LT(tip_moved_mm, 0.5);
-  EXPECT_EQ(same, static_cast<int>(scene.truth_hand.size()));
+  EXPECT_LT(t.a_mm, 0.9 * t.b_mm);
+  EXPECT_LT(t.tip_moved_mm, 0.5);
+  EXPECT_EQ(t.same, static_cast<int>(scene.truth_hand.size()));
 }
 
 TEST(Refine, OneCameraBlendsTheHandWithItsOtherTimesOnTheSameNote) {
@@ -770,42 +785,19 @@ TEST(Refine, OneCameraBlendsTheHandWithItsOtherTimesOnTheSameNote) {
     return Refine(scene.input, o);
   };
   const RefineResult blended = run(RefineOptions().one_view_same_note_weight), alone = run(0.0);
-  const hand::HandModel& model = scene.input.hand_model;
-  double blended_mm = 0, alone_mm = 0, tip_moved_mm = 0;
-  int judged = 0, same = 0;
-  for (size_t f = 0; f < scene.truth_hand.size(); ++f) {
-    const FrameContact& c = blended.contacts[f];
-    same += c.state == alone.contacts[f].state && c.string == alone.contacts[f].string &&
-            c.finger == alone.contacts[f].finger;
-    if (!blended.hand[f] || !alone.hand[f]) continue;
-    const hand::HandPointsMm want = hand::ForwardKinematics(model, scene.truth_hand[f]);
-    const hand::HandPointsMm a = hand::ForwardKinematics(model, *blended.hand[f]);
-    const hand::HandPointsMm b = hand::ForwardKinematics(model, *alone.hand[f]);
-    for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
-      blended_mm += (a[k] - want[k]).norm() / hand::kNumHandKeypoints;
-      alone_mm += (b[k] - want[k]).norm() / hand::kNumHandKeypoints;
-    }
-    if (c.pressed() && c.finger > 0) {
-      const int tip = hand::TipKeypoint(static_cast<hand::Finger>(c.finger));
-      tip_moved_mm = std::max(tip_moved_mm, (a[tip] - b[tip]).norm());
-    }
-    ++judged;
-  }
-  ASSERT_GT(judged, 0);
-  blended_mm /= judged;
-  alone_mm /= judged;
+  const TwoRefinements t = CompareWithTruth(scene, blended, alone);
   std::printf(
       "[ one camera ] the hand %.1f mm from the truth blended with its other times on the "
       "same note, %.1f mm without; playing tips moved <= %.2f mm; decisions the same on %d "
       "of %zu frames\n",
-      blended_mm,
-      alone_mm,
-      tip_moved_mm,
-      same,
+      t.a_mm,
+      t.b_mm,
+      t.tip_moved_mm,
+      t.same,
       scene.truth_hand.size());
-  EXPECT_LT(blended_mm, 0.93 * alone_mm);
-  EXPECT_LT(tip_moved_mm, 0.5);
-  EXPECT_EQ(same, static_cast<int>(scene.truth_hand.size()));
+  EXPECT_LT(t.a_mm, 0.93 * t.b_mm);
+  EXPECT_LT(t.tip_moved_mm, 0.5);
+  EXPECT_EQ(t.same, static_cast<int>(scene.truth_hand.size()));
 }
 
 TEST(Refine, OneCameraKeepsTheSoundsDecisionWhereTheHandIsOutOfReach) {
