@@ -19,6 +19,9 @@ Status PoseSmoothingOptions::Validate() const {
   if (max_fill_gap_frames < 0) {
     return Status::Error("pose smoothing: max_fill_gap_frames must be >= 0");
   }
+  if (max_end_hold_frames < 0) {
+    return Status::Error("pose smoothing: max_end_hold_frames must be >= 0");
+  }
   return Status::Ok();
 }
 
@@ -52,11 +55,15 @@ std::vector<InstrumentFramePose> SmoothFramePoses(const std::vector<InstrumentFr
   for (int f = 0; f < n; ++f) {
     const InstrumentFramePose& in = frames[f];
     if (in.status == FrameFitStatus::kTooFewPoints) {
-      // Fill only gaps bounded by kOk frames on both sides within the limit.
-      if (options.max_fill_gap_frames == 0 || prev_ok[f] < 0 || next_ok[f] < 0 ||
-          next_ok[f] - prev_ok[f] - 1 > options.max_fill_gap_frames) {
-        continue;
-      }
+      // Fill gaps bounded by kOk frames on both sides within the limit, and the clip's
+      // ends within theirs.
+      const bool gap = prev_ok[f] >= 0 && next_ok[f] >= 0 && options.max_fill_gap_frames > 0 &&
+                       next_ok[f] - prev_ok[f] - 1 <= options.max_fill_gap_frames;
+      const bool start = prev_ok[f] < 0 && next_ok[f] >= 0 &&
+                         next_ok[f] - f <= options.max_end_hold_frames;
+      const bool end = next_ok[f] < 0 && prev_ok[f] >= 0 &&
+                       f - prev_ok[f] <= options.max_end_hold_frames;
+      if (!gap && !start && !end) continue;
     } else if (in.status == FrameFitStatus::kHighResidual && !options.replace_high_residual) {
       continue;
     }

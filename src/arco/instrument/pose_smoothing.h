@@ -29,6 +29,12 @@ struct PoseSmoothingOptions {
   // Frames without a pose (or with kHighResidual) get a smoothed pose when kOk frames
   // exist on BOTH sides within this many frames; 0 = never fill.
   int max_fill_gap_frames = 0;
+  // Frames without a pose before the clip's first kOk frame or after its last get the
+  // smoothed pose of the posed frames beside them when within this many frames of one
+  // (a held instrument barely moves in a few frames; its points may be too few at the
+  // take's first frames, e.g. a bridge hidden from a one camera); 0 = never. At most
+  // the kernel's radius takes effect (no posed frame lies farther in the kernel).
+  int max_end_hold_frames = 0;
   // When true, kHighResidual frames keep their own pose out of the average but receive
   // the smoothed pose of their neighbours (if any lie within radius_frames).
   bool replace_high_residual = true;
@@ -38,7 +44,8 @@ struct PoseSmoothingOptions {
 
 // Returns one entry per frame: the smoothed pose (status kOk), or the input entry
 // unchanged when no kOk frame lies within the kernel (or, for frames without a pose, the
-// gap is larger than max_fill_gap_frames). rms_residual_mm, inlier_mask etc. are copied
+// gap is larger than max_fill_gap_frames, or the clip's end farther than
+// max_end_hold_frames). rms_residual_mm, inlier_mask etc. are copied
 // from the input; recompute residuals with PoseResidualMm when needed. Throws
 // std::invalid_argument for options that fail Validate().
 std::vector<InstrumentFramePose> SmoothFramePoses(const std::vector<InstrumentFramePose>& frames,

@@ -58,6 +58,7 @@ Json ToJson(const InstrumentStageOptions& o) {
            {{"sigma_frames", o.smoothing.sigma_frames},
             {"radius_frames", o.smoothing.radius_frames},
             {"max_fill_gap_frames", o.smoothing.max_fill_gap_frames},
+            {"max_end_hold_frames", o.smoothing.max_end_hold_frames},
             {"replace_high_residual", o.smoothing.replace_high_residual}}},
           {"smoothing_candidates_frames", o.smoothing_candidates_frames},
           {"num_threads", o.num_threads}};

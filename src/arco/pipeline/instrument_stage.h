@@ -23,10 +23,14 @@ struct InstrumentStageOptions {
   std::string result_dir;  // holds the triangulation
   InstrumentFitOptions fit;
   // Gaussian pose smoothing; frames without a pose within 15 frames of posed frames on both
-  // sides get one.
+  // sides get one, and so do the take's first and last frames within 5 of a posed frame
+  // (a sixth of a second at 30 fps: on the real take seen by one camera, the first 1-3
+  // frames of 17 of 30 captures had too few points; docs/accuracy.md, "The take's first
+  // frames").
   PoseSmoothingOptions smoothing = [] {
     PoseSmoothingOptions o;
     o.max_fill_gap_frames = 15;
+    o.max_end_hold_frames = 5;
     return o;
   }();
   // The kernel's width chosen per capture among these (frames, each > 0; empty: always
