@@ -44,7 +44,8 @@ std::optional<Frame> InstrumentFrame(const std::vector<StringSegment>& strings) 
 }
 
 // The played note of a pressed frame (header comment): string, finger and the note's
-// equal-tempered pitch in semitones from A4 (its median f0); nullopt when not pressed.
+// equal-tempered pitch in semitones from the capture's A4 (its median f0); nullopt when
+// not pressed.
 using PlayedNote = std::tuple<int, int, long>;
 std::optional<PlayedNote> PlayedNoteOf(const DecodeContext& context, const FrameContact& c) {
   if (!c.pressed() || c.finger < 1 || c.finger > 4 || c.note < 0) return std::nullopt;
@@ -52,7 +53,24 @@ std::optional<PlayedNote> PlayedNoteOf(const DecodeContext& context, const Frame
   if (static_cast<size_t>(c.note) >= notes.size()) return std::nullopt;
   const double f0 = notes[static_cast<size_t>(c.note)].f0_hz;
   if (!(f0 > 0)) return std::nullopt;
-  return PlayedNote{c.string, c.finger, std::lround(12.0 * std::log2(f0 / 440.0))};
+  return PlayedNote{
+      c.string, c.finger, std::lround(12.0 * std::log2(f0 / context.input->a4_hz))};
+}
+
+// Each keypoint's coordinates, one by one, the median over the frames `members` (each
+// with keypoints).
+hand::HandPointsMm MedianKeypoints(const std::vector<std::optional<hand::HandPointsMm>>& local,
+                                   const std::vector<size_t>& members) {
+  hand::HandPointsMm median;
+  std::vector<double> values;
+  for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
+    for (int a = 0; a < 3; ++a) {
+      values.clear();
+      for (size_t i : members) values.push_back((*local[i])[k](a));
+      median[k](a) = Median(values);
+    }
+  }
+  return median;
 }
 
 }  // namespace
@@ -91,17 +109,8 @@ int SmoothHandsInInstrumentFrame(const DecodeContext& context,
   }
   std::map<PlayedNote, hand::HandPointsMm> note_median;
   for (const auto& [note, members] : frames_of_note) {
-    if (static_cast<int>(members.size()) < kMinSameNoteFrames) continue;
-    hand::HandPointsMm median;
-    std::vector<double> values;
-    for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
-      for (int a = 0; a < 3; ++a) {
-        values.clear();
-        for (size_t i : members) values.push_back((*local[i])[k](a));
-        median[k](a) = Median(values);
-      }
-    }
-    note_median[note] = median;
+    if (static_cast<int>(members.size()) >= kMinSameNoteFrames)
+      note_median[note] = MedianKeypoints(local, members);
   }
   const std::vector<std::optional<hand::HandPose>> refined = *hands;
   std::vector<uint8_t> changed(static_cast<size_t>(n), 0);
@@ -111,24 +120,19 @@ int SmoothHandsInInstrumentFrame(const DecodeContext& context,
       [&](int64_t f, int) {
         const size_t i = static_cast<size_t>(f);
         if (!local[i]) return;
-        hand::HandPointsMm held;
         const hand::HandPointsMm* same_note = nullptr;
         if (note_of_frame[i]) {
           const auto it = note_median.find(*note_of_frame[i]);
           if (it != note_median.end()) same_note = &it->second;
         }
-        std::vector<double> values;
+        std::vector<size_t> around;
+        for (int64_t g = std::max<int64_t>(0, f - window_frames);
+             g <= std::min<int64_t>(n - 1, f + window_frames);
+             ++g) {
+          if (local[static_cast<size_t>(g)]) around.push_back(static_cast<size_t>(g));
+        }
+        hand::HandPointsMm held = MedianKeypoints(local, around);
         for (int k = 0; k < hand::kNumHandKeypoints; ++k) {
-          for (int a = 0; a < 3; ++a) {
-            values.clear();
-            for (int64_t g = std::max<int64_t>(0, f - window_frames);
-                 g <= std::min<int64_t>(n - 1, f + window_frames);
-                 ++g) {
-              const auto& p = local[static_cast<size_t>(g)];
-              if (p) values.push_back((*p)[k](a));
-            }
-            held[k](a) = Median(values);
-          }
           if (same_note)
             held[k] = (1 - same_note_weight) * held[k] + same_note_weight * (*same_note)[k];
           held[k] = frames[i]->rotation * held[k] + frames[i]->origin;
