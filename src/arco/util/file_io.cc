@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "arco/util/interrupt.h"
 #include "arco/util/output_set.h"
 
 namespace arco {
@@ -119,7 +120,12 @@ Status AtomicWriteFile(const std::string& path, const std::string& contents) {
 
 Status MakeDirectories(const std::string& path) {
   std::error_code ec;
-  fs::create_directories(path, ec);
+  {
+    // Not while an interrupt's cleanup removes the temporaries: a folder made inside a
+    // removed temporary would bring it back (util/interrupt.h).
+    const std::unique_lock<std::mutex> no_interrupt = HoldOffInterrupts();
+    fs::create_directories(path, ec);
+  }
   if (ec) return Status::Error(path + ": cannot create folder: " + ec.message());
   if (!fs::is_directory(path, ec)) return Status::Error(path + ": exists and is not a folder");
   return Status::Ok();

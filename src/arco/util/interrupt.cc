@@ -55,17 +55,19 @@ void Write(const std::string& text) {
     std::lock_guard<std::mutex> lock(state.paths_mutex);
     paths = state.paths;
   }
-  // The command's threads still run until _exit and may write into a temporary folder
-  // while it is removed: retry until it stays gone.
-  for (int pass = 0; pass < 5; ++pass) {
+  // The command's threads still run until _exit and may still create files in a temporary
+  // folder while it is removed (remove_all then fails on a folder no longer empty), but
+  // cannot bring back one that is gone: folders and temporaries are made only under the
+  // commit lock, held here (MakeDirectories, OutputSet). Retry until each is gone.
+  for (int pass = 0; pass < 200; ++pass) {
     bool any = false;
     for (const auto& [path, count] : paths) {
       std::error_code ec;
       fs::remove_all(path, ec);
       any = any || fs::exists(fs::symlink_status(path, ec));
     }
-    if (!any && pass > 0) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (!any) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   const char* name = g_signal.load() == SIGTERM ? "SIGTERM" : "SIGINT";
   Write(std::string(isatty(STDERR_FILENO) ? "\n" : "") + "arco: interrupted (" + name +

@@ -37,9 +37,11 @@ void WaitIfInterrupted();
 void TrackTemporary(const std::string& path);
 void UntrackTemporary(const std::string& path);
 
-// Held while outputs are moved into place (OutputSet::Commit): an interrupt waits for it,
-// so the cleanup never sees half a commit; once the cleanup has started, taking it blocks
-// for good.
+// Held while outputs are moved into place (OutputSet::Commit), while a temporary is
+// registered and created (OutputSet::AddFile, AddFolder) and while folders are made
+// (MakeDirectories): an interrupt waits for it, so the cleanup never sees half a commit nor
+// misses a temporary, and no folder inside a removed temporary brings it back; once the
+// cleanup has started, taking it blocks for good.
 std::unique_lock<std::mutex> HoldOffInterrupts();
 
 }  // namespace arco

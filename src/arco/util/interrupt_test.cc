@@ -5,9 +5,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <set>
 #include <string>
+#include <thread>
 
 #include "arco/testing/temp_dir.h"
 #include "arco/util/file_io.h"
@@ -56,6 +58,31 @@ TEST(InterruptCleanup, RemovesTheTemporariesAndExits130) {
     });
     EXPECT_EQ(status, 130) << "signal " << signal;
     EXPECT_EQ(Entries(tmp.path()), (std::set<std::string>{"done.csv"})) << "signal " << signal;
+  }
+}
+
+// A thread that keeps making folders inside a temporary folder while the interrupt's
+// cleanup removes it (as `arco run`'s stages write into its result folder) cannot bring the
+// temporary back: every run of the race leaves only the committed output.
+TEST(InterruptCleanup, AFolderMadeInsideARemovedTemporaryDoesNotBringItBack) {
+  for (int attempt = 0; attempt < 10; ++attempt) {
+    testing::TempDir tmp;
+    const int status = InterruptedChild(SIGTERM, [&] {
+      ASSERT_TRUE(AtomicWriteFile(tmp / "done.csv", "whole").ok());
+      static OutputSet outputs;  // never committed: the interrupt comes first
+      static std::string folder;
+      auto made = outputs.AddFolder(tmp / "res", FolderReplace{});
+      ASSERT_TRUE(made.ok());
+      folder = *made;
+      std::thread([] {
+        for (long i = 0;; ++i) {
+          (void)MakeDirectories(folder + "/stage" + std::to_string(i % 7) + "/sub");
+        }
+      }).detach();
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    });
+    EXPECT_EQ(status, 130) << "attempt " << attempt;
+    EXPECT_EQ(Entries(tmp.path()), (std::set<std::string>{"done.csv"})) << "attempt " << attempt;
   }
 }
 

@@ -32,7 +32,10 @@ Status CheckParent(const std::string& path, const fs::path& parent, bool create)
   if (!create) {
     return Status::Error(path + ": output folder " + parent.string() + " does not exist");
   }
-  fs::create_directories(parent, ec);
+  {
+    const std::unique_lock<std::mutex> no_interrupt = HoldOffInterrupts();  // util/interrupt.h
+    fs::create_directories(parent, ec);
+  }
   if (ec) {
     return Status::Error(path + ": cannot create folder " + parent.string() + ": " + ec.message());
   }
@@ -183,6 +186,8 @@ StatusOr<std::string> OutputSet::AddFile(const std::string& given) {
   RemoveStaleTemporaries(path);
   std::error_code ec;
   fs::remove_all(o.tmp, ec);
+  // Tracked and created together, before or after an interrupt's cleanup takes its list.
+  const std::unique_lock<std::mutex> no_interrupt = HoldOffInterrupts();
   TrackTemporary(o.tmp);  // removed if the process is interrupted (util/interrupt.h)
   const int fd = ::open(o.tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd < 0) {
@@ -206,6 +211,7 @@ StatusOr<std::string> OutputSet::AddFolder(const std::string& given, const Folde
   RemoveStaleTemporaries(path);
   std::error_code ec;
   fs::remove_all(o.tmp, ec);
+  const std::unique_lock<std::mutex> no_interrupt = HoldOffInterrupts();  // as in AddFile
   TrackTemporary(o.tmp);  // removed if the process is interrupted (util/interrupt.h)
   fs::create_directory(o.tmp, ec);
   if (ec) {
