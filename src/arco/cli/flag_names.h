@@ -42,6 +42,7 @@ inline constexpr FieldFlag kRefineFlags[] = {
     {"lateral_weight", "--lateral-weight"},
     {"hand_lateral_weight", "--hand-lateral-weight"},
     {"shift_cost_per_semitone", "--shift-cost"},
+    {"one_view_shift_cost_factor", "--one-view-shift-cost-factor"},
     {"one_view_lateral_weight", "--one-view-lateral-weight"},
     {"one_view_above_margin_mm", "--one-view-above-margin-mm"},
     {"frame_sigma_mm", "--one-view-frame-sigma-mm"},

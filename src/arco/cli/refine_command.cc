@@ -224,6 +224,13 @@ std::function<int()> SetupRefine(CLI::App& app) {
             refine::kCostWeightRange)
       ->capture_default_str();
   AddNumber(sub,
+            "--one-view-shift-cost-factor",
+            r.decode.one_view_shift_cost_factor,
+            "arco decoding, one camera: the shift cost times this as well (the hand's place "
+            "along the string is partly the first decoding's sound; 1: the view's factor alone)",
+            refine::kCostWeightRange)
+      ->capture_default_str();
+  AddNumber(sub,
             "--one-view-lateral-weight",
             r.decode.one_view_lateral_weight,
             "arco decoding, one camera: --lateral-weight for the candidates compared along "

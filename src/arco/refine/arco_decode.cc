@@ -164,12 +164,11 @@ std::vector<State> NoteStates(const DecodeContext& context,
   return states;
 }
 
-// One camera (header comment, "One camera"): 1 / sin^2 of the angle between the strings and
-// the camera's ray to their middle (the median over the frames with strings), at most
-// one_view_max_shift_factor; 1 with several cameras.
-double OneViewShiftFactor(const DecodeContext& context, const ArcoDecodeOptions& options) {
+// 1 / sin^2 of the strings' angle to the one camera's ray, in [1, one_view_max_shift_factor]
+// (the input has a one-view camera centre).
+double ForeshorteningFactor(const DecodeContext& context, const ArcoDecodeOptions& options) {
   const auto& centre = context.input->one_view_camera_centre_mm;
-  if (!centre || !(options.one_view_max_shift_factor > 1)) return 1.0;
+  if (!(options.one_view_max_shift_factor > 1)) return 1.0;
   std::vector<double> sines;
   for (int f = 0; f < context.num_frames(); ++f) {
     if (!context.has_strings[static_cast<size_t>(f)]) continue;
@@ -188,6 +187,16 @@ double OneViewShiftFactor(const DecodeContext& context, const ArcoDecodeOptions&
   if (sines.empty()) return 1.0;
   const double sine = Median(sines);
   return std::clamp(1.0 / (sine * sine), 1.0, options.one_view_max_shift_factor);
+}
+
+// One camera (header comment, "One camera"): one_view_shift_cost_factor times 1 / sin^2 of
+// the angle between the strings and the camera's ray to their middle (the median over the
+// frames with strings), the latter at most one_view_max_shift_factor; 1 with several
+// cameras.
+double OneViewShiftFactor(const DecodeContext& context, const ArcoDecodeOptions& options) {
+  const auto& centre = context.input->one_view_camera_centre_mm;
+  if (!centre) return 1.0;
+  return options.one_view_shift_cost_factor * ForeshorteningFactor(context, options);
 }
 
 double TransitionCost(const NoteSpan& from_note,

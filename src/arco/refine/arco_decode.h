@@ -56,7 +56,9 @@
 // by 1 / sin^2 of the angle between the strings and the camera's ray to their middle (the
 // median over the frames), at most one_view_max_shift_factor: a move along the strings is
 // foreshortened by sin theta in the view, so the view tells sin^2 theta of what several do
-// about the hand's place along the string, and the prior that the hand stays weighs more.
+// about the hand's place along the string, and the prior that the hand stays weighs more;
+// times one_view_shift_cost_factor, as the second decoding's hand was placed along its rays
+// by the first decoding's sound (refine.h).
 #pragma once
 
 #include <array>

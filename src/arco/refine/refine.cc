@@ -170,6 +170,7 @@ Status ArcoDecodeOptions::Validate() const {
       {"infeasible_cost", infeasible_cost},
       {"onset_lead_margin_mm", onset_lead_margin_mm},
       {"one_view_max_shift_factor", one_view_max_shift_factor},
+      {"one_view_shift_cost_factor", one_view_shift_cost_factor},
       {"one_view_lateral_weight", one_view_lateral_weight},
       {"one_view_above_margin_mm", one_view_above_margin_mm}};
   for (const auto& [name, value] : values) {
@@ -397,6 +398,7 @@ Json ToJson(const RefineOptions& o) {
             {"audio_onsets", o.decode.audio_onsets},
             {"one_view_along_rays", o.decode.one_view_along_rays},
             {"one_view_max_shift_factor", o.decode.one_view_max_shift_factor},
+            {"one_view_shift_cost_factor", o.decode.one_view_shift_cost_factor},
             {"one_view_lateral_weight", o.decode.one_view_lateral_weight},
             {"one_view_above_margin_mm", o.decode.one_view_above_margin_mm},
             {"one_view_keep_out_of_reach", o.decode.one_view_keep_out_of_reach},

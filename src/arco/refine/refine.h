@@ -167,6 +167,14 @@ struct ArcoDecodeOptions {
   // and the camera's ray to them, at most this (arco_decode.h, "One camera"); 1: the
   // cameras' cost. No effect with several cameras.
   double one_view_max_shift_factor = 8.0;
+  // One camera: the shift cost times this as well, beyond the view's foreshortening. One
+  // view's hand is placed along its rays by the sound's depth of a first decoding
+  // (RefineOptions::one_view_depth), so the second decoding's emissions measure the hand's
+  // place along the string partly from that decoding's own contacts: they tell less than
+  // the foreshortening alone says, and the prior that a hand stays weighs more. 2 on the
+  // real take (docs/accuracy.md, "One camera: the hand stays where it is, twice"); 1: the
+  // foreshortening's factor alone. No effect with several cameras.
+  double one_view_shift_cost_factor = 2.0;
   // One camera, along the rays: the weight of the tip-to-contact distance across the string
   // instead of lateral_weight. After the along-ray scaling what is left of tip - contact
   // lies across the camera's ray: across the string it is the image's evidence (the
