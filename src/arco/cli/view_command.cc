@@ -83,9 +83,16 @@ int WriteFolder(Args a) {
 
 int Serve(const Args& a) {
   std::string pattern = (std::filesystem::temp_directory_path() / "arco-view-XXXXXX").string();
-  if (mkdtemp(pattern.data()) == nullptr) return PrintError(pattern + ": cannot create");
+  bool made = false;
+  {
+    // Made and registered together, before or after an interrupt's cleanup takes its list
+    // (no message under the lock: the error path waits for the cleanup if interrupted).
+    const std::unique_lock<std::mutex> no_interrupt = HoldOffInterrupts();
+    made = mkdtemp(pattern.data()) != nullptr;
+    if (made) TrackTemporary(pattern);  // an interrupt before the server listens removes it too
+  }
+  if (!made) return PrintError(pattern + ": cannot create");
   const std::string dir = pattern;
-  TrackTemporary(dir);  // an interrupt before the server listens removes it too
   auto summary = view::WriteViewFolder(a.options, dir);
   int rc = 0;
   if (!summary.ok()) {
