@@ -94,22 +94,26 @@ void SeeFromOneCamera(const Eigen::Vector3d& centre,
   scene->input.one_view_camera_centre_mm = centre;
 }
 
-// First position on the A string (fingers 1, 2, 4, 12 frames a note) seen by one camera at
-// `camera_in_instrument` (mm, the instrument frame of the first frame), each note's vision
-// hand moved along its rays by up to +-`depth_error_mm` (a one-view lift's depth error).
+// First position on the A string: fingers 1, 2, 4 in turn, 12 frames a note, ten notes.
+std::vector<SceneNote> FirstPositionNotes() {
+  return {{1, 1, 2, 12},
+          {1, 2, 3, 12},
+          {1, 4, 5, 12},
+          {1, 2, 3, 12},
+          {1, 1, 2, 12},
+          {1, 4, 5, 12},
+          {1, 1, 2, 12},
+          {1, 2, 3, 12},
+          {1, 4, 5, 12},
+          {1, 1, 2, 12}};
+}
+
+// FirstPositionNotes seen by one camera at `camera_in_instrument` (mm, the instrument frame
+// of the first frame), each note's vision hand moved along its rays by up to
+// +-`depth_error_mm` (a one-view lift's depth error).
 testing::Scene FirstPositionFromOneCamera(const Eigen::Vector3d& camera_in_instrument,
                                           double depth_error_mm) {
-  const std::vector<SceneNote> notes = {{1, 1, 2, 12},
-                                        {1, 2, 3, 12},
-                                        {1, 4, 5, 12},
-                                        {1, 2, 3, 12},
-                                        {1, 1, 2, 12},
-                                        {1, 4, 5, 12},
-                                        {1, 1, 2, 12},
-                                        {1, 2, 3, 12},
-                                        {1, 4, 5, 12},
-                                        {1, 1, 2, 12}};
-  testing::Scene scene = Cello(notes);
+  testing::Scene scene = Cello(FirstPositionNotes());
   const Eigen::Vector3d centre = scene.world_from_instrument[0] * camera_in_instrument;
   std::vector<double> shift_mm(scene.input.vision_hand.size());
   for (size_t f = 0; f < shift_mm.size(); ++f) {
@@ -598,16 +602,7 @@ TEST(Refine, OneCameraHoldsTheHandWhenANoteIsSeenAFingerAlongTheString) {
   // neighbouring finger. One view's hand is placed along its rays by the first decoding's
   // sound, so those notes look like a shift: the hand should stay
   // (ArcoDecodeOptions::one_view_shift_cost_factor).
-  const std::vector<SceneNote> notes = {{1, 1, 2, 12},
-                                        {1, 2, 3, 12},
-                                        {1, 4, 5, 12},
-                                        {1, 2, 3, 12},
-                                        {1, 1, 2, 12},
-                                        {1, 4, 5, 12},
-                                        {1, 1, 2, 12},
-                                        {1, 2, 3, 12},
-                                        {1, 4, 5, 12},
-                                        {1, 1, 2, 12}};
+  const std::vector<SceneNote> notes = FirstPositionNotes();
   for (const double off_mm : {22.0, 25.0, 28.0}) {
     testing::Scene scene = Cello(notes);
     for (const int note : {1, 4, 7}) {
